@@ -15,9 +15,12 @@ constexpr LogicalFormat format_for(std::uint32_t value, LogicalFormat min_format
 
 constexpr std::size_t value_size(LogicalFormat format) noexcept {
   switch (format) {
-    case LogicalFormat::k8Bit: return 1;
-    case LogicalFormat::k16Bit: return 2;
-    case LogicalFormat::k32Bit: return 4;
+    case LogicalFormat::k8Bit:
+      return 1;
+    case LogicalFormat::k16Bit:
+      return 2;
+    case LogicalFormat::k32Bit:
+      return 4;
   }
   return 0;
 }
@@ -33,20 +36,31 @@ void write_segment(ByteWriter& w, LogicalType type, const std::optional<std::uin
   const LogicalFormat format = format_for(*value, min_format);
   w.u8(logical_segment_byte(type, format));
   switch (format) {
-    case LogicalFormat::k8Bit: w.u8(static_cast<std::uint8_t>(*value)); break;
-    case LogicalFormat::k16Bit: w.u16le(static_cast<std::uint16_t>(*value)); break;
-    case LogicalFormat::k32Bit: w.u32le(*value); break;
+    case LogicalFormat::k8Bit:
+      w.u8(static_cast<std::uint8_t>(*value));
+      break;
+    case LogicalFormat::k16Bit:
+      w.u16le(static_cast<std::uint16_t>(*value));
+      break;
+    case LogicalFormat::k32Bit:
+      w.u32le(*value);
+      break;
   }
 }
 
 // Position of each segment type in the accepted order; -1 for types not handled.
 constexpr int order_of(LogicalType type) noexcept {
   switch (type) {
-    case LogicalType::kClass: return 0;
-    case LogicalType::kInstance: return 1;
-    case LogicalType::kConnectionPoint: return 2;
-    case LogicalType::kAttribute: return 3;
-    case LogicalType::kMember: return -1;
+    case LogicalType::kClass:
+      return 0;
+    case LogicalType::kInstance:
+      return 1;
+    case LogicalType::kConnectionPoint:
+      return 2;
+    case LogicalType::kAttribute:
+      return 3;
+    case LogicalType::kMember:
+      return -1;
   }
   return -1;
 }
@@ -90,17 +104,32 @@ Result<EPath> decode_epath(Bytes data) noexcept {
     last = order;
     std::uint32_t value = 0;
     switch (static_cast<LogicalFormat>(format_bits)) {
-      case LogicalFormat::k8Bit: value = r.u8(); break;
-      case LogicalFormat::k16Bit: value = r.u16le(); break;
-      case LogicalFormat::k32Bit: value = r.u32le(); break;
+      case LogicalFormat::k8Bit:
+        value = r.u8();
+        break;
+      case LogicalFormat::k16Bit:
+        value = r.u16le();
+        break;
+      case LogicalFormat::k32Bit:
+        value = r.u32le();
+        break;
     }
     if (!r.ok()) return Errc::kTruncated;
     switch (type) {
-      case LogicalType::kClass: path.class_id = value; break;
-      case LogicalType::kInstance: path.instance_id = value; break;
-      case LogicalType::kConnectionPoint: path.connection_point = value; break;
-      case LogicalType::kAttribute: path.attribute = value; break;
-      case LogicalType::kMember: return Errc::kUnsupported;
+      case LogicalType::kClass:
+        path.class_id = value;
+        break;
+      case LogicalType::kInstance:
+        path.instance_id = value;
+        break;
+      case LogicalType::kConnectionPoint:
+        path.connection_point = value;
+        break;
+      case LogicalType::kAttribute:
+        path.attribute = value;
+        break;
+      case LogicalType::kMember:
+        return Errc::kUnsupported;
     }
   }
   return path;

@@ -38,10 +38,10 @@ constexpr std::uint8_t logical_segment_byte(LogicalType type, LogicalFormat form
 // attribute, each with the smallest format that holds its value (or
 // `min_format`, see encode()). Decoding accepts any format for any value.
 struct EPath {
-  std::optional<std::uint32_t> class_id;
-  std::optional<std::uint32_t> instance_id;
-  std::optional<std::uint32_t> connection_point;
-  std::optional<std::uint32_t> attribute;
+  std::optional<std::uint32_t> class_id{};
+  std::optional<std::uint32_t> instance_id{};
+  std::optional<std::uint32_t> connection_point{};
+  std::optional<std::uint32_t> attribute{};
 
   bool empty() const noexcept {
     return !class_id && !instance_id && !connection_point && !attribute;

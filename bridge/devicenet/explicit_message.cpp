@@ -40,12 +40,18 @@ constexpr bool valid_choice(std::uint8_t choice) noexcept {
 
 Result<BodyFormat> body_format_from_code(std::uint8_t code) noexcept {
   switch (code) {
-    case 0: return BodyFormat::k8_8;
-    case 1: return BodyFormat::k8_16;
-    case 2: return BodyFormat::k16_16;
-    case 3: return BodyFormat::k16_8;
-    case 4: return Errc::kUnsupported;  // packed CIP path: not used by Group 2 only slaves
-    default: return Errc::kMalformed;
+    case 0:
+      return BodyFormat::k8_8;
+    case 1:
+      return BodyFormat::k8_16;
+    case 2:
+      return BodyFormat::k16_16;
+    case 3:
+      return BodyFormat::k16_8;
+    case 4:
+      return Errc::kUnsupported;  // packed CIP path: not used by Group 2 only slaves
+    default:
+      return Errc::kMalformed;
   }
 }
 

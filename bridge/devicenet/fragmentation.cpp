@@ -44,7 +44,8 @@ constexpr FragmentType fragment_type(std::size_t index, std::size_t total) noexc
 }  // namespace
 
 std::uint8_t encode_fragment_byte(FragmentByte f) noexcept {
-  return static_cast<std::uint8_t>((static_cast<std::uint8_t>(f.type) << 6) | (f.count & kCountMask));
+  return static_cast<std::uint8_t>((static_cast<std::uint8_t>(f.type) << 6) |
+                                   (f.count & kCountMask));
 }
 
 FragmentByte decode_fragment_byte(std::uint8_t byte) noexcept {
