@@ -117,7 +117,7 @@ struct PointStatus {
   std::array<std::uint8_t, kMaxBytes> bits{};  // (count + 7) / 8 bytes are used
   // Status bit of point `index` (0-based: instance index + 1); false past count.
   bool fault(std::size_t index) const noexcept {
-    return index < count && ((bits[index / 8] >> (index % 8)) & 1U) != 0;
+    return index < count && ((static_cast<unsigned>(bits[index / 8]) >> (index % 8)) & 1U) != 0;
   }
   bool any_fault() const noexcept;
   friend bool operator==(const PointStatus&, const PointStatus&) = default;

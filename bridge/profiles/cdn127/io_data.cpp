@@ -20,7 +20,9 @@ Result<std::uint16_t> volts_to_raw(double volts) noexcept {
 }
 
 namespace {
-constexpr bool bit(std::uint8_t byte, int n) noexcept { return ((byte >> n) & 1U) != 0; }
+constexpr bool bit(std::uint8_t byte, int n) noexcept {
+  return ((static_cast<unsigned>(byte) >> n) & 1U) != 0;
+}
 constexpr std::uint8_t set_if(bool on, int n) noexcept {
   return on ? static_cast<std::uint8_t>(1U << n) : std::uint8_t{0};
 }
