@@ -4,6 +4,7 @@
 // need and return; they must not call back into the scanner.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
@@ -49,6 +50,38 @@ class ScannerObserver {
   // The end of an explicit request submitted with Scanner::request_explicit.
   virtual void on_explicit_result(std::uint32_t /*request_id*/, MacId /*mac*/,
                                   const ExplicitResult& /*result*/, TimePoint /*at*/) {}
+};
+
+}  // namespace dnbridge::devicenet
+
+namespace dnbridge::devicenet {
+
+// Hands every event to each of several observers, in order.
+class ObserverFanout final : public ScannerObserver {
+ public:
+  void add(ScannerObserver& o) { observers_.push_back(&o); }
+
+  void on_port_state(PortState s, const std::string& r, TimePoint at) override {
+    for (auto* o : observers_) o->on_port_state(s, r, at);
+  }
+  void on_node_state(MacId m, NodeState f, NodeState t, const std::string& r, TimePoint at) override {
+    for (auto* o : observers_) o->on_node_state(m, f, t, r, at);
+  }
+  void on_node_identity(MacId m, const NodeIdentity& i, TimePoint at) override {
+    for (auto* o : observers_) o->on_node_identity(m, i, at);
+  }
+  void on_poll_response(MacId m, Bytes d, TimePoint at) override {
+    for (auto* o : observers_) o->on_poll_response(m, d, at);
+  }
+  void on_device_state(MacId m, std::uint8_t s, TimePoint at) override {
+    for (auto* o : observers_) o->on_device_state(m, s, at);
+  }
+  void on_explicit_result(std::uint32_t id, MacId m, const ExplicitResult& r, TimePoint at) override {
+    for (auto* o : observers_) o->on_explicit_result(id, m, r, at);
+  }
+
+ private:
+  std::vector<ScannerObserver*> observers_;
 };
 
 }  // namespace dnbridge::devicenet

@@ -24,6 +24,7 @@ devicenet::ScannerConfig PumpRack::scanner_config(devicenet::ScannerConfig port,
     }
     devicenet::NodeConfig node = p.node;
     node.profile = std::move(*profile);
+    if (p.identity) node.profile.identity = *p.identity;
     port.nodes.push_back(std::move(node));
   }
   return port;
@@ -63,8 +64,11 @@ Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, TimePoin
   if (auto ok = cdn127::validate(outputs); !ok) return ok;
   const auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
   const auto& layout = slot.format.request;
+  // An output the configuration leaves out of the poll request cannot be
+  // commanded: refuse it rather than drop it silently.
   if (outputs.analog_out_raw != 0 && layout.aout_count == 0) return Errc::kUnsupported;
-  if ((outputs.pump_on || outputs.n2_ballast_on) && layout.dout_size == 0) return Errc::kUnsupported;
+  if (outputs.pump_on && slot.io.num_digital_outputs < 1) return Errc::kUnsupported;
+  if (outputs.n2_ballast_on && slot.io.num_digital_outputs < 3) return Errc::kUnsupported;
   std::array<std::uint8_t, 8> buf{};
   auto size = cdn127::encode_poll_request(layout, outputs, MutableBytes(buf));
   if (!size) return size.error();

@@ -20,6 +20,9 @@ namespace dnbridge::rack {
 struct PumpConfig {
   devicenet::NodeConfig node;
   profiles::cdn127::IoConfiguration io;
+  // The identity the device must show; the CDN127's (vendor 59, product type
+  // 27, product code 1888) when not given.
+  std::optional<devicenet::ExpectedIdentity> identity;
 };
 
 struct PumpView {

@@ -1,0 +1,59 @@
+#include "adapters/sim/sim_rack.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace dnbridge::sim {
+
+SlaveOptions default_slave_options(devicenet::MacId mac) {
+  SlaveOptions o;
+  o.mac_switch = mac.value();
+  o.stored_mac = mac.value();
+  o.serial_number = 0x00010000u + mac.value();
+  return o;
+}
+
+SimRack::SimRack(SimRackConfig config, LogSink* log)
+    : config_(std::move(config)), log_(log), world_(config_.bus), pumps_(config_.pumps) {
+  fanout_.add(pumps_);
+  auto port = rack::PumpRack::scanner_config(config_.port, config_.pumps);
+  if (config_.adjust_scan_list) config_.adjust_scan_list(port);
+  master_ = std::make_unique<SimMaster>(world_, std::move(port), fanout_,
+                                        log_ ? Logger(*log_, "master") : Logger());
+  pumps_.attach(master_->scanner());
+  if (config_.create_devices) {
+    for (const auto& p : config_.pumps) add_device(default_slave_options(p.node.mac), std::nullopt);
+  }
+}
+
+SimSlave& SimRack::add_device(SlaveOptions options, std::optional<TimePoint> power_on) {
+  const unsigned mac = options.mac_switch <= devicenet::MacId::kMax ? options.mac_switch
+                                                                    : options.stored_mac;
+  Logger log = log_ ? Logger(*log_, fmt::format("sim {}", mac)) : Logger();
+  auto device = std::make_unique<SimSlave>(world_, std::move(options), power_on, std::move(log));
+  auto& ref = *device;
+  devices_[mac] = std::move(device);
+  return ref;
+}
+
+SimSlave& SimRack::device(devicenet::MacId mac) {
+  auto it = devices_.find(mac.value());
+  if (it == devices_.end()) throw std::out_of_range(fmt::format("no device at MAC {}", mac.value()));
+  return *it->second;
+}
+
+void SimRack::start() {
+  if (started_) return;
+  started_ = true;
+  for (auto& [mac, d] : devices_) d->power_on(world_.now());
+  master_->scanner().start(world_.now());
+}
+
+bool SimRack::all_online() const {
+  return std::all_of(pumps_.pumps().begin(), pumps_.pumps().end(),
+                     [](const rack::PumpView& v) { return v.online; });
+}
+
+}  // namespace dnbridge::sim

@@ -1,0 +1,65 @@
+#pragma once
+// A whole simulated rack port: the bus, the master with its rack model, and a
+// CDN127 per pump. Used by the integration tests and the demo.
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "adapters/sim/sim_master.hpp"
+#include "adapters/sim/sim_slave.hpp"
+#include "adapters/sim/sim_world.hpp"
+#include "bridge/rack/pump_rack.hpp"
+
+namespace dnbridge::sim {
+
+struct SimRackConfig {
+  BusConfig bus{kBitrate500k};
+  devicenet::ScannerConfig port;        // master MAC, timings; nodes come from `pumps`
+  std::vector<rack::PumpConfig> pumps;  // the scan list
+  bool create_devices = true;           // a CDN127 at each pump's MAC
+  // Lets a test change the scan list the master is given after it is built
+  // from `pumps` (e.g. a profile that disagrees with the device).
+  std::function<void(devicenet::ScannerConfig&)> adjust_scan_list;
+};
+
+// The options of a simulated CDN127 at `mac` as it leaves the factory: MAC
+// switch set to `mac`, serial number derived from it.
+SlaveOptions default_slave_options(devicenet::MacId mac);
+
+class SimRack {
+ public:
+  explicit SimRack(SimRackConfig config, LogSink* log = nullptr);
+  SimRack(const SimRack&) = delete;
+  SimRack& operator=(const SimRack&) = delete;
+
+  SimWorld& world() { return world_; }
+  TimePoint now() const { return world_.now(); }
+  devicenet::Scanner& scanner() { return master_->scanner(); }
+  SimMaster& master() { return *master_; }
+  rack::PumpRack& pumps() { return pumps_; }
+  // Extra observers (tests record events); add before start().
+  void observe(devicenet::ScannerObserver& o) { fanout_.add(o); }
+
+  // A simulated device, powered on at `power_on` if given.
+  SimSlave& add_device(SlaveOptions options, std::optional<TimePoint> power_on);
+  SimSlave& device(devicenet::MacId mac);
+  bool has_device(devicenet::MacId mac) const { return devices_.count(mac.value()) != 0; }
+
+  // Powers every device on and starts the master, now.
+  void start();
+  bool all_online() const;
+
+ private:
+  SimRackConfig config_;
+  LogSink* log_;
+  SimWorld world_;
+  rack::PumpRack pumps_;
+  devicenet::ObserverFanout fanout_;
+  std::unique_ptr<SimMaster> master_;
+  std::map<unsigned, std::unique_ptr<SimSlave>> devices_;
+  bool started_ = false;
+};
+
+}  // namespace dnbridge::sim
