@@ -7,6 +7,10 @@
 // then goes online. A request or response for its MAC in those windows means a
 // duplicate: Communication Fault. Online it answers requests for its MAC with a
 // response; a response received while online is a duplicate too.
+// Frames a node sends itself must not be fed back to it (a loopback of its own
+// request would read as a duplicate). When no other node acknowledges the frame
+// (alone on the bus) the CAN controller keeps retransmitting it; that is below
+// this layer.
 #include <cstdint>
 #include <optional>
 
@@ -44,20 +48,21 @@ class DuplicateMacCheck {
 
   struct Config {
     Duration window = seconds(1);
-    std::uint8_t physical_port = 0;
+    std::uint8_t physical_port = 0;  // 7 bits; higher bits are dropped
     std::uint16_t vendor_id = 0;
     std::uint32_t serial_number = 0;
   };
 
   DuplicateMacCheck(MacId mac, Config config) noexcept;
 
-  // Begins the check; returns the first request to send.
+  // Begins (or begins again) the check; returns the first request to send.
   can::CanFrame start(TimePoint now) noexcept;
   // Call when now >= deadline(). Returns the second request when the first
   // window ends; nothing when the second ends (the node is then online).
   std::optional<can::CanFrame> on_timer(TimePoint now) noexcept;
   // A duplicate MAC message for this node's MAC (the caller filters by CAN
   // ID). Returns the response to send while online, if the message is a request.
+  // Ignored before start() and once a duplicate was found.
   std::optional<can::CanFrame> on_message(const DuplicateMacMessage& m) noexcept;
 
   State state() const noexcept { return state_; }

@@ -64,7 +64,8 @@ struct RequestMessage {
 // Bytes the request takes when encoded in `format`.
 std::size_t encoded_size(const RequestMessage& request, BodyFormat format) noexcept;
 // Encodes into `out`; fails with kOutOfRange if class/instance do not fit the
-// format, kBufferTooSmall if `out` is too small. Returns the size written.
+// format or the service has the R/R bit set, kBufferTooSmall if `out` is too
+// small. Returns the size written.
 Result<std::size_t> encode_request(const RequestMessage& request, BodyFormat format,
                                    MutableBytes out) noexcept;
 // Decodes a request message (service byte first). The attribute is read for
@@ -83,13 +84,18 @@ struct ResponseMessage {
   }
 };
 
+// `service` without the R/R bit; kOutOfRange if it has it or is 0x14 (that
+// would read as an error response), kBufferTooSmall if `out` is too small.
 Result<std::size_t> encode_success_response(std::uint8_t service, Bytes data,
                                             MutableBytes out) noexcept;
+// kOutOfRange for GeneralStatus::kSuccess (an error response must report one).
 Result<std::size_t> encode_error_response(cip::GeneralStatus status, std::uint8_t additional,
                                           MutableBytes out) noexcept;
 // Decodes a response message (service byte first). Fails on a request (R/R
 // clear), an empty message, or an error response without its general status.
-// An error response without the additional code is accepted with 0xFF.
+// An error response without the additional code is accepted with 0xFF; one
+// whose general status is success is refused (kMalformed); bytes after the
+// additional code are ignored.
 Result<ResponseMessage> decode_response(Bytes message) noexcept;
 
 // Allocation choice bits (devicenet-facts §2).
@@ -109,10 +115,13 @@ inline constexpr std::uint8_t kDeviceNetClass = 0x03;
 // Group 2 only unconnected requests, sent on Group 2 message 6 to the slave:
 //   Allocate: [M][4B][03][01][choice][allocator MAC]
 //   Release:  [M][4C][03][01][choice]
+// Both refuse choice 0 and the reserved bit 0x80 (kOutOfRange).
 Result<can::CanFrame> make_allocate_frame(MacId slave, MacId master, std::uint8_t choice) noexcept;
 Result<can::CanFrame> make_release_frame(MacId slave, MacId master, std::uint8_t choice) noexcept;
 
-// The success response to Allocate carries [reserved:4 | body format:4].
+// The success response to Allocate carries [reserved:4 | body format:4]. The
+// reserved nibble and any bytes after the first are ignored; kTruncated when
+// empty, else as body_format_from_code().
 Result<BodyFormat> decode_allocate_response_data(Bytes data) noexcept;
 
 }  // namespace dnbridge::devicenet

@@ -57,12 +57,17 @@ struct PumpInputs {
 struct PollInputs {
   std::optional<ExceptionStatus> exception_status;  // when the format has DSUP
   std::optional<std::uint8_t> input_bits;           // raw input byte, when present
-  std::optional<PumpInputs> pump;                   // decoded, when the input byte is present
+  // Decoded when the input byte carries all five pump inputs
+  // (layout.din_channels >= 5): with fewer channels configured, the missing
+  // inputs' bits would decode as alarms that are not there.
+  std::optional<PumpInputs> pump;
   std::array<std::optional<std::uint16_t>, 2> analog_inputs_raw{};  // per channel, when present
 };
 
 // Decodes a poll response of exactly layout.size bytes (kTruncated if shorter,
-// kMalformed if longer). Analog values over 4095 are kOutOfRange.
+// kMalformed if longer). Analog values over 4095 are kOutOfRange. The pad byte's
+// value is ignored. Every codec below refuses a layout whose fields do not add
+// up to its size, or with more channels than the device has, with kOutOfRange.
 Result<PollInputs> decode_poll_response(const PollResponseLayout& layout, std::uint8_t no_nc_mask,
                                         Bytes payload) noexcept;
 
@@ -82,13 +87,18 @@ inline constexpr std::uint8_t kOutputN2BallastBit = 0x04;
 // Refuses an analog value over 4095 (kOutOfRange): never clipped.
 Status validate(const PumpOutputs& outputs) noexcept;
 
-// Encodes a poll request into `out` (at least layout.size bytes); returns the
-// size written (layout.size). Pad bytes are 0.
+// Encodes a poll request into `out` (at least layout.size bytes, else
+// kBufferTooSmall); returns the size written (layout.size). Pad bytes and the
+// reserved output bits are 0; fields the layout does not carry are not sent.
 Result<std::size_t> encode_poll_request(const PollRequestLayout& layout, const PumpOutputs& outputs,
                                         MutableBytes out) noexcept;
-// The slave's side: decodes a full-size poll request.
+// The slave's side: decodes a full-size poll request (kTruncated if shorter:
+// on the device a short request is the idle condition, the caller's to handle;
+// kMalformed if longer; kOutOfRange for an analog value over 4095). Reserved
+// output bits and pad bytes are ignored.
 Result<PumpOutputs> decode_poll_request(const PollRequestLayout& layout, Bytes payload) noexcept;
-// The slave's side: encodes a poll response.
+// The slave's side: encodes a poll response (kOutOfRange for an analog value
+// over 4095 in a channel the layout carries; kBufferTooSmall). Pad bytes are 0.
 Result<std::size_t> encode_poll_response(const PollResponseLayout& layout, std::uint8_t exception_status,
                                          std::uint8_t input_bits,
                                          const std::array<std::uint16_t, 2>& analog_inputs_raw,

@@ -47,12 +47,19 @@ IoConfiguration preset(ConfigurationPreset p) noexcept;
 // Refuses counts over the device's maxima (8 DI, 8 DO, 2 AI, 1 AO) with kOutOfRange.
 Status validate(const IoConfiguration& config) noexcept;
 
-// Where each field sits in a poll message; a field absent has size 0.
+// Where each field sits in a poll message; a field absent has size 0 and the
+// offset at which it would have started.
 struct PollRequestLayout {
   std::size_t dout_offset = 0, dout_size = 0;
   std::size_t pad_size = 0;
   std::size_t aout_offset = 0, aout_count = 0;  // count of 2-byte words
   std::size_t size = 0;                          // the poll connection's consumed size
+
+  // CDN127 manual, "Poll Packet Sizes": "If the Num Digital Output and Num
+  // Analog Output are both 0 then the CONSUMED SIZE for the POLL connection
+  // will be 0. In this case there is no POLL IDLE condition." Otherwise a
+  // request shorter than `size` (a 0-byte poll, typically) makes the device idle.
+  bool has_idle_condition() const noexcept { return size != 0; }
 
   friend bool operator==(const PollRequestLayout&, const PollRequestLayout&) = default;
 };
@@ -60,6 +67,10 @@ struct PollRequestLayout {
 struct PollResponseLayout {
   bool has_dsup = false;  // exception status byte first
   std::size_t din_offset = 0, din_size = 0;
+  // How many input channels the input byte carries (Num Digital Input for the
+  // configured format, 8 for the fixed assemblies): with fewer than 5 the byte
+  // does not hold every pump input, and the higher bits mean nothing.
+  std::size_t din_channels = 0;
   std::size_t pad_size = 0;
   std::size_t ain_offset = 0, ain_count = 0;  // count of 2-byte words
   std::size_t size = 0;                        // the poll connection's produced size
@@ -91,7 +102,11 @@ Result<PollRequestLayout> consumed_assembly_layout(std::uint8_t instance,
 inline constexpr std::uint8_t kDefaultProducedAssembly = 103;
 inline constexpr std::uint8_t kDefaultConsumedAssembly = 104;
 
-// Human-readable form for fault reasons, e.g. "request 4 B [DOUT PAD AOUT]".
-std::string describe(const PollFormat& format);
+// Human-readable form for fault reasons, e.g. "request 4 B [DOUT PAD AOUT]",
+// "response 6 B [DSUP DIN AIN AIN]", "request 0 B [] (no idle condition)".
+// Allocates: for messages, not for the frame path.
+std::string describe(const PollRequestLayout& layout);
+std::string describe(const PollResponseLayout& layout);
+std::string describe(const PollFormat& format);  // "<request>; <response>"
 
 }  // namespace dnbridge::profiles::cdn127

@@ -1,0 +1,21 @@
+#include "adapters/sim/sim_master.hpp"
+
+namespace dnbridge::sim {
+
+SimMaster::SimMaster(SimWorld& world, devicenet::ScannerConfig config,
+                     devicenet::ScannerObserver& observer, Logger log)
+    : world_(world), handle_(world.bus().attach(*this)) {
+  scanner_.emplace(std::move(config), world.bus().sink(handle_), observer, std::move(log));
+  world_.add(*this);
+}
+
+SimMaster::~SimMaster() {
+  world_.remove(*this);
+  (void)world_.bus().detach(handle_);
+}
+
+void SimMaster::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
+  scanner_->on_frame(frame, rx_time);
+}
+
+}  // namespace dnbridge::sim

@@ -1,0 +1,31 @@
+#pragma once
+// The master's port on the simulated bus: a Scanner attached as one node.
+#include <memory>
+#include <optional>
+
+#include "adapters/sim/sim_world.hpp"
+#include "bridge/devicenet/scanner.hpp"
+
+namespace dnbridge::sim {
+
+class SimMaster final : public SimEndpoint {
+ public:
+  SimMaster(SimWorld& world, devicenet::ScannerConfig config, devicenet::ScannerObserver& observer,
+            Logger log = {});
+  ~SimMaster() override;
+
+  devicenet::Scanner& scanner() { return *scanner_; }
+  const devicenet::Scanner& scanner() const { return *scanner_; }
+  NodeHandle handle() const { return handle_; }
+
+  void on_frame(const can::CanFrame& frame, TimePoint rx_time) override;
+  TimePoint next_deadline() const override { return scanner_->next_deadline(); }
+  void on_timer(TimePoint now) override { scanner_->on_timer(now); }
+
+ private:
+  SimWorld& world_;
+  NodeHandle handle_;
+  std::optional<devicenet::Scanner> scanner_;
+};
+
+}  // namespace dnbridge::sim

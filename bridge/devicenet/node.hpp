@@ -1,0 +1,184 @@
+#pragma once
+// One scan-list node as the master drives it: its life cycle
+//   absent -> allocate -> identify -> configure -> verify sizes -> online
+// (with the faults wrong device, configuration fault and owned by another
+// master), its poll connection and its explicit connection.
+//
+// Sans-IO: frames come in through on_*(), time through on_timer(now); frames
+// go out through the FrameSink, events through the ScannerObserver.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "bridge/can/frame_sink.hpp"
+#include "bridge/common/bytes.hpp"
+#include "bridge/common/log.hpp"
+#include "bridge/common/result.hpp"
+#include "bridge/common/time.hpp"
+#include "bridge/devicenet/explicit_client.hpp"
+#include "bridge/devicenet/fragmentation.hpp"
+#include "bridge/devicenet/node_state.hpp"
+#include "bridge/devicenet/scan_list.hpp"
+#include "bridge/devicenet/scanner_events.hpp"
+
+namespace dnbridge::devicenet {
+
+class Node final : private ExplicitClient::Listener {
+ public:
+  // Largest poll message handled (fragmented I/O above 8 bytes).
+  static constexpr std::size_t kMaxIoSize = 64;
+  // Internal request tags have this bit set; external request ids must not.
+  static constexpr std::uint32_t kInternalTag = 0x8000'0000u;
+
+  Node(const NodeConfig& config, const ScannerConfig& port, can::FrameSink& sink,
+       ScannerObserver& observer, Logger log);
+
+  // Begins allocation at `first_attempt` (the scanner staggers nodes).
+  void start(TimePoint first_attempt);
+  // Orderly shutdown: an idle poll, then Release. stopped() tells when done.
+  void begin_shutdown(TimePoint now);
+  // Stops at once without sending anything (the port lost its MAC).
+  void halt(std::string_view reason, TimePoint now);
+
+  void on_explicit_frame(Bytes payload, TimePoint now);  // Group 2 message 3
+  void on_poll_response(Bytes payload, TimePoint now);   // Group 1 message 15
+  // The node sent a duplicate MAC check request: it is powering up.
+  void on_duplicate_mac_request(TimePoint now);
+  void on_timer(TimePoint now);
+  TimePoint deadline() const;
+
+  // New outputs (consumed-size bytes): sent on the next poll, or at once when
+  // configured so. Clears idle. kOutOfRange when the size is wrong.
+  Status set_outputs(Bytes data, TimePoint now);
+  // Idle: zero-length polls, so the device applies its idle actions.
+  void set_idle(bool idle, TimePoint now);
+  // An explicit request from above; its result comes through the observer.
+  Status request_explicit(std::uint32_t request_id, const RequestMessage& request, TimePoint now);
+
+  // Poll slot: the node polls at phase + k * poll_period.
+  void set_poll_phase(TimePoint phase) { poll_phase_ = phase; }
+
+  MacId mac() const { return config_.mac; }
+  const NodeConfig& config() const { return config_; }
+  NodeState state() const { return state_; }
+  const std::string& reason() const { return reason_; }
+  const NodeCounters& counters() const { return counters_; }
+  const ExplicitCounters& explicit_counters() const { return client_.counters(); }
+  const NodeError& last_error() const { return last_error_; }
+  const NodeIdentity& identity() const { return identity_; }
+  std::optional<std::uint8_t> device_state() const { return device_state_; }
+  bool idle() const { return idle_; }
+  // Outputs and idle flag of the last poll the device answered.
+  Bytes applied_outputs() const { return applied_outputs_.view(); }
+  bool applied_idle() const { return applied_idle_; }
+  Duration poll_epr() const { return poll_epr_; }
+  Duration explicit_epr() const { return explicit_epr_; }
+  bool stopped() const { return state_ == NodeState::kStopped; }
+
+ private:
+  enum class Step : std::uint8_t {
+    kNone,
+    kAllocate,
+    kReleaseStale,  // Release after "already allocated", then Allocate again
+    kVendor,
+    kProductType,
+    kProductCode,
+    kRevision,
+    kSerial,
+    kName,
+    kReadSetting,
+    kWriteSetting,
+    kProducedPath,
+    kConsumedPath,
+    kProducedSize,
+    kConsumedSize,
+    kFallbackProducedSize,
+    kFallbackConsumedSize,
+    kPollEpr,
+    kExplicitEpr,
+    kKeepAlive,
+    kReleaseFault,     // Release after a fault, then wait for the recheck
+    kReleaseShutdown,  // Release at orderly shutdown
+  };
+
+  void on_explicit_result(std::uint32_t tag, const ExplicitResult& result, TimePoint now) override;
+  void on_step_result(Step step, const ExplicitResult& result, TimePoint now);
+
+  void issue(Step step, const RequestMessage& request, bool unconnected, TimePoint now);
+  void resend_step(TimePoint now);
+  void get(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, TimePoint now);
+  void set(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, Bytes value,
+           TimePoint now);
+
+  void attempt_allocate(TimePoint now);
+  void release(Step step, TimePoint now);
+  void begin_identify(TimePoint now);
+  void next_setting(TimePoint now);
+  void begin_verify(TimePoint now);
+  void check_sizes(TimePoint now);
+  void go_online(TimePoint now);
+  void lose(std::string reason, TimePoint now);
+  void enter_fault(NodeState fault, std::string reason, TimePoint now);
+  void set_state(NodeState next, std::string reason, TimePoint now);
+  void record(NodeError::Kind kind, TimePoint now, std::uint32_t got = 0, std::uint32_t expected = 0);
+  void record_device_error(const ExplicitResult& result, TimePoint now);
+
+  void send_poll(TimePoint now);
+  void accept_poll_response(Bytes data, TimePoint now);
+  void bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now);
+  TimePoint next_poll_slot(TimePoint after) const;
+
+  const NodeConfig& config_;
+  const ScannerConfig& port_;
+  can::FrameSink& sink_;
+  ScannerObserver& observer_;
+  Logger log_;
+  ExplicitClient client_;
+
+  NodeState state_ = NodeState::kAbsent;
+  std::string reason_ = "not started";
+  Step step_ = Step::kNone;
+  bool connected_ = false;      // the master holds the node's connections
+  bool shutting_down_ = false;
+  bool started_ = false;
+  TimePoint retry_at_ = kNever;
+  Duration retry_delay_{};
+  std::size_t setting_index_ = 0;
+  unsigned step_timeouts_ = 0;  // consecutive timeouts of the current life-cycle step
+  Step last_step_ = Step::kNone;
+  RequestMessage last_request_;
+  InlineBytes<64> last_request_data_;
+  bool last_unconnected_ = false;
+  std::optional<std::uint32_t> produced_size_;
+  std::optional<std::uint32_t> consumed_size_;
+
+  NodeIdentity identity_;
+  std::optional<std::uint8_t> device_state_;
+  Duration poll_epr_{};
+  Duration explicit_epr_{};
+
+  // Poll connection.
+  TimePoint poll_phase_{};
+  TimePoint next_poll_ = kNever;
+  TimePoint poll_deadline_ = kNever;
+  TimePoint last_response_{};
+  TimePoint keepalive_at_ = kNever;
+  bool poll_outstanding_ = false;
+  bool poll_unanswered_ = false;  // the last poll timed out: the next is a retry
+  bool outputs_dirty_ = false;
+  bool idle_ = true;              // no outputs until the layer above sets them
+  unsigned consecutive_errors_ = 0;
+  unsigned keepalive_failures_ = 0;
+  InlineBytes<kMaxIoSize> outputs_;
+  InlineBytes<kMaxIoSize> sent_outputs_;
+  bool sent_idle_ = true;
+  InlineBytes<kMaxIoSize> applied_outputs_;
+  bool applied_idle_ = true;
+  IoReassembler io_reassembler_{kMaxIoSize};
+
+  NodeCounters counters_;
+  NodeError last_error_;
+  RateLimiter error_log_limit_;
+};
+
+}  // namespace dnbridge::devicenet

@@ -1,0 +1,70 @@
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "bridge/cip/general_status.hpp"
+#include "bridge/common/time.hpp"
+
+namespace dnbridge::devicenet {
+
+// Life cycle of a scan-list node, as the master sees it.
+enum class NodeState : std::uint8_t {
+  kAbsent,              // not answering Allocate (or not tried yet)
+  kIdentifying,         // allocated; reading and checking the Identity object
+  kConfiguring,         // making the device's configuration match the scan list
+  kVerifying,           // checking the poll connection's sizes against the configuration
+  kOnline,              // polled
+  kWrongDevice,         // identity differs from the scan list: never polled
+  kConfigurationFault,  // device refuses the configuration, or its sizes differ
+  kOwnedByOtherMaster,  // Allocate refused with 0x0C/0x01
+  kStopped,             // released by an orderly shutdown, or the port stopped
+};
+
+std::string_view to_string(NodeState state) noexcept;
+
+// States in which the device is known not to be polled because of what it is
+// or how it answers; re-checked periodically without leaving the state until
+// the outcome changes.
+constexpr bool is_fault(NodeState s) noexcept {
+  return s == NodeState::kWrongDevice || s == NodeState::kConfigurationFault ||
+         s == NodeState::kOwnedByOtherMaster;
+}
+
+// The last thing that went wrong with a node, kept as values (no text on the
+// frame path); describe() renders it.
+struct NodeError {
+  enum class Kind : std::uint8_t {
+    kNone,
+    kPollTimeout,         // no poll response before the next poll
+    kPollLength,          // poll response of the wrong size (got/expected)
+    kPollUnexpected,      // poll response with no poll outstanding
+    kPollMalformed,       // fragmented poll response out of order
+    kExplicitTimeout,     // explicit request unanswered
+    kExplicitAborted,     // fragment never acknowledged
+    kExplicitMalformed,   // unparsable explicit response
+    kDeviceError,         // CIP error status (general/additional)
+    kConnectionLost,      // silence for 4 x EPR
+  };
+  Kind kind = Kind::kNone;
+  TimePoint at{};
+  std::uint32_t got = 0;
+  std::uint32_t expected = 0;
+  cip::GeneralStatus general_status = cip::GeneralStatus::kSuccess;
+  std::uint8_t additional_status = cip::kNoAdditionalCode;
+
+  std::string describe() const;
+};
+
+struct NodeCounters {
+  std::uint64_t polls = 0;
+  std::uint64_t idle_polls = 0;
+  std::uint64_t responses = 0;
+  std::uint64_t timeouts = 0;        // polls not answered in time
+  std::uint64_t retries = 0;         // polls sent after an unanswered one
+  std::uint64_t errors = 0;          // bad responses (length, order, late)
+  std::uint64_t reconnects = 0;      // returns from online to allocation
+  std::uint64_t allocate_attempts = 0;
+};
+
+}  // namespace dnbridge::devicenet

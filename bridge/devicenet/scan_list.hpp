@@ -1,0 +1,96 @@
+#pragma once
+// What the master is told to scan: per port, the master's own MAC and the
+// nodes it owns, each with what it must be and how it is configured.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bridge/common/bytes.hpp"
+#include "bridge/common/time.hpp"
+#include "bridge/devicenet/explicit_client.hpp"
+#include "bridge/devicenet/mac_id.hpp"
+
+namespace dnbridge::devicenet {
+
+// The identity a scan-list entry expects (Identity object attributes 1..3).
+struct ExpectedIdentity {
+  std::uint16_t vendor_id = 0;
+  std::uint16_t product_type = 0;
+  std::uint16_t product_code = 0;
+
+  friend bool operator==(const ExpectedIdentity&, const ExpectedIdentity&) = default;
+};
+
+// One attribute the master makes equal to a value before it starts the poll
+// connection: read first, written only when it differs.
+struct AttributeSetting {
+  std::uint16_t class_id = 0;
+  std::uint16_t instance_id = 0;
+  std::uint8_t attribute = 0;
+  std::vector<std::uint8_t> value;
+  std::string name;  // for reasons and logs, e.g. "Configuration.NumAnalogInput"
+};
+
+// Where the device reports the poll connection's sizes: Connection instance 2
+// attributes 7/8, with a profile-specific fallback (the CDN127's Configuration
+// object attributes 16/17) for devices that refuse those.
+struct SizeSource {
+  std::uint16_t class_id = 0;
+  std::uint16_t instance_id = 0;
+  std::uint8_t produced_attribute = 0;
+  std::uint8_t consumed_attribute = 0;
+  bool one_byte = false;  // USINT rather than UINT
+};
+
+// Device-specific knowledge the node life cycle needs, as data: built by a
+// profile (profiles/cdn127/node_profile.hpp).
+struct NodeProfile {
+  ExpectedIdentity identity;
+  std::vector<AttributeSetting> settings;   // applied in order
+  std::vector<std::uint8_t> produced_path;  // Connection 2 attribute 14 (EPATH)
+  std::vector<std::uint8_t> consumed_path;  // Connection 2 attribute 16 (EPATH)
+  std::size_t produced_size = 0;            // poll response bytes expected
+  std::size_t consumed_size = 0;            // poll request bytes expected
+  std::string format_description;           // e.g. "request 4 B [DOUT PAD AOUT] ..."
+  bool has_size_fallback = false;
+  SizeSource size_fallback;
+};
+
+struct NodeConfig {
+  MacId mac;
+  std::string name;
+  NodeProfile profile;
+  Duration poll_period = milliseconds(100);
+  // Expected packet rate of the poll connection; the device (and the master)
+  // declare the connection dead after 4 x EPR of silence. The device may
+  // round it; the value it returns is used.
+  Duration expected_packet_rate = milliseconds(1000);
+  // Expected packet rate asked for the explicit connection; the master sends
+  // a keep-alive request once per returned EPR.
+  Duration explicit_packet_rate = milliseconds(2500);
+  // Poll at once when new outputs are set, rather than on the next period.
+  bool immediate_poll_on_change = true;
+};
+
+struct ScannerConfig {
+  MacId master_mac;
+  // Duplicate MAC ID check of the master's own MAC.
+  Duration duplicate_mac_window = seconds(1);
+  std::uint16_t vendor_id = 0;
+  std::uint32_t serial_number = 0;
+  // Explicit messaging.
+  ExplicitClient::Config explicit_messaging{};
+  // Retry of absent nodes: first after `allocate_retry_min`, doubling up to
+  // `allocate_retry_max`, forever. Faulted nodes (wrong device, configuration
+  // fault, owned by another master) are re-checked every `fault_recheck`.
+  Duration allocate_retry_min = milliseconds(250);
+  Duration allocate_retry_max = seconds(5);
+  Duration fault_recheck = seconds(10);
+  // Consecutive bad poll responses after which the node is reconnected.
+  unsigned max_consecutive_errors = 10;
+  // Outstanding poll given up after this long (or at the next poll, if sooner).
+  Duration poll_response_timeout = milliseconds(50);
+  std::vector<NodeConfig> nodes;
+};
+
+}  // namespace dnbridge::devicenet

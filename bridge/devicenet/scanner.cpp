@@ -1,0 +1,234 @@
+#include "bridge/devicenet/scanner.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "bridge/devicenet/identifier.hpp"
+
+namespace dnbridge::devicenet {
+namespace {
+
+DuplicateMacCheck::Config mac_check_config(const ScannerConfig& c) {
+  DuplicateMacCheck::Config m;
+  m.window = c.duplicate_mac_window;
+  m.vendor_id = c.vendor_id;
+  m.serial_number = c.serial_number;
+  return m;
+}
+
+void validate(const ScannerConfig& c) {
+  std::array<bool, MacId::kMax + 1> seen{};
+  for (const auto& n : c.nodes) {
+    const unsigned mac = n.mac.value();
+    if (mac > MacId::kMax) throw std::invalid_argument(fmt::format("node MAC {} out of range", mac));
+    if (n.mac == c.master_mac) {
+      throw std::invalid_argument(fmt::format("node {} has the master's MAC", mac));
+    }
+    if (seen[mac]) throw std::invalid_argument(fmt::format("MAC {} is in the scan list twice", mac));
+    seen[mac] = true;
+    if (n.poll_period <= Duration::zero()) {
+      throw std::invalid_argument(fmt::format("node {}: poll period must be positive", mac));
+    }
+    if (n.expected_packet_rate < n.poll_period) {
+      throw std::invalid_argument(
+          fmt::format("node {}: expected packet rate shorter than the poll period", mac));
+    }
+    if (n.profile.consumed_size > Node::kMaxIoSize || n.profile.produced_size > Node::kMaxIoSize) {
+      throw std::invalid_argument(fmt::format("node {}: poll messages over {} bytes", mac,
+                                              Node::kMaxIoSize));
+    }
+  }
+}
+
+}  // namespace
+
+std::string_view to_string(PortState state) noexcept {
+  switch (state) {
+    case PortState::kStopped: return "stopped";
+    case PortState::kCheckingMac: return "checking MAC";
+    case PortState::kRunning: return "running";
+    case PortState::kStopping: return "stopping";
+    case PortState::kDuplicateMac: return "duplicate MAC";
+  }
+  return "?";
+}
+
+Scanner::Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& observer, Logger log)
+    : config_(std::move(config)),
+      sink_(sink),
+      observer_(observer),
+      log_(std::move(log)),
+      mac_check_(config_.master_mac, mac_check_config(config_)) {
+  validate(config_);
+  nodes_.reserve(config_.nodes.size());
+  for (const auto& n : config_.nodes) {
+    Logger node_log(log_.sink(), fmt::format("{} node {}", log_.component(), n.mac.value()));
+    nodes_.push_back(std::make_unique<Node>(n, config_, sink_, observer_, std::move(node_log)));
+    by_mac_[n.mac.value()] = nodes_.back().get();
+  }
+}
+
+void Scanner::set_state(PortState next, std::string reason, TimePoint now) {
+  if (next == state_ && reason == reason_) return;
+  state_ = next;
+  reason_ = std::move(reason);
+  log_.info("port {}: {}", to_string(next), reason_);
+  observer_.on_port_state(next, reason_, now);
+}
+
+void Scanner::start(TimePoint now) {
+  if (state_ != PortState::kStopped) return;
+  set_state(PortState::kCheckingMac,
+            fmt::format("checking that no other node has MAC {}", config_.master_mac.value()), now);
+  sink_.send(mac_check_.start(now), now);
+}
+
+void Scanner::begin_scanning(TimePoint now) {
+  set_state(PortState::kRunning, "MAC check passed: scanning", now);
+  // Stagger first allocations and poll slots across the scan list so the bus
+  // sees an even load rather than bursts.
+  const auto count = static_cast<std::int64_t>(nodes_.size());
+  for (std::int64_t i = 0; i < count; ++i) {
+    Node& node = *nodes_[static_cast<std::size_t>(i)];
+    const Duration period = node.config().poll_period;
+    node.set_poll_phase(now + period * i / count);
+    node.start(now + milliseconds(2) * i);
+  }
+}
+
+void Scanner::stop(TimePoint now) {
+  if (state_ == PortState::kRunning) {
+    set_state(PortState::kStopping, "orderly shutdown: idling and releasing nodes", now);
+    for (auto& n : nodes_) n->begin_shutdown(now);
+  } else if (state_ == PortState::kCheckingMac) {
+    for (auto& n : nodes_) n->halt("port stopped", now);
+  }
+  if (stopped() && state_ != PortState::kDuplicateMac) {
+    set_state(PortState::kStopped, "all nodes released", now);
+  }
+}
+
+bool Scanner::stopped() const {
+  if (state_ == PortState::kStopped || state_ == PortState::kDuplicateMac) return true;
+  if (state_ != PortState::kStopping) return false;
+  return std::all_of(nodes_.begin(), nodes_.end(), [](const auto& n) { return n->stopped(); });
+}
+
+Node* Scanner::find(MacId mac) { return by_mac_[mac.value()]; }
+
+const Node* Scanner::node(MacId mac) const { return by_mac_[mac.value()]; }
+
+void Scanner::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
+  ++counters_.frames_received;
+  if (state_ == PortState::kStopped || state_ == PortState::kDuplicateMac) return;
+  auto id = decode_identifier(frame.id);
+  if (!id) {
+    ++counters_.invalid_identifiers;
+    unsigned suppressed = 0;
+    if (foreign_log_limit_.allow(rx_time, suppressed)) {
+      log_.warn("frame with a non-DeviceNet identifier 0x{:03X} ignored", frame.id);
+    }
+    return;
+  }
+  const Bytes payload = frame.payload();
+
+  if (id->group == MessageGroup::k2 &&
+      id->message_id == static_cast<std::uint8_t>(Group2Message::kDuplicateMacCheck)) {
+    auto message = decode_duplicate_mac(payload);
+    if (!message) {
+      ++counters_.foreign_frames;
+      return;
+    }
+    if (id->mac == config_.master_mac) {
+      if (auto reply = mac_check_.on_message(*message)) sink_.send(*reply, rx_time);
+      if (mac_check_.state() == DuplicateMacCheck::State::kDuplicate) {
+        const std::string reason =
+            fmt::format("another node (vendor {}, serial {}) has the master's MAC {}",
+                        message->vendor_id, message->serial_number, config_.master_mac.value());
+        log_.error("{}: port stopped", reason);
+        for (auto& n : nodes_) n->halt("port stopped: duplicate master MAC", rx_time);
+        set_state(PortState::kDuplicateMac, reason, rx_time);
+      }
+      return;
+    }
+    if (Node* n = find(id->mac); n && !message->response) n->on_duplicate_mac_request(rx_time);
+    return;
+  }
+
+  if (state_ == PortState::kCheckingMac) return;
+
+  if (id->group == MessageGroup::k1 &&
+      id->message_id == static_cast<std::uint8_t>(Group1Message::kSlavePollResponse)) {
+    if (Node* n = find(id->mac)) {
+      n->on_poll_response(payload, rx_time);
+    } else {
+      ++counters_.unknown_nodes;
+    }
+    return;
+  }
+  if (id->group == MessageGroup::k2 &&
+      id->message_id == static_cast<std::uint8_t>(Group2Message::kSlaveExplicitResponse)) {
+    if (Node* n = find(id->mac)) {
+      n->on_explicit_frame(payload, rx_time);
+    } else {
+      ++counters_.unknown_nodes;
+    }
+    return;
+  }
+  // Requests from other masters, other connection types, Group 3 and 4.
+  ++counters_.foreign_frames;
+}
+
+void Scanner::on_timer(TimePoint now) {
+  if (state_ == PortState::kCheckingMac) {
+    if (now >= mac_check_.deadline()) {
+      if (auto again = mac_check_.on_timer(now)) sink_.send(*again, now);
+      if (mac_check_.state() == DuplicateMacCheck::State::kOnline) begin_scanning(now);
+    }
+    return;
+  }
+  if (state_ != PortState::kRunning && state_ != PortState::kStopping) return;
+  for (auto& n : nodes_) {
+    if (now >= n->deadline()) n->on_timer(now);
+  }
+  if (state_ == PortState::kStopping && stopped()) {
+    set_state(PortState::kStopped, "all nodes released", now);
+  }
+}
+
+TimePoint Scanner::next_deadline() const {
+  if (state_ == PortState::kCheckingMac) return mac_check_.deadline();
+  if (state_ != PortState::kRunning && state_ != PortState::kStopping) return kNever;
+  TimePoint t = kNever;
+  for (const auto& n : nodes_) t = std::min(t, n->deadline());
+  return t;
+}
+
+Status Scanner::set_outputs(MacId mac, Bytes data, TimePoint now) {
+  Node* n = find(mac);
+  if (!n) return Errc::kOutOfRange;
+  if (state_ == PortState::kStopping) return Errc::kStopped;
+  return n->set_outputs(data, now);
+}
+
+Status Scanner::set_idle(MacId mac, bool idle, TimePoint now) {
+  Node* n = find(mac);
+  if (!n) return Errc::kOutOfRange;
+  n->set_idle(idle, now);
+  return {};
+}
+
+Result<std::uint32_t> Scanner::request_explicit(MacId mac, const RequestMessage& request,
+                                                TimePoint now) {
+  Node* n = find(mac);
+  if (!n) return Errc::kOutOfRange;
+  if (state_ != PortState::kRunning) return Errc::kStopped;
+  const std::uint32_t id = next_request_id_;
+  next_request_id_ = next_request_id_ + 1 >= Node::kInternalTag ? 1 : next_request_id_ + 1;
+  if (auto s = n->request_explicit(id, request, now); !s) return s.error();
+  return id;
+}
+
+}  // namespace dnbridge::devicenet

@@ -1,0 +1,87 @@
+#pragma once
+// The DeviceNet master of one CAN port: checks its own MAC, then drives every
+// scan-list node (node.hpp) and routes received frames to them.
+//
+// Sans-IO: the port's event loop calls on_frame() for every received frame,
+// on_timer() when next_deadline() has come, and the request methods on behalf
+// of the layer above. Frames go out through the FrameSink, events through the
+// ScannerObserver.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bridge/can/can_frame.hpp"
+#include "bridge/can/frame_sink.hpp"
+#include "bridge/common/log.hpp"
+#include "bridge/common/result.hpp"
+#include "bridge/common/time.hpp"
+#include "bridge/devicenet/duplicate_mac.hpp"
+#include "bridge/devicenet/node.hpp"
+#include "bridge/devicenet/scan_list.hpp"
+#include "bridge/devicenet/scanner_events.hpp"
+
+namespace dnbridge::devicenet {
+
+struct PortCounters {
+  std::uint64_t frames_received = 0;
+  std::uint64_t invalid_identifiers = 0;  // outside the DeviceNet groups
+  std::uint64_t foreign_frames = 0;       // valid, but not for this master
+  std::uint64_t unknown_nodes = 0;        // from a MAC not in the scan list
+};
+
+class Scanner {
+ public:
+  // Throws std::invalid_argument for a scan list that cannot work (duplicate
+  // or out-of-range MACs, the master's MAC in it, periods of zero, EPR shorter
+  // than the poll period, a poll message over Node::kMaxIoSize).
+  Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& observer, Logger log);
+  Scanner(const Scanner&) = delete;
+  Scanner& operator=(const Scanner&) = delete;
+
+  // Starts the duplicate MAC ID check; scanning follows when it passes.
+  void start(TimePoint now);
+  // Orderly shutdown: idle polls and Release for every node; stopped() when done.
+  void stop(TimePoint now);
+
+  void on_frame(const can::CanFrame& frame, TimePoint rx_time);
+  void on_timer(TimePoint now);
+  TimePoint next_deadline() const;
+
+  Status set_outputs(MacId mac, Bytes data, TimePoint now);
+  Status set_idle(MacId mac, bool idle, TimePoint now);
+  // Queues an explicit request to a node; returns its id, which the result
+  // carries. kNotConnected when the node holds no connection, kBusy when its
+  // queue is full, kOutOfRange for a MAC not in the scan list.
+  Result<std::uint32_t> request_explicit(MacId mac, const RequestMessage& request, TimePoint now);
+
+  PortState state() const { return state_; }
+  const std::string& reason() const { return reason_; }
+  bool stopped() const;
+  const Node* node(MacId mac) const;
+  const std::vector<std::unique_ptr<Node>>& nodes() const { return nodes_; }
+  const PortCounters& counters() const { return counters_; }
+  const ScannerConfig& config() const { return config_; }
+
+ private:
+  void set_state(PortState next, std::string reason, TimePoint now);
+  void begin_scanning(TimePoint now);
+  Node* find(MacId mac);
+
+  ScannerConfig config_;
+  can::FrameSink& sink_;
+  ScannerObserver& observer_;
+  Logger log_;
+  std::vector<std::unique_ptr<Node>> nodes_;
+  std::array<Node*, MacId::kMax + 1> by_mac_{};
+  DuplicateMacCheck mac_check_;
+  PortState state_ = PortState::kStopped;
+  std::string reason_ = "not started";
+  std::uint32_t next_request_id_ = 1;
+  PortCounters counters_;
+  RateLimiter foreign_log_limit_;
+};
+
+}  // namespace dnbridge::devicenet

@@ -1,0 +1,54 @@
+#pragma once
+// What the master tells the layer above. Called from inside the scanner's
+// event handling (on the port's own thread): implementations copy what they
+// need and return; they must not call back into the scanner.
+#include <cstdint>
+#include <string>
+
+#include "bridge/common/bytes.hpp"
+#include "bridge/common/time.hpp"
+#include "bridge/devicenet/explicit_client.hpp"
+#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/node_state.hpp"
+
+namespace dnbridge::devicenet {
+
+enum class PortState : std::uint8_t {
+  kStopped,       // not started, or stopped after an orderly shutdown
+  kCheckingMac,   // duplicate MAC ID check of the master's own MAC
+  kRunning,       // scanning
+  kStopping,      // orderly shutdown: nodes going idle and being released
+  kDuplicateMac,  // another node has the master's MAC: nothing is sent
+};
+
+std::string_view to_string(PortState state) noexcept;
+
+// The Identity object as read from a node.
+struct NodeIdentity {
+  std::uint16_t vendor_id = 0;
+  std::uint16_t product_type = 0;
+  std::uint16_t product_code = 0;
+  std::uint8_t major_revision = 0;
+  std::uint8_t minor_revision = 0;
+  std::uint32_t serial_number = 0;
+  std::string product_name;
+};
+
+class ScannerObserver {
+ public:
+  virtual ~ScannerObserver() = default;
+  virtual void on_port_state(PortState /*state*/, const std::string& /*reason*/, TimePoint /*at*/) {}
+  // Every life-cycle transition, with its reason.
+  virtual void on_node_state(MacId /*mac*/, NodeState /*from*/, NodeState /*to*/,
+                             const std::string& /*reason*/, TimePoint /*at*/) {}
+  virtual void on_node_identity(MacId /*mac*/, const NodeIdentity& /*identity*/, TimePoint /*at*/) {}
+  // A poll response of the expected size; `rx_time` is the CAN receive time.
+  virtual void on_poll_response(MacId /*mac*/, Bytes /*data*/, TimePoint /*rx_time*/) {}
+  // Identity object State (attribute 8) read by the keep-alive, when it changes.
+  virtual void on_device_state(MacId /*mac*/, std::uint8_t /*state*/, TimePoint /*at*/) {}
+  // The end of an explicit request submitted with Scanner::request_explicit.
+  virtual void on_explicit_result(std::uint32_t /*request_id*/, MacId /*mac*/,
+                                  const ExplicitResult& /*result*/, TimePoint /*at*/) {}
+};
+
+}  // namespace dnbridge::devicenet

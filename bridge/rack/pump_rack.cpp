@@ -1,0 +1,144 @@
+#include "bridge/rack/pump_rack.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "bridge/profiles/cdn127/node_profile.hpp"
+
+namespace dnbridge::rack {
+
+using devicenet::MacId;
+using devicenet::NodeState;
+namespace cdn127 = profiles::cdn127;
+
+devicenet::ScannerConfig PumpRack::scanner_config(devicenet::ScannerConfig port,
+                                                  const std::vector<PumpConfig>& pumps) {
+  port.nodes.clear();
+  for (const auto& p : pumps) {
+    auto profile = cdn127::make_node_profile(p.io);
+    if (!profile) {
+      throw std::invalid_argument(fmt::format("node {} ({}): invalid I/O configuration: {}",
+                                              p.node.mac.value(), p.node.name,
+                                              profile.error().message()));
+    }
+    devicenet::NodeConfig node = p.node;
+    node.profile = std::move(*profile);
+    port.nodes.push_back(std::move(node));
+  }
+  return port;
+}
+
+PumpRack::PumpRack(const std::vector<PumpConfig>& pumps) {
+  index_.fill(-1);
+  for (const auto& p : pumps) {
+    auto format = cdn127::poll_format(p.io);
+    if (!format) {
+      throw std::invalid_argument(fmt::format("node {}: invalid I/O configuration",
+                                              p.node.mac.value()));
+    }
+    index_[p.node.mac.value()] = static_cast<int>(views_.size());
+    PumpView v;
+    v.mac = p.node.mac;
+    v.name = p.node.name;
+    v.reason = "not started";
+    views_.push_back(std::move(v));
+    slots_.push_back({p.io, *format});
+  }
+}
+
+PumpView* PumpRack::find(MacId mac) {
+  const int i = index_[mac.value()];
+  return i < 0 ? nullptr : &views_[static_cast<std::size_t>(i)];
+}
+
+const PumpView* PumpRack::pump(MacId mac) const {
+  const int i = index_[mac.value()];
+  return i < 0 ? nullptr : &views_[static_cast<std::size_t>(i)];
+}
+
+Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, TimePoint now) {
+  PumpView* v = find(mac);
+  if (!v || !scanner_) return Errc::kOutOfRange;
+  if (auto ok = cdn127::validate(outputs); !ok) return ok;
+  const auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
+  const auto& layout = slot.format.request;
+  if (outputs.analog_out_raw != 0 && layout.aout_count == 0) return Errc::kUnsupported;
+  if ((outputs.pump_on || outputs.n2_ballast_on) && layout.dout_size == 0) return Errc::kUnsupported;
+  std::array<std::uint8_t, 8> buf{};
+  auto size = cdn127::encode_poll_request(layout, outputs, MutableBytes(buf));
+  if (!size) return size.error();
+  if (auto s = scanner_->set_outputs(mac, Bytes(buf.data(), *size), now); !s) return s;
+  v->outputs_requested = outputs;
+  ++v->changes;
+  return {};
+}
+
+Status PumpRack::release_command(MacId mac, TimePoint now) {
+  PumpView* v = find(mac);
+  if (!v || !scanner_) return Errc::kOutOfRange;
+  v->outputs_requested.reset();
+  ++v->changes;
+  return scanner_->set_idle(mac, true, now);
+}
+
+void PumpRack::on_port_state(devicenet::PortState state, const std::string& reason, TimePoint) {
+  port_state_ = state;
+  port_reason_ = reason;
+}
+
+void PumpRack::on_node_state(MacId mac, NodeState, NodeState to, const std::string& reason,
+                             TimePoint at) {
+  PumpView* v = find(mac);
+  if (!v) return;
+  v->state = to;
+  v->reason = reason;
+  v->state_since = at;
+  v->online = to == NodeState::kOnline;
+  ++v->changes;
+}
+
+void PumpRack::on_node_identity(MacId mac, const devicenet::NodeIdentity& identity, TimePoint) {
+  if (PumpView* v = find(mac)) {
+    v->identity = identity;
+    ++v->changes;
+  }
+}
+
+void PumpRack::refresh_applied(std::size_t index) {
+  PumpView& v = views_[index];
+  const devicenet::Node* node = scanner_ ? scanner_->node(v.mac) : nullptr;
+  if (!node) return;
+  v.outputs_idle = node->applied_idle();
+  if (!v.outputs_idle) {
+    if (auto out = cdn127::decode_poll_request(slots_[index].format.request,
+                                               node->applied_outputs());
+        out) {
+      v.outputs_applied = *out;
+    }
+  }
+}
+
+void PumpRack::on_poll_response(MacId mac, Bytes data, TimePoint rx_time) {
+  const int i = index_[mac.value()];
+  if (i < 0) return;
+  const auto index = static_cast<std::size_t>(i);
+  PumpView& v = views_[index];
+  const Slot& slot = slots_[index];
+  auto inputs = cdn127::decode_poll_response(slot.format.response, slot.io.no_nc_mask, data);
+  if (!inputs) return;  // the master checked the size; values out of range are dropped
+  v.inputs = *inputs;
+  v.has_inputs = true;
+  v.inputs_time = rx_time;
+  refresh_applied(index);
+  ++v.changes;
+}
+
+void PumpRack::on_device_state(MacId mac, std::uint8_t state, TimePoint) {
+  if (PumpView* v = find(mac)) {
+    v->device_state = state;
+    ++v->changes;
+  }
+}
+
+}  // namespace dnbridge::rack

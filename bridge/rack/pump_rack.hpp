@@ -1,0 +1,99 @@
+#pragma once
+// The state of a rack's pumps as the layer above sees it: the master's events
+// turned into plain values with meaning (decoded inputs, applied outputs, life
+// cycle, identity, errors). The DDS face publishes from here; the demo draws
+// it. Commands are checked here before they reach the master.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bridge/devicenet/scanner.hpp"
+#include "bridge/profiles/cdn127/io_data.hpp"
+#include "bridge/profiles/cdn127/poll_format.hpp"
+
+namespace dnbridge::rack {
+
+// One pump's configuration in the rack: the scan-list entry and the CDN127
+// I/O configuration its poll data is decoded with.
+struct PumpConfig {
+  devicenet::NodeConfig node;
+  profiles::cdn127::IoConfiguration io;
+};
+
+struct PumpView {
+  devicenet::MacId mac;
+  std::string name;
+  bool online = false;
+  devicenet::NodeState state = devicenet::NodeState::kAbsent;
+  std::string reason;
+  TimePoint state_since{};
+
+  // Inputs from the last poll response (valid once `has_inputs`).
+  bool has_inputs = false;
+  TimePoint inputs_time{};  // CAN receive time of that response
+  profiles::cdn127::PollInputs inputs;
+
+  // Outputs the device applied with its last answered poll.
+  bool outputs_idle = true;
+  profiles::cdn127::PumpOutputs outputs_applied;
+  // Outputs requested by the layer above (not yet necessarily applied).
+  std::optional<profiles::cdn127::PumpOutputs> outputs_requested;
+
+  devicenet::NodeIdentity identity;
+  std::optional<std::uint8_t> device_state;
+  std::uint64_t changes = 0;  // bumped on every change, for publishers
+};
+
+class PumpRack final : public devicenet::ScannerObserver {
+ public:
+  // Builds the scan list's node profiles from the pumps' I/O configurations.
+  // Throws std::invalid_argument for an invalid configuration.
+  static devicenet::ScannerConfig scanner_config(devicenet::ScannerConfig port,
+                                                 const std::vector<PumpConfig>& pumps);
+
+  explicit PumpRack(const std::vector<PumpConfig>& pumps);
+
+  // Attach after the scanner is built (the scanner reports to this rack).
+  void attach(devicenet::Scanner& scanner) { scanner_ = &scanner; }
+
+  // Validates and forwards new outputs: refused, never clipped, when out of
+  // range; refused when the configuration has no room for them (e.g. an
+  // analog value for a configuration without analog output).
+  Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs, TimePoint now);
+  // No live commander: the node polls idle so the device applies its own
+  // configured idle actions.
+  Status release_command(devicenet::MacId mac, TimePoint now);
+
+  const std::vector<PumpView>& pumps() const { return views_; }
+  const PumpView* pump(devicenet::MacId mac) const;
+  devicenet::PortState port_state() const { return port_state_; }
+  const std::string& port_reason() const { return port_reason_; }
+
+  // ScannerObserver
+  void on_port_state(devicenet::PortState state, const std::string& reason, TimePoint at) override;
+  void on_node_state(devicenet::MacId mac, devicenet::NodeState from, devicenet::NodeState to,
+                     const std::string& reason, TimePoint at) override;
+  void on_node_identity(devicenet::MacId mac, const devicenet::NodeIdentity& identity,
+                        TimePoint at) override;
+  void on_poll_response(devicenet::MacId mac, Bytes data, TimePoint rx_time) override;
+  void on_device_state(devicenet::MacId mac, std::uint8_t state, TimePoint at) override;
+
+ private:
+  struct Slot {
+    profiles::cdn127::IoConfiguration io;
+    profiles::cdn127::PollFormat format;
+  };
+  PumpView* find(devicenet::MacId mac);
+  void refresh_applied(std::size_t index);
+
+  devicenet::Scanner* scanner_ = nullptr;
+  std::vector<PumpView> views_;
+  std::vector<Slot> slots_;
+  std::array<int, devicenet::MacId::kMax + 1> index_{};
+  devicenet::PortState port_state_ = devicenet::PortState::kStopped;
+  std::string port_reason_;
+};
+
+}  // namespace dnbridge::rack
