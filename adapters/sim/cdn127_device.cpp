@@ -1,0 +1,556 @@
+#include "adapters/sim/cdn127_device.hpp"
+
+#include <algorithm>
+
+#include "bridge/devicenet/explicit_message.hpp"
+
+namespace dnbridge::sim {
+
+using cip::GeneralStatus;
+using devicenet::MacId;
+using profiles::cdn127::PollRequestLayout;
+using profiles::cdn127::PollResponseLayout;
+using profiles::cdn127::PumpOutputs;
+namespace alloc = devicenet::allocation;
+
+namespace {
+
+// Allocate/Release additional codes (devicenet-facts §2).
+constexpr std::uint8_t kAllocationConflict = 0x01;
+constexpr std::uint8_t kInvalidChoice = 0x02;
+
+constexpr std::uint8_t kSupportedChoices = alloc::kExplicit | alloc::kPoll;
+
+E2Memory initial_e2(const SlaveOptions& o) noexcept {
+  E2Memory e2;
+  e2.configuration = o.configuration;
+  e2.mac = o.stored_mac <= MacId::kMax ? o.stored_mac : MacId::kMax;
+  e2.baud = o.stored_baud <= 2 ? o.stored_baud : 0;
+  return e2;
+}
+
+bool is_produced_assembly(std::uint8_t a) noexcept {
+  return a == 1 || a == 2 || a == 3 || a == 101 || a == 102 || a == 103;
+}
+bool is_consumed_assembly(std::uint8_t a) noexcept { return a == 5 || a == 100 || a == 104; }
+
+std::uint16_t aop_action(std::uint8_t state, std::uint16_t value, std::uint16_t current) noexcept {
+  switch (state) {
+    case 1: return 0;
+    case 2: return profiles::cdn127::kAnalogMaxRaw;
+    case 3: return value;
+    default: return current;  // 0: hold the last value
+  }
+}
+
+}  // namespace
+
+Cdn127Device::Cdn127Device(const SlaveOptions& options) noexcept
+    : options_(options),
+      e2_(initial_e2(options)),
+      pump_(options.pump),
+      mac_switch_(options.mac_switch),
+      baud_switch_(options.baud_switch),
+      mac_switch_at_power_up_(options.mac_switch),
+      baud_switch_at_power_up_(options.baud_switch) {}
+
+void Cdn127Device::power_up(TimePoint now) noexcept {
+  now_ = now;
+  // The switches are only read during power-up; a valid switch also becomes
+  // the software setting ("defaults to the last hardware setting").
+  mac_switch_at_power_up_ = mac_switch_;
+  baud_switch_at_power_up_ = baud_switch_;
+  if (!mac_switch_in_program_position()) e2_.mac = mac_switch_;
+  if (!baud_switch_in_program_position()) e2_.baud = baud_switch_;
+  mac_ = MacId::from_bits(e2_.mac);
+  baud_ = e2_.baud;
+  bus_off_counter_ = 0;
+  owner_ = MacId::kNone;
+  explicit_ = Connection{};
+  poll_ = Connection{};
+  poll_running_ = false;
+  pending_ = PendingAction::kNone;
+  pump_.set_outputs(PumpOutputs{}, OutputCause::kPowerUp, now);
+}
+
+void Cdn127Device::restore_factory_defaults() noexcept { e2_ = initial_e2(options_); }
+
+void Cdn127Device::set_switches(std::uint8_t mac_switch, std::uint8_t baud_switch) noexcept {
+  mac_switch_ = mac_switch;
+  baud_switch_ = baud_switch;
+}
+
+Reply Cdn127Device::set_mac(std::uint8_t mac) noexcept {
+  // A valid switch setting governs the MAC; software setting needs the
+  // program position (manual, DeviceNet object attribute 1).
+  if (!mac_switch_in_program_position()) return reply_error(GeneralStatus::kAttributeNotSettable);
+  if (mac > MacId::kMax) return reply_error(GeneralStatus::kInvalidAttributeValue);
+  e2_.mac = mac;
+  // The node leaves the network and comes back with its new MAC.
+  if (mac != mac_.value()) pending_ = PendingAction::kRestart;
+  return kReplyOk;
+}
+
+Reply Cdn127Device::set_baud(std::uint8_t baud) noexcept {
+  if (!baud_switch_in_program_position()) return reply_error(GeneralStatus::kAttributeNotSettable);
+  if (baud > 2) return reply_error(GeneralStatus::kInvalidAttributeValue);
+  // Kept in E2, used from the next power-up (the bit rate cannot change under
+  // a running network).
+  e2_.baud = baud;
+  return kReplyOk;
+}
+
+std::uint8_t Cdn127Device::allocation_choice() const noexcept {
+  std::uint8_t c = 0;
+  if (explicit_.state != ConnectionState::kNonExistent) c |= alloc::kExplicit;
+  if (poll_.state != ConnectionState::kNonExistent) c |= alloc::kPoll;
+  return c;
+}
+
+Reply Cdn127Device::allocate(std::uint8_t choice, std::uint8_t allocator, TimePoint now) noexcept {
+  now_ = now;
+  if (allocator > MacId::kMax) return reply_error(GeneralStatus::kInvalidParameter);
+  if (owned() && owner_ != allocator) {
+    return reply_error(GeneralStatus::kObjectStateConflict, kAllocationConflict);
+  }
+  if (choice == 0) return reply_error(GeneralStatus::kInvalidAttributeValue, kInvalidChoice);
+  if ((choice & ~kSupportedChoices) != 0) {
+    return reply_error(GeneralStatus::kResourceUnavailable, kInvalidChoice);
+  }
+  const std::uint8_t allocated = allocation_choice();
+  if ((choice & allocated) != 0) {
+    return reply_error(GeneralStatus::kAlreadyInRequestedMode, kInvalidChoice);
+  }
+  // I/O connections are configured through the explicit connection: one of
+  // them must be requested or already there.
+  if (((choice | allocated) & alloc::kExplicit) == 0) {
+    return reply_error(GeneralStatus::kInvalidAttributeValue, kInvalidChoice);
+  }
+  owner_ = allocator;
+  if ((choice & alloc::kExplicit) != 0) open_explicit(now);
+  if ((choice & alloc::kPoll) != 0) open_poll();
+  return kReplyOk;
+}
+
+Reply Cdn127Device::release(std::uint8_t choice, std::uint8_t requester, TimePoint now) noexcept {
+  now_ = now;
+  if (owned() && owner_ != requester) {
+    return reply_error(GeneralStatus::kObjectStateConflict, kAllocationConflict);
+  }
+  if (choice == 0) return reply_error(GeneralStatus::kInvalidAttributeValue, kInvalidChoice);
+  if ((choice & ~kSupportedChoices) != 0) {
+    return reply_error(GeneralStatus::kResourceUnavailable, kInvalidChoice);
+  }
+  if ((choice & ~allocation_choice()) != 0) {
+    return reply_error(GeneralStatus::kAlreadyInRequestedMode, kInvalidChoice);
+  }
+  if ((choice & alloc::kPoll) != 0) delete_poll(now);
+  if ((choice & alloc::kExplicit) != 0) explicit_ = Connection{};
+  if (allocation_choice() == 0) owner_ = MacId::kNone;
+  return kReplyOk;
+}
+
+void Cdn127Device::open_explicit(TimePoint now) noexcept {
+  explicit_ = Connection{};
+  explicit_.state = ConnectionState::kEstablished;
+  explicit_.expected_packet_rate_ms = kExplicitDefaultEprMs;
+  explicit_.watchdog_action = WatchdogAction::kAutoDelete;
+  restart_watchdog(explicit_, now);
+}
+
+void Cdn127Device::open_poll() noexcept {
+  poll_ = Connection{};
+  poll_.state = ConnectionState::kConfiguring;
+  poll_.watchdog_action = WatchdogAction::kTimedOut;  // "I/O Messaging default"
+  poll_.produced_assembly = profiles::cdn127::kDefaultProducedAssembly;
+  poll_.consumed_assembly = profiles::cdn127::kDefaultConsumedAssembly;
+  poll_running_ = false;
+}
+
+void Cdn127Device::delete_poll(TimePoint now) noexcept {
+  // A master that releases the poll connection has stopped the exchange on
+  // purpose: the outputs take their idle values (the manual names no action
+  // for this case; idle rather than fault is this simulator's reading).
+  if (poll_.state == ConnectionState::kEstablished) apply_idle_actions(now);
+  poll_ = Connection{};
+  poll_running_ = false;
+}
+
+const Connection* Cdn127Device::connection(std::uint16_t instance) const noexcept {
+  if (instance == profiles::cdn127::connection_instance::kExplicit) return &explicit_;
+  if (instance == profiles::cdn127::connection_instance::kPoll) return &poll_;
+  return nullptr;
+}
+
+Connection* Cdn127Device::mutable_connection(std::uint16_t instance) noexcept {
+  return const_cast<Connection*>(std::as_const(*this).connection(instance));
+}
+
+bool Cdn127Device::connection_exists(std::uint16_t instance) const noexcept {
+  const Connection* c = connection(instance);
+  return c != nullptr && c->state != ConnectionState::kNonExistent;
+}
+
+std::uint16_t Cdn127Device::round_rate(std::uint16_t requested_ms) const noexcept {
+  const auto res = std::max<std::int64_t>(
+      1, std::chrono::duration_cast<milliseconds>(options_.timer_resolution).count());
+  const std::int64_t rounded = (requested_ms + res - 1) / res * res;
+  if (rounded > 0xFFFF) return static_cast<std::uint16_t>(0xFFFF / res * res);
+  return static_cast<std::uint16_t>(rounded);
+}
+
+void Cdn127Device::restart_watchdog(Connection& c, TimePoint now) noexcept {
+  c.watchdog_deadline = c.expected_packet_rate_ms == 0
+                            ? kNever
+                            : now + milliseconds(kWatchdogMultiplier * c.expected_packet_rate_ms);
+}
+
+Reply Cdn127Device::set_expected_packet_rate(std::uint16_t instance, std::uint16_t requested_ms,
+                                             TimePoint now, std::uint16_t& actual) noexcept {
+  now_ = now;
+  Connection* c = mutable_connection(instance);
+  if (c == nullptr || c->state == ConnectionState::kNonExistent) {
+    return reply_error(GeneralStatus::kObjectDoesNotExist);
+  }
+  if (c->state != ConnectionState::kConfiguring && c->state != ConnectionState::kEstablished) {
+    return reply_error(GeneralStatus::kObjectStateConflict);
+  }
+  actual = round_rate(requested_ms);
+  c->expected_packet_rate_ms = actual;
+  // Setting the rate is what moves a Configuring I/O connection to
+  // Established (devicenet-facts §5).
+  if (c->state == ConnectionState::kConfiguring) {
+    c->state = ConnectionState::kEstablished;
+    poll_running_ = false;
+  }
+  restart_watchdog(*c, now);
+  return kReplyOk;
+}
+
+Reply Cdn127Device::set_watchdog_action(std::uint16_t instance, std::uint8_t action) noexcept {
+  Connection* c = mutable_connection(instance);
+  if (c == nullptr || c->state == ConnectionState::kNonExistent) {
+    return reply_error(GeneralStatus::kObjectDoesNotExist);
+  }
+  if (instance == profiles::cdn127::connection_instance::kExplicit) {
+    if (!options_.explicit_timeout_action_settable) {
+      return reply_error(GeneralStatus::kAttributeNotSettable);
+    }
+    if (action != 1 && action != 3) return reply_error(GeneralStatus::kInvalidAttributeValue);
+  } else if (action > 3) {
+    return reply_error(GeneralStatus::kInvalidAttributeValue);
+  }
+  c->watchdog_action = static_cast<WatchdogAction>(action);
+  return kReplyOk;
+}
+
+Reply Cdn127Device::set_poll_assembly(bool produced, std::uint8_t assembly) noexcept {
+  if (poll_.state == ConnectionState::kNonExistent) {
+    return reply_error(GeneralStatus::kObjectDoesNotExist);
+  }
+  if (poll_.state != ConnectionState::kConfiguring) {
+    return reply_error(GeneralStatus::kObjectStateConflict);
+  }
+  if (produced ? !is_produced_assembly(assembly) : !is_consumed_assembly(assembly)) {
+    return reply_error(GeneralStatus::kInvalidAttributeValue);
+  }
+  (produced ? poll_.produced_assembly : poll_.consumed_assembly) = assembly;
+  return kReplyOk;
+}
+
+Reply Cdn127Device::reset_connection(std::uint16_t instance, TimePoint now) noexcept {
+  now_ = now;
+  Connection* c = mutable_connection(instance);
+  if (c == nullptr || c->state == ConnectionState::kNonExistent) {
+    return reply_error(GeneralStatus::kObjectDoesNotExist);
+  }
+  if (c->state == ConnectionState::kConfiguring) return kReplyOk;  // nothing to restart
+  if (c->state == ConnectionState::kDeferredDelete) {
+    return reply_error(GeneralStatus::kObjectStateConflict);
+  }
+  c->state = ConnectionState::kEstablished;
+  restart_watchdog(*c, now);
+  return kReplyOk;
+}
+
+std::uint16_t Cdn127Device::produced_size(std::uint16_t instance) const noexcept {
+  if (instance == profiles::cdn127::connection_instance::kExplicit) return kExplicitMessageSize;
+  auto layout = profiles::cdn127::produced_assembly_layout(poll_.produced_assembly, e2_.configuration);
+  return layout.ok() ? static_cast<std::uint16_t>(layout->size) : 0;
+}
+
+std::uint16_t Cdn127Device::consumed_size(std::uint16_t instance) const noexcept {
+  if (instance == profiles::cdn127::connection_instance::kExplicit) return kExplicitMessageSize;
+  auto layout = profiles::cdn127::consumed_assembly_layout(poll_.consumed_assembly, e2_.configuration);
+  return layout.ok() ? static_cast<std::uint16_t>(layout->size) : 0;
+}
+
+void Cdn127Device::explicit_consumed(TimePoint now) noexcept {
+  now_ = now;
+  if (explicit_.state == ConnectionState::kEstablished) restart_watchdog(explicit_, now);
+}
+
+std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout, MutableBytes out) noexcept {
+  pump_.advance(now_);
+  const std::uint8_t bits = pump_.inputs().encode(e2_.configuration.no_nc_mask);
+  auto size = profiles::cdn127::encode_poll_response(layout, exception_status_byte(), bits,
+                                                     pump_.analog_inputs_raw(), out);
+  return size.ok() ? *size : 0;
+}
+
+PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {
+  now_ = now;
+  PollResult result;
+  if (poll_.state != ConnectionState::kEstablished) return result;
+  auto request_layout =
+      profiles::cdn127::consumed_assembly_layout(poll_.consumed_assembly, e2_.configuration);
+  auto response_layout =
+      profiles::cdn127::produced_assembly_layout(poll_.produced_assembly, e2_.configuration);
+  if (!request_layout.ok() || !response_layout.ok()) return result;
+  if (command.size() > request_layout->size) {
+    result.outcome = PollOutcome::kOversize;
+    return result;
+  }
+  restart_watchdog(poll_, now);
+
+  // A command shorter than the consumed size is the idle condition; with a
+  // consumed size of 0 there is none (manual, "Poll Packet Sizes").
+  const bool idle = command.size() < request_layout->size;
+  result.outcome = idle ? PollOutcome::kIdle : PollOutcome::kApplied;
+  PumpOutputs decoded{};
+  if (!idle && request_layout->size > 0) {
+    auto d = profiles::cdn127::decode_poll_request(*request_layout, command);
+    if (d.ok()) {
+      decoded = *d;
+    } else {
+      result.outcome = PollOutcome::kInvalid;
+    }
+  }
+  auto apply = [&] {
+    if (result.outcome == PollOutcome::kIdle) {
+      apply_idle_actions(now);
+      poll_running_ = false;
+    } else if (result.outcome == PollOutcome::kApplied) {
+      if (request_layout->size > 0) apply_decoded_outputs(*request_layout, decoded, OutputCause::kPoll, now);
+      poll_running_ = true;
+    }
+  };
+  // Mode NoPollUpdate: inputs are those sampled before the request, outputs
+  // are updated after the response (manual, Mode Byte). Otherwise the I/O is
+  // updated during poll processing, so the response sees the new outputs.
+  const bool no_poll_update = (e2_.configuration.mode & profiles::cdn127::mode::kNoPollUpdate) != 0;
+  if (!no_poll_update) apply();
+  result.response.resize(build_produced(*response_layout, result.response.storage()));
+  if (no_poll_update) apply();
+  return result;
+}
+
+std::size_t Cdn127Device::produced_data(std::uint8_t assembly, MutableBytes out) noexcept {
+  auto layout = profiles::cdn127::produced_assembly_layout(assembly, e2_.configuration);
+  if (!layout.ok()) return 0;
+  return build_produced(*layout, out);
+}
+
+std::size_t Cdn127Device::consumed_data(std::uint8_t assembly, MutableBytes out) const noexcept {
+  auto layout = profiles::cdn127::consumed_assembly_layout(assembly, e2_.configuration);
+  if (!layout.ok()) return 0;
+  auto size = profiles::cdn127::encode_poll_request(*layout, pump_.outputs(), out);
+  return size.ok() ? *size : 0;
+}
+
+Reply Cdn127Device::set_consumed_assembly(std::uint8_t assembly, Bytes data, TimePoint now) noexcept {
+  now_ = now;
+  auto layout = profiles::cdn127::consumed_assembly_layout(assembly, e2_.configuration);
+  if (!layout.ok()) return reply_error(GeneralStatus::kAttributeNotSettable);
+  if (data.size() < layout->size) return reply_error(GeneralStatus::kNotEnoughData);
+  if (data.size() > layout->size) return reply_error(GeneralStatus::kTooMuchData);
+  // The poll connection owns the assembly it consumes while it runs.
+  if (poll_.state == ConnectionState::kEstablished && poll_.consumed_assembly == assembly) {
+    return reply_error(GeneralStatus::kObjectStateConflict);
+  }
+  if (layout->size == 0) return kReplyOk;
+  auto decoded = profiles::cdn127::decode_poll_request(*layout, data);
+  if (!decoded.ok()) return reply_error(GeneralStatus::kInvalidAttributeValue);
+  apply_decoded_outputs(*layout, *decoded, OutputCause::kExplicit, now);
+  return kReplyOk;
+}
+
+void Cdn127Device::apply_decoded_outputs(const PollRequestLayout& layout, const PumpOutputs& decoded,
+                                         OutputCause cause, TimePoint now) noexcept {
+  // Fields the layout does not carry keep their values.
+  PumpOutputs next = pump_.outputs();
+  if (layout.dout_size > 0) {
+    next.pump_on = decoded.pump_on;
+    next.n2_ballast_on = decoded.n2_ballast_on;
+  }
+  if (layout.aout_count > 0) next.analog_out_raw = decoded.analog_out_raw;
+  pump_.set_outputs(next, cause, now);
+}
+
+void Cdn127Device::set_outputs(const PumpOutputs& outputs, OutputCause cause, TimePoint now) noexcept {
+  now_ = now;
+  pump_.set_outputs(outputs, cause, now);
+}
+
+void Cdn127Device::apply_fault_actions(TimePoint now) noexcept {
+  PumpOutputs next = pump_.outputs();
+  const auto& dop = e2_.dop;
+  if (!dop[0].fault_hold) next.pump_on = dop[0].fault_value;
+  if (!dop[1].fault_hold) next.n2_ballast_on = dop[1].fault_value;
+  next.analog_out_raw = aop_action(e2_.aop.fault_state, e2_.aop.fault_value, next.analog_out_raw);
+  pump_.set_outputs(next, OutputCause::kFault, now);
+}
+
+void Cdn127Device::apply_idle_actions(TimePoint now) noexcept {
+  PumpOutputs next = pump_.outputs();
+  const auto& dop = e2_.dop;
+  if (!dop[0].idle_hold) next.pump_on = dop[0].idle_value;
+  if (!dop[1].idle_hold) next.n2_ballast_on = dop[1].idle_value;
+  next.analog_out_raw = aop_action(e2_.aop.idle_state, e2_.aop.idle_value, next.analog_out_raw);
+  pump_.set_outputs(next, OutputCause::kIdle, now);
+}
+
+Reply Cdn127Device::set_configuration(const profiles::cdn127::IoConfiguration& config) noexcept {
+  // "may only be set when the POLL connection is not in the RUNNING state"
+  if (poll_.state == ConnectionState::kEstablished) {
+    return reply_error(GeneralStatus::kObjectStateConflict);
+  }
+  // Mode bits 3..5 "should be set to 0"; counts within the device's maxima.
+  if ((config.mode & 0x38) != 0 || !profiles::cdn127::validate(config).ok()) {
+    return reply_error(GeneralStatus::kInvalidAttributeValue);
+  }
+  e2_.configuration = config;
+  return kReplyOk;
+}
+
+std::uint16_t Cdn127Device::identity_status() const noexcept {
+  std::uint16_t s = 0;
+  if (owned()) s |= 0x0001;
+  if (faults_.minor_recoverable) s |= 0x0100;
+  if (faults_.minor_unrecoverable) s |= 0x0200;
+  if (faults_.major_recoverable) s |= 0x0400;
+  if (faults_.major_unrecoverable) s |= 0x0800;
+  return s;
+}
+
+std::uint8_t Cdn127Device::identity_state() const noexcept {
+  if (faults_.major_unrecoverable) return 5;
+  if (faults_.major_recoverable) return 4;
+  return 3;  // Operating
+}
+
+std::uint8_t Cdn127Device::supervisor_device_status() const noexcept {
+  if (faults_.major_unrecoverable) return 6;  // Critical Fault
+  if (poll_.state == ConnectionState::kEstablished && poll_running_) return 4;  // Executing
+  return 2;  // Idle
+}
+
+std::uint8_t Cdn127Device::exception_status_byte() noexcept {
+  std::uint8_t b = pump_.exception_status(e2_.alarm_enable, e2_.warning_enable).encode();
+  if (options_.report_expanded_mode) b |= 0x80;
+  return b;
+}
+
+// Manufacturer detail bits (the manual's "See Below" never defines them):
+// alarm bit 0 N2 flow failed, bit 1 pump alarm, bit 2 interlock failed;
+// warning bit 0 pump warning.
+std::uint8_t Cdn127Device::alarm_detail() const noexcept {
+  if (!e2_.alarm_enable) return 0;
+  std::uint8_t d = 0;
+  if (!pump_.n2_flow_ok()) d |= 0x01;
+  if (pump_.alarm_active()) d |= 0x02;
+  if (!pump_.interlock_ok()) d |= 0x04;
+  return d;
+}
+
+std::uint8_t Cdn127Device::warning_detail() const noexcept {
+  return (e2_.warning_enable && pump_.warning_active()) ? 0x01 : 0x00;
+}
+
+PendingAction Cdn127Device::take_pending_action() noexcept {
+  return std::exchange(pending_, PendingAction::kNone);
+}
+
+void Cdn127Device::explicit_timeout(TimePoint now) noexcept {
+  (void)now;
+  if (explicit_.watchdog_action == WatchdogAction::kDeferredDelete &&
+      poll_.state == ConnectionState::kEstablished) {
+    explicit_.state = ConnectionState::kDeferredDelete;
+    explicit_.watchdog_deadline = kNever;
+    return;
+  }
+  explicit_ = Connection{};  // auto delete
+}
+
+void Cdn127Device::poll_timeout(TimePoint now) noexcept {
+  apply_fault_actions(now);
+  poll_running_ = false;
+  switch (poll_.watchdog_action) {
+    case WatchdogAction::kTimedOut:
+      poll_.state = ConnectionState::kTimedOut;
+      poll_.watchdog_deadline = kNever;
+      break;
+    case WatchdogAction::kAutoDelete:
+      poll_ = Connection{};
+      break;
+    case WatchdogAction::kAutoReset:
+      restart_watchdog(poll_, now);
+      break;
+    case WatchdogAction::kDeferredDelete:
+      if (explicit_.state == ConnectionState::kEstablished) {
+        poll_.state = ConnectionState::kDeferredDelete;
+        poll_.watchdog_deadline = kNever;
+      } else {
+        poll_ = Connection{};
+      }
+      break;
+  }
+}
+
+void Cdn127Device::release_if_nothing_established() noexcept {
+  if (!owned()) return;
+  if (explicit_.state == ConnectionState::kEstablished || poll_.state == ConnectionState::kEstablished) {
+    return;
+  }
+  // With nothing left established the slave drops the whole set; the master
+  // must allocate again (devicenet-facts §5).
+  explicit_ = Connection{};
+  poll_ = Connection{};
+  poll_running_ = false;
+  owner_ = MacId::kNone;
+}
+
+void Cdn127Device::go_offline(TimePoint now) noexcept {
+  now_ = now;
+  if (poll_.state == ConnectionState::kEstablished) apply_fault_actions(now);
+  explicit_ = Connection{};
+  poll_ = Connection{};
+  poll_running_ = false;
+  owner_ = MacId::kNone;
+}
+
+void Cdn127Device::on_timer(TimePoint now) noexcept {
+  now_ = now;
+  pump_.advance(now);
+  bool expired = false;
+  if (explicit_.state == ConnectionState::kEstablished && now >= explicit_.watchdog_deadline) {
+    explicit_timeout(now);
+    ++watchdog_timeouts_;
+    expired = true;
+  }
+  if (poll_.state == ConnectionState::kEstablished && now >= poll_.watchdog_deadline) {
+    poll_timeout(now);
+    ++watchdog_timeouts_;
+    expired = true;
+  }
+  if (expired) release_if_nothing_established();
+}
+
+TimePoint Cdn127Device::next_deadline() const noexcept {
+  TimePoint t = pump_.next_deadline();
+  if (explicit_.state == ConnectionState::kEstablished) t = std::min(t, explicit_.watchdog_deadline);
+  if (poll_.state == ConnectionState::kEstablished) t = std::min(t, poll_.watchdog_deadline);
+  return t;
+}
+
+}  // namespace dnbridge::sim

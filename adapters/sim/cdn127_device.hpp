@@ -1,0 +1,300 @@
+#pragma once
+// The state of a simulated CDN127 and the rules that change it: allocation,
+// the two predefined connections and their watchdogs, the E2 (non-volatile)
+// settings, outputs with their fault and idle actions, and poll processing.
+// No frames here: cdn127_slave.hpp moves bytes, cdn127_objects.hpp maps
+// attributes onto this state.
+#include <array>
+#include <cstdint>
+
+#include "adapters/sim/pump_model.hpp"
+#include "bridge/cip/general_status.hpp"
+#include "bridge/common/bytes.hpp"
+#include "bridge/common/time.hpp"
+#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/profiles/cdn127/io_data.hpp"
+#include "bridge/profiles/cdn127/objects.hpp"
+#include "bridge/profiles/cdn127/poll_format.hpp"
+
+namespace dnbridge::sim {
+
+// Connection object attribute 1 (devicenet-facts §5).
+enum class ConnectionState : std::uint8_t {
+  kNonExistent = 0,
+  kConfiguring = 1,
+  kWaitingForConnectionId = 2,
+  kEstablished = 3,
+  kTimedOut = 4,
+  kDeferredDelete = 5,
+};
+
+// Connection object attribute 12 (devicenet-facts §5).
+enum class WatchdogAction : std::uint8_t {
+  kTimedOut = 0,
+  kAutoDelete = 1,
+  kAutoReset = 2,
+  kDeferredDelete = 3,
+};
+
+// The outcome of a service: CIP general status and additional code.
+struct Reply {
+  cip::GeneralStatus status = cip::GeneralStatus::kSuccess;
+  std::uint8_t additional = cip::kNoAdditionalCode;
+
+  bool ok() const noexcept { return status == cip::GeneralStatus::kSuccess; }
+  friend bool operator==(const Reply&, const Reply&) = default;
+};
+inline constexpr Reply kReplyOk{};
+constexpr Reply reply_error(cip::GeneralStatus s,
+                            std::uint8_t additional = cip::kNoAdditionalCode) noexcept {
+  return Reply{s, additional};
+}
+
+struct SlaveOptions {
+  // Front-panel rotary switches, read at power-up only (manual, "Switches"):
+  // MAC 0..63 valid, 64..99 the program position (MAC set in software); baud
+  // 0..2 valid (125k, 250k, 500k), 3..9 the program position.
+  std::uint8_t mac_switch = 99;
+  std::uint8_t baud_switch = 9;
+  // Software MAC and baud held in E2 before the first power-up.
+  std::uint8_t stored_mac = 63;
+  std::uint8_t stored_baud = 0;
+
+  std::uint8_t revision_major = 1;
+  std::uint8_t revision_minor = 5;
+  std::uint8_t hardware_major = 1;
+  std::uint8_t hardware_minor = 0;
+  // The manual types Identity attribute 6 as UINT (2 bytes); the ODVA
+  // Identity object has UDINT (4 bytes). The duplicate MAC message carries 4.
+  std::uint32_t serial_number = 0x00001234;
+  bool serial_number_udint = false;
+  // Device Supervisor attribute 12 bit 7 "1 == Expanded Mode", also in the
+  // poll response's DSUP byte.
+  bool report_expanded_mode = true;
+  // The manual lists the explicit connection's attribute 12 as Get, "fixed
+  // value" 1; some devices accept 1 or 3.
+  bool explicit_timeout_action_settable = false;
+  // Expected packet rates are rounded up to this (devicenet-facts §5).
+  Duration timer_resolution = milliseconds(10);
+  // Configuration object values in E2 before the first power-up.
+  profiles::cdn127::IoConfiguration configuration =
+      profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127);
+
+  PumpModel::Config pump{};
+  Duration duplicate_mac_window = seconds(1);
+  Duration fragment_ack_timeout = seconds(1);
+};
+
+// DOP attributes 5..8. The manual's encoding: action 0 = use the value, 1 = hold.
+struct DopSettings {
+  bool fault_hold = false;
+  bool fault_value = false;
+  bool idle_hold = false;
+  bool idle_value = false;
+};
+
+// AOP attributes 9..12: state 0 hold, 1 low (0 V), 2 high (4095), 3 the value.
+struct AopSettings {
+  std::uint8_t fault_state = 0;
+  std::uint8_t idle_state = 0;
+  std::uint16_t fault_value = 0;
+  std::uint16_t idle_value = 0;
+};
+
+// What the CDN127 keeps in E2 across power cycles. The manual says so for the
+// Configuration object (NOTE 1) and the software MAC/baud ("defaults to the
+// last hardware setting"); the fault/idle settings, BOI and the alarm/warning
+// enables are kept too, as parameters of a device are.
+struct E2Memory {
+  profiles::cdn127::IoConfiguration configuration{};
+  std::uint8_t mac = 63;
+  std::uint8_t baud = 0;
+  bool bus_off_interrupt = false;
+  std::array<DopSettings, 2> dop{};
+  AopSettings aop{};
+  bool alarm_enable = true;
+  bool warning_enable = true;
+};
+
+struct Connection {
+  ConnectionState state = ConnectionState::kNonExistent;
+  std::uint16_t expected_packet_rate_ms = 0;
+  WatchdogAction watchdog_action = WatchdogAction::kTimedOut;
+  std::uint8_t produced_assembly = 0;  // poll connection only
+  std::uint8_t consumed_assembly = 0;
+  TimePoint watchdog_deadline = kNever;
+};
+
+// Identity attribute 5 bits 8..11 (ODVA numbering; the manual lists 8/9 twice).
+struct IdentityFaults {
+  bool minor_recoverable = false;    // DOP short circuit
+  bool minor_unrecoverable = false;
+  bool major_recoverable = false;    // loss of +24 Vdc
+  bool major_unrecoverable = false;  // checksum, A/D
+};
+
+// Work to do once the response to the current request has been sent.
+enum class PendingAction : std::uint8_t {
+  kNone,
+  kRestart,                 // Identity Reset type 0, or a new MAC: re-enter the network
+  kRestartFactoryDefaults,  // Identity Reset type 1
+};
+
+enum class PollOutcome : std::uint8_t {
+  kNotEstablished,  // ignored: no established poll connection
+  kOversize,        // ignored: longer than the consumed size
+  kApplied,         // outputs updated, response built
+  kIdle,            // shorter than the consumed size: idle actions, response built
+  kInvalid,         // full size but an analog value over 4095: outputs kept, response built
+};
+
+struct PollResult {
+  PollOutcome outcome = PollOutcome::kNotEstablished;
+  InlineBytes<8> response;  // the produced data, when outcome is not an ignore
+};
+
+inline constexpr unsigned kWatchdogMultiplier = 4;
+inline constexpr std::uint16_t kExplicitDefaultEprMs = 2500;
+inline constexpr std::uint16_t kExplicitMessageSize = 24;  // attributes 7/8 of instance 1
+
+class Cdn127Device {
+ public:
+  explicit Cdn127Device(const SlaveOptions& options) noexcept;
+
+  // Power-up: volatile state cleared, switches read, outputs off.
+  void power_up(TimePoint now) noexcept;
+  // Identity Reset type 1: E2 back to the out-of-box values.
+  void restore_factory_defaults() noexcept;
+
+  const SlaveOptions& options() const noexcept { return options_; }
+  E2Memory& e2() noexcept { return e2_; }
+  const E2Memory& e2() const noexcept { return e2_; }
+  PumpModel& pump() noexcept { return pump_; }
+  const PumpModel& pump() const noexcept { return pump_; }
+
+  // --- DeviceNet object ---
+  devicenet::MacId mac() const noexcept { return mac_; }
+  std::uint8_t baud() const noexcept { return baud_; }
+  void set_switches(std::uint8_t mac_switch, std::uint8_t baud_switch) noexcept;
+  std::uint8_t mac_switch() const noexcept { return mac_switch_; }
+  std::uint8_t baud_switch() const noexcept { return baud_switch_; }
+  bool mac_switch_in_program_position() const noexcept { return mac_switch_ > devicenet::MacId::kMax; }
+  bool baud_switch_in_program_position() const noexcept { return baud_switch_ > 2; }
+  bool mac_switch_changed() const noexcept { return mac_switch_ != mac_switch_at_power_up_; }
+  bool baud_switch_changed() const noexcept { return baud_switch_ != baud_switch_at_power_up_; }
+  std::uint8_t bus_off_counter() const noexcept { return bus_off_counter_; }
+  void clear_bus_off_counter() noexcept { bus_off_counter_ = 0; }
+  Reply set_mac(std::uint8_t mac) noexcept;
+  Reply set_baud(std::uint8_t baud) noexcept;
+
+  // --- allocation (devicenet-facts §2) ---
+  // 255 when no master owns the connection set.
+  std::uint8_t owner() const noexcept { return owner_; }
+  bool owned() const noexcept { return owner_ != devicenet::MacId::kNone; }
+  std::uint8_t allocation_choice() const noexcept;
+  Reply allocate(std::uint8_t choice, std::uint8_t allocator, TimePoint now) noexcept;
+  Reply release(std::uint8_t choice, std::uint8_t requester, TimePoint now) noexcept;
+
+  // --- Connection object ---
+  const Connection& explicit_connection() const noexcept { return explicit_; }
+  const Connection& poll_connection() const noexcept { return poll_; }
+  // instance 1 or 2; nullptr for others
+  const Connection* connection(std::uint16_t instance) const noexcept;
+  bool connection_exists(std::uint16_t instance) const noexcept;
+  // Sets attribute 9, rounded up to the timer resolution; `actual` receives
+  // the value kept. Establishes a Configuring poll connection.
+  Reply set_expected_packet_rate(std::uint16_t instance, std::uint16_t requested_ms, TimePoint now,
+                                 std::uint16_t& actual) noexcept;
+  Reply set_watchdog_action(std::uint16_t instance, std::uint8_t action) noexcept;
+  // Attributes 14/16 of the poll connection, while Configuring.
+  Reply set_poll_assembly(bool produced, std::uint8_t assembly) noexcept;
+  // Connection Reset: restarts the watchdog; a timed-out poll connection is
+  // Established again.
+  Reply reset_connection(std::uint16_t instance, TimePoint now) noexcept;
+  std::uint16_t produced_size(std::uint16_t instance) const noexcept;
+  std::uint16_t consumed_size(std::uint16_t instance) const noexcept;
+  // Every message the explicit connection consumes restarts its watchdog.
+  void explicit_consumed(TimePoint now) noexcept;
+  bool explicit_established() const noexcept { return explicit_.state == ConnectionState::kEstablished; }
+
+  // --- poll I/O ---
+  PollResult on_poll(Bytes command, TimePoint now) noexcept;
+  // Produced assembly data (1, 2, 3, 101, 102, 103); 0 if not produced.
+  std::size_t produced_data(std::uint8_t assembly, MutableBytes out) noexcept;
+  std::size_t consumed_data(std::uint8_t assembly, MutableBytes out) const noexcept;
+  Reply set_consumed_assembly(std::uint8_t assembly, Bytes data, TimePoint now) noexcept;
+
+  // --- outputs ---
+  void set_outputs(const profiles::cdn127::PumpOutputs& outputs, OutputCause cause,
+                   TimePoint now) noexcept;
+  void apply_fault_actions(TimePoint now) noexcept;
+  void apply_idle_actions(TimePoint now) noexcept;
+
+  // --- Configuration object ---
+  const profiles::cdn127::IoConfiguration& configuration() const noexcept { return e2_.configuration; }
+  // Refused with 0x0C while the poll connection is established (manual, NOTE 1).
+  Reply set_configuration(const profiles::cdn127::IoConfiguration& config) noexcept;
+
+  // --- Identity / Device Supervisor ---
+  std::uint16_t identity_status() const noexcept;
+  std::uint8_t identity_state() const noexcept;
+  std::uint8_t supervisor_device_status() const noexcept;
+  std::uint8_t exception_status_byte() noexcept;
+  void set_faults(const IdentityFaults& faults) noexcept { faults_ = faults; }
+  const IdentityFaults& faults() const noexcept { return faults_; }
+  // The manufacturer detail bytes of Device Supervisor attributes 13/14.
+  std::uint8_t alarm_detail() const noexcept;
+  std::uint8_t warning_detail() const noexcept;
+
+  void request_action(PendingAction a) noexcept { pending_ = a; }
+  PendingAction take_pending_action() noexcept;
+
+  // Communication Fault: connections and ownership dropped; a running poll
+  // connection's outputs take their fault values.
+  void go_offline(TimePoint now) noexcept;
+  std::uint32_t watchdog_timeouts() const noexcept { return watchdog_timeouts_; }
+
+  // --- time ---
+  void on_timer(TimePoint now) noexcept;
+  TimePoint next_deadline() const noexcept;
+
+ private:
+  Connection* mutable_connection(std::uint16_t instance) noexcept;
+  void open_explicit(TimePoint now) noexcept;
+  void open_poll() noexcept;
+  void delete_poll(TimePoint now) noexcept;
+  void explicit_timeout(TimePoint now) noexcept;
+  void poll_timeout(TimePoint now) noexcept;
+  void release_if_nothing_established() noexcept;
+  void restart_watchdog(Connection& c, TimePoint now) noexcept;
+  std::uint16_t round_rate(std::uint16_t requested_ms) const noexcept;
+  void apply_decoded_outputs(const profiles::cdn127::PollRequestLayout& layout,
+                             const profiles::cdn127::PumpOutputs& decoded, OutputCause cause,
+                             TimePoint now) noexcept;
+  std::size_t build_produced(const profiles::cdn127::PollResponseLayout& layout,
+                             MutableBytes out) noexcept;
+
+  SlaveOptions options_;
+  E2Memory e2_;
+  PumpModel pump_;
+
+  devicenet::MacId mac_;
+  std::uint8_t baud_ = 0;
+  std::uint8_t mac_switch_;
+  std::uint8_t baud_switch_;
+  std::uint8_t mac_switch_at_power_up_;
+  std::uint8_t baud_switch_at_power_up_;
+  std::uint8_t bus_off_counter_ = 0;
+
+  std::uint8_t owner_ = devicenet::MacId::kNone;
+  Connection explicit_;
+  Connection poll_;
+  bool poll_running_ = false;  // a full poll since the poll connection was established
+
+  IdentityFaults faults_;
+  PendingAction pending_ = PendingAction::kNone;
+  std::uint32_t watchdog_timeouts_ = 0;
+  TimePoint now_{};
+};
+
+}  // namespace dnbridge::sim

@@ -1,0 +1,385 @@
+#include "adapters/sim/cdn127_slave.hpp"
+
+#include <algorithm>
+#include <array>
+
+#include "bridge/devicenet/explicit_message.hpp"
+#include "bridge/devicenet/identifier.hpp"
+
+namespace dnbridge::sim {
+
+using devicenet::BodyFormat;
+using devicenet::DuplicateMacCheck;
+using devicenet::ExplicitFragmentSender;
+using devicenet::ExplicitReassembler;
+using devicenet::Group1Message;
+using devicenet::Group2Message;
+using devicenet::MacId;
+using devicenet::MessageGroup;
+
+namespace {
+
+DuplicateMacCheck::Config duplicate_mac_config(const SlaveOptions& o) noexcept {
+  DuplicateMacCheck::Config c;
+  c.window = o.duplicate_mac_window;
+  c.physical_port = 0;
+  c.vendor_id = profiles::cdn127::kVendorId;
+  c.serial_number = o.serial_number;
+  return c;
+}
+
+ExplicitFragmentSender::Config sender_config(const SlaveOptions& o) noexcept {
+  ExplicitFragmentSender::Config c;
+  c.ack_timeout = o.fragment_ack_timeout;
+  return c;
+}
+
+// Unconnected-port additional code: invalid Group 2 only request (devicenet-facts §2).
+constexpr std::uint8_t kInvalidGroup2Request = 0x03;
+constexpr std::uint8_t kFragBit = 0x80;
+
+}  // namespace
+
+const char* to_string(Cdn127Slave::NetworkState s) noexcept {
+  switch (s) {
+    case Cdn127Slave::NetworkState::kOff: return "off";
+    case Cdn127Slave::NetworkState::kDuplicateMacCheck: return "duplicate MAC check";
+    case Cdn127Slave::NetworkState::kOnline: return "online";
+    case Cdn127Slave::NetworkState::kCommunicationFault: return "communication fault";
+  }
+  return "?";
+}
+
+Cdn127Slave::Cdn127Slave(can::FrameSink& sink, SlaveOptions options, Logger log)
+    : sink_(sink),
+      log_(std::move(log)),
+      device_(options),
+      dup_check_(MacId::from_bits(options.stored_mac), duplicate_mac_config(options)),
+      sender_(sender_config(options)) {}
+
+void Cdn127Slave::power_on(TimePoint now) noexcept {
+  ++counters_.restarts;
+  device_.power_up(now);
+  reassembler_.reset();
+  sender_.cancel();
+  dup_check_ = DuplicateMacCheck(device_.mac(), duplicate_mac_config(device_.options()));
+  network_ = NetworkState::kDuplicateMacCheck;
+  log_.debug("power-up with MAC {}: duplicate MAC check", device_.mac().value());
+  const can::CanFrame request = dup_check_.start(now);
+  sink_.send(request, now);
+}
+
+void Cdn127Slave::send(std::uint32_t id, Bytes payload, TimePoint now) noexcept {
+  auto frame = can::CanFrame::make(id, payload);
+  if (frame.ok()) sink_.send(*frame, now);
+}
+
+std::uint32_t Cdn127Slave::response_id() const noexcept {
+  return devicenet::group2_id(device_.mac(), Group2Message::kSlaveExplicitResponse);
+}
+
+void Cdn127Slave::enter_communication_fault() noexcept {
+  network_ = NetworkState::kCommunicationFault;
+  sender_.cancel();
+  reassembler_.reset();
+  log_.debug("duplicate MAC {} detected: communication fault", device_.mac().value());
+}
+
+void Cdn127Slave::restart(TimePoint now) noexcept { power_on(now); }
+
+// ---------------------------------------------------------------------------
+
+void Cdn127Slave::on_timer(TimePoint now) noexcept {
+  if (network_ == NetworkState::kOff || network_ == NetworkState::kCommunicationFault) {
+    device_.pump().advance(now);
+    return;
+  }
+  if (network_ == NetworkState::kDuplicateMacCheck) {
+    device_.pump().advance(now);
+    if (now < dup_check_.deadline()) return;
+    if (auto frame = dup_check_.on_timer(now)) sink_.send(*frame, now);
+    if (dup_check_.state() == DuplicateMacCheck::State::kOnline) {
+      network_ = NetworkState::kOnline;
+      log_.debug("online");
+    } else if (dup_check_.state() == DuplicateMacCheck::State::kDuplicate) {
+      enter_communication_fault();
+    }
+    return;
+  }
+  if (sender_.active() && now >= sender_.deadline()) {
+    switch (sender_.on_timer(now)) {
+      case ExplicitFragmentSender::Step::kSend:
+        send(response_id(), sender_.frame(), now);
+        break;
+      case ExplicitFragmentSender::Step::kFailed:
+        ++counters_.fragment_transfers_failed;
+        break;
+      case ExplicitFragmentSender::Step::kNone:
+      case ExplicitFragmentSender::Step::kComplete:
+        break;
+    }
+  }
+  const auto explicit_before = device_.explicit_connection().state;
+  const auto poll_before = device_.poll_connection().state;
+  device_.on_timer(now);
+  if (device_.explicit_connection().state != explicit_before ||
+      device_.poll_connection().state != poll_before) {
+    log_.debug("watchdog: explicit {} -> {}, poll {} -> {}, owner {}",
+               static_cast<int>(explicit_before), static_cast<int>(device_.explicit_connection().state),
+               static_cast<int>(poll_before), static_cast<int>(device_.poll_connection().state),
+               device_.owner());
+  }
+  if (!device_.explicit_established()) {
+    sender_.cancel();
+    reassembler_.reset();
+  }
+}
+
+TimePoint Cdn127Slave::next_deadline() const noexcept {
+  TimePoint t = device_.pump().next_deadline();
+  switch (network_) {
+    case NetworkState::kOff:
+    case NetworkState::kCommunicationFault:
+      return t;
+    case NetworkState::kDuplicateMacCheck:
+      return std::min(t, dup_check_.deadline());
+    case NetworkState::kOnline:
+      break;
+  }
+  return std::min({t, sender_.deadline(), device_.next_deadline()});
+}
+
+// ---------------------------------------------------------------------------
+
+void Cdn127Slave::on_frame(const can::CanFrame& frame, TimePoint now) noexcept {
+  if (network_ == NetworkState::kOff || network_ == NetworkState::kCommunicationFault) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  // A frame arriving after a deadline does not rescue what expired.
+  if (now >= next_deadline()) on_timer(now);
+
+  auto id = devicenet::decode_identifier(frame.id);
+  if (!id.ok()) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  if (id->group == MessageGroup::k1) {  // other slaves' messages
+    ++counters_.frames_not_addressed;
+    return;
+  }
+  if (id->group != MessageGroup::k2) {  // UCMM (Group 3) and the Group 4 offline set
+    ++counters_.frames_ignored;
+    return;
+  }
+  if (id->mac != device_.mac()) {
+    ++counters_.frames_not_addressed;
+    return;
+  }
+  const auto message = static_cast<Group2Message>(id->message_id);
+  if (message == Group2Message::kDuplicateMacCheck) {
+    on_duplicate_mac(frame, now);
+    return;
+  }
+  if (network_ != NetworkState::kOnline) {  // nothing but the check before going online
+    ++counters_.frames_ignored;
+    return;
+  }
+  switch (message) {
+    case Group2Message::kUnconnectedExplicitRequest:
+      on_unconnected(frame, now);
+      break;
+    case Group2Message::kMasterExplicitRequest:
+      on_explicit(frame, now);
+      break;
+    case Group2Message::kMasterIoPoll:
+      on_poll(frame, now);
+      break;
+    default:  // bit strobe, multicast poll, COS ack: not supported
+      ++counters_.frames_ignored;
+      break;
+  }
+}
+
+void Cdn127Slave::on_duplicate_mac(const can::CanFrame& frame, TimePoint now) noexcept {
+  auto m = devicenet::decode_duplicate_mac(frame.payload());
+  if (!m.ok()) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  if (auto response = dup_check_.on_message(*m)) sink_.send(*response, now);
+  if (dup_check_.state() == DuplicateMacCheck::State::kDuplicate) {
+    device_.go_offline(now);
+    enter_communication_fault();
+  }
+}
+
+// Group 2 only unconnected port: Allocate and Release to the DeviceNet object.
+void Cdn127Slave::on_unconnected(const can::CanFrame& frame, TimePoint now) noexcept {
+  const Bytes p = frame.payload();
+  if (p.size() < 2 || (p[0] & kFragBit) != 0 || (p[1] & cip::kResponseFlag) != 0) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  const std::uint8_t header = static_cast<std::uint8_t>(p[0] & 0x7F);
+  std::array<std::uint8_t, devicenet::kMaxExplicitMessage> out{};
+  std::size_t n = 0;
+  auto request = devicenet::decode_request(p.subspan(1), BodyFormat::k8_8);
+  const std::uint8_t service = p[1];
+  const bool allocation_service =
+      service == static_cast<std::uint8_t>(cip::Service::kAllocateMasterSlave) ||
+      service == static_cast<std::uint8_t>(cip::Service::kReleaseMasterSlave);
+  if (!allocation_service || !request.ok() || request->class_id != devicenet::kDeviceNetClass ||
+      request->instance_id != 1) {
+    auto e = devicenet::encode_error_response(cip::GeneralStatus::kResourceUnavailable,
+                                              kInvalidGroup2Request, out);
+    n = e.ok() ? *e : 0;
+  } else {
+    n = execute_request(device_, *request, static_cast<std::uint8_t>(header & 0x3F), now, out);
+  }
+  if (n > 0 && out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
+    ++counters_.requests_refused;
+  }
+  std::array<std::uint8_t, 8> payload{};
+  payload[0] = header;
+  const std::size_t len = std::min<std::size_t>(n, devicenet::kMaxUnfragmentedMessage);
+  std::copy_n(out.begin(), len, payload.begin() + 1);
+  send(response_id(), Bytes(payload.data(), len + 1), now);
+  after_response(now);
+}
+
+void Cdn127Slave::on_explicit(const can::CanFrame& frame, TimePoint now) noexcept {
+  const Bytes p = frame.payload();
+  if (!device_.explicit_established() || p.empty()) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  device_.explicit_consumed(now);
+  const std::uint8_t header = p[0];
+  if ((header & kFragBit) == 0) {
+    handle_explicit_message(header, p.subspan(1), now);
+    return;
+  }
+  if (p.size() < 2) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  // An ack of a response fragment, or a fragment of a request.
+  if (devicenet::decode_fragment_byte(p[1]).type == devicenet::FragmentType::kAck) {
+    switch (sender_.on_ack(p, now)) {
+      case ExplicitFragmentSender::Step::kSend:
+        send(response_id(), sender_.frame(), now);
+        break;
+      case ExplicitFragmentSender::Step::kFailed:
+        ++counters_.fragment_transfers_failed;
+        break;
+      case ExplicitFragmentSender::Step::kNone:
+        ++counters_.frames_ignored;
+        break;
+      case ExplicitFragmentSender::Step::kComplete:
+        break;
+    }
+    return;
+  }
+  switch (reassembler_.on_fragment(p)) {
+    case ExplicitReassembler::Outcome::kDropped:
+      ++counters_.frames_ignored;
+      break;
+    case ExplicitReassembler::Outcome::kAccepted:
+    case ExplicitReassembler::Outcome::kRepeated:
+    case ExplicitReassembler::Outcome::kOverflow:
+      send(response_id(), reassembler_.ack(), now);
+      break;
+    case ExplicitReassembler::Outcome::kRestarted:
+      if (reassembler_.in_progress()) {
+        send(response_id(), reassembler_.ack(), now);
+      } else {
+        ++counters_.frames_ignored;
+      }
+      break;
+    case ExplicitReassembler::Outcome::kComplete:
+      send(response_id(), reassembler_.ack(), now);
+      handle_explicit_message(header, reassembler_.message(), now);
+      break;
+  }
+}
+
+void Cdn127Slave::handle_explicit_message(std::uint8_t header, Bytes message, TimePoint now) noexcept {
+  if (message.empty() || (message[0] & cip::kResponseFlag) != 0) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  ++counters_.explicit_requests;
+  std::array<std::uint8_t, devicenet::kMaxExplicitMessage> out{};
+  std::size_t n = 0;
+  auto request = devicenet::decode_request(message, BodyFormat::k8_8);
+  if (request.ok()) {
+    n = execute_request(device_, *request, static_cast<std::uint8_t>(header & 0x3F), now, out);
+  } else {
+    auto e = devicenet::encode_error_response(cip::GeneralStatus::kNotEnoughData,
+                                              cip::kNoAdditionalCode, out);
+    n = e.ok() ? *e : 0;
+  }
+  if (n > 0 && out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
+    ++counters_.requests_refused;
+  }
+  send_explicit_response(header, Bytes(out.data(), n), now);
+  after_response(now);
+}
+
+// Responses echo the request's XID and MAC (request[0] & 0x7F); longer than
+// one frame, they go out in acknowledged fragments.
+void Cdn127Slave::send_explicit_response(std::uint8_t header, Bytes message, TimePoint now) noexcept {
+  const auto response_header = static_cast<std::uint8_t>(header & 0x7F);
+  if (message.size() <= devicenet::kMaxUnfragmentedMessage) {
+    std::array<std::uint8_t, 8> payload{};
+    payload[0] = response_header;
+    std::copy(message.begin(), message.end(), payload.begin() + 1);
+    send(response_id(), Bytes(payload.data(), message.size() + 1), now);
+    return;
+  }
+  sender_.cancel();
+  if (sender_.start(devicenet::decode_header(response_header), message, now).ok()) {
+    send(response_id(), sender_.frame(), now);
+  } else {
+    ++counters_.fragment_transfers_failed;
+  }
+}
+
+void Cdn127Slave::after_response(TimePoint now) noexcept {
+  switch (device_.take_pending_action()) {
+    case PendingAction::kNone:
+      return;
+    case PendingAction::kRestartFactoryDefaults:
+      device_.restore_factory_defaults();
+      [[fallthrough]];
+    case PendingAction::kRestart:
+      log_.debug("reset: restarting");
+      restart(now);
+      return;
+  }
+}
+
+void Cdn127Slave::on_poll(const can::CanFrame& frame, TimePoint now) noexcept {
+  PollResult r = device_.on_poll(frame.payload(), now);
+  switch (r.outcome) {
+    case PollOutcome::kNotEstablished:
+      ++counters_.polls_ignored;
+      return;
+    case PollOutcome::kOversize:
+      ++counters_.polls_oversize;
+      return;
+    case PollOutcome::kApplied:
+      ++counters_.polls_applied;
+      break;
+    case PollOutcome::kIdle:
+      ++counters_.polls_idle;
+      break;
+    case PollOutcome::kInvalid:
+      ++counters_.polls_invalid;
+      break;
+  }
+  send(devicenet::group1_id(Group1Message::kSlavePollResponse, device_.mac()), r.response.view(), now);
+}
+
+}  // namespace dnbridge::sim
