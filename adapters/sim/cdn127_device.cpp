@@ -1,6 +1,7 @@
 #include "adapters/sim/cdn127_device.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "bridge/devicenet/explicit_message.hpp"
 

@@ -1,5 +1,7 @@
 #include "adapters/sim/cdn127_objects.hpp"
 
+#include <array>
+#include <optional>
 #include <string_view>
 
 #include "bridge/cip/data_types.hpp"

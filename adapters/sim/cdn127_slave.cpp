@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <utility>
 
 #include "bridge/devicenet/explicit_message.hpp"
 #include "bridge/devicenet/identifier.hpp"
