@@ -47,7 +47,9 @@ SimSlave& SimRack::device(devicenet::MacId mac) {
 void SimRack::start() {
   if (started_) return;
   started_ = true;
-  for (auto& [mac, d] : devices_) d->power_on(world_.now());
+  for (auto& [mac, d] : devices_) {
+    if (d->device().network_state() == Cdn127Slave::NetworkState::kOff) d->power_on(world_.now());
+  }
   master_->scanner().start(world_.now());
 }
 

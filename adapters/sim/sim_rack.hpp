@@ -47,7 +47,7 @@ class SimRack {
   SimSlave& device(devicenet::MacId mac);
   bool has_device(devicenet::MacId mac) const { return devices_.count(mac.value()) != 0; }
 
-  // Powers every device on and starts the master, now.
+  // Powers on every device still off and starts the master, now.
   void start();
   bool all_online() const;
 

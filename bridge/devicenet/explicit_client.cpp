@@ -21,7 +21,7 @@ std::uint32_t ExplicitClient::request_id(bool unconnected) const noexcept {
 }
 
 Status ExplicitClient::submit(Tag tag, const RequestMessage& request, bool unconnected,
-                              TimePoint now) noexcept {
+                              TimePoint now, std::optional<Duration> timeout) noexcept {
   if (cancelling_) return Errc::kStopped;
   if (count_ == kQueueCapacity) return Errc::kBusy;
   Pending& slot = queue_[(head_ + count_) % kQueueCapacity];
@@ -34,6 +34,7 @@ Status ExplicitClient::submit(Tag tag, const RequestMessage& request, bool uncon
   slot.tag = tag;
   slot.unconnected = unconnected;
   slot.service = request.service;
+  slot.timeout = timeout.value_or(config_.response_timeout);
   ++count_;
   if (!outstanding_ && !in_callback_) start_next(now);
   return {};
@@ -61,7 +62,7 @@ void ExplicitClient::send_message(TimePoint now) noexcept {
     buf[0] = encode_header(header);
     std::copy(message.begin(), message.end(), buf.begin() + 1);
     send_payload(request_id(current_.unconnected), Bytes(buf.data(), message.size() + 1), now);
-    response_deadline_ = now + config_.response_timeout;
+    response_deadline_ = now + current_.timeout;
     return;
   }
   // Longer requests go in acknowledged fragments; the response timer starts
@@ -114,7 +115,7 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
         send_payload(request_id(current_.unconnected), sender_.frame(), now);
         break;
       case ExplicitFragmentSender::Step::kComplete:
-        response_deadline_ = now + config_.response_timeout;
+        response_deadline_ = now + current_.timeout;
         break;
       case ExplicitFragmentSender::Step::kFailed:
         ++counters_.fragment_aborts;
@@ -140,7 +141,7 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
     case ExplicitReassembler::Outcome::kRepeated:
       // The response is arriving: its next fragment may take the slave's own
       // ack timeout and a resend, so the wait starts again from here.
-      response_deadline_ = now + config_.response_timeout;
+      response_deadline_ = now + current_.timeout;
       break;
     case ExplicitReassembler::Outcome::kComplete: {
       // Copy out: handling the response may start the next transaction,
@@ -156,7 +157,7 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
       break;
     case ExplicitReassembler::Outcome::kRestarted:
       ++counters_.malformed_frames;
-      if (reassembler_.in_progress()) response_deadline_ = now + config_.response_timeout;
+      if (reassembler_.in_progress()) response_deadline_ = now + current_.timeout;
       break;
     case ExplicitReassembler::Outcome::kDropped:
       ++counters_.malformed_frames;

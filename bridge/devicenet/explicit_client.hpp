@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "bridge/can/frame_sink.hpp"
 #include "bridge/cip/general_status.hpp"
@@ -75,7 +76,9 @@ class ExplicitClient {
   // Queues a request; sends it at once when nothing is outstanding. Fails with
   // kBusy when the queue is full and kOutOfRange when the request does not fit
   // the body format or the message buffer; no result is delivered then.
-  Status submit(Tag tag, const RequestMessage& request, bool unconnected, TimePoint now) noexcept;
+  // `timeout` replaces the configured response timeout for this request.
+  Status submit(Tag tag, const RequestMessage& request, bool unconnected, TimePoint now,
+                std::optional<Duration> timeout = std::nullopt) noexcept;
 
   // A frame from the slave on Group 2 message 3.
   void on_frame(Bytes payload, TimePoint now) noexcept;
@@ -95,6 +98,7 @@ class ExplicitClient {
     Tag tag = 0;
     bool unconnected = false;
     std::uint8_t service = 0;
+    Duration timeout{};
     InlineBytes<kMaxExplicitMessage> message;
   };
 

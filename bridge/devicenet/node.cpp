@@ -26,9 +26,6 @@ constexpr std::uint8_t kIdentityState = 8;
 // Life-cycle reads that time out are retried this many times before the node
 // is taken for gone: single lost frames must not cost a reconnection.
 constexpr unsigned kStepTimeoutRetries = 2;
-// Keep-alive requests that fail in a row before the explicit connection is
-// taken for lost.
-constexpr unsigned kKeepAliveFailures = 3;
 
 std::uint16_t to_ms(Duration d) {
   const auto ms = std::chrono::duration_cast<milliseconds>(d).count();
@@ -100,16 +97,18 @@ void Node::set_state(NodeState next, std::string reason, TimePoint now) {
   observer_.on_node_state(config_.mac, from, next, reason_, now);
 }
 
-void Node::issue(Step step, const RequestMessage& request, bool unconnected, TimePoint now) {
+void Node::issue(Step step, const RequestMessage& request, bool unconnected, TimePoint now,
+                 std::optional<Duration> timeout) {
   // Kept so that a request lost on the bus can be sent again as it was.
   last_step_ = step;
   last_request_ = request;
   last_request_data_.assign(request.data);
   last_request_.data = last_request_data_.view();
   last_unconnected_ = unconnected;
+  last_timeout_ = timeout;
   step_ = step;
   auto submitted = client_.submit(kInternalTag | static_cast<std::uint32_t>(step), request,
-                                  unconnected, now);
+                                  unconnected, now, timeout);
   if (!submitted) {
     // Only a request larger than the message buffer can fail here: the
     // internal requests are small and external ones leave room in the queue.
@@ -124,7 +123,7 @@ void Node::resend_step(TimePoint now) {
   const InlineBytes<64> data = last_request_data_;
   RequestMessage request = last_request_;
   request.data = data.view();
-  issue(last_step_, request, last_unconnected_, now);
+  issue(last_step_, request, last_unconnected_, now, last_timeout_);
 }
 
 void Node::get(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, TimePoint now) {
@@ -137,14 +136,14 @@ void Node::get(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t at
 }
 
 void Node::set(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, Bytes value,
-               TimePoint now) {
+               TimePoint now, std::optional<Duration> timeout) {
   RequestMessage r;
   r.service = static_cast<std::uint8_t>(cip::Service::kSetAttributeSingle);
   r.class_id = cls;
   r.instance_id = inst;
   r.attribute = attr;
   r.data = value;
-  issue(step, r, false, now);
+  issue(step, r, false, now, timeout);
 }
 
 void Node::attempt_allocate(TimePoint now) {
@@ -171,6 +170,7 @@ void Node::release(Step step, TimePoint now) {
 }
 
 void Node::on_explicit_result(std::uint32_t tag, const ExplicitResult& result, TimePoint now) {
+  if (result.ok() || result.error == Errc::kDeviceError) last_explicit_answer_ = now;
   if ((tag & kInternalTag) == 0) {
     observer_.on_explicit_result(tag, config_.mac, result, now);
     return;
@@ -409,8 +409,8 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
       return;
     }
 
-    case Step::kPollEpr:
-    case Step::kExplicitEpr: {
+    case Step::kExplicitEpr:
+    case Step::kPollEpr: {
       const bool poll = step == Step::kPollEpr;
       if (!r.ok()) {
         enter_fault(NodeState::kConfigurationFault,
@@ -427,32 +427,33 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
       const Duration epr = actual && *actual > 0 ? milliseconds(*actual) : asked;
       if (poll) {
         poll_epr_ = epr;
-        const std::array<std::uint8_t, 2> value{
-            static_cast<std::uint8_t>(to_ms(config_.explicit_packet_rate) & 0xFF),
-            static_cast<std::uint8_t>(to_ms(config_.explicit_packet_rate) >> 8)};
-        set(Step::kExplicitEpr, kConnectionClass, kExplicitConnection, kAttrExpectedPacketRate,
-            Bytes(value), now);
+        go_online(now);
       } else {
         explicit_epr_ = epr;
-        go_online(now);
+        set_poll_epr(now);
       }
       return;
     }
 
     case Step::kKeepAlive:
-      if (r.ok()) {
-        keepalive_failures_ = 0;
-        if (!r.data.empty() && device_state_ != r.data[0]) {
+      if (r.ok() || r.error == Errc::kDeviceError) {
+        if (r.ok() && !r.data.empty() && device_state_ != r.data[0]) {
           device_state_ = r.data[0];
           observer_.on_device_state(config_.mac, r.data[0], now);
         }
-      } else if (r.error != Errc::kDeviceError && ++keepalive_failures_ >= kKeepAliveFailures) {
-        lose(fmt::format("explicit connection lost: {} keep-alive requests failed ({})",
-                         keepalive_failures_, status_text(r)),
+        return;
+      }
+      // The device drops the explicit connection after 4 x EPR without a
+      // request; single lost frames must not be taken for that. Try again at
+      // once, and give up only when nothing has come back for that long.
+      if (now - last_explicit_answer_ >= 4 * explicit_epr_) {
+        lose(fmt::format("explicit connection lost: no answer for {} ms (4 x EPR; {})",
+                         std::chrono::duration_cast<milliseconds>(now - last_explicit_answer_).count(),
+                         status_text(r)),
              now);
         return;
       }
-      if (keepalive_failures_ > 0) keepalive_at_ = now;  // try again at once
+      keepalive_at_ = now;
       return;
 
     case Step::kReleaseFault:
@@ -509,19 +510,30 @@ void Node::check_sizes(TimePoint now) {
                 now);
     return;
   }
+  const std::uint16_t ms = to_ms(config_.explicit_packet_rate);
+  const std::array<std::uint8_t, 2> value{static_cast<std::uint8_t>(ms & 0xFF),
+                                          static_cast<std::uint8_t>(ms >> 8)};
+  set(Step::kExplicitEpr, kConnectionClass, kExplicitConnection, kAttrExpectedPacketRate,
+      Bytes(value), now);
+}
+
+void Node::set_poll_epr(TimePoint now) {
+  // Last step before polling: setting EPR establishes the poll connection and
+  // starts the device's 4 x EPR watchdog, so the first poll follows at once.
+  // A lost answer is retried after 2 x EPR, while the connection still lives.
   const std::uint16_t ms = to_ms(config_.expected_packet_rate);
   const std::array<std::uint8_t, 2> value{static_cast<std::uint8_t>(ms & 0xFF),
                                           static_cast<std::uint8_t>(ms >> 8)};
   set(Step::kPollEpr, kConnectionClass, kPollConnection, kAttrExpectedPacketRate, Bytes(value),
-      now);
+      now, std::min(port_.explicit_messaging.response_timeout, 2 * config_.expected_packet_rate));
 }
 
 void Node::go_online(TimePoint now) {
   poll_outstanding_ = false;
   poll_unanswered_ = false;
   consecutive_errors_ = 0;
-  keepalive_failures_ = 0;
   last_response_ = now;
+  last_explicit_answer_ = now;
   next_poll_ = next_poll_slot(now);
   keepalive_at_ = now + explicit_epr_;
   io_reassembler_.reset();

@@ -94,8 +94,8 @@ class Node final : private ExplicitClient::Listener {
     kConsumedSize,
     kFallbackProducedSize,
     kFallbackConsumedSize,
-    kPollEpr,
     kExplicitEpr,
+    kPollEpr,
     kKeepAlive,
     kReleaseFault,     // Release after a fault, then wait for the recheck
     kReleaseShutdown,  // Release at orderly shutdown
@@ -104,11 +104,12 @@ class Node final : private ExplicitClient::Listener {
   void on_explicit_result(std::uint32_t tag, const ExplicitResult& result, TimePoint now) override;
   void on_step_result(Step step, const ExplicitResult& result, TimePoint now);
 
-  void issue(Step step, const RequestMessage& request, bool unconnected, TimePoint now);
+  void issue(Step step, const RequestMessage& request, bool unconnected, TimePoint now,
+             std::optional<Duration> timeout = std::nullopt);
   void resend_step(TimePoint now);
   void get(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, TimePoint now);
   void set(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, Bytes value,
-           TimePoint now);
+           TimePoint now, std::optional<Duration> timeout = std::nullopt);
 
   void attempt_allocate(TimePoint now);
   void release(Step step, TimePoint now);
@@ -116,6 +117,7 @@ class Node final : private ExplicitClient::Listener {
   void next_setting(TimePoint now);
   void begin_verify(TimePoint now);
   void check_sizes(TimePoint now);
+  void set_poll_epr(TimePoint now);
   void go_online(TimePoint now);
   void lose(std::string reason, TimePoint now);
   void enter_fault(NodeState fault, std::string reason, TimePoint now);
@@ -149,6 +151,7 @@ class Node final : private ExplicitClient::Listener {
   RequestMessage last_request_;
   InlineBytes<64> last_request_data_;
   bool last_unconnected_ = false;
+  std::optional<Duration> last_timeout_;
   std::optional<std::uint32_t> produced_size_;
   std::optional<std::uint32_t> consumed_size_;
 
@@ -168,7 +171,7 @@ class Node final : private ExplicitClient::Listener {
   bool outputs_dirty_ = false;
   bool idle_ = true;              // no outputs until the layer above sets them
   unsigned consecutive_errors_ = 0;
-  unsigned keepalive_failures_ = 0;
+  TimePoint last_explicit_answer_{};  // last explicit response, error or not
   InlineBytes<kMaxIoSize> outputs_;
   InlineBytes<kMaxIoSize> sent_outputs_;
   bool sent_idle_ = true;

@@ -102,11 +102,10 @@ void Scanner::stop(TimePoint now) {
   if (state_ == PortState::kRunning) {
     set_state(PortState::kStopping, "orderly shutdown: idling and releasing nodes", now);
     for (auto& n : nodes_) n->begin_shutdown(now);
+    finish_stopping(now);
   } else if (state_ == PortState::kCheckingMac) {
     for (auto& n : nodes_) n->halt("port stopped", now);
-  }
-  if (stopped() && state_ != PortState::kDuplicateMac) {
-    set_state(PortState::kStopped, "all nodes released", now);
+    set_state(PortState::kStopped, "stopped during the MAC check", now);
   }
 }
 
@@ -121,6 +120,17 @@ Node* Scanner::find(MacId mac) { return by_mac_[mac.value()]; }
 const Node* Scanner::node(MacId mac) const { return by_mac_[mac.value()]; }
 
 void Scanner::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
+  dispatch(frame, rx_time);
+  finish_stopping(rx_time);
+}
+
+void Scanner::finish_stopping(TimePoint now) {
+  if (state_ == PortState::kStopping && stopped()) {
+    set_state(PortState::kStopped, "all nodes released", now);
+  }
+}
+
+void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
   ++counters_.frames_received;
   if (state_ == PortState::kStopped || state_ == PortState::kDuplicateMac) return;
   auto id = decode_identifier(frame.id);
@@ -193,9 +203,7 @@ void Scanner::on_timer(TimePoint now) {
   for (auto& n : nodes_) {
     if (now >= n->deadline()) n->on_timer(now);
   }
-  if (state_ == PortState::kStopping && stopped()) {
-    set_state(PortState::kStopped, "all nodes released", now);
-  }
+  finish_stopping(now);
 }
 
 TimePoint Scanner::next_deadline() const {

@@ -68,6 +68,8 @@ class Scanner {
  private:
   void set_state(PortState next, std::string reason, TimePoint now);
   void begin_scanning(TimePoint now);
+  void dispatch(const can::CanFrame& frame, TimePoint rx_time);
+  void finish_stopping(TimePoint now);
   Node* find(MacId mac);
 
   ScannerConfig config_;
