@@ -557,8 +557,12 @@ void Node::lose(std::string reason, TimePoint now) {
   next_poll_ = kNever;
   poll_deadline_ = kNever;
   keepalive_at_ = kNever;
+  if (shutting_down_) {
+    set_state(NodeState::kStopped, "stopped: " + reason, now);
+    return;
+  }
   set_state(NodeState::kAbsent, std::move(reason), now);
-  if (!shutting_down_) retry_at_ = now + port_.allocate_retry_min;
+  retry_at_ = now + port_.allocate_retry_min;
   retry_delay_ = port_.allocate_retry_min;
 }
 
@@ -591,25 +595,33 @@ void Node::record_device_error(const ExplicitResult& result, TimePoint now) {
 }
 
 void Node::begin_shutdown(TimePoint now) {
+  if (shutting_down_) return;
   shutting_down_ = true;
   retry_at_ = kNever;
-  if (state_ == NodeState::kOnline) {
-    // Outputs to the device's idle state first, then give the connections up.
-    idle_ = true;
-    send_poll(now);
-  }
   next_poll_ = kNever;
-  poll_deadline_ = kNever;
   keepalive_at_ = kNever;
+  step_ = Step::kNone;
+  client_.cancel_all(Errc::kStopped, now);
+  if (state_ == NodeState::kOnline) {
+    // Outputs to the device's own idle state first: one idle poll (after the
+    // one outstanding, if any); the Release follows its answer or timeout.
+    idle_ = true;
+    outputs_dirty_ = true;
+    if (!poll_outstanding_) send_poll(now);
+    return;
+  }
   if (connected_) {
-    step_ = Step::kNone;
-    client_.cancel_all(Errc::kStopped, now);
     release(Step::kReleaseShutdown, now);
     return;
   }
-  step_ = Step::kNone;
-  client_.cancel_all(Errc::kStopped, now);
   set_state(NodeState::kStopped, "orderly shutdown", now);
+}
+
+void Node::release_for_shutdown(TimePoint now) {
+  if (step_ == Step::kReleaseShutdown || state_ == NodeState::kStopped) return;
+  poll_outstanding_ = false;
+  poll_deadline_ = kNever;
+  release(Step::kReleaseShutdown, now);
 }
 
 void Node::halt(std::string_view reason, TimePoint now) {
@@ -648,7 +660,10 @@ void Node::on_timer(TimePoint now) {
     poll_deadline_ = kNever;
     ++counters_.timeouts;
     record(NodeError::Kind::kPollTimeout, now);
+    // The idle poll of a shutdown went unanswered: release all the same.
+    if (shutting_down_) release_for_shutdown(now);
   }
+  if (shutting_down_) return;
   // The device drops the connection after 4 x EPR without a poll; the master
   // drops the node after 4 x EPR without a response.
   if (now - last_response_ >= 4 * poll_epr_) {
@@ -671,10 +686,12 @@ void Node::on_timer(TimePoint now) {
 }
 
 TimePoint Node::deadline() const {
-  TimePoint t = std::min(client_.deadline(), shutting_down_ ? kNever : retry_at_);
+  TimePoint t = client_.deadline();
+  if (state_ == NodeState::kOnline && poll_outstanding_) t = std::min(t, poll_deadline_);
+  if (shutting_down_) return t;
+  t = std::min(t, retry_at_);
   if (state_ == NodeState::kOnline) {
     t = std::min({t, next_poll_, keepalive_at_, last_response_ + 4 * poll_epr_});
-    if (poll_outstanding_) t = std::min(t, poll_deadline_);
   }
   return t;
 }
@@ -778,6 +795,14 @@ void Node::accept_poll_response(Bytes data, TimePoint now) {
   applied_idle_ = sent_idle_;
   applied_outputs_ = sent_outputs_;
   observer_.on_poll_response(config_.mac, data, now);
+  if (shutting_down_) {
+    if (outputs_dirty_) {
+      send_poll(now);  // the idle poll, after the one that was outstanding
+    } else {
+      release_for_shutdown(now);
+    }
+    return;
+  }
   if (outputs_dirty_ && config_.immediate_poll_on_change) send_poll(now);
 }
 

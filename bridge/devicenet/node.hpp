@@ -120,6 +120,7 @@ class Node final : private ExplicitClient::Listener {
   void set_poll_epr(TimePoint now);
   void go_online(TimePoint now);
   void lose(std::string reason, TimePoint now);
+  void release_for_shutdown(TimePoint now);
   void enter_fault(NodeState fault, std::string reason, TimePoint now);
   void set_state(NodeState next, std::string reason, TimePoint now);
   void record(NodeError::Kind kind, TimePoint now, std::uint32_t got = 0, std::uint32_t expected = 0);

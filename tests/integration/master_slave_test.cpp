@@ -81,7 +81,12 @@ TEST_F(MasterSlave, SixtyThreeNodesOnOnePortComeOnline) {
   // Every node then stays online and is polled at its period.
   const auto polls_before = node(33).counters().responses;
   rack().world().run_for(seconds(10));
-  for (unsigned m : macs) EXPECT_EQ(view(m).state, NodeState::kOnline) << m;
+  for (unsigned m : macs) {
+    EXPECT_EQ(view(m).state, NodeState::kOnline) << m;
+    // A clean bus: every poll answered, nothing malformed.
+    EXPECT_EQ(node(m).counters().timeouts, 0u) << m;
+    EXPECT_EQ(node(m).counters().errors, 0u) << m;
+  }
   EXPECT_NEAR(static_cast<double>(node(33).counters().responses - polls_before), 100.0, 2.0);
   EXPECT_EQ(node(33).counters().reconnects, 0u);
 }
@@ -441,6 +446,10 @@ TEST_F(MasterSlave, OrderlyShutdownIdlesThenReleasesEveryNode) {
   out.pump_on = true;
   for (unsigned m : {1u, 2u, 3u}) ASSERT_TRUE(rack().pumps().command(mac(m), out, now()).ok());
   rack().world().run_for(milliseconds(300));
+  // Stop while some polls are outstanding: their answers come first, then
+  // one idle poll each, then the Release.
+  rack().world().run_until([&] { return node(2).counters().polls > node(2).counters().responses; },
+                           seconds(1));
   rack().scanner().stop(now());
   rack().world().run_until([&] { return rack().scanner().stopped(); }, seconds(5));
   EXPECT_EQ(rack().scanner().state(), PortState::kStopped);
@@ -449,6 +458,8 @@ TEST_F(MasterSlave, OrderlyShutdownIdlesThenReleasesEveryNode) {
     EXPECT_FALSE(device(m).outputs().pump_on) << m;  // idle action: off
     EXPECT_TRUE(device(m).pump().last_change_was_idle()) << m;
     EXPECT_EQ(device(m).owner(), devicenet::MacId::kNone) << m;
+    EXPECT_EQ(node(m).counters().errors, 0u) << m;  // never two polls outstanding
+    EXPECT_EQ(node(m).counters().polls, node(m).counters().responses) << m;
   }
 }
 
