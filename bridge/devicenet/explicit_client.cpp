@@ -29,7 +29,9 @@ Status ExplicitClient::submit(Tag tag, const RequestMessage& request, bool uncon
   // body format is only known from the Allocate response.
   const BodyFormat format = unconnected ? BodyFormat::k8_8 : format_;
   auto size = encode_request(request, format, slot.message.storage());
-  if (!size) return size.error();
+  // A message longer than the buffer is a request out of range, as documented,
+  // not the encoder's kBufferTooSmall (the buffer is not the caller's).
+  if (!size) return size.error() == Errc::kBufferTooSmall ? Errc::kOutOfRange : size.error();
   slot.message.resize(*size);
   slot.tag = tag;
   slot.unconnected = unconnected;
