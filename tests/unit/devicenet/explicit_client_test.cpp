@@ -514,6 +514,50 @@ TEST_F(ExplicitClientTest, RepeatedResponseFragmentIsReAckedNotAppended) {
   EXPECT_EQ(client.counters().unexpected_frames, 0u);
 }
 
+TEST_F(ExplicitClientTest, FinalResponseFragmentRepeatedAfterCompletionIsReAcked) {
+  ASSERT_TRUE(submit_get(1).ok());
+  ASSERT_TRUE(submit_get(2, 8).ok());
+  answer({0xCA, 0x00, 0x8E, 0x06, 0x43, 0x44, 0x4E, 0x31});
+  answer({0xCA, 0x81, 0x32, 0x37});
+  ASSERT_EQ(listener.results.size(), 1u);
+  EXPECT_EQ(sink.last(), "41C: 0A 0E 01 01 08");  // the next request is out
+  const std::size_t sent = sink.frames.size();
+
+  // The slave missed our ack of its last fragment and sends it again after
+  // its 1 s ack timeout: re-acked so that it does not abort a response that
+  // arrived (devicenet-facts §3), and not taken as an answer to request 2.
+  advance(seconds(1));
+  answer({0xCA, 0x81, 0x32, 0x37});
+  ASSERT_EQ(sink.frames.size(), sent + 1);
+  EXPECT_EQ(sink.last(), "41C: CA C1 00");
+  EXPECT_EQ(listener.results.size(), 1u);
+  // Any other fragment of the old XID is still not ours and not acked.
+  answer({0xCA, 0x41, 0x32, 0x37});
+  answer({0xCA, 0x00, 0x8E, 0x06, 0x43, 0x44, 0x4E, 0x31});
+  EXPECT_EQ(sink.frames.size(), sent + 1);
+  EXPECT_EQ(client.counters().unexpected_frames, 2u);
+
+  answer({0x0A, 0x8E, 0x02});
+  ASSERT_EQ(listener.results.size(), 2u);
+  EXPECT_EQ(listener.results[1].data, "02");
+
+  // Idle, the same repeat is re-acked too.
+  answer({0xCA, 0x81, 0x32, 0x37});
+  EXPECT_EQ(sink.last(), "41C: CA C1 00");
+  EXPECT_EQ(sink.frames.size(), sent + 2);
+  EXPECT_EQ(listener.results.size(), 2u);
+
+  // Once a transaction with that XID is under way again, the frame is taken as
+  // one of its own: a last fragment with no first, dropped and not acked.
+  ASSERT_TRUE(submit_get(3).ok());
+  EXPECT_EQ(sink.last(), "41C: 4A 0E 01 01 07");
+  const std::uint64_t malformed = client.counters().malformed_frames;
+  answer({0xCA, 0x81, 0x32, 0x37});
+  EXPECT_EQ(sink.frames.size(), sent + 3);
+  EXPECT_EQ(client.counters().malformed_frames, malformed + 1);
+  EXPECT_EQ(listener.results.size(), 2u);
+}
+
 TEST_F(ExplicitClientTest, ResponseFragmentWithOldXidIsNotAcked) {
   ASSERT_TRUE(submit_get(1).ok());
   answer({0x8A, 0x00, 0x8E, 0x06, 0x43, 0x44, 0x4E, 0x31});  // XID 0
