@@ -29,7 +29,9 @@ Status ExplicitClient::submit(Tag tag, const RequestMessage& request, bool uncon
   // body format is only known from the Allocate response.
   const BodyFormat format = unconnected ? BodyFormat::k8_8 : format_;
   auto size = encode_request(request, format, slot.message.storage());
-  if (!size) return size.error();
+  // A message longer than the buffer is a request out of range, as documented,
+  // not the encoder's kBufferTooSmall (the buffer is not the caller's).
+  if (!size) return size.error() == Errc::kBufferTooSmall ? Errc::kOutOfRange : size.error();
   slot.message.resize(*size);
   slot.tag = tag;
   slot.unconnected = unconnected;
@@ -88,7 +90,12 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
   const ExplicitHeader header = decode_header(payload[0]);
   // On Group 2 the header carries the master's MAC: an answer with another
   // MAC belongs to another master's conversation with this slave.
-  if (header.mac != master_ || !outstanding_) {
+  if (header.mac != master_) {
+    ++counters_.unexpected_frames;
+    return;
+  }
+  if ((!outstanding_ || header.xid != xid_) && reack_final_fragment(payload, now)) return;
+  if (!outstanding_) {
     ++counters_.unexpected_frames;
     return;
   }
@@ -144,6 +151,8 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
       response_deadline_ = now + current_.timeout;
       break;
     case ExplicitReassembler::Outcome::kComplete: {
+      final_fragment_ = {payload[0], payload[1]};
+      final_ack_.assign(reassembler_.ack());
       // Copy out: handling the response may start the next transaction,
       // which resets the reassembler.
       InlineBytes<kMaxExplicitMessage> message;
@@ -163,6 +172,19 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
       ++counters_.malformed_frames;
       break;
   }
+}
+
+// The slave resends the last fragment of a response when it misses the ack
+// (devicenet-facts §3), by then the transaction is over (and the next one may
+// be under way with the other XID). Re-ack it, or the slave gives up on a
+// response that arrived. Nothing else of an ended transfer is acked.
+bool ExplicitClient::reack_final_fragment(Bytes payload, TimePoint now) noexcept {
+  if (final_ack_.empty() || payload.size() < 2 || payload[0] != final_fragment_[0] ||
+      payload[1] != final_fragment_[1]) {
+    return false;
+  }
+  send_payload(request_id(false), final_ack_.view(), now);
+  return true;
 }
 
 void ExplicitClient::handle_response(Bytes message, TimePoint now) noexcept {

@@ -106,6 +106,7 @@ class ExplicitClient {
   void send_message(TimePoint now) noexcept;
   void send_payload(std::uint32_t can_id, Bytes payload, TimePoint now) noexcept;
   void handle_response(Bytes message, TimePoint now) noexcept;
+  bool reack_final_fragment(Bytes payload, TimePoint now) noexcept;
   void finish(const ExplicitResult& result, TimePoint now) noexcept;
   void fail(Errc reason, TimePoint now) noexcept;
   std::uint32_t request_id(bool unconnected) const noexcept;
@@ -127,6 +128,10 @@ class ExplicitClient {
   TimePoint response_deadline_ = kNever;
   ExplicitFragmentSender sender_;
   ExplicitReassembler reassembler_;
+  // Header and fragment byte of the last fragment of the latest response
+  // reassembled, and the ack sent for it (empty: none yet).
+  std::array<std::uint8_t, 2> final_fragment_{};
+  InlineBytes<3> final_ack_;
   ExplicitCounters counters_{};
   bool in_callback_ = false;
   bool cancelling_ = false;
