@@ -125,8 +125,11 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
         response_deadline_ = now + current_.timeout;
         break;
       case ExplicitFragmentSender::Step::kFailed:
+        // A negative ack: the device refused a fragment (error / too much
+        // data). No CIP status came with it, so it is an aborted transfer,
+        // not a device error reply.
         ++counters_.fragment_aborts;
-        fail(sender_.failure(), now);
+        fail(Errc::kAborted, now);
         break;
       case ExplicitFragmentSender::Step::kNone:
         ++counters_.unexpected_frames;
