@@ -639,7 +639,22 @@ void Node::halt(std::string_view reason, TimePoint now) {
 // ---------------------------------------------------------------------------
 // Frames and time
 
-void Node::on_explicit_frame(Bytes payload, TimePoint now) { client_.on_frame(payload, now); }
+void Node::on_explicit_frame(Bytes payload, TimePoint now) {
+  const auto before = client_.counters();
+  client_.on_frame(payload, now);
+  const auto& after = client_.counters();
+  if (after.malformed_frames == before.malformed_frames &&
+      after.unexpected_frames == before.unexpected_frames) {
+    return;
+  }
+  unsigned suppressed = 0;
+  if (error_log_limit_.allow(now, suppressed)) {
+    log_.warn("{} explicit frame ignored: {}{}",
+              after.malformed_frames != before.malformed_frames ? "malformed" : "unexpected",
+              hex(payload),
+              suppressed ? fmt::format(" ({} similar suppressed)", suppressed) : std::string());
+  }
+}
 
 void Node::on_duplicate_mac_request(TimePoint now) {
   // A node checks its MAC only at power-up: whatever connections the master

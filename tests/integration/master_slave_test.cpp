@@ -7,6 +7,7 @@
 
 #include "bridge/cip/data_types.hpp"
 #include "bridge/devicenet/identifier.hpp"
+#include "bridge/profiles/cdn127/device_info.hpp"
 #include "bridge/profiles/cdn127/node_profile.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 #include "rack_fixture.hpp"
@@ -385,6 +386,40 @@ TEST_F(MasterSlave, DeviceSupervisorStringsAreReadThroughFragmentation) {
     // More than the 6 data bytes an unfragmented response can carry.
     EXPECT_GT(done->result.data.size(), 6u);
   }
+}
+
+TEST_F(MasterSlave, ExceptionAndWarningDetailAreReadAndDecoded) {
+  build(rack_config({8}));
+  rack().start();
+  ASSERT_TRUE(run_until_online());
+  device(8).pump().set_n2_flow_ok(false);
+  device(8).pump().set_warning(true);
+  rack().world().run_for(milliseconds(200));
+
+  const auto* exception = explicit_request(
+      8, get(cdn127::class_id::kDeviceSupervisor, 1, cdn127::supervisor_attr::kExceptionDetail));
+  ASSERT_NE(exception, nullptr);
+  ASSERT_TRUE(exception->result.ok()) << exception->result.error.message();
+  auto detail = cdn127::decode_exception_detail(exception->result.data.view());
+  ASSERT_TRUE(detail.ok()) << detail.error().message();
+  // The manual's structure: DIP 8, DOP 8, AIP 2, AOP 1 status bits.
+  ASSERT_EQ(detail->point_count, 4u);
+  EXPECT_EQ(detail->points[cdn127::SupervisorDetail::kDip].count, 8u);
+  EXPECT_EQ(detail->points[cdn127::SupervisorDetail::kDop].count, 8u);
+  EXPECT_EQ(detail->points[cdn127::SupervisorDetail::kAip].count, 2u);
+  EXPECT_EQ(detail->points[cdn127::SupervisorDetail::kAop].count, 1u);
+
+  const auto* warning = explicit_request(
+      8, get(cdn127::class_id::kDeviceSupervisor, 1, cdn127::supervisor_attr::kWarningDetail));
+  ASSERT_NE(warning, nullptr);
+  ASSERT_TRUE(warning->result.ok());
+  auto warnings = cdn127::decode_warning_detail(warning->result.data.view());
+  ASSERT_TRUE(warnings.ok());
+  EXPECT_EQ(warnings->point_count, 0u);
+  // What the poll's exception byte says agrees.
+  ASSERT_TRUE(view(8).inputs.exception_status.has_value());
+  EXPECT_TRUE(view(8).inputs.exception_status->alarm_device_specific);
+  EXPECT_TRUE(view(8).inputs.exception_status->warning_device_specific);
 }
 
 TEST_F(MasterSlave, ExplicitErrorsComeBackAsData) {

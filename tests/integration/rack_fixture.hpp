@@ -87,3 +87,21 @@ inline sim::SimRackConfig rack_config(std::vector<unsigned> macs, unsigned maste
 }
 
 }  // namespace dnbridge::test
+
+namespace dnbridge::test {
+
+// Counts what reaches the log, by level.
+class CountingLogSink final : public LogSink {
+ public:
+  bool enabled(LogLevel level) const noexcept override { return level >= LogLevel::kInfo; }
+  void write(LogLevel level, std::string_view, std::string_view message) override {
+    if (level >= LogLevel::kWarn) {
+      ++warnings;
+      last_warning = std::string(message);
+    }
+  }
+  std::size_t warnings = 0;
+  std::string last_warning;
+};
+
+}  // namespace dnbridge::test

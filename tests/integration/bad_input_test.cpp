@@ -1,0 +1,153 @@
+// Bad input never crashes or stalls the scan: frames of unexpected length or
+// identifier, malformed or unexpected explicit answers, fragments out of
+// order are counted, logged at a limited rate, and polling goes on.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "bridge/devicenet/identifier.hpp"
+#include "rack_fixture.hpp"
+
+namespace dnbridge::test {
+namespace {
+
+using devicenet::group2_id;
+using devicenet::Group2Message;
+
+// A misbehaving node: every few milliseconds, a frame that no correct
+// DeviceNet node would send.
+class RogueNode final : public sim::SimEndpoint {
+ public:
+  RogueNode(sim::SimWorld& world, std::vector<unsigned> victims, TimePoint start)
+      : world_(world), handle_(world.bus().attach(*this)), victims_(std::move(victims)), next_(start) {
+    world.add(*this);
+  }
+  ~RogueNode() override { world_.remove(*this); }
+
+  void on_frame(const can::CanFrame&, TimePoint) override {}
+  TimePoint next_deadline() const override { return next_; }
+  void on_timer(TimePoint now) override {
+    next_ = now + milliseconds(7);
+    const unsigned victim = victims_[sent_ % victims_.size()];
+    const auto m = mac(victim);
+    can::CanFrame f;
+    std::uniform_int_distribution<int> byte(0, 255);
+    auto fill = [&](std::uint8_t len) {
+      f.len = len;
+      for (std::uint8_t i = 0; i < len; ++i) f.data[i] = static_cast<std::uint8_t>(byte(rng_));
+    };
+    switch (sent_ % 8) {
+      case 0:  // an identifier outside the DeviceNet groups
+        f.id = 0x7F0 + static_cast<std::uint32_t>(sent_ % 16);
+        fill(8);
+        break;
+      case 1:  // a poll response of the wrong size (the CDN127 preset produces 6)
+        f.id = 0x3C0 + victim;
+        fill(static_cast<std::uint8_t>(1 + sent_ % 5));
+        break;
+      case 2:  // an explicit answer to the master with random bytes
+        f.id = group2_id(m, Group2Message::kSlaveExplicitResponse);
+        fill(static_cast<std::uint8_t>(sent_ % 9));
+        f.data[0] = static_cast<std::uint8_t>(f.data[0] & 0xC0);  // header MAC 0: the master's
+        if (f.len == 0) f.len = 1;
+        break;
+      case 3:  // a response fragment out of order (middle, count 17)
+        f.id = group2_id(m, Group2Message::kSlaveExplicitResponse);
+        f.len = 5;
+        f.data = {0x80, 0x51, 0x01, 0x02, 0x03};
+        break;
+      case 4:  // an error response cut short
+        f.id = group2_id(m, Group2Message::kSlaveExplicitResponse);
+        f.len = 2;
+        f.data = {0x00, 0x94};
+        break;
+      case 5:  // a duplicate MAC message of the wrong size
+        f.id = group2_id(m, Group2Message::kDuplicateMacCheck);
+        fill(3);
+        break;
+      case 6:  // Group 3 and Group 4 traffic nobody here uses
+        f.id = 0x600 + static_cast<std::uint32_t>(sent_ % 0x1C0);
+        fill(4);
+        break;
+      default:  // an empty explicit frame
+        f.id = group2_id(m, Group2Message::kSlaveExplicitResponse);
+        f.len = 0;
+        break;
+    }
+    ++sent_;
+    world_.bus().sink(handle_).send(f, now);
+  }
+  std::uint64_t sent() const { return sent_; }
+
+ private:
+  sim::SimWorld& world_;
+  sim::NodeHandle handle_;
+  std::vector<unsigned> victims_;
+  TimePoint next_;
+  std::mt19937 rng_{7};
+  std::uint64_t sent_ = 0;
+};
+
+TEST(BadInput, GarbageOnTheBusIsCountedAndTheScanGoesOn) {
+  CountingLogSink log;
+  sim::SimRack rack(rack_config({1, 2, 3, 4}), &log);
+  rack.start();
+  ASSERT_TRUE(rack.world().run_until([&] { return rack.all_online(); }, seconds(20)));
+
+  RogueNode rogue(rack.world(), {1, 2, 3, 4}, rack.now());
+  rack.world().run_for(seconds(30));
+  ASSERT_GT(rogue.sent(), 4000u);
+
+  std::uint64_t poll_errors = 0, explicit_bad = 0;
+  for (unsigned m : {1u, 2u, 3u, 4u}) {
+    const auto& node = *rack.scanner().node(mac(m));
+    EXPECT_EQ(node.state(), NodeState::kOnline) << m << ": " << node.reason();
+    EXPECT_EQ(node.counters().reconnects, 0u) << m;
+    poll_errors += node.counters().errors;
+    explicit_bad += node.explicit_counters().malformed_frames + node.explicit_counters().unexpected_frames;
+  }
+  const auto& port = rack.scanner().counters();
+  EXPECT_GT(port.invalid_identifiers, 400u);
+  EXPECT_GT(port.foreign_frames, 400u);
+  EXPECT_GT(poll_errors, 400u);
+  EXPECT_GT(explicit_bad, 1500u);
+  // Logged, but not one line per bad frame.
+  EXPECT_GT(log.warnings, 0u);
+  EXPECT_LT(log.warnings, 200u) << log.last_warning;
+
+  // And the pumps still do what they are told.
+  profiles::cdn127::PumpOutputs out;
+  out.pump_on = true;
+  out.analog_out_raw = 777;
+  for (unsigned m : {1u, 2u, 3u, 4u}) ASSERT_TRUE(rack.pumps().command(mac(m), out, rack.now()).ok());
+  rack.world().run_for(milliseconds(300));
+  for (unsigned m : {1u, 2u, 3u, 4u}) {
+    EXPECT_EQ(rack.device(mac(m)).device().outputs(), out) << m;
+    EXPECT_EQ(rack.pumps().pump(mac(m))->outputs_applied, out) << m;
+  }
+}
+
+TEST(BadInput, CorruptedPollResponsesAreCountedNotTaken) {
+  sim::SimRack rack(rack_config({6}));
+  rack.start();
+  ASSERT_TRUE(rack.world().run_until([&] { return rack.all_online(); }, seconds(20)));
+  // One poll response in ten loses a byte on its way.
+  auto rule = sim::FaultRule::corrupt(0x3C0 + 6, sim::Corruption::kTruncate, 1);
+  rule.rate = 0.1;
+  rack.world().bus().faults().add(rule);
+  rack.device(mac(6)).device().pump().set_analog_input(0, 1234);
+  rack.world().run_for(seconds(20));
+  const auto& node = *rack.scanner().node(mac(6));
+  EXPECT_EQ(node.state(), NodeState::kOnline);
+  // 20 s at 10 polls/s, one in ten corrupted: about 20.
+  EXPECT_GT(node.counters().errors, 8u);
+  EXPECT_LT(node.counters().errors, 40u);
+  EXPECT_EQ(node.last_error().kind, devicenet::NodeError::Kind::kPollLength);
+  EXPECT_EQ(node.last_error().got, 5u);
+  EXPECT_EQ(node.last_error().expected, 6u);
+  // What was taken is what the device sent.
+  EXPECT_EQ(rack.pumps().pump(mac(6))->inputs.analog_inputs_raw[0], 1234);
+}
+
+}  // namespace
+}  // namespace dnbridge::test
