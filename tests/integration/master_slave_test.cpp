@@ -473,6 +473,19 @@ TEST_F(MasterSlave, AnotherNodeWithTheMastersMacStopsThePort) {
             0u);
 }
 
+TEST_F(MasterSlave, OnlineMasterDefendsItsMac) {
+  build(rack_config({10}, 30));
+  rack().start();
+  ASSERT_TRUE(run_until_online());
+  // A device set to the master's MAC is powered up on the running network:
+  // the master answers its check, and the newcomer goes silent.
+  auto& intruder = rack().add_device(sim::default_slave_options(mac(30)), now());
+  rack().world().run_for(seconds(3));
+  EXPECT_EQ(intruder.device().network_state(), sim::Cdn127Slave::NetworkState::kCommunicationFault);
+  EXPECT_EQ(rack().scanner().state(), PortState::kRunning);
+  EXPECT_EQ(view(10).state, NodeState::kOnline);
+}
+
 TEST_F(MasterSlave, OrderlyShutdownIdlesThenReleasesEveryNode) {
   build(rack_config({1, 2, 3}));
   rack().start();
