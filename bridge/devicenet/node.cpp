@@ -148,6 +148,7 @@ void Node::set(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t at
 
 void Node::attempt_allocate(TimePoint now) {
   retry_at_ = kNever;
+  step_timeouts_ = 0;
   ++counters_.allocate_attempts;
   const std::array<std::uint8_t, 2> data{allocation::kExplicit | allocation::kPoll,
                                          port_.master_mac.value()};
@@ -201,7 +202,7 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
     lose(fmt::format("no answer from the explicit connection ({})", status_text(r)), now);
     return;
   }
-  if (r.ok()) step_timeouts_ = 0;
+  step_timeouts_ = 0;  // answered, even if with an error
 
   switch (step) {
     case Step::kNone:
@@ -209,6 +210,8 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
 
     case Step::kAllocate: {
       if (r.ok()) {
+        // The device is ours from here on: a fault below releases it.
+        connected_ = true;
         auto format = decode_allocate_response_data(r.data.view());
         if (!format) {
           enter_fault(NodeState::kConfigurationFault,
@@ -218,7 +221,6 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
           return;
         }
         client_.set_body_format(*format);
-        connected_ = true;
         retry_delay_ = port_.allocate_retry_min;
         begin_identify(now);
         return;
@@ -575,8 +577,7 @@ void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
   retry_at_ = now + port_.fault_recheck;
   // Leave a device that is not ours to poll unowned, so that its own
   // connection timeout puts it in its safe state.
-  if (connected_ && fault != NodeState::kOwnedByOtherMaster) release(Step::kReleaseFault, now);
-  connected_ = fault == NodeState::kOwnedByOtherMaster ? false : connected_;
+  if (connected_) release(Step::kReleaseFault, now);
 }
 
 void Node::record(NodeError::Kind kind, TimePoint now, std::uint32_t got, std::uint32_t expected) {
