@@ -66,10 +66,7 @@ void Cdn127Device::power_up(TimePoint now) noexcept {
   mac_ = MacId::from_bits(e2_.mac);
   baud_ = e2_.baud;
   bus_off_counter_ = 0;
-  owner_ = MacId::kNone;
-  explicit_ = Connection{};
-  poll_ = Connection{};
-  poll_running_ = false;
+  drop_connection_set();
   pending_ = PendingAction::kNone;
   pump_.set_outputs(PumpOutputs{}, OutputCause::kPowerUp, now);
 }
@@ -515,6 +512,10 @@ void Cdn127Device::release_if_nothing_established() noexcept {
   }
   // With nothing left established the slave drops the whole set; the master
   // must allocate again (devicenet-facts §5).
+  drop_connection_set();
+}
+
+void Cdn127Device::drop_connection_set() noexcept {
   explicit_ = Connection{};
   poll_ = Connection{};
   poll_running_ = false;
@@ -524,10 +525,7 @@ void Cdn127Device::release_if_nothing_established() noexcept {
 void Cdn127Device::go_offline(TimePoint now) noexcept {
   now_ = now;
   if (poll_.state == ConnectionState::kEstablished) apply_fault_actions(now);
-  explicit_ = Connection{};
-  poll_ = Connection{};
-  poll_running_ = false;
-  owner_ = MacId::kNone;
+  drop_connection_set();
 }
 
 void Cdn127Device::on_timer(TimePoint now) noexcept {

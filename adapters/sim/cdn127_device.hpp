@@ -266,6 +266,7 @@ class Cdn127Device {
   void explicit_timeout(TimePoint now) noexcept;
   void poll_timeout(TimePoint now) noexcept;
   void release_if_nothing_established() noexcept;
+  void drop_connection_set() noexcept;
   void restart_watchdog(Connection& c, TimePoint now) noexcept;
   std::uint16_t round_rate(std::uint16_t requested_ms) const noexcept;
   void apply_decoded_outputs(const profiles::cdn127::PollRequestLayout& layout,
