@@ -10,10 +10,14 @@
 #include <csignal>
 #include <cstdio>
 #include <deque>
+#include <memory>
+#include <string>
+#include <system_error>
 #include <thread>
 
 #include "adapters/demo/rack_table.hpp"
 #include "adapters/demo/scenario.hpp"
+#include "adapters/sim/pcap_writer.hpp"
 #include "adapters/sim/sim_rack.hpp"
 
 namespace {
@@ -61,12 +65,16 @@ int main(int argc, char** argv) {
   unsigned bitrate_k = 500;
   double loss_percent = 0;
   bool plain = !isatty(STDOUT_FILENO);
+  std::string pcap_path;
   app.add_option("-n,--nodes", nodes, "Number of simulated pumps (MACs 1..N)")->check(CLI::Range(1, 63));
   app.add_option("-d,--duration", duration_s, "Seconds to run; 0 runs until Ctrl-C")
       ->check(CLI::NonNegativeNumber);
   app.add_option("-b,--bitrate", bitrate_k, "Bus bit rate in kbit/s")->check(CLI::IsMember({125, 250, 500}));
   app.add_option("--loss", loss_percent, "Percentage of frames the bus loses")->check(CLI::Range(0.0, 50.0));
   app.add_flag("--plain", plain, "Print snapshots instead of redrawing the screen");
+  app.add_option("--pcap", pcap_path,
+                 "Record every frame on the bus to FILE (pcap, SocketCAN link type); read it with\n"
+                 "  tshark -r FILE -d 'can.subdissector,devicenet'");
   CLI11_PARSE(app, argc, argv);
 
   std::signal(SIGINT, on_signal);
@@ -105,6 +113,19 @@ int main(int argc, char** argv) {
   const TimePoint virtual_start = rack.now();
   const TimePoint real_start = mono_now();
   const Duration offset = virtual_start - real_start;  // virtual = real + offset
+
+  // The run is in real time, so the capture carries the wall-clock time.
+  std::unique_ptr<sim::BusCapture> capture;
+  if (!pcap_path.empty()) {
+    try {
+      capture = std::make_unique<sim::BusCapture>(
+          rack.world().bus(),
+          sim::PcapWriter(pcap_path, virtual_start, std::chrono::system_clock::now().time_since_epoch()));
+    } catch (const std::system_error& e) {
+      std::fprintf(stderr, "dnbridge-demo: %s\n", e.what());
+      return 2;
+    }
+  }
   rack.start();
 
   const Duration render_every = plain ? seconds(5) : milliseconds(250);
@@ -162,5 +183,19 @@ int main(int argc, char** argv) {
         std::chrono::duration_cast<std::chrono::steady_clock::duration>((wake - offset).time_since_epoch())));
   }
   render();
+  bool capture_ok = true;
+  if (capture) {
+    const std::uint64_t frames = capture->frames();
+    capture_ok = capture->close();
+    if (capture_ok) {
+      std::fprintf(stderr, "dnbridge-demo: %llu frames captured to %s\n",
+                   static_cast<unsigned long long>(frames), pcap_path.c_str());
+    } else {
+      std::fprintf(stderr, "dnbridge-demo: capture to %s incomplete: %llu write errors (%s)\n",
+                   pcap_path.c_str(), static_cast<unsigned long long>(capture->writer().write_errors()),
+                   capture->writer().error().message().c_str());
+    }
+  }
+  if (!capture_ok) return 2;
   return rack.scanner().state() == devicenet::PortState::kStopped ? 0 : 1;
 }

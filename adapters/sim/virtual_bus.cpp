@@ -263,6 +263,7 @@ void VirtualBus::deliver(const can::CanFrame& frame, NodeHandle sender, TimePoin
   for (std::size_t i = 0; i < count; ++i) {
     if (i != sender.index && nodes_[i]->attached) acknowledged = true;
   }
+  if (tap_) tap_(WireFrame{frame, sender, rx_time, acknowledged});
   if (!acknowledged) {
     ++stats_.unacknowledged;
     return;

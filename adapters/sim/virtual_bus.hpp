@@ -12,11 +12,15 @@
 // real controller would retransmit it until an error counter took it off the
 // bus; tests that want that behaviour should look at the counter instead.
 //
+// A tap (set_tap) sees every frame that completed on the wire, in wire order,
+// for captures and traces.
+//
 // Power cycling is the node's business: it detaches (sends and receives
 // nothing, its queued frames are lost), resets itself and reattaches.
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -72,8 +76,26 @@ struct BusStats {
   std::uint64_t fault_corrupted = 0;
 };
 
+// A frame as a bus analyser clamped onto the cable sees it.
+struct WireFrame {
+  can::CanFrame frame;  // as transmitted, after fault injection (a corrupted frame as corrupted)
+  NodeHandle sender;
+  TimePoint end;  // end of frame (ideal mode: the time it went out)
+  // False when no other node was attached to acknowledge it. Such frames are
+  // included: an analyser on the cable sees them (its own controller would
+  // even acknowledge them), and a node alone on the bus, e.g. a master
+  // checking its MAC before any slave is powered, is what an engineer wants to
+  // see. Frames aborted mid-way (sender detached) are not: they never complete
+  // and a real analyser shows an error frame instead.
+  bool acknowledged;
+};
+
 class VirtualBus {
  public:
+  // Called once per completed frame, before any node receives it, so that a
+  // capture lists frames in wire order. It must not send, attach or detach.
+  using Tap = std::function<void(const WireFrame&)>;
+
   explicit VirtualBus(BusConfig config = {});
   ~VirtualBus();
   VirtualBus(const VirtualBus&) = delete;
@@ -104,6 +126,9 @@ class VirtualBus {
   std::uint32_t bitrate() const noexcept { return config_.bitrate; }
   bool timed() const noexcept { return config_.bitrate != 0; }
   std::size_t queued_frames(NodeHandle node) const noexcept;
+
+  // One tap at a time; setting one replaces the previous, an empty one removes it.
+  void set_tap(Tap tap) { tap_ = std::move(tap); }
 
   FaultInjector& faults() noexcept { return faults_; }
   const BusStats& stats() const noexcept { return stats_; }
@@ -156,6 +181,7 @@ class VirtualBus {
   std::uint64_t next_seq_ = 0;
   BusStats stats_;
   std::array<std::uint64_t, can::kMaxStandardId + 1> per_id_{};
+  Tap tap_;
   TimePoint window_start_{};
   Duration window_busy_{};
 };

@@ -614,5 +614,74 @@ TEST(BusFaults, SameSeedSameRun) {
   EXPECT_NE(run_scene(4321), first);
 }
 
+// ---------------------------------------------------------------- tap
+
+TEST_F(BusTest, TapSeesEveryCompletedFrameInWireOrderBeforeTheReceivers) {
+  VirtualBus bus({.bitrate = kBitrate500k});
+  const NodeHandle a = bus.attach(a_), b = bus.attach(b_);
+  bus.attach(listener_);
+  std::vector<WireFrame> tapped;
+  std::vector<std::size_t> heard_when_tapped;
+  bus.set_tap([&](const WireFrame& f) {
+    tapped.push_back(f);
+    heard_when_tapped.push_back(listener_.count());
+  });
+  const can::CanFrame fa = frame(0x300, {1, 2}), fb = frame(0x100, {3});
+  const TimePoint t0 = at(milliseconds(1));
+  bus.send(a, fa, t0);
+  bus.send(b, fb, t0);
+  bus.advance(at(seconds(1)));
+
+  ASSERT_EQ(tapped.size(), 2u);
+  // Arbitration order, each stamped with its end of frame and its sender.
+  EXPECT_EQ(tapped[0].frame, fb);
+  EXPECT_EQ(tapped[0].sender, b);
+  EXPECT_EQ(tapped[0].end, t0 + frame_duration(fb, kBitrate500k));
+  EXPECT_TRUE(tapped[0].acknowledged);
+  EXPECT_EQ(tapped[1].frame, fa);
+  EXPECT_EQ(tapped[1].sender, a);
+  EXPECT_EQ(tapped[1].end, tapped[0].end + frame_duration(fa, kBitrate500k));
+  // The same times the receivers are given, and before they are given them.
+  EXPECT_EQ(times(listener_.heard()), (std::vector<TimePoint>{tapped[0].end, tapped[1].end}));
+  EXPECT_EQ(heard_when_tapped, (std::vector<std::size_t>{0, 1}));
+
+  // An empty tap removes it.
+  bus.set_tap({});
+  bus.send(a, fa, at(seconds(2)));
+  bus.advance(at(seconds(3)));
+  EXPECT_EQ(tapped.size(), 2u);
+  EXPECT_EQ(listener_.count(), 3u);
+}
+
+TEST_F(BusTest, TapSeesUnacknowledgedFramesButNotAbortedOnes) {
+  for (std::uint32_t bitrate : {0u, kBitrate500k}) {
+    SCOPED_TRACE(bitrate);
+    VirtualBus bus({.bitrate = bitrate});
+    const NodeHandle a = bus.attach(a_);
+    std::vector<WireFrame> tapped;
+    bus.set_tap([&](const WireFrame& f) { tapped.push_back(f); });
+    // Alone on the bus: nobody acknowledges, an analyser still sees it.
+    bus.send(a, frame(0x407, {0, 59, 0, 1, 0, 0, 0xDB}), at(milliseconds(1)));
+    bus.advance(at(seconds(1)));
+    ASSERT_EQ(tapped.size(), 1u);
+    EXPECT_FALSE(tapped[0].acknowledged);
+    EXPECT_EQ(tapped[0].end, at(milliseconds(1)) + frame_duration(tapped[0].frame, bitrate));
+    EXPECT_EQ(bus.stats().unacknowledged, 1u);
+  }
+  // Cut off mid-way: never completed, not seen.
+  VirtualBus bus({.bitrate = kBitrate500k});
+  const NodeHandle a = bus.attach(a_);
+  bus.attach(listener_);
+  std::vector<WireFrame> tapped;
+  bus.set_tap([&](const WireFrame& f) { tapped.push_back(f); });
+  bus.send(a, frame(0x101, {}), at(Duration::zero()));
+  bus.advance(at(Duration::zero()));
+  ASSERT_TRUE(bus.busy());
+  ASSERT_TRUE(bus.detach(a).ok());
+  bus.advance(at(seconds(1)));
+  EXPECT_EQ(bus.stats().aborted, 1u);
+  EXPECT_TRUE(tapped.empty());
+}
+
 }  // namespace
 }  // namespace dnbridge::sim
