@@ -1,0 +1,115 @@
+#pragma once
+// Explicit messaging on behalf of remote clients, in the transaction model of
+// a DeviceNet scanner (2100-GK61 manual, "Using DeviceNet Explicit
+// Messaging"): a request names a transaction (requester, txid) and a command
+// (1 execute, 2 get status, 3 reset all); every request gets exactly one
+// reply with a status code (1 success ... 15 connection busy) and, when the
+// device answered, its CIP general/additional status and data. A repeated
+// request is answered again, never executed twice.
+//
+// One gateway per port, owned by the port's loop like its Scanner. Sans-IO:
+// requests and scanner results come in, replies go out as return values.
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bridge/common/time.hpp"
+#include "bridge/devicenet/scanner.hpp"
+
+namespace dnbridge::rack {
+
+enum class ExplicitCommand : std::uint8_t { kExecute = 1, kGetStatus = 2, kResetAll = 3 };
+
+enum class TransactionStatus : std::uint8_t {
+  kSuccess = 1,
+  kInProgress = 2,
+  kNotInScanList = 3,
+  kSlaveOffline = 4,
+  kPortOffline = 5,  // port disabled or off-line
+  kTxidUnknown = 6,
+  kInvalidCommand = 8,
+  kOutOfBuffers = 9,
+  kOtherTransaction = 10,  // other transaction in progress
+  kCouldNotConnect = 11,
+  kResponseTooLarge = 12,
+  kInvalidPort = 13,
+  kInvalidSize = 14,
+  kConnectionBusy = 15,
+};
+
+std::string_view to_string(TransactionStatus status) noexcept;
+
+// A request as received (the DDS layer copies its sample into this).
+struct ExplicitCall {
+  std::string requester;
+  std::uint32_t txid = 0;
+  std::uint8_t command = 0;
+  std::string port;
+  std::uint8_t mac = 0;  // as received: may be out of range
+  std::uint8_t service = 0;
+  std::uint16_t class_id = 0;
+  std::uint16_t instance_id = 0;
+  std::optional<std::uint8_t> attribute;
+  std::vector<std::uint8_t> data;
+
+  // The parts that make two executions the same request.
+  bool same_request(const ExplicitCall& other) const;
+};
+
+struct ExplicitAnswer {
+  std::string requester;
+  std::uint32_t txid = 0;
+  TransactionStatus status = TransactionStatus::kSuccess;
+  std::uint8_t general_status = 0;  // the device's CIP general status; 0 when none
+  std::uint8_t additional_status = cip::kNoAdditionalCode;
+  std::vector<std::uint8_t> data;
+  std::string message;
+};
+
+// A reply that refuses `call` without executing it.
+ExplicitAnswer refuse(const ExplicitCall& call, TransactionStatus status, std::string message);
+
+class ExplicitGateway {
+ public:
+  struct Limits {
+    std::size_t in_progress = 32;  // transactions executing at once (then "out of buffers")
+    std::size_t retained = 256;    // completed transactions kept to answer repeats
+  };
+
+  explicit ExplicitGateway(devicenet::Scanner& scanner) : ExplicitGateway(scanner, Limits{}) {}
+  ExplicitGateway(devicenet::Scanner& scanner, Limits limits);
+
+  // A request for this gateway's port. Returns the reply to send now, if one
+  // is due now (executions reply later, from on_result()).
+  std::optional<ExplicitAnswer> on_request(const ExplicitCall& call, TimePoint now);
+  // A result the scanner reported (ScannerObserver::on_explicit_result).
+  // Returns the reply of the transaction it completes, if it is one of ours.
+  std::optional<ExplicitAnswer> on_result(std::uint32_t request_id,
+                                          const devicenet::ExplicitResult& result, TimePoint now);
+
+  std::size_t in_progress() const { return by_request_id_.size(); }
+  std::size_t retained() const { return done_order_.size(); }
+
+ private:
+  using Key = std::pair<std::string, std::uint32_t>;
+  struct Transaction {
+    ExplicitCall call;
+    bool done = false;
+    ExplicitAnswer answer;  // when done
+  };
+
+  std::optional<ExplicitAnswer> execute(const ExplicitCall& call, TimePoint now);
+  void retain(const Key& key);
+
+  devicenet::Scanner& scanner_;
+  Limits limits_;
+  std::map<Key, Transaction> transactions_;
+  std::map<std::uint32_t, Key> by_request_id_;  // executing
+  std::deque<Key> done_order_;                  // completed, oldest first
+};
+
+}  // namespace dnbridge::rack
