@@ -44,7 +44,7 @@ PumpRack::PumpRack(const std::vector<PumpConfig>& pumps) {
     v.name = p.node.name;
     v.reason = "not started";
     views_.push_back(std::move(v));
-    slots_.push_back({p.io, *format});
+    slots_.push_back({p.io, *format, p.no_commander});
   }
 }
 
@@ -58,22 +58,47 @@ const PumpView* PumpRack::pump(MacId mac) const {
   return i < 0 ? nullptr : &views_[static_cast<std::size_t>(i)];
 }
 
-Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, TimePoint now) {
+Status PumpRack::refuse(PumpView& view, Status why, std::string text) {
+  ++view.commands_refused;
+  view.last_command_refused = std::move(text);
+  ++view.changes;
+  return why;
+}
+
+Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, std::string_view issuer,
+                         TimePoint now) {
   PumpView* v = find(mac);
   if (!v || !scanner_) return Errc::kOutOfRange;
-  if (auto ok = cdn127::validate(outputs); !ok) return ok;
+  if (auto ok = cdn127::validate(outputs); !ok) {
+    return refuse(*v, ok,
+                  fmt::format("from {}: analog output {} is out of range 0..{}", issuer,
+                              outputs.analog_out_raw, cdn127::kAnalogMaxRaw));
+  }
   const auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
   const auto& layout = slot.format.request;
   // An output the configuration leaves out of the poll request cannot be
   // commanded: refuse it rather than drop it silently.
-  if (outputs.analog_out_raw != 0 && layout.aout_count == 0) return Errc::kUnsupported;
-  if (outputs.pump_on && slot.io.num_digital_outputs < 1) return Errc::kUnsupported;
-  if (outputs.n2_ballast_on && slot.io.num_digital_outputs < 3) return Errc::kUnsupported;
+  if (outputs.analog_out_raw != 0 && layout.aout_count == 0) {
+    return refuse(*v, Errc::kUnsupported,
+                  fmt::format("from {}: the node's configuration has no analog output", issuer));
+  }
+  if (outputs.pump_on && slot.io.num_digital_outputs < 1) {
+    return refuse(*v, Errc::kUnsupported,
+                  fmt::format("from {}: the node's configuration has no pump output", issuer));
+  }
+  if (outputs.n2_ballast_on && slot.io.num_digital_outputs < 3) {
+    return refuse(*v, Errc::kUnsupported,
+                  fmt::format("from {}: the node's configuration has no N2 ballast output", issuer));
+  }
   std::array<std::uint8_t, 8> buf{};
   auto size = cdn127::encode_poll_request(layout, outputs, MutableBytes(buf));
-  if (!size) return size.error();
-  if (auto s = scanner_->set_outputs(mac, Bytes(buf.data(), *size), now); !s) return s;
+  if (!size) return refuse(*v, size.error(), fmt::format("from {}: {}", issuer, size.error().message()));
+  if (auto s = scanner_->set_outputs(mac, Bytes(buf.data(), *size), now); !s) {
+    return refuse(*v, s, fmt::format("from {}: {}", issuer, s.error().message()));
+  }
   v->outputs_requested = outputs;
+  v->commanded_by = std::string(issuer);
+  ++v->commands_accepted;
   ++v->changes;
   return {};
 }
@@ -81,7 +106,10 @@ Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, TimePoin
 Status PumpRack::release_command(MacId mac, TimePoint now) {
   PumpView* v = find(mac);
   if (!v || !scanner_) return Errc::kOutOfRange;
+  const auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
+  if (slot.no_commander == NoCommanderPolicy::kHoldLastOutputs) return {};
   v->outputs_requested.reset();
+  v->commanded_by.clear();
   ++v->changes;
   return scanner_->set_idle(mac, true, now);
 }
@@ -99,6 +127,7 @@ void PumpRack::on_node_state(MacId mac, NodeState, NodeState to, const std::stri
   v->reason = reason;
   v->state_since = at;
   v->online = to == NodeState::kOnline;
+  v->has_inputs = false;  // until a poll response since this transition
   ++v->changes;
 }
 

@@ -17,8 +17,15 @@ namespace dnbridge::rack {
 
 // One pump's configuration in the rack: the scan-list entry and the CDN127
 // I/O configuration its poll data is decoded with.
+// What the bridge does with a pump when no live commander is left.
+enum class NoCommanderPolicy : std::uint8_t {
+  kIdle,             // idle polls: the device applies its own configured idle actions
+  kHoldLastOutputs,  // keep polling the last commanded outputs
+};
+
 struct PumpConfig {
   devicenet::NodeConfig node;
+  NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
   profiles::cdn127::IoConfiguration io;
   // The identity the device must show; the CDN127's (vendor 59, product type
   // 27, product code 1888) when not given.
@@ -41,8 +48,14 @@ struct PumpView {
   // Outputs the device applied with its last answered poll.
   bool outputs_idle = true;
   profiles::cdn127::PumpOutputs outputs_applied;
-  // Outputs requested by the layer above (not yet necessarily applied).
+  // Outputs requested by the layer above (not yet necessarily applied), and
+  // who asked for them.
   std::optional<profiles::cdn127::PumpOutputs> outputs_requested;
+  std::string commanded_by;
+
+  std::uint64_t commands_accepted = 0;
+  std::uint64_t commands_refused = 0;
+  std::string last_command_refused;  // why the last refused command was refused
 
   devicenet::NodeIdentity identity;
   std::optional<std::uint8_t> device_state;
@@ -63,10 +76,17 @@ class PumpRack final : public devicenet::ScannerObserver {
 
   // Validates and forwards new outputs: refused, never clipped, when out of
   // range; refused when the configuration has no room for them (e.g. an
-  // analog value for a configuration without analog output).
-  Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs, TimePoint now);
-  // No live commander: the node polls idle so the device applies its own
-  // configured idle actions.
+  // analog value for a configuration without analog output). A refusal is
+  // counted and its reason kept in the pump's view; nothing of the command
+  // is applied. kOutOfRange for a MAC not in the rack.
+  Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
+                 std::string_view issuer, TimePoint now);
+  Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs, TimePoint now) {
+    return command(mac, outputs, "local", now);
+  }
+  // No live commander left: the node goes idle (zero-length polls, so the
+  // device applies its own configured idle actions) or, if configured so,
+  // keeps its last outputs.
   Status release_command(devicenet::MacId mac, TimePoint now);
 
   const std::vector<PumpView>& pumps() const { return views_; }
@@ -87,7 +107,9 @@ class PumpRack final : public devicenet::ScannerObserver {
   struct Slot {
     profiles::cdn127::IoConfiguration io;
     profiles::cdn127::PollFormat format;
+    NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
   };
+  Status refuse(PumpView& view, Status why, std::string text);
   PumpView* find(devicenet::MacId mac);
   void refresh_applied(std::size_t index);
 

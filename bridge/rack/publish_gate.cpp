@@ -1,0 +1,55 @@
+#include "bridge/rack/publish_gate.hpp"
+
+#include <cmath>
+
+namespace dnbridge::rack {
+
+PumpStateGate::Discrete PumpStateGate::discrete(const PumpView& v) {
+  Discrete d;
+  d.online = v.online;
+  d.inputs_valid = v.has_inputs;
+  if (v.has_inputs) {
+    d.input_bits = v.inputs.input_bits.value_or(0);
+    d.has_exception = v.inputs.exception_status.has_value();
+    if (d.has_exception) d.exception_bits = v.inputs.exception_status->encode();
+  }
+  d.outputs_idle = v.outputs_idle;
+  if (!v.outputs_idle) d.outputs = v.outputs_applied;
+  return d;
+}
+
+std::array<int, 2> PumpStateGate::analog(const PumpView& v) {
+  std::array<int, 2> a{-1, -1};
+  if (!v.has_inputs) return a;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (v.inputs.analog_inputs_raw[i]) a[i] = *v.inputs.analog_inputs_raw[i];
+  }
+  return a;
+}
+
+bool PumpStateGate::due(const PumpView& view, TimePoint now) const {
+  if (!published_once_ || now >= last_time_ + policy_.max_period) return true;
+  if (!(discrete(view) == last_)) return true;
+  if (view.commanded_by != last_commander_) return true;
+  const auto now_analog = analog(view);
+  for (std::size_t i = 0; i < now_analog.size(); ++i) {
+    const int before = last_analog_[i];
+    const int after = now_analog[i];
+    if ((before < 0) != (after < 0)) return true;  // appeared or disappeared
+    if (before < 0) continue;
+    const double delta = std::abs(profiles::cdn127::raw_to_volts(static_cast<std::uint16_t>(after)) -
+                                  profiles::cdn127::raw_to_volts(static_cast<std::uint16_t>(before)));
+    if (delta > policy_.analog_deadband_volts) return true;
+  }
+  return false;
+}
+
+void PumpStateGate::published(const PumpView& view, TimePoint now) {
+  published_once_ = true;
+  last_time_ = now;
+  last_ = discrete(view);
+  last_analog_ = analog(view);
+  last_commander_ = view.commanded_by;
+}
+
+}  // namespace dnbridge::rack

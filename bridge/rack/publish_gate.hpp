@@ -1,0 +1,55 @@
+#pragma once
+// When a pump's state is worth a new sample: at once on any change of a
+// discrete value (online, inputs, alarms, outputs, idle, who commands), on an
+// analog change larger than the deadband, and in any case once per maximum
+// period, so that readers can hold the bridge to a deadline.
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "bridge/common/time.hpp"
+#include "bridge/rack/pump_rack.hpp"
+
+namespace dnbridge::rack {
+
+struct PublishPolicy {
+  Duration max_period = seconds(1);
+  double analog_deadband_volts = 0.05;
+};
+
+class PumpStateGate {
+ public:
+  explicit PumpStateGate(PublishPolicy policy) : policy_(policy) {}
+
+  // True if `view` differs enough from what was last published, or the
+  // maximum period has passed.
+  bool due(const PumpView& view, TimePoint now) const;
+  void published(const PumpView& view, TimePoint now);
+  // When the maximum period next forces a sample (kNever before the first).
+  TimePoint deadline() const { return published_once_ ? last_time_ + policy_.max_period : kNever; }
+  const PublishPolicy& policy() const { return policy_; }
+
+ private:
+  // The discrete part of a view: any difference is published.
+  struct Discrete {
+    bool online = false;
+    bool inputs_valid = false;
+    std::uint8_t input_bits = 0;
+    std::uint8_t exception_bits = 0;
+    bool has_exception = false;
+    bool outputs_idle = true;
+    profiles::cdn127::PumpOutputs outputs;
+    friend bool operator==(const Discrete&, const Discrete&) = default;
+  };
+  static Discrete discrete(const PumpView& view);
+  static std::array<int, 2> analog(const PumpView& view);
+
+  PublishPolicy policy_;
+  bool published_once_ = false;
+  TimePoint last_time_{};
+  Discrete last_;
+  std::array<int, 2> last_analog_{-1, -1};
+  std::string last_commander_;
+};
+
+}  // namespace dnbridge::rack
