@@ -26,6 +26,7 @@ class SimWorld {
   SimWorld& operator=(const SimWorld&) = delete;
 
   VirtualBus& bus() { return bus_; }
+  const VirtualBus& bus() const { return bus_; }
   TimePoint now() const { return now_; }
 
   // Adds an endpoint that is already attached to the bus (endpoints attach

@@ -62,6 +62,7 @@ Status PumpRack::refuse(PumpView& view, Status why, std::string text) {
   ++view.commands_refused;
   view.last_command_refused = std::move(text);
   ++view.changes;
+  ++view.status_changes;
   return why;
 }
 
@@ -129,12 +130,14 @@ void PumpRack::on_node_state(MacId mac, NodeState, NodeState to, const std::stri
   v->online = to == NodeState::kOnline;
   v->has_inputs = false;  // until a poll response since this transition
   ++v->changes;
+  ++v->status_changes;
 }
 
 void PumpRack::on_node_identity(MacId mac, const devicenet::NodeIdentity& identity, TimePoint) {
   if (PumpView* v = find(mac)) {
     v->identity = identity;
     ++v->changes;
+    ++v->status_changes;
   }
 }
 
@@ -171,6 +174,7 @@ void PumpRack::on_device_state(MacId mac, std::uint8_t state, TimePoint) {
   if (PumpView* v = find(mac)) {
     v->device_state = state;
     ++v->changes;
+    ++v->status_changes;
   }
 }
 

@@ -59,7 +59,9 @@ struct PumpView {
 
   devicenet::NodeIdentity identity;
   std::optional<std::uint8_t> device_state;
-  std::uint64_t changes = 0;  // bumped on every change, for publishers
+  std::uint64_t changes = 0;         // bumped on every change, for publishers
+  std::uint64_t status_changes = 0;  // bumped on changes of state, identity,
+                                     // device state and command refusals only
 };
 
 class PumpRack final : public devicenet::ScannerObserver {

@@ -1,0 +1,48 @@
+#pragma once
+// Where a port's frames come from and go to: the in-process simulated bus, or
+// a SocketCAN interface. Used from the port's own thread only, except wake().
+#include <cstdint>
+#include <string>
+
+#include "bridge/can/can_frame.hpp"
+#include "bridge/can/frame_sink.hpp"
+#include "bridge/common/time.hpp"
+
+namespace dnbridge::port {
+
+class FrameReceiver {
+ public:
+  virtual ~FrameReceiver() = default;
+  virtual void on_frame(const can::CanFrame& frame, TimePoint rx_time) = 0;
+};
+
+// CAN controller state, as the interface reports it.
+enum class BusState : std::uint8_t { kErrorActive, kErrorWarning, kErrorPassive, kBusOff, kUnknown };
+
+struct BusCounters {
+  BusState state = BusState::kUnknown;
+  std::uint16_t tx_errors = 0;  // transmit error counter
+  std::uint16_t rx_errors = 0;  // receive error counter
+  std::uint64_t frames = 0;     // frames seen on the bus, both ways
+  std::uint64_t bits = 0;       // their length on the wire, stuffing included
+};
+
+class CanBackend {
+ public:
+  virtual ~CanBackend() = default;
+
+  virtual can::FrameSink& sink() = 0;
+  // The backend's monotonic time: the clock its receive times are on.
+  virtual TimePoint now() const = 0;
+  // Hands received frames to `receiver` and returns when at least one was
+  // handled, `deadline` has come, or wake() was called.
+  virtual void wait(TimePoint deadline, FrameReceiver& receiver) = 0;
+  // Makes a wait() in progress (or the next one) return at once. Any thread.
+  virtual void wake() = 0;
+
+  virtual BusCounters counters() const = 0;
+  virtual std::string interface_name() const = 0;  // "can0", "simulated"
+  virtual std::uint32_t bitrate() const = 0;
+};
+
+}  // namespace dnbridge::port

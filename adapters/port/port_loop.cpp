@@ -1,0 +1,234 @@
+#include "adapters/port/port_loop.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace dnbridge::port {
+
+using devicenet::MacId;
+
+PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
+                   PortPublisher& publisher, LogSink& log)
+    : config_(std::move(config)),
+      backend_(std::move(backend)),
+      publisher_(publisher),
+      log_(log, fmt::format("port {}", config_.port)),
+      rack_(config_.pumps) {
+  devicenet::ScannerObserver& observer = *this;
+  scanner_.emplace(rack::PumpRack::scanner_config(config_.scanner, config_.pumps), backend_->sink(),
+                   observer, Logger(log, fmt::format("port {}", config_.port)));
+  rack_.attach(*scanner_);
+  gateway_.emplace(*scanner_);
+  for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
+    const rack::PublishPolicy policy =
+        i < config_.publish.size() ? config_.publish[i] : rack::PublishPolicy{};
+    published_.push_back(Published{rack::PumpStateGate(policy)});
+  }
+  last_polls_.assign(config_.pumps.size(), 0);
+}
+
+PortLoop::~PortLoop() {
+  if (thread_.joinable()) {
+    stop();
+    join();
+  }
+}
+
+void PortLoop::start() {
+  running_ = true;
+  thread_ = std::thread([this] { run(); });
+}
+
+void PortLoop::stop() { push(Stop{}); }
+
+void PortLoop::join() {
+  if (thread_.joinable()) thread_.join();
+}
+
+bool PortLoop::has_node(MacId mac) const {
+  return std::any_of(config_.pumps.begin(), config_.pumps.end(),
+                     [&](const rack::PumpConfig& p) { return p.node.mac == mac; });
+}
+
+void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs, std::string issuer) {
+  push(Command{mac, outputs, std::move(issuer)});
+}
+void PortLoop::release_command(MacId mac) { push(Release{mac}); }
+void PortLoop::explicit_request(rack::ExplicitCall call) { push(std::move(call)); }
+void PortLoop::post(std::function<void(CanBackend&)> fn) { push(std::move(fn)); }
+
+void PortLoop::push(Item item) {
+  {
+    std::lock_guard lock(inbox_mutex_);
+    inbox_.push_back(std::move(item));
+  }
+  backend_->wake();
+}
+
+bool PortLoop::drain_inbox(TimePoint now) {
+  std::vector<Item> items;
+  {
+    std::lock_guard lock(inbox_mutex_);
+    items.swap(inbox_);
+  }
+  bool keep_running = true;
+  for (auto& item : items) {
+    if (auto* c = std::get_if<Command>(&item)) {
+      if (auto s = rack_.command(c->mac, c->outputs, c->issuer, now); !s) {
+        if (!has_node(c->mac)) {
+          log_.warn("command from {} for MAC {} refused: not in this port's scan list", c->issuer,
+                    c->mac.value());
+        } else {
+          log_.warn("command refused: {}", rack_.pump(c->mac)->last_command_refused);
+        }
+      }
+    } else if (auto* r = std::get_if<Release>(&item)) {
+      if (rack_.release_command(r->mac, now)) {
+        log_.info("node {}: no live commander left", r->mac.value());
+      }
+    } else if (auto* call = std::get_if<rack::ExplicitCall>(&item)) {
+      if (auto answer = gateway_->on_request(*call, now)) publisher_.explicit_reply(*answer);
+    } else if (auto* fn = std::get_if<std::function<void(CanBackend&)>>(&item)) {
+      (*fn)(*backend_);
+    } else {
+      keep_running = false;
+    }
+  }
+  return keep_running;
+}
+
+void PortLoop::run() {
+  TimePoint now = backend_->now();
+  metrics_time_ = now;
+  port_status_time_ = now;
+  scanner_->start(now);
+  bool stopping = false;
+  TimePoint stop_deadline = kNever;
+  for (;;) {
+    now = backend_->now();
+    while (scanner_->next_deadline() <= now) scanner_->on_timer(now);
+    if (!drain_inbox(now) && !stopping) {
+      stopping = true;
+      stop_deadline = now + config_.shutdown_timeout;
+      log_.info("stopping: idling and releasing every node");
+      scanner_->stop(now);
+    }
+    publish(now, false);
+    if (stopping && (scanner_->stopped() || now >= stop_deadline)) break;
+
+    TimePoint wake = std::min({scanner_->next_deadline(), stop_deadline,
+                               port_status_time_ + config_.status_period});
+    for (const auto& p : published_) {
+      wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
+    }
+    FrameReceiver& receiver = *this;
+    backend_->wait(wake, receiver);
+  }
+  if (!scanner_->stopped()) log_.warn("stopped before every node was released");
+  publish(backend_->now(), true);
+  publisher_.port_stopped(config_.port);
+  running_ = false;
+}
+
+void PortLoop::publish(TimePoint now, bool force) {
+  const auto& views = rack_.pumps();
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const rack::PumpView& v = views[i];
+    Published& p = published_[i];
+    // The source time is that of the latest event the sample reflects.
+    TimePoint source = v.state_since;
+    if (v.has_inputs) source = std::max(source, v.inputs_time);
+    if (force || p.gate.due(v, now)) {
+      publisher_.pump_state(config_.port, v, source);
+      p.gate.published(v, now);
+    }
+    if (force || !p.status_once || v.status_changes != p.changes ||
+        now >= p.status_time + config_.status_period) {
+      publisher_.node_status(config_.port, v, *scanner_->node(v.mac), std::max(source, p.status_time));
+      p.changes = v.status_changes;
+      p.status_time = now;
+      p.status_once = true;
+    }
+  }
+  if (force || port_dirty_ || now >= port_status_time_ + config_.status_period) publish_port(now);
+}
+
+void PortLoop::publish_port(TimePoint now) {
+  PortStatusView s;
+  s.port = config_.port;
+  s.interface_name = backend_->interface_name();
+  s.bitrate = backend_->bitrate();
+  s.master_mac = config_.scanner.master_mac;
+  s.state = scanner_->state();
+  s.reason = scanner_->reason();
+  s.bus = backend_->counters();
+  s.nodes_configured = static_cast<std::uint16_t>(config_.pumps.size());
+  for (const auto& p : config_.pumps) {
+    if (scanner_->node(p.node.mac)->state() == devicenet::NodeState::kOnline) ++s.nodes_online;
+  }
+  // Rates are measured over whole status periods; a state change in between
+  // publishes the last measured ones.
+  if (now - metrics_time_ >= config_.status_period) update_metrics(s.bus, now);
+  s.frames_per_second = metrics_.frames_per_second;
+  s.bus_load_percent = metrics_.bus_load_percent;
+  s.scan_cycle_ms = metrics_.scan_cycle_ms;
+  publisher_.port_status(s, std::max(now, port_event_time_));
+  port_status_time_ = now;
+  port_dirty_ = false;
+}
+
+void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
+  const double elapsed = std::chrono::duration<double>(now - metrics_time_).count();
+  double cycle_sum = 0;
+  unsigned cycles = 0;
+  for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
+    const auto* node = scanner_->node(config_.pumps[i].node.mac);
+    const std::uint64_t polls = node->counters().polls;
+    if (node->state() == devicenet::NodeState::kOnline && polls > last_polls_[i]) {
+      cycle_sum += 1000.0 * elapsed / static_cast<double>(polls - last_polls_[i]);
+      ++cycles;
+    }
+    last_polls_[i] = polls;
+  }
+  metrics_.frames_per_second = static_cast<double>(bus.frames - last_counters_.frames) / elapsed;
+  const auto bitrate = backend_->bitrate();
+  metrics_.bus_load_percent =
+      bitrate ? 100.0 * static_cast<double>(bus.bits - last_counters_.bits) /
+                    (static_cast<double>(bitrate) * elapsed)
+              : 0.0;
+  metrics_.scan_cycle_ms = cycles ? cycle_sum / cycles : 0.0;
+  last_counters_ = bus;
+  metrics_time_ = now;
+}
+
+void PortLoop::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
+  scanner_->on_frame(frame, rx_time);
+}
+
+void PortLoop::on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) {
+  rack_.on_port_state(s, r, at);
+  port_dirty_ = true;
+  port_event_time_ = at;
+}
+void PortLoop::on_node_state(MacId m, devicenet::NodeState f, devicenet::NodeState t,
+                             const std::string& r, TimePoint at) {
+  if (t == devicenet::NodeState::kOnline || f == devicenet::NodeState::kOnline) {
+    log_.info("node {} {} -> {}: {}", m.value(), devicenet::to_string(f), devicenet::to_string(t), r);
+  }
+  rack_.on_node_state(m, f, t, r, at);
+  port_dirty_ = true;
+}
+void PortLoop::on_node_identity(MacId m, const devicenet::NodeIdentity& i, TimePoint at) {
+  rack_.on_node_identity(m, i, at);
+}
+void PortLoop::on_poll_response(MacId m, Bytes d, TimePoint at) { rack_.on_poll_response(m, d, at); }
+void PortLoop::on_device_state(MacId m, std::uint8_t s, TimePoint at) {
+  rack_.on_device_state(m, s, at);
+}
+void PortLoop::on_explicit_result(std::uint32_t id, MacId, const devicenet::ExplicitResult& r,
+                                  TimePoint at) {
+  if (auto answer = gateway_->on_result(id, r, at)) publisher_.explicit_reply(*answer);
+}
+
+}  // namespace dnbridge::port

@@ -1,0 +1,128 @@
+#pragma once
+// One CAN port's event loop, on a thread of its own. It owns the port's
+// DeviceNet master (Scanner), the rack model of its pumps, the explicit
+// gateway and the CAN backend; nothing else touches them. Other threads
+// (the DDS input) talk to it through its inbox, which wakes it. State is
+// published from here.
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "adapters/port/can_backend.hpp"
+#include "adapters/port/port_publisher.hpp"
+#include "bridge/common/log.hpp"
+#include "bridge/devicenet/scanner.hpp"
+#include "bridge/rack/explicit_gateway.hpp"
+#include "bridge/rack/publish_gate.hpp"
+#include "bridge/rack/pump_rack.hpp"
+
+namespace dnbridge::port {
+
+struct PortLoopConfig {
+  std::string port;                         // the port's name
+  devicenet::ScannerConfig scanner;         // master MAC and timings; nodes from `pumps`
+  std::vector<rack::PumpConfig> pumps;      // the scan list
+  std::vector<rack::PublishPolicy> publish; // per pump, same order
+  Duration status_period = seconds(1);      // NodeStatus/PortStatus at least this often
+  Duration shutdown_timeout = seconds(3);   // for idling and releasing every node
+};
+
+class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver {
+ public:
+  // Throws std::invalid_argument for a configuration the master refuses.
+  PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend, PortPublisher& publisher,
+           LogSink& log);
+  ~PortLoop() override;
+  PortLoop(const PortLoop&) = delete;
+  PortLoop& operator=(const PortLoop&) = delete;
+
+  void start();
+  // Orderly stop: every node idle, then released; then the port's instances
+  // are unregistered. Returns at once; join() waits.
+  void stop();
+  void join();
+
+  // From any thread: queued for the port's thread, which is woken.
+  void command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
+               std::string issuer);
+  void release_command(devicenet::MacId mac);
+  void explicit_request(rack::ExplicitCall call);
+  // Runs `fn` on the port's thread with its backend (tests and tools only).
+  void post(std::function<void(CanBackend&)> fn);
+
+  const std::string& name() const { return config_.port; }
+  bool has_node(devicenet::MacId mac) const;
+
+ private:
+  struct Command {
+    devicenet::MacId mac;
+    profiles::cdn127::PumpOutputs outputs;
+    std::string issuer;
+  };
+  struct Release {
+    devicenet::MacId mac;
+  };
+  struct Stop {};
+  using Item = std::variant<Command, Release, rack::ExplicitCall, Stop,
+                            std::function<void(CanBackend&)>>;
+
+  void run();
+  void push(Item item);
+  bool drain_inbox(TimePoint now);  // false once a Stop was seen
+  void publish(TimePoint now, bool force);
+  void publish_port(TimePoint now);
+  void update_metrics(const BusCounters& bus, TimePoint now);
+
+  // ScannerObserver: the rack model and the gateway hear the master first.
+  void on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) override;
+  void on_node_state(devicenet::MacId m, devicenet::NodeState f, devicenet::NodeState t,
+                     const std::string& r, TimePoint at) override;
+  void on_node_identity(devicenet::MacId m, const devicenet::NodeIdentity& i, TimePoint at) override;
+  void on_poll_response(devicenet::MacId m, Bytes d, TimePoint at) override;
+  void on_device_state(devicenet::MacId m, std::uint8_t s, TimePoint at) override;
+  void on_explicit_result(std::uint32_t id, devicenet::MacId m, const devicenet::ExplicitResult& r,
+                          TimePoint at) override;
+  // FrameReceiver
+  void on_frame(const can::CanFrame& frame, TimePoint rx_time) override;
+
+  PortLoopConfig config_;
+  std::unique_ptr<CanBackend> backend_;
+  PortPublisher& publisher_;
+  Logger log_;
+  rack::PumpRack rack_;
+  std::optional<devicenet::Scanner> scanner_;
+  std::optional<rack::ExplicitGateway> gateway_;
+
+  struct Published {
+    rack::PumpStateGate gate;
+    std::uint64_t changes = ~0ull;   // PumpView::changes at the last NodeStatus
+    TimePoint status_time{};
+    bool status_once = false;
+    TimePoint event_time{};          // latest event of this node: the source time
+  };
+  std::vector<Published> published_;
+  bool port_dirty_ = true;
+  TimePoint port_status_time_{};
+  TimePoint port_event_time_{};
+  BusCounters last_counters_{};
+  std::vector<std::uint64_t> last_polls_;
+  TimePoint metrics_time_{};
+  struct Metrics {
+    double frames_per_second = 0;
+    double bus_load_percent = 0;
+    double scan_cycle_ms = 0;
+  } metrics_;
+
+  std::mutex inbox_mutex_;
+  std::vector<Item> inbox_;
+  std::thread thread_;
+  std::atomic<bool> running_{false};
+};
+
+}  // namespace dnbridge::port

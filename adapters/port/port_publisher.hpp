@@ -1,0 +1,45 @@
+#pragma once
+// What a port's loop hands to the DDS face: plain views, called on the
+// port's own thread. Implementations copy what they need and return quickly.
+#include <cstdint>
+#include <string>
+
+#include "adapters/port/can_backend.hpp"
+#include "bridge/devicenet/node.hpp"
+#include "bridge/devicenet/scanner_events.hpp"
+#include "bridge/rack/explicit_gateway.hpp"
+#include "bridge/rack/pump_rack.hpp"
+
+namespace dnbridge::port {
+
+struct PortStatusView {
+  std::string port;
+  std::string interface_name;
+  std::uint32_t bitrate = 0;
+  devicenet::MacId master_mac;
+  devicenet::PortState state = devicenet::PortState::kStopped;
+  std::string reason;
+  BusCounters bus;
+  double frames_per_second = 0;
+  double bus_load_percent = 0;
+  double scan_cycle_ms = 0;  // mean interval between two polls of an online node
+  std::uint16_t nodes_online = 0;
+  std::uint16_t nodes_configured = 0;
+};
+
+class PortPublisher {
+ public:
+  virtual ~PortPublisher() = default;
+  // `source_time` is the monotonic time of the event the sample comes from
+  // (a frame's receive time, or a timer's); the publisher maps it to the
+  // wall clock DDS timestamps use.
+  virtual void pump_state(const std::string& port, const rack::PumpView& pump, TimePoint source_time) = 0;
+  virtual void node_status(const std::string& port, const rack::PumpView& pump,
+                           const devicenet::Node& node, TimePoint source_time) = 0;
+  virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;
+  virtual void explicit_reply(const rack::ExplicitAnswer& answer) = 0;
+  // The port has stopped: its instances are unregistered (never disposed).
+  virtual void port_stopped(const std::string& port) = 0;
+};
+
+}  // namespace dnbridge::port

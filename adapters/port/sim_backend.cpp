@@ -1,0 +1,94 @@
+#include "adapters/port/sim_backend.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <stdexcept>
+
+#include "adapters/sim/sim_rack.hpp"
+
+namespace dnbridge::port {
+namespace {
+
+TimePoint steady_now() {
+  return TimePoint(std::chrono::duration_cast<Duration>(
+      std::chrono::steady_clock::now().time_since_epoch()));
+}
+
+std::chrono::steady_clock::time_point to_steady(TimePoint t) {
+  return std::chrono::steady_clock::time_point(
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(t.time_since_epoch()));
+}
+
+}  // namespace
+
+SimBackend::SimBackend(std::uint32_t bitrate, const std::vector<devicenet::MacId>& device_macs,
+                       LogSink* log)
+    : world_(sim::BusConfig{bitrate}, steady_now()), handle_(world_.bus().attach(*this)) {
+  for (auto mac : device_macs) {
+    Logger device_log = log ? Logger(*log, fmt::format("sim {}", mac.value())) : Logger();
+    devices_[mac.value()] = std::make_unique<sim::SimSlave>(world_, sim::default_slave_options(mac),
+                                                            world_.now(), std::move(device_log));
+  }
+}
+
+SimBackend::~SimBackend() { (void)world_.bus().detach(handle_); }
+
+TimePoint SimBackend::now() const { return steady_now(); }
+
+sim::SimSlave& SimBackend::device(devicenet::MacId mac) {
+  auto it = devices_.find(mac.value());
+  if (it == devices_.end()) throw std::out_of_range(fmt::format("no simulated device {}", mac.value()));
+  return *it->second;
+}
+
+void SimBackend::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
+  received_.emplace_back(frame, rx_time);
+}
+
+void SimBackend::wait(TimePoint deadline, FrameReceiver& receiver) {
+  for (;;) {
+    // Bring the simulated world up to the real time; what it sends the
+    // master is handed over with its simulated receive time.
+    world_.run_until(std::max(world_.now(), now()));
+    if (!received_.empty()) {
+      while (!received_.empty()) {
+        auto [frame, rx] = received_.front();
+        received_.pop_front();
+        receiver.on_frame(frame, rx);
+      }
+      world_.run_until(std::max(world_.now(), now()));
+      return;
+    }
+    const TimePoint until = std::min(deadline, world_.next_event());
+    std::unique_lock lock(mutex_);
+    if (wake_) {
+      wake_ = false;
+      return;
+    }
+    if (now() >= deadline) return;
+    woken_.wait_until(lock, to_steady(until), [&] { return wake_; });
+    if (wake_) {
+      wake_ = false;
+      return;
+    }
+  }
+}
+
+void SimBackend::wake() {
+  {
+    std::lock_guard lock(mutex_);
+    wake_ = true;
+  }
+  woken_.notify_one();
+}
+
+BusCounters SimBackend::counters() const {
+  BusCounters c;
+  c.state = BusState::kErrorActive;  // the simulated bus has no error confinement
+  c.frames = world_.bus().stats().transmitted;
+  c.bits = world_.bus().stats().bits;
+  return c;
+}
+
+}  // namespace dnbridge::port

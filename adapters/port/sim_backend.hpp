@@ -1,0 +1,52 @@
+#pragma once
+// The simulated bus as a port's CAN backend: a SimWorld with a simulated
+// CDN127 per node, run in real time on the steady clock. The master is not a
+// simulation endpoint here: its frames reach the world through sink(), and
+// the world's frames reach it through wait(), exactly as with a real bus.
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "adapters/port/can_backend.hpp"
+#include "adapters/sim/sim_slave.hpp"
+#include "adapters/sim/sim_world.hpp"
+
+namespace dnbridge::port {
+
+class SimBackend final : public CanBackend, private sim::BusPort {
+ public:
+  // A simulated bus at `bitrate` with a CDN127 at each of `device_macs`,
+  // powered on now.
+  SimBackend(std::uint32_t bitrate, const std::vector<devicenet::MacId>& device_macs,
+             LogSink* log = nullptr);
+  ~SimBackend() override;
+
+  can::FrameSink& sink() override { return world_.bus().sink(handle_); }
+  TimePoint now() const override;
+  void wait(TimePoint deadline, FrameReceiver& receiver) override;
+  void wake() override;
+  BusCounters counters() const override;
+  std::string interface_name() const override { return "simulated"; }
+  std::uint32_t bitrate() const override { return world_.bus().bitrate(); }
+
+  // The simulated devices, for tests and demonstrations (port thread only).
+  sim::SimWorld& world() { return world_; }
+  sim::SimSlave& device(devicenet::MacId mac);
+
+ private:
+  void on_frame(const can::CanFrame& frame, TimePoint rx_time) override;
+
+  sim::SimWorld world_;
+  sim::NodeHandle handle_;
+  std::map<unsigned, std::unique_ptr<sim::SimSlave>> devices_;
+  std::deque<std::pair<can::CanFrame, TimePoint>> received_;
+
+  std::mutex mutex_;
+  std::condition_variable woken_;
+  bool wake_ = false;
+};
+
+}  // namespace dnbridge::port
