@@ -75,12 +75,12 @@ Node::Node(const NodeConfig& config, const ScannerConfig& port, can::FrameSink& 
 // ---------------------------------------------------------------------------
 // Life cycle
 
-void Node::start(TimePoint first_attempt) {
+void Node::start(TimePoint now, TimePoint first_attempt) {
   started_ = true;
   shutting_down_ = false;
   retry_at_ = first_attempt;
   retry_delay_ = port_.allocate_retry_min;
-  set_state(NodeState::kAbsent, "waiting for the first Allocate", first_attempt);
+  set_state(NodeState::kAbsent, "waiting for the first Allocate", now);
 }
 
 void Node::set_state(NodeState next, std::string reason, TimePoint now) {

@@ -33,8 +33,9 @@ class Node final : private ExplicitClient::Listener {
   Node(const NodeConfig& config, const ScannerConfig& port, can::FrameSink& sink,
        ScannerObserver& observer, Logger log);
 
-  // Begins allocation at `first_attempt` (the scanner staggers nodes).
-  void start(TimePoint first_attempt);
+  // Begins allocation at `first_attempt` (the scanner staggers nodes); the
+  // state change is reported at `now`, when it happens.
+  void start(TimePoint now, TimePoint first_attempt);
   // Orderly shutdown: an idle poll, then Release. stopped() tells when done.
   void begin_shutdown(TimePoint now);
   // Stops at once without sending anything (the port lost its MAC).

@@ -94,7 +94,7 @@ void Scanner::begin_scanning(TimePoint now) {
     Node& node = *nodes_[static_cast<std::size_t>(i)];
     const Duration period = node.config().poll_period;
     node.set_poll_phase(now + period * i / count);
-    node.start(now + milliseconds(2) * i);
+    node.start(now, now + milliseconds(2) * i);
   }
 }
 

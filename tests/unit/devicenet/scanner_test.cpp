@@ -1,0 +1,64 @@
+#include "bridge/devicenet/scanner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace dnbridge::devicenet {
+namespace {
+
+MacId mac(unsigned v) { return MacId::from(v).value(); }
+
+class DiscardSink final : public can::FrameSink {
+ public:
+  void send(const can::CanFrame&, TimePoint) override {}
+};
+
+class StateTimes final : public ScannerObserver {
+ public:
+  void on_node_state(MacId m, NodeState, NodeState, const std::string&, TimePoint at) override {
+    events.push_back({m, at});
+  }
+  struct Event {
+    MacId mac;
+    TimePoint at;
+  };
+  std::vector<Event> events;
+};
+
+ScannerConfig three_nodes() {
+  ScannerConfig c;
+  c.master_mac = mac(0);
+  for (unsigned m : {1U, 2U, 3U}) {
+    NodeConfig n;
+    n.mac = mac(m);
+    n.name = "node";
+    c.nodes.push_back(n);
+  }
+  return c;
+}
+
+// Regression (found by the scanner fuzz target): when scanning began, each
+// node reported "waiting for the first Allocate" stamped with its staggered
+// first attempt (now + 2 ms * index), a time still to come, so the events the
+// layer above saw went back in time as the next one arrived.
+TEST(Scanner, NodeStartIsReportedWhenItHappensNotAtTheStaggeredFirstAttempt) {
+  DiscardSink sink;
+  StateTimes observer;
+  Scanner scanner(three_nodes(), sink, observer, Logger());
+  TimePoint now = TimePoint{} + seconds(100);
+  scanner.start(now);
+  // The duplicate MAC check of the master's MAC: two windows, nobody answers.
+  for (int i = 0; i < 2; ++i) {
+    now = scanner.next_deadline();
+    scanner.on_timer(now);
+  }
+  ASSERT_EQ(scanner.state(), PortState::kRunning);
+  ASSERT_EQ(observer.events.size(), 3u);
+  for (const auto& e : observer.events) {
+    EXPECT_EQ(e.at, now) << "node " << int{e.mac.value()};
+  }
+}
+
+}  // namespace
+}  // namespace dnbridge::devicenet
