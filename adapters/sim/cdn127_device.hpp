@@ -12,6 +12,7 @@
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/offline_connection.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
@@ -50,6 +51,25 @@ constexpr Reply reply_error(cip::GeneralStatus s,
   return Reply{s, additional};
 }
 
+// The Group 4 Offline Connection Set (devicenet-facts §7, UNVERIFIED; layouts
+// and sources in bridge/devicenet/offline_connection.hpp). Where the sources
+// disagree or are silent, the choice is here.
+struct OfflineOptions {
+  // The manual ("DeviceNet Message Types") lists the set as supported.
+  bool supported = true;
+  // Layout of the answer to an identify request: Wireshark's 8-byte form
+  // [match/value][R/R | service][vendor][serial] (value = the node's MAC), or
+  // the ICP DAS manual's 7-byte [port][vendor][serial].
+  devicenet::CommFaultedLayout identify_response = devicenet::CommFaultedLayout::kLong;
+  devicenet::OwnershipIdentity ownership_identity = devicenet::OwnershipIdentity::kTarget;
+  // The identify service is the ICP DAS example's. No source gives the
+  // service that sets the MAC offline: Set_Attribute_Single (the DeviceNet
+  // object's MAC ID attribute, implied), the new MAC in the value field of a
+  // long-form request that names the node by vendor and serial.
+  std::uint8_t identify_service = devicenet::kCommFaultedIdentifyService;
+  std::uint8_t set_mac_service = 0x10;
+};
+
 struct SlaveOptions {
   // Front-panel rotary switches, read at power-up only (manual, "Switches"):
   // MAC 0..63 valid, 64..99 the program position (MAC set in software); baud
@@ -83,6 +103,7 @@ struct SlaveOptions {
   PumpModel::Config pump{};
   Duration duplicate_mac_window = seconds(1);
   Duration fragment_ack_timeout = seconds(1);
+  OfflineOptions offline{};
 };
 
 // DOP attributes 5..8. The manual's encoding: action 0 = use the value, 1 = hold.

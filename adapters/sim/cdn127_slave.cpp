@@ -10,6 +10,11 @@
 namespace dnbridge::sim {
 
 using devicenet::BodyFormat;
+using devicenet::CommFaultedLayout;
+using devicenet::CommFaultedMessage;
+using devicenet::Group4Message;
+using devicenet::OfflineOwnershipMessage;
+using devicenet::OwnershipIdentity;
 using devicenet::DuplicateMacCheck;
 using devicenet::ExplicitFragmentSender;
 using devicenet::ExplicitReassembler;
@@ -63,6 +68,7 @@ void Cdn127Slave::power_on(TimePoint now) noexcept {
   device_.power_up(now);
   reassembler_.reset();
   sender_.cancel();
+  offline_owner_ = {};
   dup_check_ = DuplicateMacCheck(device_.mac(), duplicate_mac_config(device_.options()));
   network_ = NetworkState::kDuplicateMacCheck;
   log_.debug("power-up with MAC {}: duplicate MAC check", device_.mac().value());
@@ -153,8 +159,12 @@ TimePoint Cdn127Slave::next_deadline() const noexcept {
 // ---------------------------------------------------------------------------
 
 void Cdn127Slave::on_frame(const can::CanFrame& frame, TimePoint now) noexcept {
-  if (network_ == NetworkState::kOff || network_ == NetworkState::kCommunicationFault) {
+  if (network_ == NetworkState::kOff) {
     ++counters_.frames_ignored;
+    return;
+  }
+  if (network_ == NetworkState::kCommunicationFault) {
+    on_offline(frame, now);
     return;
   }
   // A frame arriving after a deadline does not rescue what expired.
@@ -381,6 +391,138 @@ void Cdn127Slave::on_poll(const can::CanFrame& frame, TimePoint now) noexcept {
       break;
   }
   send(devicenet::group1_id(Group1Message::kSlavePollResponse, device_.mac()), r.response.view(), now);
+}
+
+// ---------------------------------------------------------------------------
+// Group 4 Offline Connection Set, in Communication Fault only (see the header).
+
+bool Cdn127Slave::names_this_node(std::uint16_t vendor_id, std::uint32_t serial_number) const noexcept {
+  return vendor_id == profiles::cdn127::kVendorId && serial_number == device_.options().serial_number;
+}
+
+void Cdn127Slave::on_offline(const can::CanFrame& frame, TimePoint now) noexcept {
+  auto id = devicenet::decode_identifier(frame.id);
+  if (!device_.options().offline.supported || !id.ok() || id->group != MessageGroup::k4) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  switch (static_cast<Group4Message>(id->message_id)) {
+    case Group4Message::kOfflineOwnershipRequest: {
+      auto m = devicenet::decode_offline_ownership(frame.payload());
+      if (!m.ok() || m->response) break;
+      on_offline_ownership(*m, now);
+      return;
+    }
+    case Group4Message::kCommFaultedRequest: {
+      auto m = devicenet::decode_comm_faulted(frame.payload());
+      if (!m.ok() || m->response) break;
+      on_comm_faulted(*m, now);
+      return;
+    }
+    case Group4Message::kCommFaultedResponse:
+    case Group4Message::kOfflineOwnershipResponse:
+      ++counters_.frames_not_addressed;  // other faulted nodes answering
+      return;
+  }
+  ++counters_.frames_ignored;
+}
+
+void Cdn127Slave::on_offline_ownership(const OfflineOwnershipMessage& m, TimePoint now) noexcept {
+  if (device_.options().offline.ownership_identity == OwnershipIdentity::kTarget &&
+      !names_this_node(m.vendor_id, m.serial_number)) {
+    ++counters_.frames_not_addressed;
+    return;
+  }
+  const bool same_client = offline_owner_.client == m.client_mac &&
+                           offline_owner_.vendor_id == m.vendor_id &&
+                           offline_owner_.serial_number == m.serial_number;
+  if (offline_owner_.owned && !same_client) {
+    ++counters_.requests_refused;
+    log_.debug("offline ownership request from MAC {} refused: owned by MAC {}",
+               m.client_mac.value(), offline_owner_.client.value());
+    return;
+  }
+  if (m.allocate == devicenet::kOfflineAllocate) {
+    offline_owner_ = {true, m.client_mac, m.vendor_id, m.serial_number};
+  } else if (m.allocate == devicenet::kOfflineRelease) {
+    offline_owner_ = {};
+  } else {
+    ++counters_.frames_ignored;
+    return;
+  }
+  log_.debug("offline connection set {} by client MAC {}",
+             offline_owner_.owned ? "owned" : "released", m.client_mac.value());
+  OfflineOwnershipMessage response = m;
+  response.response = true;
+  if (auto f = devicenet::encode_offline_ownership(response)) {
+    sink_.send(*f, now);
+    ++counters_.offline_responses;
+  }
+}
+
+void Cdn127Slave::on_comm_faulted(const CommFaultedMessage& m, TimePoint now) noexcept {
+  const OfflineOptions& o = device_.options().offline;
+  bool identify = false;
+  switch (m.layout) {
+    case CommFaultedLayout::kShort:
+    case CommFaultedLayout::kShortWithDelay:
+      if (m.match && m.value != device_.mac().value()) {
+        ++counters_.frames_not_addressed;
+        return;
+      }
+      identify = m.service == o.identify_service;
+      break;
+    case CommFaultedLayout::kLong:
+      if (!names_this_node(m.vendor_id, m.serial_number)) {
+        ++counters_.frames_not_addressed;
+        return;
+      }
+      identify = m.service == o.identify_service;
+      if (!identify && m.service == o.set_mac_service) {
+        if (!offline_owner_.owned) {
+          ++counters_.requests_refused;
+          log_.debug("offline MAC change to {} refused: no ownership", m.value);
+          return;
+        }
+        const Reply r = device_.set_mac(m.value);
+        if (!r.ok()) {
+          ++counters_.requests_refused;
+          log_.debug("offline MAC change to {} refused: status {:#x}", m.value,
+                     static_cast<unsigned>(r.status));
+          return;
+        }
+        CommFaultedMessage response = m;
+        response.response = true;
+        if (auto f = devicenet::encode_comm_faulted(response)) {
+          sink_.send(*f, now);
+          ++counters_.offline_responses;
+        }
+        // The restart below re-enters the network whether or not the MAC changed.
+        (void)device_.take_pending_action();
+        log_.debug("offline MAC set to {}: duplicate MAC check again", m.value);
+        restart(now);
+        return;
+      }
+      break;
+    case CommFaultedLayout::kPortVendorSerial:
+      break;  // a response layout
+  }
+  if (!identify) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  CommFaultedMessage response;
+  response.layout = o.identify_response;
+  response.response = true;
+  response.value = device_.mac().value();
+  response.service = static_cast<std::uint8_t>(o.identify_service & 0x7F);
+  response.physical_port = 0;
+  response.vendor_id = profiles::cdn127::kVendorId;
+  response.serial_number = device_.options().serial_number;
+  if (auto f = devicenet::encode_comm_faulted(response)) {
+    sink_.send(*f, now);
+    ++counters_.offline_responses;
+  }
 }
 
 }  // namespace dnbridge::sim

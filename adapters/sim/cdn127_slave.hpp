@@ -11,8 +11,33 @@
 // command), 6 (Allocate/Release) and 7 (duplicate MAC check) for its MAC, and
 // answers on Group 2 message 3 (explicit and unconnected responses), Group 1
 // message 15 (poll response) and Group 2 message 7. Everything else (UCMM,
-// Group 1/3, bit strobe, the Group 4 offline set) is ignored and counted.
+// Group 1/3, bit strobe) is ignored and counted.
+//
+// In Communication Fault it listens to the Group 4 Offline Connection Set
+// only (bridge/devicenet/offline_connection.hpp has the layouts, their
+// sources and what is assumed; SlaveOptions::offline the choices):
+// - Offline Ownership Request (0x7EF): allocate 1 takes ownership for the
+//   client MAC, 0 gives it up; answered on 0x7EE with the request echoed, R/R
+//   set. A node owned by another client MAC stays silent. With
+//   OwnershipIdentity::kTarget only the node named by vendor + serial answers.
+// - Communication Faulted Request (0x7ED), identify service: answered on
+//   0x7EC when it matches: the short forms by match/value (match 0: every
+//   faulted node; match 1: the node whose MAC is value), the long form by
+//   vendor + serial. The ICP DAS form's time delay byte offset is accepted
+//   and not acted on: responses go out at once.
+// - Communication Faulted Request, long form, set MAC service, naming this
+//   node, while owned: the MAC is set as the DeviceNet object's attribute 1
+//   would be (refused while the MAC switch is valid: manual, DeviceNet object;
+//   also Rockwell 855T manual, "Off-Line Node Recovery"); the request is
+//   echoed with R/R set and the node restarts its duplicate MAC check, also
+//   for an unchanged MAC: a MAC set offline, "possibly to the same value",
+//   restarts the check (Dr. DeviceNet, can-wiki "Duplicate MAC ID"). A refusal
+//   is not answered (no source gives an error form).
+// Not done, for want of a source: other services (e.g. the baud change the
+// ICP DAS manual mentions), staggered identify responses, ownership timeouts.
+// Outside Communication Fault the set is ignored.
 #include <cstdint>
+#include <optional>
 
 #include "adapters/sim/cdn127_device.hpp"
 #include "adapters/sim/cdn127_objects.hpp"
@@ -21,6 +46,7 @@
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/duplicate_mac.hpp"
 #include "bridge/devicenet/fragmentation.hpp"
+#include "bridge/devicenet/offline_connection.hpp"
 
 namespace dnbridge::sim {
 
@@ -36,6 +62,7 @@ struct SlaveCounters {
   std::uint32_t polls_ignored = 0;         // no established poll connection
   std::uint32_t fragment_transfers_failed = 0;
   std::uint32_t restarts = 0;              // power-ups, Identity Reset, MAC change
+  std::uint32_t offline_responses = 0;     // Group 4 responses sent
 };
 
 class Cdn127Slave {
@@ -71,6 +98,11 @@ class Cdn127Slave {
   const PumpModel& pump() const noexcept { return device_.pump(); }
   Cdn127Device& device() noexcept { return device_; }
   const Cdn127Device& device() const noexcept { return device_; }
+  // The client MAC owning the offline connection set, if any.
+  std::optional<devicenet::MacId> offline_owner() const noexcept {
+    if (!offline_owner_.owned) return std::nullopt;
+    return offline_owner_.client;
+  }
   // Turns the front-panel switches; read at the next power-up.
   void set_switches(std::uint8_t mac_switch, std::uint8_t baud_switch) noexcept {
     device_.set_switches(mac_switch, baud_switch);
@@ -82,6 +114,10 @@ class Cdn127Slave {
   void on_unconnected(const can::CanFrame& frame, TimePoint now) noexcept;
   void on_explicit(const can::CanFrame& frame, TimePoint now) noexcept;
   void on_poll(const can::CanFrame& frame, TimePoint now) noexcept;
+  void on_offline(const can::CanFrame& frame, TimePoint now) noexcept;
+  void on_offline_ownership(const devicenet::OfflineOwnershipMessage& m, TimePoint now) noexcept;
+  void on_comm_faulted(const devicenet::CommFaultedMessage& m, TimePoint now) noexcept;
+  bool names_this_node(std::uint16_t vendor_id, std::uint32_t serial_number) const noexcept;
   void handle_explicit_message(std::uint8_t header, Bytes message, TimePoint now) noexcept;
   void send_explicit_response(std::uint8_t header, Bytes message, TimePoint now) noexcept;
   void after_response(TimePoint now) noexcept;
@@ -97,6 +133,13 @@ class Cdn127Slave {
   devicenet::ExplicitFragmentSender sender_;
   NetworkState network_ = NetworkState::kOff;
   SlaveCounters counters_;
+  struct OfflineOwner {
+    bool owned = false;
+    devicenet::MacId client;
+    std::uint16_t vendor_id = 0;
+    std::uint32_t serial_number = 0;
+  };
+  OfflineOwner offline_owner_;
 };
 
 const char* to_string(Cdn127Slave::NetworkState s) noexcept;
