@@ -15,6 +15,8 @@ namespace dnbridge::rack {
 struct PublishPolicy {
   Duration max_period = seconds(1);
   double analog_deadband_volts = 0.05;
+
+  friend bool operator==(const PublishPolicy&, const PublishPolicy&) = default;
 };
 
 class PumpStateGate {

@@ -1,0 +1,966 @@
+#include "adapters/daemon/config.hpp"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <set>
+#include <span>
+#include <sstream>
+#include <tuple>
+#include <utility>
+
+#include "bridge/profiles/cdn127/objects.hpp"
+
+namespace dnbridge::daemon {
+
+namespace cdn127 = profiles::cdn127;
+using devicenet::MacId;
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// Problems, collected with their position so that all of them are reported
+// at once, in the order of the file.
+
+struct Position {
+  std::uint32_t line = 1;
+  std::uint32_t column = 1;
+};
+
+Position at(const toml::source_region& region) {
+  // An empty document has no position; its problems are at its start.
+  return {std::max<std::uint32_t>(region.begin.line, 1),
+          std::max<std::uint32_t>(region.begin.column, 1)};
+}
+
+class Reporter {
+ public:
+  explicit Reporter(std::string_view source) : source_(source) {}
+
+  void error(Position p, std::string text) { add(errors_, p, std::move(text)); }
+  void warning(Position p, std::string text) { add(warnings_, p, std::move(text)); }
+  bool has_errors() const noexcept { return !errors_.empty(); }
+  std::vector<std::string> errors() const { return format(errors_); }
+  std::vector<std::string> warnings() const { return format(warnings_); }
+
+ private:
+  struct Entry {
+    Position at;
+    std::string text;
+  };
+  // Settings of [defaults] are read again for every node that inherits them:
+  // a problem in one is reported once.
+  void add(std::vector<Entry>& list, Position p, std::string text) {
+    if (seen_.emplace(p.line, p.column, text).second) list.push_back({p, std::move(text)});
+  }
+  std::vector<std::string> format(std::vector<Entry> list) const {
+    std::stable_sort(list.begin(), list.end(), [](const Entry& a, const Entry& b) {
+      return std::tie(a.at.line, a.at.column) < std::tie(b.at.line, b.at.column);
+    });
+    std::vector<std::string> out;
+    out.reserve(list.size());
+    for (const auto& e : list) {
+      out.push_back(fmt::format("{}:{}:{}: {}", source_, e.at.line, e.at.column, e.text));
+    }
+    return out;
+  }
+
+  std::string source_;
+  std::vector<Entry> errors_;
+  std::vector<Entry> warnings_;
+  std::set<std::tuple<std::uint32_t, std::uint32_t, std::string>> seen_;
+};
+
+// ---------------------------------------------------------------------------
+// Keys and typed values.
+
+std::string_view type_name(toml::node_type type) {
+  switch (type) {
+    case toml::node_type::none:
+      return "nothing";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a floating-point number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::date:
+      return "a date";
+    case toml::node_type::time:
+      return "a time";
+    case toml::node_type::date_time:
+      return "a date-time";
+  }
+  return "an unknown type";
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0u : 1u)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+using KeyList = std::span<const std::string_view>;
+
+// A misspelt key must not fall back silently to a default: every key a table
+// holds must be one it may hold.
+void check_keys(const toml::table& table, std::string_view where, KeyList known, Reporter& r) {
+  for (auto&& [key, value] : table) {
+    const std::string_view name = key.str();
+    if (std::find(known.begin(), known.end(), name) != known.end()) continue;
+    std::string hint;
+    std::size_t best = 3;  // suggest only close matches
+    for (std::string_view k : known) {
+      if (const std::size_t d = edit_distance(name, k); d < best) {
+        best = d;
+        hint = fmt::format(" (did you mean '{}'?)", k);
+      }
+    }
+    r.error(at(key.source()), fmt::format("unknown key '{}' in {}{}", name, where, hint));
+  }
+}
+
+const toml::node* require(const toml::table& table, std::string_view key, std::string_view where,
+                          Reporter& r) {
+  const toml::node* n = table.get(key);
+  if (!n) r.error(at(table.source()), fmt::format("missing required key '{}' in {}", key, where));
+  return n;
+}
+
+struct IntRange {
+  std::int64_t min;
+  std::int64_t max;
+  std::string_view unit = {};  // " ms"
+  std::string_view note = {};  // replaces "(min..max unit)" in the message
+};
+
+std::optional<std::int64_t> read_integer(const toml::node& n, std::string_view key, IntRange range,
+                                         Reporter& r) {
+  const auto* v = n.as_integer();
+  if (!v) {
+    r.error(at(n.source()), fmt::format("{} must be an integer, not {}", key, type_name(n.type())));
+    return std::nullopt;
+  }
+  const std::int64_t value = v->get();
+  if (value < range.min || value > range.max) {
+    if (range.note.empty()) {
+      r.error(at(n.source()), fmt::format("{} = {} is out of range ({}..{}{})", key, value,
+                                          range.min, range.max, range.unit));
+    } else {
+      r.error(at(n.source()), fmt::format("{} = {} is out of range: {}", key, value, range.note));
+    }
+    return std::nullopt;
+  }
+  return value;
+}
+
+template <class T>
+std::optional<T> read_int_as(const toml::node& n, std::string_view key, IntRange range,
+                             Reporter& r) {
+  auto v = read_integer(n, key, range, r);
+  if (!v) return std::nullopt;
+  return static_cast<T>(*v);
+}
+
+std::optional<Duration> read_ms(const toml::node& n, std::string_view key, std::int64_t min,
+                                std::int64_t max, Reporter& r) {
+  auto v = read_integer(n, key, {min, max, " ms"}, r);
+  if (!v) return std::nullopt;
+  return milliseconds(*v);
+}
+
+std::optional<std::string> read_string(const toml::node& n, std::string_view key, Reporter& r) {
+  const auto* v = n.as_string();
+  if (!v) {
+    r.error(at(n.source()), fmt::format("{} must be a string, not {}", key, type_name(n.type())));
+    return std::nullopt;
+  }
+  return v->get();
+}
+
+// A name is a DDS key and what operators read: never empty.
+std::optional<std::string> read_name(const toml::node& n, std::string_view key, Reporter& r) {
+  auto v = read_string(n, key, r);
+  if (v && v->empty()) {
+    r.error(at(n.source()), fmt::format("{} must not be empty", key));
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<bool> read_bool(const toml::node& n, std::string_view key, Reporter& r) {
+  const auto* v = n.as_boolean();
+  if (!v) {
+    r.error(at(n.source()),
+            fmt::format("{} must be true or false, not {}", key, type_name(n.type())));
+    return std::nullopt;
+  }
+  return v->get();
+}
+
+std::optional<double> read_number(const toml::node& n, std::string_view key, Reporter& r) {
+  if (const auto* i = n.as_integer()) return static_cast<double>(i->get());
+  if (const auto* f = n.as_floating_point()) return f->get();
+  r.error(at(n.source()), fmt::format("{} must be a number, not {}", key, type_name(n.type())));
+  return std::nullopt;
+}
+
+const IntRange kMacRange{0, MacId::kMax, {}, "a DeviceNet MAC ID is 0..63"};
+
+std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Reporter& r) {
+  auto v = read_integer(n, key, kMacRange, r);
+  if (!v) return std::nullopt;
+  return MacId::from(static_cast<unsigned>(*v));
+}
+
+// ---------------------------------------------------------------------------
+// Node settings: a node's own keys, else [defaults], else the built-in values.
+
+constexpr std::string_view kProfileCdn127 = "cdn127";
+
+// Every key of a node; [defaults] takes all but mac and name.
+constexpr std::array<std::string_view, 12> kNodeKeys{"mac",
+                                                     "name",
+                                                     "profile",
+                                                     "io",
+                                                     "identity",
+                                                     "poll_period_ms",
+                                                     "expected_packet_rate_ms",
+                                                     "explicit_packet_rate_ms",
+                                                     "immediate_poll",
+                                                     "publish_max_period_ms",
+                                                     "analog_deadband_volts",
+                                                     "no_commander"};
+constexpr KeyList kDefaultsKeys = KeyList(kNodeKeys).subspan(2);
+
+constexpr std::array<std::string_view, 7> kIoKeys{
+    "preset",        "mode",           "digital_inputs", "digital_outputs",
+    "analog_inputs", "analog_outputs", "no_nc_mask"};
+constexpr std::array<std::string_view, 3> kIdentityKeys{"vendor_id", "product_type",
+                                                        "product_code"};
+constexpr std::array<std::string_view, 13> kPortKeys{"name",
+                                                     "interface",
+                                                     "bitrate",
+                                                     "master_mac",
+                                                     "master_vendor_id",
+                                                     "master_serial_number",
+                                                     "allocate_retry_min_ms",
+                                                     "allocate_retry_max_ms",
+                                                     "fault_recheck_ms",
+                                                     "poll_response_timeout_ms",
+                                                     "explicit_response_timeout_ms",
+                                                     "max_consecutive_errors",
+                                                     "node"};
+constexpr std::array<std::string_view, 6> kRootKeys{"rack",      "domain",   "master_mac",
+                                                    "log_level", "defaults", "port"};
+
+enum class Level { kBuiltIn, kDefaults, kNode };
+
+struct Found {
+  const toml::node* value = nullptr;
+  Level level = Level::kBuiltIn;
+};
+
+struct Layers {
+  const toml::table* node = nullptr;  // null when [defaults] is read alone
+  const toml::table* defaults = nullptr;
+
+  Found find(std::string_view key) const {
+    if (node) {
+      if (const toml::node* v = node->get(key)) return {v, Level::kNode};
+    }
+    if (defaults) {
+      if (const toml::node* v = defaults->get(key)) return {v, Level::kDefaults};
+    }
+    return {};
+  }
+};
+
+// Where a value another one is compared with came from, for the message.
+std::string origin(const Found& f) {
+  switch (f.level) {
+    case Level::kNode:
+      return {};
+    case Level::kDefaults:
+      return fmt::format(" (from [defaults], line {})", at(f.value->source()).line);
+    case Level::kBuiltIn:
+      return " (the default)";
+  }
+  return {};
+}
+
+// The device's maximum of one I/O count, as profiles::cdn127::validate knows it.
+std::uint8_t device_maximum(std::uint8_t cdn127::IoConfiguration::*count) {
+  cdn127::IoConfiguration c{.mode = 0x86,
+                            .num_digital_inputs = 0,
+                            .num_digital_outputs = 0,
+                            .num_analog_inputs = 0,
+                            .num_analog_outputs = 0,
+                            .no_nc_mask = 0};
+  std::uint8_t max = 0;
+  for (unsigned v = 1; v <= 0xFF; ++v) {
+    c.*count = static_cast<std::uint8_t>(v);
+    if (!cdn127::validate(c)) break;
+    max = static_cast<std::uint8_t>(v);
+  }
+  return max;
+}
+
+std::optional<cdn127::IoConfiguration> preset_named(std::string_view name) {
+  if (name == "cdn127") return cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
+  if (name == "cdn118") return cdn127::preset(cdn127::ConfigurationPreset::kCdn118);
+  return std::nullopt;
+}
+
+std::optional<cdn127::IoConfiguration> read_preset(const toml::node& n, std::string_view key,
+                                                   Reporter& r) {
+  auto name = read_string(n, key, r);
+  if (!name) return std::nullopt;
+  auto io = preset_named(*name);
+  if (!io) {
+    r.error(at(n.source()),
+            fmt::format("{} = \"{}\" is not a preset: use \"cdn127\" or \"cdn118\"{}", key, *name,
+                        key == "io" ? ", or a table of Configuration object values" : ""));
+  }
+  return io;
+}
+
+// `io` is a preset name, or a table of Configuration object values over a
+// preset (the CDN127's unless `preset` names another).
+std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Reporter& r) {
+  if (n.is_string()) return read_preset(n, "io", r);
+  const toml::table* t = n.as_table();
+  if (!t) {
+    r.error(at(n.source()),
+            fmt::format("io must be a preset name (\"cdn127\", \"cdn118\") or a table, not {}",
+                        type_name(n.type())));
+    return std::nullopt;
+  }
+  check_keys(*t, "io", kIoKeys, r);
+  bool ok = true;
+  auto io = cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
+  if (const toml::node* p = t->get("preset")) {
+    if (auto base = read_preset(*p, "io.preset", r)) {
+      io = *base;
+    } else {
+      ok = false;
+    }
+  }
+  if (const toml::node* m = t->get("mode")) {
+    if (auto v = read_int_as<std::uint8_t>(*m, "io.mode", {0, 0xFF}, r)) {
+      io.mode = *v;
+      // CDN127 manual, Configuration object, Mode: "Bits 3..5 should be set
+      // to 0"; bit 6 is not described. Loaded as given, but said.
+      if (*v & 0x78) {
+        r.warning(at(m->source()),
+                  fmt::format("io.mode = 0x{:02X} sets bits 3..6, which the CDN127 manual leaves "
+                              "reserved",
+                              *v));
+      }
+    } else {
+      ok = false;
+    }
+  }
+  if (const toml::node* m = t->get("no_nc_mask")) {
+    if (auto v = read_int_as<std::uint8_t>(*m, "io.no_nc_mask", {0, 0xFF}, r)) {
+      io.no_nc_mask = *v;
+    } else {
+      ok = false;
+    }
+  }
+  struct Count {
+    std::string_view key;
+    std::uint8_t cdn127::IoConfiguration::*field;
+  };
+  for (const Count& c : {Count{"digital_inputs", &cdn127::IoConfiguration::num_digital_inputs},
+                         Count{"digital_outputs", &cdn127::IoConfiguration::num_digital_outputs},
+                         Count{"analog_inputs", &cdn127::IoConfiguration::num_analog_inputs},
+                         Count{"analog_outputs", &cdn127::IoConfiguration::num_analog_outputs}}) {
+    const toml::node* v = t->get(c.key);
+    if (!v) continue;
+    const std::string key = fmt::format("io.{}", c.key);
+    auto count = read_integer(*v, key, {0, 0xFF}, r);
+    if (!count) {
+      ok = false;
+      continue;
+    }
+    const std::uint8_t max = device_maximum(c.field);
+    if (*count > max) {
+      r.error(at(v->source()),
+              fmt::format("{} = {} is more than a CDN127 has (at most {})", key, *count, max));
+      ok = false;
+      continue;
+    }
+    io.*(c.field) = static_cast<std::uint8_t>(*count);
+  }
+  if (!ok) return std::nullopt;
+  // Whatever the checks above let through, the poll formats must exist.
+  if (!cdn127::validate(io) || !cdn127::poll_format(io)) {
+    r.error(at(n.source()), "io is not a configuration a CDN127 accepts");
+    return std::nullopt;
+  }
+  return io;
+}
+
+std::optional<devicenet::ExpectedIdentity> read_identity(const toml::node& n, Reporter& r) {
+  const toml::table* t = n.as_table();
+  if (!t) {
+    r.error(at(n.source()),
+            fmt::format("identity must be a table {{ vendor_id, product_type, product_code }}, "
+                        "not {}",
+                        type_name(n.type())));
+    return std::nullopt;
+  }
+  check_keys(*t, "identity", kIdentityKeys, r);
+  devicenet::ExpectedIdentity id;
+  bool ok = true;
+  auto field = [&](std::string_view key, std::uint16_t& out) {
+    const toml::node* v = require(*t, key, "identity", r);
+    auto value = v ? read_int_as<std::uint16_t>(*v, fmt::format("identity.{}", key), {0, 0xFFFF}, r)
+                   : std::nullopt;
+    if (value) {
+      out = *value;
+    } else {
+      ok = false;
+    }
+  };
+  field("vendor_id", id.vendor_id);
+  field("product_type", id.product_type);
+  field("product_code", id.product_code);
+  if (!ok) return std::nullopt;
+  return id;
+}
+
+// DeviceNet expected packet rates are UINT milliseconds (Connection object
+// attribute 9); the poll period is bounded by the expected packet rate.
+constexpr std::int64_t kMaxPacketRateMs = 0xFFFF;
+constexpr std::int64_t kMaxPublishPeriodMs = 3'600'000;
+constexpr double kAnalogFullScaleVolts = 10.0;
+
+// Reads every setting a node and [defaults] share into `s`, which holds the
+// built-in values to start with.
+void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
+  if (Found f = layers.find("profile"); f.value) {
+    if (auto v = read_string(*f.value, "profile", r)) {
+      if (*v == kProfileCdn127) {
+        s.profile = *v;
+      } else {
+        r.error(at(f.value->source()),
+                fmt::format("profile \"{}\" is not supported: the only profile is \"cdn127\"", *v));
+      }
+    }
+  }
+  if (Found f = layers.find("io"); f.value) {
+    if (auto v = read_io(*f.value, r)) s.io = *v;
+  }
+  if (Found f = layers.find("identity"); f.value) {
+    if (auto v = read_identity(*f.value, r)) s.identity = *v;
+  }
+
+  const Found poll = layers.find("poll_period_ms");
+  const Found epr = layers.find("expected_packet_rate_ms");
+  bool poll_ok = true, epr_ok = true;
+  if (poll.value) {
+    auto v = read_ms(*poll.value, "poll_period_ms", 1, kMaxPacketRateMs, r);
+    poll_ok = v.has_value();
+    if (v) s.poll_period = *v;
+  }
+  if (epr.value) {
+    auto v = read_ms(*epr.value, "expected_packet_rate_ms", 1, kMaxPacketRateMs, r);
+    epr_ok = v.has_value();
+    if (v) s.expected_packet_rate = *v;
+  }
+  // Compared per node only: [defaults] alone may rely on what nodes add.
+  const bool per_node = layers.node != nullptr;
+  if (per_node && poll_ok && epr_ok && s.expected_packet_rate < s.poll_period) {
+    // Reported where the more specific of the two is written.
+    const bool at_epr = epr.level >= poll.level;
+    const Found& here = at_epr ? epr : poll;
+    r.error(at(here.value->source()),
+            fmt::format("expected_packet_rate_ms = {}{} is shorter than poll_period_ms = {}{}: the "
+                        "node expects a poll at least once per expected packet rate",
+                        std::chrono::duration_cast<milliseconds>(s.expected_packet_rate).count(),
+                        at_epr ? std::string() : origin(epr),
+                        std::chrono::duration_cast<milliseconds>(s.poll_period).count(),
+                        at_epr ? origin(poll) : std::string()));
+  }
+  if (Found f = layers.find("explicit_packet_rate_ms"); f.value) {
+    if (auto v = read_ms(*f.value, "explicit_packet_rate_ms", 1, kMaxPacketRateMs, r)) {
+      s.explicit_packet_rate = *v;
+    }
+  }
+  if (Found f = layers.find("immediate_poll"); f.value) {
+    if (auto v = read_bool(*f.value, "immediate_poll", r)) s.immediate_poll_on_change = *v;
+  }
+  if (Found f = layers.find("publish_max_period_ms"); f.value) {
+    if (auto v = read_ms(*f.value, "publish_max_period_ms", 1, kMaxPublishPeriodMs, r)) {
+      s.publish.max_period = *v;
+      if (per_node && poll_ok && *v < s.poll_period) {
+        r.warning(at(f.value->source()),
+                  fmt::format("publish_max_period_ms = {} is shorter than poll_period_ms = {}{}: "
+                              "samples in between repeat the last poll",
+                              std::chrono::duration_cast<milliseconds>(*v).count(),
+                              std::chrono::duration_cast<milliseconds>(s.poll_period).count(),
+                              f.level == poll.level ? std::string() : origin(poll)));
+      }
+    }
+  }
+  if (Found f = layers.find("analog_deadband_volts"); f.value) {
+    if (auto v = read_number(*f.value, "analog_deadband_volts", r)) {
+      if (*v < 0 || *v > kAnalogFullScaleVolts) {
+        r.error(at(f.value->source()),
+                fmt::format("analog_deadband_volts = {} is out of range (0..10 V)", *v));
+      } else {
+        s.publish.analog_deadband_volts = *v;
+      }
+    }
+  }
+  if (Found f = layers.find("no_commander"); f.value) {
+    if (auto v = read_string(*f.value, "no_commander", r)) {
+      if (*v == "idle") {
+        s.no_commander = NoCommanderPolicy::kIdle;
+      } else if (*v == "hold") {
+        s.no_commander = NoCommanderPolicy::kHoldLastOutputs;
+      } else {
+        r.error(at(f.value->source()),
+                fmt::format("no_commander = \"{}\" is not a policy: use \"idle\" or \"hold\"", *v));
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Ports.
+
+// A SocketCAN interface name: at most IFNAMSIZ - 1 = 15 characters, no slash
+// or white space (what the kernel accepts as a network device name).
+bool valid_interface_name(std::string_view name) {
+  if (name.empty() || name.size() > 15 || name == "." || name == "..") return false;
+  return std::none_of(name.begin(), name.end(), [](char c) {
+    return c == '/' || c == ':' || c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\0';
+  });
+}
+
+struct NodeSeen {
+  std::string name;
+  std::uint32_t line;
+};
+
+PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml::table* defaults,
+                     Reporter& r) {
+  constexpr std::string_view kWhere = "[[port]]";
+  check_keys(t, kWhere, kPortKeys, r);
+  PortConfig port;
+  port.master_mac = rack.master_mac;
+  if (const toml::node* n = require(t, "name", kWhere, r)) {
+    if (auto v = read_name(*n, "name", r)) port.name = *v;
+  }
+  if (const toml::node* n = require(t, "interface", kWhere, r)) {
+    if (auto v = read_string(*n, "interface", r)) {
+      if (*v == kSimulatedInterface || valid_interface_name(*v)) {
+        port.interface = *v;
+      } else {
+        r.error(at(n->source()),
+                fmt::format("interface = \"{}\" is not a CAN interface name: use \"simulated\" or "
+                            "a SocketCAN interface such as \"can0\" (at most 15 characters)",
+                            *v));
+      }
+    }
+  }
+  if (const toml::node* n = require(t, "bitrate", kWhere, r)) {
+    if (auto v = read_integer(
+            *n, "bitrate",
+            {std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()},
+            r)) {
+      if (*v == 125000 || *v == 250000 || *v == 500000) {
+        port.bitrate = static_cast<std::uint32_t>(*v);
+      } else {
+        r.error(at(n->source()),
+                fmt::format(
+                    "bitrate = {} is not a DeviceNet bit rate: use 125000, 250000 or 500000", *v));
+      }
+    }
+  }
+  const toml::node* master_mac_node = t.get("master_mac");
+  if (master_mac_node) {
+    if (auto v = read_mac(*master_mac_node, "master_mac", r)) port.master_mac = *v;
+  }
+  if (const toml::node* n = t.get("master_vendor_id")) {
+    if (auto v = read_int_as<std::uint16_t>(*n, "master_vendor_id", {0, 0xFFFF}, r)) {
+      port.master_vendor_id = *v;
+    }
+  }
+  if (const toml::node* n = t.get("master_serial_number")) {
+    if (auto v = read_int_as<std::uint32_t>(*n, "master_serial_number", {0, 0xFFFF'FFFF}, r)) {
+      port.master_serial_number = *v;
+    }
+  }
+
+  auto timing = [&](std::string_view key, Duration& out) {
+    if (const toml::node* n = t.get(key)) {
+      if (auto v = read_ms(*n, key, 1, kMaxPublishPeriodMs, r)) out = *v;
+    }
+  };
+  ScannerTimings& tm = port.timings;
+  timing("allocate_retry_min_ms", tm.allocate_retry_min);
+  timing("allocate_retry_max_ms", tm.allocate_retry_max);
+  timing("fault_recheck_ms", tm.fault_recheck);
+  timing("poll_response_timeout_ms", tm.poll_response_timeout);
+  timing("explicit_response_timeout_ms", tm.explicit_response_timeout);
+  if (const toml::node* n = t.get("max_consecutive_errors")) {
+    if (auto v = read_int_as<unsigned>(*n, "max_consecutive_errors", {1, 1000}, r)) {
+      tm.max_consecutive_errors = *v;
+    }
+  }
+  if (tm.allocate_retry_max < tm.allocate_retry_min) {
+    const toml::node* n = t.get("allocate_retry_max_ms");
+    if (!n) n = t.get("allocate_retry_min_ms");
+    r.error(at(n ? n->source() : t.source()),
+            "allocate_retry_max_ms is shorter than allocate_retry_min_ms");
+  }
+
+  const toml::node* nodes = t.get("node");
+  const toml::array* list = nodes ? nodes->as_array() : nullptr;
+  if (nodes && (!list || !list->is_array_of_tables())) {
+    r.error(at(nodes->source()),
+            fmt::format("node must be an array of tables ([[port.node]]), not {}",
+                        type_name(nodes->type())));
+    return port;
+  }
+  if (!list || list->empty()) {
+    r.warning(at(t.source()), fmt::format("port \"{}\" has no [[port.node]]: its master scans "
+                                          "nothing",
+                                          port.name));
+    return port;
+  }
+
+  std::map<std::uint8_t, NodeSeen> macs;
+  std::map<std::string, std::uint32_t> names;
+  for (const toml::node& element : *list) {
+    const toml::table& nt = *element.as_table();
+    constexpr std::string_view kNodeWhere = "[[port.node]]";
+    check_keys(nt, kNodeWhere, kNodeKeys, r);
+    NodeSettings s;
+    bool ok = true;
+    const toml::node* mac_node = require(nt, "mac", kNodeWhere, r);
+    const toml::node* name_node = require(nt, "name", kNodeWhere, r);
+    std::optional<MacId> mac = mac_node ? read_mac(*mac_node, "mac", r) : std::nullopt;
+    std::optional<std::string> name = name_node ? read_name(*name_node, "name", r) : std::nullopt;
+    if (mac) {
+      s.mac = *mac;
+      if (*mac == port.master_mac) {
+        r.error(at(mac_node->source()),
+                fmt::format(
+                    "mac = {} is the master's own MAC on port \"{}\"{}", mac->value(), port.name,
+                    master_mac_node
+                        ? fmt::format(" (master_mac, line {})", at(master_mac_node->source()).line)
+                        : std::string(" (the rack's master_mac)")));
+        ok = false;
+      }
+      const std::uint32_t line = at(mac_node->source()).line;
+      auto [it, added] = macs.try_emplace(mac->value(), NodeSeen{name.value_or(""), line});
+      if (!added) {
+        r.error(at(mac_node->source()),
+                fmt::format("mac = {} is already used on port \"{}\" by node \"{}\" (line {})",
+                            mac->value(), port.name, it->second.name, it->second.line));
+        ok = false;
+      }
+    } else {
+      ok = false;
+    }
+    if (name) {
+      s.name = *name;
+      const std::uint32_t line = at(name_node->source()).line;
+      auto [it, added] = names.try_emplace(*name, line);
+      if (!added) {
+        r.error(at(name_node->source()),
+                fmt::format("name \"{}\" is already used on port \"{}\" (line {})", *name,
+                            port.name, it->second));
+        ok = false;
+      }
+    } else {
+      ok = false;
+    }
+    read_node_settings(Layers{&nt, defaults}, s, r);
+    if (ok) port.nodes.push_back(std::move(s));
+  }
+  return port;
+}
+
+std::optional<LogLevel> log_level_named(std::string_view name) {
+  for (LogLevel l :
+       {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn, LogLevel::kError}) {
+    if (to_string(l) == name) return l;
+  }
+  return std::nullopt;
+}
+
+// RTPS maps domain IDs to UDP ports; with the standard port parameters the
+// highest that fits is 232.
+constexpr std::int64_t kMaxDomainId = 232;
+
+DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporter& r) {
+  constexpr std::string_view kWhere = "the top level";
+  check_keys(root, kWhere, kRootKeys, r);
+  DaemonConfig config;
+  config.source = std::string(source);
+  if (const toml::node* n = require(root, "rack", kWhere, r)) {
+    if (auto v = read_name(*n, "rack", r)) config.rack = *v;
+  }
+  if (const toml::node* n = root.get("domain")) {
+    if (auto v = read_int_as<std::uint32_t>(
+            *n, "domain", {0, kMaxDomainId, {}, "a DDS domain ID is 0..232"}, r)) {
+      config.domain_id = *v;
+    }
+  }
+  if (const toml::node* n = root.get("master_mac")) {
+    if (auto v = read_mac(*n, "master_mac", r)) config.master_mac = *v;
+  }
+  if (const toml::node* n = root.get("log_level")) {
+    if (auto v = read_string(*n, "log_level", r)) {
+      if (auto l = log_level_named(*v)) {
+        config.log_level = *l;
+      } else {
+        r.error(
+            at(n->source()),
+            fmt::format("log_level = \"{}\" is not a level: use \"trace\", \"debug\", \"info\", "
+                        "\"warn\" or \"error\"",
+                        *v));
+      }
+    }
+  }
+
+  const toml::table* defaults = nullptr;
+  if (const toml::node* n = root.get("defaults")) {
+    defaults = n->as_table();
+    if (!defaults) {
+      r.error(at(n->source()),
+              fmt::format("defaults must be a table ([defaults]), not {}", type_name(n->type())));
+    } else {
+      check_keys(*defaults, "[defaults]", kDefaultsKeys, r);
+      // Read once on their own, so that their problems are reported even
+      // when no node inherits them.
+      NodeSettings ignored;
+      read_node_settings(Layers{nullptr, defaults}, ignored, r);
+    }
+  }
+
+  const toml::node* ports = root.get("port");
+  if (!ports) {
+    r.error(at(root.source()), "no [[port]]: a rack has at least one DeviceNet port");
+    return config;
+  }
+  const toml::array* list = ports->as_array();
+  if (list && list->empty()) {
+    r.error(at(ports->source()), "port is empty: a rack has at least one DeviceNet port");
+    return config;
+  }
+  if (!list || !list->is_array_of_tables()) {
+    r.error(at(ports->source()),
+            fmt::format("port must be an array of tables: write [[port]], not {}",
+                        ports->is_table() ? "[port]" : type_name(ports->type())));
+    return config;
+  }
+  std::map<std::string, std::uint32_t> names;
+  std::map<std::string, std::string> interfaces;
+  for (const toml::node& element : *list) {
+    const toml::table& pt = *element.as_table();
+    PortConfig port = read_port(pt, config, defaults, r);
+    if (!port.name.empty()) {
+      const toml::node* name_node = pt.get("name");
+      auto [it, added] = names.try_emplace(port.name, at(name_node->source()).line);
+      if (!added) {
+        r.error(at(name_node->source()),
+                fmt::format("port name \"{}\" is already used by the port at line {}", port.name,
+                            it->second));
+      }
+    }
+    if (!port.interface.empty() && port.interface != kSimulatedInterface) {
+      auto [it, added] = interfaces.try_emplace(port.interface, port.name);
+      if (!added) {
+        r.error(at(pt.get("interface")->source()),
+                fmt::format("interface \"{}\" is already used by port \"{}\"", port.interface,
+                            it->second));
+      }
+    }
+    config.ports.push_back(std::move(port));
+  }
+  return config;
+}
+
+std::string join_lines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& l : lines) {
+    if (!out.empty()) out += '\n';
+    out += l;
+  }
+  return out;
+}
+
+// What `dnbridge --simulate` runs; also printed by --print-default-config, so
+// it is written for people to start from.
+constexpr std::string_view kDefaultConfig =
+    R"(# dnbridge: the configuration `dnbridge --simulate` runs.
+# Eight CDN127 pump interfaces on the in-process simulated bus.
+
+rack = "sim-rack"
+domain = 0
+master_mac = 0
+log_level = "info"
+
+[defaults]
+poll_period_ms = 100
+expected_packet_rate_ms = 500
+io = "cdn127"
+
+[[port]]
+name = "A"
+interface = "simulated"
+bitrate = 500000
+
+  [[port.node]]
+  mac = 1
+  name = "pump-1"
+
+  [[port.node]]
+  mac = 2
+  name = "pump-2"
+
+  [[port.node]]
+  mac = 3
+  name = "pump-3"
+
+  [[port.node]]
+  mac = 4
+  name = "pump-4"
+
+  [[port.node]]
+  mac = 5
+  name = "pump-5"
+
+  [[port.node]]
+  mac = 6
+  name = "pump-6"
+
+  [[port.node]]
+  mac = 7
+  name = "pump-7"
+
+  [[port.node]]
+  mac = 8
+  name = "pump-8"
+  io = "cdn118"
+)";
+
+}  // namespace
+
+ConfigError::ConfigError(std::vector<std::string> problems)
+    : std::runtime_error(join_lines(problems)), problems_(std::move(problems)) {}
+
+std::string_view to_string(NoCommanderPolicy policy) noexcept {
+  switch (policy) {
+    case NoCommanderPolicy::kIdle:
+      return "idle";
+    case NoCommanderPolicy::kHoldLastOutputs:
+      return "hold";
+  }
+  return "?";
+}
+
+DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(text);
+  } catch (const toml::parse_error& e) {
+    const Position p = at(e.source());
+    throw ConfigError(
+        {fmt::format("{}:{}:{}: {}", source_name, p.line, p.column, e.description())});
+  }
+  Reporter r(source_name);
+  DaemonConfig config = read_rack(root, source_name, r);
+  if (r.has_errors()) throw ConfigError(r.errors());
+  config.warnings = r.warnings();
+  return config;
+}
+
+DaemonConfig load_config_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw ConfigError({fmt::format("{}: is a directory, not a configuration file", path.string())});
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw ConfigError({fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno))});
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    throw ConfigError({fmt::format("{}: cannot read: {}", path.string(), std::strerror(errno))});
+  }
+  return parse_config(text.str(), path.string());
+}
+
+std::string_view embedded_default_config_text() noexcept { return kDefaultConfig; }
+
+DaemonConfig embedded_default_config() { return parse_config(kDefaultConfig, "embedded default"); }
+
+rack::PumpConfig to_pump_config(const NodeSettings& node) {
+  rack::PumpConfig p;
+  p.node.mac = node.mac;
+  p.node.name = node.name;
+  p.node.poll_period = node.poll_period;
+  p.node.expected_packet_rate = node.expected_packet_rate;
+  p.node.explicit_packet_rate = node.explicit_packet_rate;
+  p.node.immediate_poll_on_change = node.immediate_poll_on_change;
+  p.io = node.io;
+  p.identity = node.identity;
+  p.no_commander = node.no_commander;
+  return p;
+}
+
+std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port) {
+  std::vector<rack::PumpConfig> out;
+  out.reserve(port.nodes.size());
+  for (const auto& n : port.nodes) out.push_back(to_pump_config(n));
+  return out;
+}
+
+devicenet::ScannerConfig to_scanner_config(const PortConfig& port) {
+  devicenet::ScannerConfig c;
+  c.master_mac = port.master_mac;
+  c.vendor_id = port.master_vendor_id;
+  c.serial_number = port.master_serial_number;
+  c.explicit_messaging.response_timeout = port.timings.explicit_response_timeout;
+  c.allocate_retry_min = port.timings.allocate_retry_min;
+  c.allocate_retry_max = port.timings.allocate_retry_max;
+  c.fault_recheck = port.timings.fault_recheck;
+  c.max_consecutive_errors = port.timings.max_consecutive_errors;
+  c.poll_response_timeout = port.timings.poll_response_timeout;
+  return c;
+}
+
+}  // namespace dnbridge::daemon

@@ -1,0 +1,817 @@
+#include "adapters/daemon/config.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "bridge/profiles/cdn127/node_profile.hpp"
+#include "bridge/profiles/cdn127/objects.hpp"
+#include "bridge/rack/pump_rack.hpp"
+
+namespace dnbridge::daemon {
+namespace {
+
+namespace cdn127 = profiles::cdn127;
+using devicenet::MacId;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+MacId mac(unsigned v) { return MacId::from(v).value(); }
+
+const cdn127::IoConfiguration kCdn127 = cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
+const cdn127::IoConfiguration kCdn118 = cdn127::preset(cdn127::ConfigurationPreset::kCdn118);
+
+// The problems parse_config reports for `text`, one per line, or "(none)".
+std::string problems(std::string_view text) {
+  try {
+    parse_config(text, "t.toml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(none)";
+}
+
+// Lines 1..5 of most texts below: a rack with one simulated port.
+#define ONE_PORT                \
+  "rack = \"r\"\n"              \
+  "[[port]]\n"                  \
+  "name = \"A\"\n"              \
+  "interface = \"simulated\"\n" \
+  "bitrate = 500000\n"
+
+// ---------------------------------------------------------------------------
+// Files that load.
+
+TEST(ConfigFile, ExampleLoadsWithEveryValueWhereItWasWritten) {
+  const std::string path = DNBRIDGE_SOURCE_DIR "/deploy/config/rack-example.toml";
+  const DaemonConfig c = load_config_file(path);
+  EXPECT_EQ(c.source, path);
+  EXPECT_EQ(c.rack, "etch-3-rack-A");
+  EXPECT_EQ(c.domain_id, 0u);
+  EXPECT_EQ(c.master_mac, mac(0));
+  EXPECT_EQ(c.log_level, LogLevel::kInfo);
+  EXPECT_TRUE(c.warnings.empty());
+  ASSERT_EQ(c.ports.size(), 2u);
+
+  const PortConfig& a = c.ports[0];
+  EXPECT_EQ(a.name, "A");
+  EXPECT_EQ(a.interface, "can0");
+  EXPECT_EQ(a.bitrate, 500000u);
+  EXPECT_EQ(a.master_mac, mac(0));
+  EXPECT_EQ(a.master_vendor_id, 0u);
+  EXPECT_EQ(a.master_serial_number, 0u);
+  ASSERT_EQ(a.nodes.size(), 3u);
+  EXPECT_EQ(a.nodes[0].mac, mac(1));
+  EXPECT_EQ(a.nodes[0].name, "chamber-1-dry-pump");
+  EXPECT_EQ(a.nodes[0].profile, "cdn127");
+  EXPECT_EQ(a.nodes[0].io, kCdn127);
+  EXPECT_EQ(a.nodes[0].poll_period, milliseconds(100));           // [defaults]
+  EXPECT_EQ(a.nodes[0].expected_packet_rate, milliseconds(500));  // [defaults]
+  EXPECT_EQ(a.nodes[0].no_commander, NoCommanderPolicy::kIdle);
+  EXPECT_FALSE(a.nodes[0].identity.has_value());
+  EXPECT_EQ(a.nodes[1].io, kCdn118);
+  EXPECT_EQ(a.nodes[2].name, "loadlock-pump");
+  EXPECT_EQ(a.nodes[2].io, (cdn127::IoConfiguration{.mode = 0x86,
+                                                    .num_digital_inputs = 8,
+                                                    .num_digital_outputs = 3,
+                                                    .num_analog_inputs = 1,
+                                                    .num_analog_outputs = 0,
+                                                    .no_nc_mask = 0}));
+  EXPECT_EQ(a.nodes[2].no_commander, NoCommanderPolicy::kHoldLastOutputs);
+
+  const PortConfig& b = c.ports[1];
+  EXPECT_EQ(b.name, "B");
+  EXPECT_EQ(b.interface, "can1");
+  EXPECT_EQ(b.bitrate, 250000u);
+  EXPECT_EQ(b.master_mac, mac(62));
+  ASSERT_EQ(b.nodes.size(), 2u);
+  EXPECT_EQ(b.nodes[0].mac, mac(10));
+  EXPECT_EQ(b.nodes[0].poll_period, milliseconds(200));
+  EXPECT_EQ(b.nodes[0].expected_packet_rate, milliseconds(1000));
+  EXPECT_DOUBLE_EQ(b.nodes[0].publish.analog_deadband_volts, 0.1);
+  EXPECT_DOUBLE_EQ(b.nodes[1].publish.analog_deadband_volts, 0.05);  // [defaults]
+  EXPECT_EQ(b.nodes[1].io, kCdn118);
+  EXPECT_EQ(b.nodes[1].identity, (devicenet::ExpectedIdentity{
+                                     .vendor_id = 59, .product_type = 27, .product_code = 1888}));
+}
+
+TEST(ConfigFile, EmbeddedDefaultIsTheSimulatedRack) {
+  const DaemonConfig c = embedded_default_config();
+  EXPECT_EQ(c.source, "embedded default");
+  EXPECT_EQ(c.rack, "sim-rack");
+  EXPECT_EQ(c.domain_id, 0u);
+  EXPECT_EQ(c.master_mac, mac(0));
+  EXPECT_TRUE(c.warnings.empty());
+  ASSERT_EQ(c.ports.size(), 1u);
+  const PortConfig& p = c.ports[0];
+  EXPECT_EQ(p.name, "A");
+  EXPECT_EQ(p.interface, kSimulatedInterface);
+  EXPECT_EQ(p.bitrate, 500000u);
+  EXPECT_EQ(p.master_mac, mac(0));
+  ASSERT_EQ(p.nodes.size(), 8u);
+  for (unsigned i = 0; i < 8; ++i) {
+    SCOPED_TRACE(i);
+    const NodeSettings& n = p.nodes[i];
+    EXPECT_EQ(n.mac, mac(i + 1));
+    EXPECT_EQ(n.name, "pump-" + std::to_string(i + 1));
+    EXPECT_EQ(n.io, i == 7 ? kCdn118 : kCdn127);
+    EXPECT_EQ(n.poll_period, milliseconds(100));
+    EXPECT_EQ(n.expected_packet_rate, milliseconds(500));
+  }
+}
+
+TEST(ConfigFile, EmbeddedDefaultTextIsWhatItRuns) {
+  const DaemonConfig printed = parse_config(embedded_default_config_text(), "printed.toml");
+  const DaemonConfig embedded = embedded_default_config();
+  ASSERT_EQ(printed.ports.size(), embedded.ports.size());
+  ASSERT_EQ(printed.ports[0].nodes.size(), embedded.ports[0].nodes.size());
+  for (std::size_t i = 0; i < printed.ports[0].nodes.size(); ++i) {
+    EXPECT_EQ(printed.ports[0].nodes[i].mac, embedded.ports[0].nodes[i].mac);
+    EXPECT_EQ(printed.ports[0].nodes[i].io, embedded.ports[0].nodes[i].io);
+  }
+}
+
+TEST(ConfigFile, MinimalFileTakesTheBuiltInDefaults) {
+  const DaemonConfig c = parse_config(ONE_PORT
+                                      "[[port.node]]\n"
+                                      "mac = 5\n"
+                                      "name = \"p\"\n",
+                                      "t.toml");
+  EXPECT_EQ(c.domain_id, 0u);
+  EXPECT_EQ(c.log_level, LogLevel::kInfo);
+  const NodeSettings& n = c.ports.at(0).nodes.at(0);
+  const devicenet::NodeConfig scan_list_defaults;
+  EXPECT_EQ(n.profile, "cdn127");
+  EXPECT_EQ(n.io, kCdn127);
+  EXPECT_EQ(n.poll_period, scan_list_defaults.poll_period);
+  EXPECT_EQ(n.expected_packet_rate, scan_list_defaults.expected_packet_rate);
+  EXPECT_EQ(n.explicit_packet_rate, scan_list_defaults.explicit_packet_rate);
+  EXPECT_EQ(n.immediate_poll_on_change, scan_list_defaults.immediate_poll_on_change);
+  EXPECT_EQ(n.publish, PublishPolicy{});
+  EXPECT_EQ(n.no_commander, NoCommanderPolicy::kIdle);
+  const devicenet::ScannerConfig scanner_defaults;
+  const ScannerTimings& t = c.ports[0].timings;
+  EXPECT_EQ(t.allocate_retry_min, scanner_defaults.allocate_retry_min);
+  EXPECT_EQ(t.allocate_retry_max, scanner_defaults.allocate_retry_max);
+  EXPECT_EQ(t.fault_recheck, scanner_defaults.fault_recheck);
+  EXPECT_EQ(t.poll_response_timeout, scanner_defaults.poll_response_timeout);
+  EXPECT_EQ(t.explicit_response_timeout, scanner_defaults.explicit_messaging.response_timeout);
+  EXPECT_EQ(t.max_consecutive_errors, scanner_defaults.max_consecutive_errors);
+}
+
+TEST(ConfigFile, NodeSettingsOverrideDefaults) {
+  const DaemonConfig c = parse_config(
+      "rack = \"r\"\n"
+      "log_level = \"debug\"\n"
+      "domain = 7\n"
+      "[defaults]\n"
+      "poll_period_ms = 50\n"
+      "expected_packet_rate_ms = 400\n"
+      "explicit_packet_rate_ms = 3000\n"
+      "immediate_poll = false\n"
+      "publish_max_period_ms = 2000\n"
+      "analog_deadband_volts = 1\n"
+      "no_commander = \"hold\"\n"
+      "io = \"cdn118\"\n"
+      "[[port]]\n"
+      "name = \"A\"\n"
+      "interface = \"vcan0\"\n"
+      "bitrate = 125000\n"
+      "master_vendor_id = 1234\n"
+      "master_serial_number = 0xDB000001\n"
+      "allocate_retry_min_ms = 100\n"
+      "allocate_retry_max_ms = 800\n"
+      "fault_recheck_ms = 3000\n"
+      "poll_response_timeout_ms = 20\n"
+      "explicit_response_timeout_ms = 1500\n"
+      "max_consecutive_errors = 4\n"
+      "[[port.node]]\n"
+      "mac = 1\n"
+      "name = \"inherits\"\n"
+      "[[port.node]]\n"
+      "mac = 2\n"
+      "name = \"overrides\"\n"
+      "poll_period_ms = 25\n"
+      "expected_packet_rate_ms = 100\n"
+      "explicit_packet_rate_ms = 1000\n"
+      "immediate_poll = true\n"
+      "publish_max_period_ms = 500\n"
+      "analog_deadband_volts = 0.25\n"
+      "no_commander = \"idle\"\n"
+      "io = \"cdn127\"\n",
+      "t.toml");
+  EXPECT_EQ(c.log_level, LogLevel::kDebug);
+  EXPECT_EQ(c.domain_id, 7u);
+  const PortConfig& p = c.ports.at(0);
+  EXPECT_EQ(p.bitrate, 125000u);
+  EXPECT_EQ(p.master_vendor_id, 1234u);
+  EXPECT_EQ(p.master_serial_number, 0xDB000001u);
+  EXPECT_EQ(p.timings.allocate_retry_min, milliseconds(100));
+  EXPECT_EQ(p.timings.allocate_retry_max, milliseconds(800));
+  EXPECT_EQ(p.timings.fault_recheck, milliseconds(3000));
+  EXPECT_EQ(p.timings.poll_response_timeout, milliseconds(20));
+  EXPECT_EQ(p.timings.explicit_response_timeout, milliseconds(1500));
+  EXPECT_EQ(p.timings.max_consecutive_errors, 4u);
+
+  const NodeSettings& a = p.nodes.at(0);
+  EXPECT_EQ(a.poll_period, milliseconds(50));
+  EXPECT_EQ(a.expected_packet_rate, milliseconds(400));
+  EXPECT_EQ(a.explicit_packet_rate, milliseconds(3000));
+  EXPECT_FALSE(a.immediate_poll_on_change);
+  EXPECT_EQ(a.publish.max_period, milliseconds(2000));
+  EXPECT_DOUBLE_EQ(a.publish.analog_deadband_volts, 1.0);
+  EXPECT_EQ(a.no_commander, NoCommanderPolicy::kHoldLastOutputs);
+  EXPECT_EQ(a.io, kCdn118);
+
+  const NodeSettings& b = p.nodes.at(1);
+  EXPECT_EQ(b.poll_period, milliseconds(25));
+  EXPECT_EQ(b.expected_packet_rate, milliseconds(100));
+  EXPECT_EQ(b.explicit_packet_rate, milliseconds(1000));
+  EXPECT_TRUE(b.immediate_poll_on_change);
+  EXPECT_EQ(b.publish.max_period, milliseconds(500));
+  EXPECT_DOUBLE_EQ(b.publish.analog_deadband_volts, 0.25);
+  EXPECT_EQ(b.no_commander, NoCommanderPolicy::kIdle);
+  EXPECT_EQ(b.io, kCdn127);
+}
+
+TEST(ConfigFile, MissingFileIsReportedWithItsName) {
+  try {
+    load_config_file("/nonexistent/dnbridge/rack.toml");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "/nonexistent/dnbridge/rack.toml: cannot open: No such file or directory");
+  }
+}
+
+// ---------------------------------------------------------------------------
+// I/O configurations.
+
+cdn127::IoConfiguration io_of(std::string_view io_value) {
+  const std::string text = std::string(ONE_PORT "[[port.node]]\nmac = 1\nname = \"p\"\nio = ") +
+                           std::string(io_value) + "\n";
+  return parse_config(text, "t.toml").ports.at(0).nodes.at(0).io;
+}
+
+TEST(ConfigIo, PresetNamesAreTheDevicePresets) {
+  EXPECT_EQ(io_of("\"cdn127\""), kCdn127);
+  EXPECT_EQ(io_of("\"cdn118\""), kCdn118);
+  EXPECT_NE(kCdn127, kCdn118);
+}
+
+TEST(ConfigIo, TableOverridesItsPreset) {
+  EXPECT_EQ(io_of("{}"), kCdn127);
+  EXPECT_EQ(io_of("{ preset = \"cdn118\" }"), kCdn118);
+  cdn127::IoConfiguration expected = kCdn118;
+  expected.num_analog_outputs = 0;
+  expected.no_nc_mask = 0x05;
+  EXPECT_EQ(io_of("{ preset = \"cdn118\", analog_outputs = 0, no_nc_mask = 0x05 }"), expected);
+  EXPECT_EQ(io_of("{ mode = 0x80, digital_inputs = 4, digital_outputs = 2, analog_inputs = 0, "
+                  "analog_outputs = 1, no_nc_mask = 255 }"),
+            (cdn127::IoConfiguration{.mode = 0x80,
+                                     .num_digital_inputs = 4,
+                                     .num_digital_outputs = 2,
+                                     .num_analog_inputs = 0,
+                                     .num_analog_outputs = 1,
+                                     .no_nc_mask = 0xFF}));
+}
+
+TEST(ConfigIo, DeviceMaximaAreAccepted) {
+  EXPECT_EQ(io_of("{ digital_inputs = 8, digital_outputs = 8, analog_inputs = 2, "
+                  "analog_outputs = 1 }"),
+            kCdn127);
+  EXPECT_EQ(io_of("{ digital_inputs = 0, digital_outputs = 0, analog_inputs = 0, "
+                  "analog_outputs = 0 }")
+                .num_digital_inputs,
+            0);
+}
+
+TEST(ConfigIo, CountsOverTheDeviceMaximaAreRefusedOneByOne) {
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "io = { digital_inputs = 9, digital_outputs = 9, analog_inputs = 3, "
+                              "analog_outputs = 2 }\n"),
+            "t.toml:9:25: io.digital_inputs = 9 is more than a CDN127 has (at most 8)\n"
+            "t.toml:9:46: io.digital_outputs = 9 is more than a CDN127 has (at most 8)\n"
+            "t.toml:9:65: io.analog_inputs = 3 is more than a CDN127 has (at most 2)\n"
+            "t.toml:9:85: io.analog_outputs = 2 is more than a CDN127 has (at most 1)");
+}
+
+TEST(ConfigIo, BadPresetTypeAndKeysAreErrors) {
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "io = \"cdn200\"\n"),
+            "t.toml:9:6: io = \"cdn200\" is not a preset: use \"cdn127\" or \"cdn118\", or a table "
+            "of Configuration object values");
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "io = 127\n"),
+            "t.toml:9:6: io must be a preset name (\"cdn127\", \"cdn118\") or a table, not an "
+            "integer");
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "io = { preset = \"x\", mode = 256, analog_input = 1 }\n"),
+            "t.toml:9:17: io.preset = \"x\" is not a preset: use \"cdn127\" or \"cdn118\"\n"
+            "t.toml:9:29: io.mode = 256 is out of range (0..255)\n"
+            "t.toml:9:34: unknown key 'analog_input' in io (did you mean 'analog_inputs'?)");
+}
+
+TEST(ConfigIo, ReservedModeBitsLoadWithAWarning) {
+  const DaemonConfig c = parse_config(ONE_PORT
+                                      "[[port.node]]\n"
+                                      "mac = 1\n"
+                                      "name = \"p\"\n"
+                                      "io = { mode = 0x88 }\n",
+                                      "t.toml");
+  EXPECT_EQ(c.ports.at(0).nodes.at(0).io.mode, 0x88);
+  EXPECT_THAT(c.warnings, ElementsAre("t.toml:9:15: io.mode = 0x88 sets bits 3..6, which the "
+                                      "CDN127 manual leaves reserved"));
+}
+
+// ---------------------------------------------------------------------------
+// Errors, each with its position and text.
+
+TEST(ConfigErrors, TomlSyntaxErrorHasItsPosition) {
+  // The text after the position is toml++'s own.
+  const std::string p = problems("rack = \"r\"\nbitrate = = 2\n");
+  EXPECT_THAT(p, ::testing::StartsWith("t.toml:2:11: "));
+  EXPECT_THAT(p, HasSubstr("could not determine value type"));
+  EXPECT_THAT(p, Not(HasSubstr("\n")));  // the first syntax error only
+  const std::string redefined = problems("rack = \"r\"\nrack = \"s\"\n");
+  EXPECT_THAT(redefined, ::testing::StartsWith("t.toml:2:8: "));
+  EXPECT_THAT(redefined, HasSubstr("cannot redefine existing string 'rack'"));
+}
+
+TEST(ConfigErrors, UnknownKeysAreNamedWithASuggestion) {
+  EXPECT_EQ(
+      problems("rack = \"r\"\n"
+               "colour = \"blue\"\n"
+               "[defaults]\n"
+               "pollperiod_ms = 100\n"
+               "[[port]]\n"
+               "name = \"A\"\n"
+               "interface = \"simulated\"\n"
+               "bitrate = 500000\n"
+               "bit_rate = 500000\n"
+               "[[port.node]]\n"
+               "mac = 1\n"
+               "name = \"p\"\n"
+               "  poll_perod_ms = 100\n"
+               "identity = { vendor_id = 1, product_type = 2, product_code = 3, rev = 1 }\n"),
+      "t.toml:2:1: unknown key 'colour' in the top level\n"
+      "t.toml:4:1: unknown key 'pollperiod_ms' in [defaults] (did you mean 'poll_period_ms'?)\n"
+      "t.toml:9:1: unknown key 'bit_rate' in [[port]] (did you mean 'bitrate'?)\n"
+      "t.toml:13:3: unknown key 'poll_perod_ms' in [[port.node]] (did you mean "
+      "'poll_period_ms'?)\n"
+      "t.toml:14:65: unknown key 'rev' in identity");
+}
+
+TEST(ConfigErrors, MacAndNameOnlyInNodesNotInDefaults) {
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "[defaults]\n"
+                              "mac = 3\n"
+                              "name = \"x\"\n"),
+            "t.toml:10:1: unknown key 'mac' in [defaults]\n"
+            "t.toml:11:1: unknown key 'name' in [defaults]");
+}
+
+TEST(ConfigErrors, WrongTypes) {
+  EXPECT_EQ(problems("rack = 5\n"
+                     "domain = \"0\"\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"simulated\"\n"
+                     "bitrate = 500e3\n"
+                     "[[port.node]]\n"
+                     "mac = \"1\"\n"
+                     "name = \"p\"\n"
+                     "immediate_poll = \"yes\"\n"
+                     "analog_deadband_volts = \"0.1\"\n"
+                     "identity = 59\n"
+                     "[[port.node]]\n"
+                     "mac = 2\n"
+                     "name = \"q\"\n"
+                     "poll_period_ms = 100.0\n"),
+            "t.toml:1:8: rack must be a string, not an integer\n"
+            "t.toml:2:10: domain must be an integer, not a string\n"
+            "t.toml:6:11: bitrate must be an integer, not a floating-point number\n"
+            "t.toml:8:7: mac must be an integer, not a string\n"
+            "t.toml:10:18: immediate_poll must be true or false, not a string\n"
+            "t.toml:11:25: analog_deadband_volts must be a number, not a string\n"
+            "t.toml:12:12: identity must be a table { vendor_id, product_type, product_code }, "
+            "not an integer\n"
+            "t.toml:16:18: poll_period_ms must be an integer, not a floating-point number");
+}
+
+TEST(ConfigErrors, OutOfRangeValues) {
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "domain = 233\n"
+                     "master_mac = -1\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"simulated\"\n"
+                     "bitrate = 300000\n"
+                     "master_vendor_id = 65536\n"
+                     "[[port.node]]\n"
+                     "mac = 64\n"
+                     "name = \"p\"\n"
+                     "poll_period_ms = 0\n"
+                     "analog_deadband_volts = -0.5\n"
+                     "explicit_packet_rate_ms = 65536\n"
+                     "identity = { vendor_id = 59, product_type = 27, product_code = 70000 }\n"),
+            "t.toml:2:10: domain = 233 is out of range: a DDS domain ID is 0..232\n"
+            "t.toml:3:14: master_mac = -1 is out of range: a DeviceNet MAC ID is 0..63\n"
+            "t.toml:7:11: bitrate = 300000 is not a DeviceNet bit rate: use 125000, 250000 or "
+            "500000\n"
+            "t.toml:8:20: master_vendor_id = 65536 is out of range (0..65535)\n"
+            "t.toml:10:7: mac = 64 is out of range: a DeviceNet MAC ID is 0..63\n"
+            "t.toml:12:18: poll_period_ms = 0 is out of range (1..65535 ms)\n"
+            "t.toml:13:25: analog_deadband_volts = -0.5 is out of range (0..10 V)\n"
+            "t.toml:14:27: explicit_packet_rate_ms = 65536 is out of range (1..65535 ms)\n"
+            "t.toml:15:64: identity.product_code = 70000 is out of range (0..65535)");
+}
+
+TEST(ConfigErrors, ExpectedPacketRateShorterThanThePollPeriod) {
+  // Both on the node: at the expected packet rate.
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "poll_period_ms = 100\n"
+                              "expected_packet_rate_ms = 50\n"),
+            "t.toml:10:27: expected_packet_rate_ms = 50 is shorter than poll_period_ms = 100: the "
+            "node expects a poll at least once per expected packet rate");
+  // The poll period on the node, the rate from [defaults]: at the poll period,
+  // saying where the rate came from.
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "[defaults]\n"
+                     "expected_packet_rate_ms = 200\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"simulated\"\n"
+                     "bitrate = 500000\n"
+                     "[[port.node]]\n"
+                     "mac = 1\n"
+                     "name = \"p\"\n"
+                     "poll_period_ms = 300\n"),
+            "t.toml:11:18: expected_packet_rate_ms = 200 (from [defaults], line 3) is shorter "
+            "than poll_period_ms = 300: the node expects a poll at least once per expected packet "
+            "rate");
+  // Against the built-in rate (1000 ms).
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "poll_period_ms = 2000\n"),
+            "t.toml:9:18: expected_packet_rate_ms = 1000 (the default) is shorter than "
+            "poll_period_ms = 2000: the node expects a poll at least once per expected packet "
+            "rate");
+  // Equal is fine.
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "poll_period_ms = 100\n"
+                              "expected_packet_rate_ms = 100\n"),
+            "(none)");
+}
+
+TEST(ConfigErrors, ProblemInDefaultsIsReportedOnceForAllNodes) {
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "[defaults]\n"
+                     "poll_period_ms = 400\n"
+                     "expected_packet_rate_ms = 300\n"
+                     "no_commander = \"stop\"\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"simulated\"\n"
+                     "bitrate = 500000\n"
+                     "[[port.node]]\n"
+                     "mac = 1\n"
+                     "name = \"p\"\n"
+                     "[[port.node]]\n"
+                     "mac = 2\n"
+                     "name = \"q\"\n"),
+            "t.toml:4:27: expected_packet_rate_ms = 300 is shorter than poll_period_ms = 400 "
+            "(from [defaults], line 3): the node expects a poll at least once per expected packet "
+            "rate\n"
+            "t.toml:5:16: no_commander = \"stop\" is not a policy: use \"idle\" or \"hold\"");
+}
+
+TEST(ConfigErrors, DuplicateMacOnAPort) {
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 4\n"
+                              "name = \"first\"\n"
+                              "[[port.node]]\n"
+                              "mac = 4\n"
+                              "name = \"second\"\n"),
+            "t.toml:10:7: mac = 4 is already used on port \"A\" by node \"first\" (line 7)");
+}
+
+TEST(ConfigErrors, SameMacOnTwoPortsIsFine) {
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 4\n"
+                              "name = \"p\"\n"
+                              "[[port]]\n"
+                              "name = \"B\"\n"
+                              "interface = \"simulated\"\n"
+                              "bitrate = 500000\n"
+                              "[[port.node]]\n"
+                              "mac = 4\n"
+                              "name = \"p\"\n"),
+            "(none)");
+}
+
+TEST(ConfigErrors, NodeWithTheMastersMac) {
+  // The rack's master MAC, inherited by the port.
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "master_mac = 3\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"simulated\"\n"
+                     "bitrate = 500000\n"
+                     "[[port.node]]\n"
+                     "mac = 3\n"
+                     "name = \"p\"\n"),
+            "t.toml:8:7: mac = 3 is the master's own MAC on port \"A\" (the rack's master_mac)");
+  // The port's own.
+  EXPECT_EQ(problems(ONE_PORT "master_mac = 62\n"
+                              "[[port.node]]\n"
+                              "mac = 62\n"
+                              "name = \"p\"\n"),
+            "t.toml:8:7: mac = 62 is the master's own MAC on port \"A\" (master_mac, line 6)");
+  // A port with its own master MAC frees the rack's for a node.
+  EXPECT_EQ(problems(ONE_PORT "master_mac = 62\n"
+                              "[[port.node]]\n"
+                              "mac = 0\n"
+                              "name = \"p\"\n"),
+            "(none)");
+}
+
+// Warnings are not errors: a file with errors reports only its errors.
+TEST(ConfigErrors, DuplicatePortNamesAndInterfaces) {
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"can0\"\n"
+                     "bitrate = 500000\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"can0\"\n"
+                     "bitrate = 500000\n"),
+            "t.toml:7:8: port name \"A\" is already used by the port at line 3\n"
+            "t.toml:8:13: interface \"can0\" is already used by port \"A\"");
+}
+
+TEST(ConfigErrors, EmptyNames) {
+  EXPECT_EQ(problems("rack = \"\"\n"
+                     "[[port]]\n"
+                     "name = \"\"\n"
+                     "interface = \"simulated\"\n"
+                     "bitrate = 500000\n"
+                     "[[port.node]]\n"
+                     "mac = 1\n"
+                     "name = \"\"\n"),
+            "t.toml:1:8: rack must not be empty\n"
+            "t.toml:3:8: name must not be empty\n"
+            "t.toml:8:8: name must not be empty");
+}
+
+TEST(ConfigErrors, DuplicateNodeNamesOnAPort) {
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "[[port.node]]\n"
+                              "mac = 2\n"
+                              "name = \"p\"\n"),
+            "t.toml:11:8: name \"p\" is already used on port \"A\" (line 8)");
+}
+
+TEST(ConfigErrors, MissingRequiredKeys) {
+  EXPECT_EQ(problems(""),
+            "t.toml:1:1: missing required key 'rack' in the top level\n"
+            "t.toml:1:1: no [[port]]: a rack has at least one DeviceNet port");
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "[[port]]\n"
+                     "interface = \"simulated\"\n"
+                     "  [[port.node]]\n"
+                     "  profile = \"cdn127\"\n"
+                     "  identity = { vendor_id = 59 }\n"),
+            "t.toml:2:1: missing required key 'name' in [[port]]\n"
+            "t.toml:2:1: missing required key 'bitrate' in [[port]]\n"
+            "t.toml:4:3: missing required key 'mac' in [[port.node]]\n"
+            "t.toml:4:3: missing required key 'name' in [[port.node]]\n"
+            "t.toml:6:14: missing required key 'product_type' in identity\n"
+            "t.toml:6:14: missing required key 'product_code' in identity");
+}
+
+TEST(ConfigErrors, PortMustBeAnArrayOfTables) {
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "[port]\n"
+                     "name = \"A\"\n"),
+            "t.toml:2:1: port must be an array of tables: write [[port]], not [port]");
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "port = []\n"),
+            "t.toml:2:8: port is empty: a rack has at least one DeviceNet port");
+  EXPECT_EQ(problems(ONE_PORT "node = 3\n"),
+            "t.toml:6:8: node must be an array of tables ([[port.node]]), not an integer");
+}
+
+TEST(ConfigErrors, UnsupportedChoices) {
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "log_level = \"verbose\"\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"can0/x\"\n"
+                     "bitrate = 500000\n"
+                     "[[port.node]]\n"
+                     "mac = 1\n"
+                     "name = \"p\"\n"
+                     "profile = \"cdn999\"\n"),
+            "t.toml:2:13: log_level = \"verbose\" is not a level: use \"trace\", \"debug\", "
+            "\"info\", \"warn\" or \"error\"\n"
+            "t.toml:5:13: interface = \"can0/x\" is not a CAN interface name: use \"simulated\" "
+            "or a SocketCAN interface such as \"can0\" (at most 15 characters)\n"
+            "t.toml:10:11: profile \"cdn999\" is not supported: the only profile is \"cdn127\"");
+}
+
+TEST(ConfigErrors, RetryBoundsInOrder) {
+  EXPECT_EQ(problems(ONE_PORT "allocate_retry_min_ms = 1000\n"
+                              "allocate_retry_max_ms = 500\n"
+                              "[[port.node]]\nmac = 1\nname = \"p\"\n"),
+            "t.toml:7:25: allocate_retry_max_ms is shorter than allocate_retry_min_ms");
+}
+
+TEST(ConfigErrors, SeveralErrorsAreReportedTogetherInFileOrder) {
+  try {
+    parse_config(
+        "rack = \"r\"\n"
+        "domian = 1\n"
+        "[[port]]\n"
+        "name = \"A\"\n"
+        "interface = \"simulated\"\n"
+        "bitrate = 300000\n"
+        "[[port.node]]\n"
+        "mac = 64\n"
+        "name = \"p\"\n"
+        "[[port.node]]\n"
+        "mac = 0\n"
+        "name = \"q\"\n"
+        "analog_deadband_volts = -1\n",
+        "rack.toml");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(
+        e.problems(),
+        ElementsAre("rack.toml:2:1: unknown key 'domian' in the top level (did you mean "
+                    "'domain'?)",
+                    "rack.toml:6:11: bitrate = 300000 is not a DeviceNet bit rate: use "
+                    "125000, 250000 or 500000",
+                    "rack.toml:8:7: mac = 64 is out of range: a DeviceNet MAC ID is 0..63",
+                    "rack.toml:11:7: mac = 0 is the master's own MAC on port \"A\" (the "
+                    "rack's master_mac)",
+                    "rack.toml:13:25: analog_deadband_volts = -1 is out of range (0..10 V)"));
+    EXPECT_EQ(std::string(e.what()), e.problems()[0] + "\n" + e.problems()[1] + "\n" +
+                                         e.problems()[2] + "\n" + e.problems()[3] + "\n" +
+                                         e.problems()[4]);
+  }
+}
+
+TEST(ConfigWarnings, PublishFasterThanPollAndEmptyPort) {
+  const DaemonConfig c = parse_config(ONE_PORT
+                                      "[[port.node]]\n"
+                                      "mac = 1\n"
+                                      "name = \"p\"\n"
+                                      "publish_max_period_ms = 50\n"
+                                      "[[port]]\n"
+                                      "name = \"B\"\n"
+                                      "interface = \"simulated\"\n"
+                                      "bitrate = 500000\n",
+                                      "t.toml");
+  EXPECT_THAT(c.warnings,
+              ElementsAre("t.toml:9:25: publish_max_period_ms = 50 is shorter than poll_period_ms "
+                          "= 100 (the default): samples in between repeat the last poll",
+                          "t.toml:10:1: port \"B\" has no [[port.node]]: its master scans "
+                          "nothing"));
+}
+
+// ---------------------------------------------------------------------------
+// What the master is given.
+
+TEST(ConfigToMaster, PumpConfigCarriesTheNodeSettings) {
+  NodeSettings n;
+  n.mac = mac(9);
+  n.name = "pump-9";
+  n.io = kCdn118;
+  n.identity = devicenet::ExpectedIdentity{.vendor_id = 1, .product_type = 2, .product_code = 3};
+  n.poll_period = milliseconds(40);
+  n.expected_packet_rate = milliseconds(160);
+  n.explicit_packet_rate = milliseconds(5000);
+  n.immediate_poll_on_change = false;
+  const rack::PumpConfig p = to_pump_config(n);
+  EXPECT_EQ(p.node.mac, mac(9));
+  EXPECT_EQ(p.node.name, "pump-9");
+  EXPECT_EQ(p.node.poll_period, milliseconds(40));
+  EXPECT_EQ(p.node.expected_packet_rate, milliseconds(160));
+  EXPECT_EQ(p.node.explicit_packet_rate, milliseconds(5000));
+  EXPECT_FALSE(p.node.immediate_poll_on_change);
+  EXPECT_EQ(p.io, kCdn118);
+  EXPECT_EQ(p.identity, n.identity);
+}
+
+TEST(ConfigToMaster, ScannerConfigCarriesThePortsMasterAndTimings) {
+  const DaemonConfig c = parse_config(
+      "rack = \"r\"\n"
+      "master_mac = 5\n"
+      "[[port]]\n"
+      "name = \"A\"\n"
+      "interface = \"can0\"\n"
+      "bitrate = 250000\n"
+      "master_vendor_id = 777\n"
+      "master_serial_number = 123456789\n"
+      "allocate_retry_min_ms = 100\n"
+      "allocate_retry_max_ms = 1600\n"
+      "fault_recheck_ms = 20000\n"
+      "poll_response_timeout_ms = 30\n"
+      "explicit_response_timeout_ms = 1500\n"
+      "max_consecutive_errors = 3\n"
+      "[[port.node]]\nmac = 1\nname = \"p\"\n"
+      "[[port]]\n"
+      "name = \"B\"\n"
+      "interface = \"can1\"\n"
+      "bitrate = 500000\n"
+      "master_mac = 60\n"
+      "[[port.node]]\nmac = 1\nname = \"p\"\n",
+      "t.toml");
+  const devicenet::ScannerConfig a = to_scanner_config(c.ports.at(0));
+  EXPECT_EQ(a.master_mac, mac(5));
+  EXPECT_EQ(a.vendor_id, 777u);
+  EXPECT_EQ(a.serial_number, 123456789u);
+  EXPECT_EQ(a.allocate_retry_min, milliseconds(100));
+  EXPECT_EQ(a.allocate_retry_max, milliseconds(1600));
+  EXPECT_EQ(a.fault_recheck, milliseconds(20000));
+  EXPECT_EQ(a.poll_response_timeout, milliseconds(30));
+  EXPECT_EQ(a.explicit_messaging.response_timeout, milliseconds(1500));
+  EXPECT_EQ(a.max_consecutive_errors, 3u);
+  EXPECT_EQ(a.duplicate_mac_window, devicenet::ScannerConfig{}.duplicate_mac_window);
+  EXPECT_TRUE(a.nodes.empty());
+
+  const devicenet::ScannerConfig b = to_scanner_config(c.ports.at(1));
+  EXPECT_EQ(b.master_mac, mac(60));
+  EXPECT_EQ(b.vendor_id, 0u);  // dnbridge has no vendor ID of its own
+  EXPECT_EQ(b.serial_number, 0u);
+  EXPECT_EQ(b.allocate_retry_min, devicenet::ScannerConfig{}.allocate_retry_min);
+}
+
+TEST(ConfigToMaster, ScanListOfTheExampleFileIsWhatTheRackBuilds) {
+  const DaemonConfig c = load_config_file(DNBRIDGE_SOURCE_DIR "/deploy/config/rack-example.toml");
+  for (const PortConfig& port : c.ports) {
+    SCOPED_TRACE(port.name);
+    const auto pumps = to_pump_configs(port);
+    const devicenet::ScannerConfig scan =
+        rack::PumpRack::scanner_config(to_scanner_config(port), pumps);
+    EXPECT_EQ(scan.master_mac, port.master_mac);
+    ASSERT_EQ(scan.nodes.size(), port.nodes.size());
+    for (std::size_t i = 0; i < port.nodes.size(); ++i) {
+      const NodeSettings& n = port.nodes[i];
+      const devicenet::NodeConfig& node = scan.nodes[i];
+      SCOPED_TRACE(n.name);
+      EXPECT_EQ(node.mac, n.mac);
+      EXPECT_EQ(node.name, n.name);
+      EXPECT_EQ(node.poll_period, n.poll_period);
+      EXPECT_EQ(node.expected_packet_rate, n.expected_packet_rate);
+      const auto format = cdn127::poll_format(n.io);
+      ASSERT_TRUE(format.ok());
+      EXPECT_EQ(node.profile.consumed_size, format->request.size);
+      EXPECT_EQ(node.profile.produced_size, format->response.size);
+      const devicenet::ExpectedIdentity cdn127_identity{.vendor_id = cdn127::kVendorId,
+                                                        .product_type = cdn127::kProductType,
+                                                        .product_code = cdn127::kProductCode};
+      EXPECT_EQ(node.profile.identity, n.identity.value_or(cdn127_identity));
+    }
+  }
+  // The custom I/O node polls with its own sizes: 1 output byte, no analog out.
+  const auto custom = cdn127::poll_format(c.ports.at(0).nodes.at(2).io);
+  ASSERT_TRUE(custom.ok());
+  EXPECT_EQ(custom->request.size, 1u);
+}
+
+TEST(ConfigToMaster, EmbeddedDefaultBuildsEightPumps) {
+  const DaemonConfig c = embedded_default_config();
+  const devicenet::ScannerConfig scan = rack::PumpRack::scanner_config(
+      to_scanner_config(c.ports.at(0)), to_pump_configs(c.ports[0]));
+  ASSERT_EQ(scan.nodes.size(), 8u);
+  // CDN127 preset: 4 bytes out, 6 in; CDN118: 3 out, 2 in (README).
+  EXPECT_EQ(scan.nodes[0].profile.consumed_size, 4u);
+  EXPECT_EQ(scan.nodes[0].profile.produced_size, 6u);
+  EXPECT_EQ(scan.nodes[7].profile.consumed_size, 3u);
+  EXPECT_EQ(scan.nodes[7].profile.produced_size, 2u);
+}
+
+}  // namespace
+}  // namespace dnbridge::daemon
