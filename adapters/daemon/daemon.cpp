@@ -1,0 +1,88 @@
+#include "adapters/daemon/daemon.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "adapters/port/sim_backend.hpp"
+
+namespace dnbridge::daemon {
+namespace {
+
+// The deadline the state topics offer: every instance is written at least
+// once per its node's maximum publish period (and status period); twice the
+// longest leaves room for a loaded machine.
+Duration offered_deadline(const DaemonConfig& c) {
+  Duration longest = seconds(1);  // the status period
+  for (const auto& p : c.ports) {
+    for (const auto& n : p.nodes) longest = std::max(longest, n.publish.max_period);
+  }
+  return 2 * longest;
+}
+
+port::PortLoopConfig loop_config(const PortConfig& p) {
+  port::PortLoopConfig c;
+  c.port = p.name;
+  c.scanner = to_scanner_config(p);
+  c.pumps = to_pump_configs(p);
+  for (const auto& n : p.nodes) c.publish.push_back(n.publish);
+  return c;
+}
+
+}  // namespace
+
+BackendFactory default_backend_factory(LogSink& log) {
+  return [&log](const PortConfig& p) -> std::unique_ptr<port::CanBackend> {
+    if (p.interface == kSimulatedInterface) {
+      std::vector<devicenet::MacId> macs;
+      for (const auto& n : p.nodes) macs.push_back(n.mac);
+      return std::make_unique<port::SimBackend>(p.bitrate, macs, &log);
+    }
+    throw std::runtime_error(fmt::format(
+        "port {}: interface \"{}\": this build drives only the simulated bus (interface = \"{}\")",
+        p.name, p.interface, kSimulatedInterface));
+  };
+}
+
+Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
+    : config_(std::move(config)),
+      log_(log, "dnbridge"),
+      participant_(static_cast<dds_domainid_t>(config_.domain_id), config_.rack),
+      publisher_(participant_, config_.rack, offered_deadline(config_), Logger(log, "dds")) {
+  std::map<std::string, port::PortLoop*> by_name;
+  for (const auto& p : config_.ports) {
+    ports_.push_back(std::make_unique<port::PortLoop>(loop_config(p), backends(p), publisher_, log));
+    by_name[p.name] = ports_.back().get();
+  }
+  input_.emplace(participant_, publisher_, config_.rack, std::move(by_name), Logger(log, "dds input"));
+}
+
+Daemon::~Daemon() { stop(); }
+
+port::PortLoop* Daemon::port(std::string_view name) {
+  for (auto& p : ports_) {
+    if (p->name() == name) return p.get();
+  }
+  return nullptr;
+}
+
+void Daemon::start() {
+  if (running_) return;
+  running_ = true;
+  log_.info("rack {}: {} port(s) on DDS domain {}", config_.rack, ports_.size(), config_.domain_id);
+  for (auto& p : ports_) p->start();
+  input_->start();
+}
+
+void Daemon::stop() {
+  if (!running_) return;
+  running_ = false;
+  input_->stop();
+  for (auto& p : ports_) p->stop();
+  for (auto& p : ports_) p->join();
+  publisher_.flush(seconds(2));
+  log_.info("rack {}: stopped", config_.rack);
+}
+
+}  // namespace dnbridge::daemon

@@ -1,0 +1,52 @@
+#pragma once
+// The bridge of one rack: a DDS participant "dnbridge <rack>", a port loop
+// per CAN port, the DDS input thread. start() and stop() are called from one
+// thread (main, or a test).
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "adapters/daemon/config.hpp"
+#include "adapters/daemon/dds_input.hpp"
+#include "adapters/daemon/dds_publisher.hpp"
+#include "adapters/dds/participant.hpp"
+#include "adapters/port/port_loop.hpp"
+
+namespace dnbridge::daemon {
+
+// Makes the CAN backend of a port: the simulated bus for interface
+// "simulated". Throws std::runtime_error for an interface it cannot open.
+using BackendFactory = std::function<std::unique_ptr<port::CanBackend>(const PortConfig&)>;
+BackendFactory default_backend_factory(LogSink& log);
+
+class Daemon {
+ public:
+  // Throws on set-up failures (DDS entities, CAN interfaces, a configuration
+  // the master refuses), with a message that says what failed.
+  Daemon(DaemonConfig config, LogSink& log, BackendFactory backends);
+  Daemon(DaemonConfig config, LogSink& log) : Daemon(std::move(config), log, default_backend_factory(log)) {}
+  ~Daemon();
+  Daemon(const Daemon&) = delete;
+  Daemon& operator=(const Daemon&) = delete;
+
+  void start();
+  // Orderly: no more DDS input, every node idle then released, the ports'
+  // instances unregistered, the last samples acknowledged (bounded wait).
+  void stop();
+
+  const DaemonConfig& config() const { return config_; }
+  port::PortLoop* port(std::string_view name);
+
+ private:
+  DaemonConfig config_;
+  Logger log_;
+  dds::Participant participant_;
+  DdsPublisher publisher_;
+  std::vector<std::unique_ptr<port::PortLoop>> ports_;
+  std::optional<DdsInput> input_;
+  bool running_ = false;
+};
+
+}  // namespace dnbridge::daemon

@@ -1,0 +1,110 @@
+#include "adapters/daemon/dds_input.hpp"
+
+#include <fmt/format.h>
+
+#include "adapters/daemon/samples.hpp"
+#include "adapters/dds/fields.hpp"
+
+namespace dnbridge::daemon {
+namespace {
+
+enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3 };
+
+TimePoint steady_now() {
+  return TimePoint(std::chrono::duration_cast<Duration>(
+      std::chrono::steady_clock::now().time_since_epoch()));
+}
+
+}  // namespace
+
+DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
+                   std::map<std::string, port::PortLoop*> ports, Logger log)
+    : rack_(std::move(rack)),
+      publisher_(publisher),
+      ports_(std::move(ports)),
+      log_(std::move(log)),
+      commands_(participant, publisher.command_topic(), dds::command_reader_qos()),
+      requests_(participant, publisher.request_topic(), dds::request_reader_qos()),
+      stop_(participant),
+      waitset_(participant) {
+  waitset_.attach(commands_, kCommands);
+  waitset_.attach(requests_, kRequests);
+  waitset_.attach(stop_, kStop);
+}
+
+DdsInput::~DdsInput() { stop(); }
+
+void DdsInput::start() { thread_ = std::thread([this] { run(); }); }
+
+void DdsInput::stop() {
+  if (!thread_.joinable()) return;
+  (void)stop_.trigger();
+  thread_.join();
+}
+
+port::PortLoop* DdsInput::port_of(std::string_view name) {
+  auto it = ports_.find(std::string(name));
+  return it == ports_.end() ? nullptr : it->second;
+}
+
+void DdsInput::run() {
+  for (;;) {
+    auto triggered = waitset_.wait(seconds(1));
+    if (!triggered) {
+      log_.error("waiting for DDS input failed: {}", triggered.error().message());
+      continue;
+    }
+    for (auto token : *triggered) {
+      if (token == kStop) return;
+      if (token == kCommands) take_commands();
+      if (token == kRequests) take_requests();
+    }
+  }
+}
+
+void DdsInput::take_commands() {
+  auto samples = commands_.take();
+  if (!samples) return;
+  for (const auto& s : *samples) {
+    const dnbridge_PumpCommand& c = s.data();
+    if (dds::view(c.rack) != rack_) continue;  // another bridge's pump
+    port::PortLoop* loop = port_of(dds::view(c.port));
+    const auto mac = devicenet::MacId::from(c.mac);
+    if (!loop || !mac || !loop->has_node(*mac)) {
+      unsigned suppressed = 0;
+      if (warn_limit_.allow(steady_now(), suppressed)) {
+        log_.warn("command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
+                  s.info().valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "",
+                  dds::view(c.port), c.mac);
+      }
+      continue;
+    }
+    if (s.info().valid_data()) {
+      loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
+    } else if (s.info().instance_state() != dds::InstanceState::kAlive) {
+      // No live commander left for this pump (all writers gone, or disposed).
+      loop->release_command(*mac);
+    }
+  }
+}
+
+void DdsInput::take_requests() {
+  auto samples = requests_.take();
+  if (!samples) return;
+  for (const auto& s : *samples) {
+    if (!s.info().valid_data()) continue;
+    const dnbridge_ExplicitRequest& r = s.data();
+    if (dds::view(r.rack) != rack_) continue;
+    rack::ExplicitCall call = call_of(r);
+    port::PortLoop* loop = port_of(call.port);
+    if (!loop) {
+      publisher_.explicit_reply(rack::refuse(
+          call, rack::TransactionStatus::kInvalidPort,
+          fmt::format("rack {} has no port \"{}\"", rack_, call.port)));
+      continue;
+    }
+    loop->explicit_request(std::move(call));
+  }
+}
+
+}  // namespace dnbridge::daemon

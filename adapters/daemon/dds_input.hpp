@@ -1,0 +1,47 @@
+#pragma once
+// What reaches the bridge from DDS: pump commands and explicit requests for
+// this rack. A waitset on a thread of its own takes them and hands each to
+// its port's loop through the loop's inbox; no DDS callback touches master
+// state. Requests for other racks are left to their bridges.
+#include <map>
+#include <string>
+#include <thread>
+
+#include "adapters/daemon/dds_publisher.hpp"
+#include "adapters/dds/reader.hpp"
+#include "adapters/dds/waitset.hpp"
+#include "adapters/port/port_loop.hpp"
+#include "bridge/common/log.hpp"
+
+namespace dnbridge::daemon {
+
+class DdsInput {
+ public:
+  DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
+           std::map<std::string, port::PortLoop*> ports, Logger log);
+  ~DdsInput();
+  DdsInput(const DdsInput&) = delete;
+  DdsInput& operator=(const DdsInput&) = delete;
+
+  void start();
+  void stop();  // returns when the thread has ended
+
+ private:
+  void run();
+  void take_commands();
+  void take_requests();
+  port::PortLoop* port_of(std::string_view name);
+
+  std::string rack_;
+  DdsPublisher& publisher_;
+  std::map<std::string, port::PortLoop*> ports_;
+  Logger log_;
+  dds::Reader<dnbridge_PumpCommand> commands_;
+  dds::Reader<dnbridge_ExplicitRequest> requests_;
+  dds::GuardCondition stop_;
+  dds::WaitSet waitset_;
+  std::thread thread_;
+  RateLimiter warn_limit_;
+};
+
+}  // namespace dnbridge::daemon

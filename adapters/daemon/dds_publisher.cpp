@@ -1,0 +1,112 @@
+#include "adapters/daemon/dds_publisher.hpp"
+
+#include "adapters/daemon/samples.hpp"
+#include "adapters/dds/fields.hpp"
+#include "adapters/dds/sample.hpp"
+
+namespace dnbridge::daemon {
+
+WallClock::WallClock() {
+  const auto wall = std::chrono::system_clock::now().time_since_epoch();
+  const auto mono = std::chrono::steady_clock::now().time_since_epoch();
+  offset_ = std::chrono::duration_cast<std::chrono::nanoseconds>(wall) -
+            std::chrono::duration_cast<std::chrono::nanoseconds>(mono);
+}
+
+dds::Timestamp WallClock::to_wall(TimePoint monotonic) const {
+  return dds::Timestamp(monotonic.time_since_epoch() + offset_);
+}
+
+DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack,
+                           Duration state_deadline, Logger log)
+    : rack_(std::move(rack)),
+      log_(std::move(log)),
+      pump_topic_(participant),
+      node_topic_(participant),
+      port_topic_(participant),
+      command_topic_(participant),
+      request_topic_(participant),
+      reply_topic_(participant),
+      pump_writer_(participant, pump_topic_, dds::state_writer_qos(state_deadline)),
+      node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
+      port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
+      reply_writer_(participant, reply_topic_, dds::reply_writer_qos()) {}
+
+void DdsPublisher::check(Status s, const char* what) {
+  if (s) return;
+  unsigned suppressed = 0;
+  if (error_limit_.allow(TimePoint(std::chrono::duration_cast<Duration>(
+                             std::chrono::steady_clock::now().time_since_epoch())),
+                         suppressed)) {
+    log_.error("writing {} failed: {}{}", what, s.error().message(),
+               suppressed ? fmt::format(" ({} more suppressed)", suppressed) : std::string());
+  }
+}
+
+void DdsPublisher::pump_state(const std::string& port, const rack::PumpView& pump,
+                              TimePoint source_time) {
+  dds::Owned<dnbridge_PumpState> sample;
+  fill_pump_state(*sample, rack_, port, pump);
+  check(pump_writer_.write(*sample, clock_.to_wall(source_time)), "PumpState");
+  std::lock_guard lock(mutex_);
+  written_[port].insert(pump.mac.value());
+}
+
+void DdsPublisher::node_status(const std::string& port, const rack::PumpView& pump,
+                               const devicenet::Node& node, TimePoint source_time) {
+  dds::Owned<dnbridge_NodeStatus> sample;
+  fill_node_status(*sample, rack_, port, pump, node);
+  check(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
+}
+
+void DdsPublisher::port_status(const port::PortStatusView& status, TimePoint source_time) {
+  dds::Owned<dnbridge_PortStatus> sample;
+  fill_port_status(*sample, rack_, status);
+  check(port_writer_.write(*sample, clock_.to_wall(source_time)), "PortStatus");
+}
+
+void DdsPublisher::explicit_reply(const rack::ExplicitAnswer& answer) {
+  dds::Owned<dnbridge_ExplicitReply> sample;
+  fill_explicit_reply(*sample, answer);
+  check(reply_writer_.write(*sample), "ExplicitReply");
+}
+
+void DdsPublisher::port_stopped(const std::string& port) {
+  // Unregister, never dispose: the last samples (online false, stopped) stay
+  // what late readers see until the bridge is back.
+  std::set<std::uint8_t> macs;
+  {
+    std::lock_guard lock(mutex_);
+    macs = written_[port];
+  }
+  const auto now = dds::dds_now();
+  for (std::uint8_t mac : macs) {
+    dds::Owned<dnbridge_PumpState> pump_key;
+    dds::set_string(pump_key->rack, rack_);
+    dds::set_string(pump_key->port, port);
+    pump_key->mac = mac;
+    check(pump_writer_.unregister_instance(*pump_key, now), "PumpState unregistration");
+    dds::Owned<dnbridge_NodeStatus> node_key;
+    dds::set_string(node_key->rack, rack_);
+    dds::set_string(node_key->port, port);
+    node_key->mac = mac;
+    check(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
+  }
+  dds::Owned<dnbridge_PortStatus> port_key;
+  dds::set_string(port_key->rack, rack_);
+  dds::set_string(port_key->port, port);
+  check(port_writer_.unregister_instance(*port_key, now), "PortStatus unregistration");
+}
+
+}  // namespace dnbridge::daemon
+
+namespace dnbridge::daemon {
+
+void DdsPublisher::flush(Duration timeout) {
+  (void)pump_writer_.wait_for_acks(timeout);
+  (void)node_writer_.wait_for_acks(timeout);
+  (void)port_writer_.wait_for_acks(timeout);
+  (void)reply_writer_.wait_for_acks(timeout);
+}
+
+}  // namespace dnbridge::daemon

@@ -1,0 +1,74 @@
+#pragma once
+// The DDS face of the ports: writes PumpState, NodeStatus, PortStatus and
+// ExplicitReply samples. Called from every port's thread (Cyclone's writers
+// are thread-safe); each sample carries the monotonic event time mapped to
+// the wall clock as its source timestamp.
+#include <map>
+#include <mutex>
+#include <set>
+#include <string>
+
+#include "adapters/dds/participant.hpp"
+#include "adapters/dds/time.hpp"
+#include "adapters/dds/topic.hpp"
+#include "adapters/dds/topics.hpp"
+#include "adapters/dds/writer.hpp"
+#include "adapters/port/port_publisher.hpp"
+#include "bridge/common/log.hpp"
+
+namespace dnbridge::daemon {
+
+// Maps the steady clock the ports run on to the wall clock DDS stamps with.
+class WallClock {
+ public:
+  WallClock();
+  dds::Timestamp to_wall(TimePoint monotonic) const;
+
+ private:
+  std::chrono::nanoseconds offset_;
+};
+
+class DdsPublisher final : public port::PortPublisher {
+ public:
+  // `state_deadline`: the deadline offered on the state topics (each
+  // instance is written at least that often while its port runs).
+  DdsPublisher(const dds::Participant& participant, std::string rack, Duration state_deadline,
+               Logger log);
+
+  void pump_state(const std::string& port, const rack::PumpView& pump, TimePoint source_time) override;
+  void node_status(const std::string& port, const rack::PumpView& pump, const devicenet::Node& node,
+                   TimePoint source_time) override;
+  void port_status(const port::PortStatusView& status, TimePoint source_time) override;
+  void explicit_reply(const rack::ExplicitAnswer& answer) override;
+  void port_stopped(const std::string& port) override;
+
+  // Waits (at most `timeout`) until every reader has acknowledged what was
+  // written: the last samples of a shutdown reach their readers.
+  void flush(Duration timeout);
+
+  const dds::Topic<dnbridge_PumpCommand>& command_topic() const { return command_topic_; }
+  const dds::Topic<dnbridge_ExplicitRequest>& request_topic() const { return request_topic_; }
+
+ private:
+  void check(Status s, const char* what);
+
+  std::string rack_;
+  Logger log_;
+  WallClock clock_;
+  dds::Topic<dnbridge_PumpState> pump_topic_;
+  dds::Topic<dnbridge_NodeStatus> node_topic_;
+  dds::Topic<dnbridge_PortStatus> port_topic_;
+  dds::Topic<dnbridge_PumpCommand> command_topic_;
+  dds::Topic<dnbridge_ExplicitRequest> request_topic_;
+  dds::Topic<dnbridge_ExplicitReply> reply_topic_;
+  dds::Writer<dnbridge_PumpState> pump_writer_;
+  dds::Writer<dnbridge_NodeStatus> node_writer_;
+  dds::Writer<dnbridge_PortStatus> port_writer_;
+  dds::Writer<dnbridge_ExplicitReply> reply_writer_;
+
+  std::mutex mutex_;
+  std::map<std::string, std::set<std::uint8_t>> written_;  // per port, the MACs written
+  RateLimiter error_limit_;
+};
+
+}  // namespace dnbridge::daemon

@@ -1,0 +1,112 @@
+// dnbridge: the DeviceNet-to-DDS bridge of one equipment rack.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "adapters/daemon/config.hpp"
+#include "adapters/daemon/daemon.hpp"
+#include "adapters/daemon/log_sink.hpp"
+
+namespace {
+
+using namespace dnbridge;
+
+// Exit codes: 0 stopped in order; 1 failed while running or at set-up;
+// 2 bad command line or configuration.
+constexpr int kFailed = 1;
+constexpr int kBadConfiguration = 2;
+
+std::optional<LogLevel> parse_level(const std::string& s) {
+  for (auto level : {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn,
+                     LogLevel::kError}) {
+    if (s == to_string(level)) return level;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "dnbridge: the DeviceNet master of an equipment rack's CAN ports, publishing its pumps as\n"
+      "typed DDS topics (dnbridge/PumpState, NodeStatus, PortStatus) and taking commands\n"
+      "(dnbridge/PumpCommand) and explicit requests (dnbridge/ExplicitRequest)."};
+  std::string config_file;
+  std::string check_file;
+  bool simulate = false;
+  bool print_default = false;
+  std::string level_name;
+  auto* config_opt = app.add_option("-c,--config", config_file, "The rack's configuration file (TOML)")
+                         ->check(CLI::ExistingFile);
+  auto* simulate_opt = app.add_flag("--simulate", simulate,
+                                    "Run the embedded default: a simulated rack of CDN127 pumps "
+                                    "on the in-process bus");
+  app.add_option("--check-config", check_file, "Check a configuration file and exit");
+  app.add_flag("--print-default-config", print_default,
+                "Print the embedded default configuration and exit");
+  app.add_option("--log-level", level_name, "trace, debug, info, warn or error (default: the file's)")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  config_opt->excludes(simulate_opt);
+  CLI11_PARSE(app, argc, argv);
+
+  if (print_default) {
+    std::fputs(std::string(daemon::embedded_default_config_text()).c_str(), stdout);
+    return 0;
+  }
+  if (!check_file.empty()) {
+    try {
+      auto c = daemon::load_config_file(check_file);
+      for (const auto& w : c.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+      std::size_t nodes = 0;
+      for (const auto& p : c.ports) nodes += p.nodes.size();
+      std::printf("%s: rack %s, %zu port(s), %zu node(s): OK\n", check_file.c_str(), c.rack.c_str(),
+                  c.ports.size(), nodes);
+      return 0;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+      return kBadConfiguration;
+    }
+  }
+  if (config_file.empty() && !simulate) {
+    std::fprintf(stderr, "give --config FILE, or --simulate for the embedded default (--help)\n");
+    return kBadConfiguration;
+  }
+
+  daemon::DaemonConfig config;
+  try {
+    config = simulate ? daemon::embedded_default_config() : daemon::load_config_file(config_file);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kBadConfiguration;
+  }
+  daemon::StderrLogSink log(config.log_level);
+  if (!level_name.empty()) log.set_level(*parse_level(level_name));
+  Logger main_log(log, "dnbridge");
+  for (const auto& w : config.warnings) main_log.warn("{}: {}", config.source, w);
+
+  // SIGINT and SIGTERM are taken by sigwait() below: blocked before any
+  // thread starts, so no other thread is interrupted by them.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  try {
+    daemon::Daemon bridge(config, log);
+    bridge.start();
+    main_log.info("running ({}); SIGINT or SIGTERM stops it in order", config.source);
+    int signal = 0;
+    sigwait(&signals, &signal);
+    main_log.info("{}: stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
+    bridge.stop();
+  } catch (const std::exception& e) {
+    main_log.error("{}", e.what());
+    return kFailed;
+  }
+  return 0;
+}

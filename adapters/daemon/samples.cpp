@@ -1,0 +1,217 @@
+#include "adapters/daemon/samples.hpp"
+
+#include <algorithm>
+
+#include "adapters/dds/fields.hpp"
+
+namespace dnbridge::daemon {
+
+namespace cdn127 = profiles::cdn127;
+using dds::set_octets;
+using dds::set_string;
+
+dnbridge_NodeLifecycle to_idl(devicenet::NodeState s) {
+  switch (s) {
+    case devicenet::NodeState::kAbsent: return dnbridge_NODE_ABSENT;
+    case devicenet::NodeState::kIdentifying: return dnbridge_NODE_IDENTIFYING;
+    case devicenet::NodeState::kConfiguring: return dnbridge_NODE_CONFIGURING;
+    case devicenet::NodeState::kVerifying: return dnbridge_NODE_VERIFYING;
+    case devicenet::NodeState::kOnline: return dnbridge_NODE_ONLINE;
+    case devicenet::NodeState::kWrongDevice: return dnbridge_NODE_WRONG_DEVICE;
+    case devicenet::NodeState::kConfigurationFault: return dnbridge_NODE_CONFIGURATION_FAULT;
+    case devicenet::NodeState::kOwnedByOtherMaster: return dnbridge_NODE_OWNED_BY_OTHER_MASTER;
+    case devicenet::NodeState::kStopped: return dnbridge_NODE_STOPPED;
+  }
+  return dnbridge_NODE_ABSENT;
+}
+
+dnbridge_PortLifecycle to_idl(devicenet::PortState s) {
+  switch (s) {
+    case devicenet::PortState::kStopped: return dnbridge_PORT_STOPPED;
+    case devicenet::PortState::kCheckingMac: return dnbridge_PORT_CHECKING_MAC;
+    case devicenet::PortState::kRunning: return dnbridge_PORT_RUNNING;
+    case devicenet::PortState::kStopping: return dnbridge_PORT_STOPPING;
+    case devicenet::PortState::kDuplicateMac: return dnbridge_PORT_DUPLICATE_MAC;
+  }
+  return dnbridge_PORT_STOPPED;
+}
+
+dnbridge_BusState to_idl(port::BusState s) {
+  switch (s) {
+    case port::BusState::kErrorActive: return dnbridge_BUS_ERROR_ACTIVE;
+    case port::BusState::kErrorWarning: return dnbridge_BUS_ERROR_WARNING;
+    case port::BusState::kErrorPassive: return dnbridge_BUS_ERROR_PASSIVE;
+    case port::BusState::kBusOff: return dnbridge_BUS_OFF;
+    case port::BusState::kUnknown: return dnbridge_BUS_STATE_UNKNOWN;
+  }
+  return dnbridge_BUS_STATE_UNKNOWN;
+}
+
+std::string_view device_state_text(std::uint8_t state) {
+  // CDN127 manual, Identity object, "Device State - Attribute 8".
+  switch (state) {
+    case 0: return "non-existent";
+    case 1: return "self test";
+    case 2: return "standby";
+    case 3: return "operating";
+    case 4: return "major recoverable fault";
+    case 5: return "major unrecoverable fault";
+    default: return "reserved";
+  }
+}
+
+void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string_view port,
+                     const rack::PumpView& v) {
+  set_string(out.rack, rack);
+  set_string(out.port, port);
+  out.mac = v.mac.value();
+  set_string(out.name, v.name);
+  out.online = v.online;
+
+  const bool inputs = v.online && v.has_inputs;
+  out.inputs_valid = inputs && v.inputs.pump.has_value();
+  const cdn127::PumpInputs pump = inputs ? v.inputs.pump.value_or(cdn127::PumpInputs{}) : cdn127::PumpInputs{};
+  out.pump_running = out.inputs_valid && pump.pump_running;
+  out.warning_active = out.inputs_valid && pump.warning_active;
+  out.alarm_active = out.inputs_valid && pump.alarm_active;
+  out.n2_flow_ok = out.inputs_valid && pump.n2_flow_ok;
+  out.interlock_ok = out.inputs_valid && pump.interlock_ok;
+  out.digital_inputs_raw = inputs ? v.inputs.input_bits.value_or(0) : 0;
+
+  const auto exception =
+      inputs ? v.inputs.exception_status : std::optional<cdn127::ExceptionStatus>{};
+  out.exception_status_valid = exception.has_value();
+  const cdn127::ExceptionStatus e = exception.value_or(cdn127::ExceptionStatus{});
+  out.alarm_device_common = e.alarm_device_common;
+  out.alarm_device_specific = e.alarm_device_specific;
+  out.alarm_manufacturer_specific = e.alarm_manufacturer_specific;
+  out.warning_device_common = e.warning_device_common;
+  out.warning_device_specific = e.warning_device_specific;
+  out.warning_manufacturer_specific = e.warning_manufacturer_specific;
+
+  out.analog_input_count = 0;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto raw = inputs ? v.inputs.analog_inputs_raw[i] : std::optional<std::uint16_t>{};
+    out.analog_input_raw[i] = raw.value_or(0);
+    out.analog_input_volts[i] = static_cast<float>(cdn127::raw_to_volts(raw.value_or(0)));
+    if (raw) out.analog_input_count = static_cast<std::uint8_t>(i + 1);
+  }
+
+  out.outputs_idle = v.outputs_idle;
+  const cdn127::PumpOutputs applied = v.outputs_idle ? cdn127::PumpOutputs{} : v.outputs_applied;
+  out.pump_on = applied.pump_on;
+  out.n2_ballast_on = applied.n2_ballast_on;
+  out.analog_output_raw = applied.analog_out_raw;
+  out.analog_output_volts = static_cast<float>(cdn127::raw_to_volts(applied.analog_out_raw));
+  set_string(out.commanded_by, v.outputs_idle ? std::string_view{} : std::string_view(v.commanded_by));
+}
+
+void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
+                      const rack::PumpView& v, const devicenet::Node& node) {
+  set_string(out.rack, rack);
+  set_string(out.port, port);
+  out.mac = v.mac.value();
+  set_string(out.name, v.name);
+  out.state = to_idl(node.state());
+  set_string(out.reason, node.reason());
+
+  const auto& id = node.identity();
+  out.vendor_id = id.vendor_id;
+  out.product_type = id.product_type;
+  out.product_code = id.product_code;
+  out.major_revision = id.major_revision;
+  out.minor_revision = id.minor_revision;
+  out.serial_number = id.serial_number;
+  set_string(out.product_name, id.product_name);
+  out.device_state_valid = node.device_state().has_value();
+  out.device_state = node.device_state().value_or(0);
+  set_string(out.device_state_text,
+             node.device_state() ? device_state_text(*node.device_state()) : std::string_view{});
+
+  const auto ms = [](Duration d) {
+    return static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(d).count());
+  };
+  out.poll_period_ms = ms(node.config().poll_period);
+  out.expected_packet_rate_ms = ms(node.poll_epr());
+  out.produced_size = static_cast<std::uint16_t>(node.config().profile.produced_size);
+  out.consumed_size = static_cast<std::uint16_t>(node.config().profile.consumed_size);
+
+  const auto& error = node.last_error();
+  set_string(out.last_error, error.kind == devicenet::NodeError::Kind::kNone
+                                 ? std::string{}
+                                 : error.describe());
+  out.last_error_general_status = static_cast<std::uint8_t>(error.general_status);
+  out.last_error_additional_status = error.additional_status;
+  set_string(out.last_command_refused, v.last_command_refused);
+
+  const auto& c = node.counters();
+  const auto& e = node.explicit_counters();
+  out.counters.polls = c.polls;
+  out.counters.idle_polls = c.idle_polls;
+  out.counters.poll_responses = c.responses;
+  out.counters.poll_timeouts = c.timeouts;
+  out.counters.poll_retries = c.retries;
+  out.counters.poll_errors = c.errors;
+  out.counters.reconnects = c.reconnects;
+  out.counters.allocate_attempts = c.allocate_attempts;
+  out.counters.explicit_requests = e.requests;
+  out.counters.explicit_timeouts = e.timeouts;
+  out.counters.explicit_device_errors = e.device_errors;
+  out.counters.commands_accepted = v.commands_accepted;
+  out.counters.commands_refused = v.commands_refused;
+}
+
+void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,
+                      const port::PortStatusView& s) {
+  set_string(out.rack, rack);
+  set_string(out.port, s.port);
+  set_string(out.can_interface, s.interface_name);
+  out.bitrate = s.bitrate;
+  out.master_mac = s.master_mac.value();
+  out.state = to_idl(s.state);
+  set_string(out.reason, s.reason);
+  out.bus_state = to_idl(s.bus.state);
+  out.tx_error_counter = s.bus.tx_errors;
+  out.rx_error_counter = s.bus.rx_errors;
+  out.frames_per_second = static_cast<float>(s.frames_per_second);
+  out.bus_load_percent = static_cast<float>(s.bus_load_percent);
+  out.scan_cycle_ms = static_cast<float>(s.scan_cycle_ms);
+  out.nodes_online = s.nodes_online;
+  out.nodes_configured = s.nodes_configured;
+}
+
+void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer& a) {
+  set_string(out.requester, a.requester);
+  out.txid = a.txid;
+  out.status = static_cast<std::uint8_t>(a.status);
+  out.general_status = a.general_status;
+  out.additional_status = a.additional_status;
+  set_octets(out.data, a.data);
+  set_string(out.message, a.message);
+}
+
+cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& c) {
+  cdn127::PumpOutputs o;
+  o.pump_on = c.pump_on;
+  o.n2_ballast_on = c.n2_ballast_on;
+  o.analog_out_raw = c.analog_output_raw;  // checked by the rack model, never clipped
+  return o;
+}
+
+rack::ExplicitCall call_of(const dnbridge_ExplicitRequest& r) {
+  rack::ExplicitCall c;
+  c.requester = std::string(dds::view(r.requester));
+  c.txid = r.txid;
+  c.command = r.command;
+  c.port = std::string(dds::view(r.port));
+  c.mac = r.mac;
+  c.service = r.service;
+  c.class_id = r.class_id;
+  c.instance_id = r.instance_id;
+  if (r.has_attribute) c.attribute = r.attribute_id;
+  const auto data = dds::view(r.data);
+  c.data.assign(data.begin(), data.end());
+  return c;
+}
+
+}  // namespace dnbridge::daemon

@@ -1,0 +1,36 @@
+#pragma once
+// The mapping between the rack model and the IDL types: what each published
+// member means is decided here, in one place.
+#include <string>
+#include <string_view>
+
+#include "adapters/dds/sample.hpp"
+#include "adapters/port/port_publisher.hpp"
+#include "bridge/devicenet/node.hpp"
+#include "bridge/rack/explicit_gateway.hpp"
+#include "bridge/rack/pump_rack.hpp"
+#include "dnbridge.h"
+
+namespace dnbridge::daemon {
+
+void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string_view port,
+                     const rack::PumpView& pump);
+void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
+                      const rack::PumpView& pump, const devicenet::Node& node);
+void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,
+                      const port::PortStatusView& status);
+void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer& answer);
+
+// A command sample's outputs, as the rack model takes them.
+profiles::cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& command);
+// A request sample as the explicit gateway takes it.
+rack::ExplicitCall call_of(const dnbridge_ExplicitRequest& request);
+
+dnbridge_NodeLifecycle to_idl(devicenet::NodeState state);
+dnbridge_PortLifecycle to_idl(devicenet::PortState state);
+dnbridge_BusState to_idl(port::BusState state);
+
+// Identity object State (attribute 8), for people.
+std::string_view device_state_text(std::uint8_t state);
+
+}  // namespace dnbridge::daemon
