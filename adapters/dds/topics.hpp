@@ -75,6 +75,12 @@ Qos command_reader_qos();
 // above what a bridge can execute, while keeping memory bounded. A
 // transaction is one instance; 4 samples per instance leave room for a
 // repeated request or the IN_PROGRESS and final replies of a GET_STATUS.
+// Past a limit a write blocks for at most the reliability max_blocking_time
+// and then fails with DDS_RETCODE_TIMEOUT: pushed back, never dropped.
+// A reader keeps an instance for as long as a writer has it registered, even
+// with no sample left, so each side unregisters a transaction's instance
+// once done with it (the requester after its reply, the bridge when it
+// forgets the transaction); readers skip the invalid samples that follow.
 inline constexpr int32_t kExplicitMaxSamples = 256;
 inline constexpr int32_t kExplicitMaxInstances = 256;
 inline constexpr int32_t kExplicitMaxSamplesPerInstance = 4;
