@@ -1,0 +1,56 @@
+#pragma once
+// Filling the generated structs without touching malloc: their strings and
+// sequences are heap memory that Cyclone frees with dds_free (through
+// dds_sample_free), so they must be allocated with dds_alloc as well.
+#include <dds/dds.h>
+
+#include "dnbridge.h"  // dds_sequence_octet, as idlc generates it
+
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <string_view>
+
+namespace dnbridge::dds {
+
+// Replaces a string member's value.
+inline void set_string(char*& field, std::string_view value) {
+  char* copy = static_cast<char*>(dds_alloc(value.size() + 1));
+  if (!value.empty()) std::memcpy(copy, value.data(), value.size());
+  copy[value.size()] = '\0';
+  dds_string_free(field);
+  field = copy;
+}
+
+inline void clear_string(char*& field) noexcept {
+  dds_string_free(field);
+  field = nullptr;
+}
+
+// A string member as a view; a null member reads as empty.
+inline std::string_view view(const char* field) noexcept {
+  return field == nullptr ? std::string_view{} : std::string_view{field};
+}
+
+// sequence<octet> members.
+inline void clear_octets(dds_sequence_octet& seq) noexcept {
+  if (seq._release) dds_free(seq._buffer);
+  seq = dds_sequence_octet{};
+}
+
+inline void set_octets(dds_sequence_octet& seq, std::span<const std::uint8_t> value) {
+  clear_octets(seq);
+  if (value.empty()) return;
+  seq._buffer = static_cast<std::uint8_t*>(dds_alloc(value.size()));
+  std::memcpy(seq._buffer, value.data(), value.size());
+  seq._length = static_cast<std::uint32_t>(value.size());
+  seq._maximum = seq._length;
+  seq._release = true;
+}
+
+inline std::span<const std::uint8_t> view(const dds_sequence_octet& seq) noexcept {
+  if (seq._buffer == nullptr) return {};
+  return {seq._buffer, seq._length};
+}
+
+}  // namespace dnbridge::dds

@@ -1,0 +1,140 @@
+#pragma once
+// A typed data reader. Samples are taken (or read) into owned copies: Cyclone
+// deserialises straight into zeroed structs of ours, whose strings and
+// sequences Sample<T> frees, so no loan is ever outstanding.
+// Creation throws Error; every operation after that returns a Status or Result.
+#include <dds/dds.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "adapters/dds/entity.hpp"
+#include "adapters/dds/participant.hpp"
+#include "adapters/dds/qos.hpp"
+#include "adapters/dds/sample.hpp"
+#include "adapters/dds/topic.hpp"
+
+namespace dnbridge::dds {
+
+// Triggers (in a waitset) while the reader holds samples matching `mask`, a
+// combination of the DDS_*_SAMPLE_STATE, DDS_*_VIEW_STATE and
+// DDS_*_INSTANCE_STATE masks (DDS_ANY_STATE for all). Taking through the
+// condition takes only those samples.
+class ReadCondition : public Entity {
+ public:
+  ReadCondition(const Entity& reader, uint32_t mask)
+      : Entity(check(dds_create_readcondition(reader.handle(), mask), "creating a read condition")),
+        reader_(reader.handle()) {}
+  dds_entity_t reader() const noexcept { return reader_; }
+
+ private:
+  dds_entity_t reader_;
+};
+
+template <class T>
+class Reader : public Entity {
+ public:
+  Reader(const Participant& participant, const Topic<T>& topic, const Qos& qos)
+      : Entity(check(dds_create_reader(participant.handle(), topic.handle(), qos.get(), nullptr),
+                     std::string("creating a reader of ") + TopicTraits<T>::kDescriptor->m_typename)) {}
+
+  // Up to `max` samples, removed from the reader.
+  Result<std::vector<Sample<T>>> take(std::size_t max = kDefaultMax) const {
+    return collect(handle(), max, true, DDS_HANDLE_NIL);
+  }
+  // Up to `max` samples, left in the reader (marked read).
+  Result<std::vector<Sample<T>>> read(std::size_t max = kDefaultMax) const {
+    return collect(handle(), max, false, DDS_HANDLE_NIL);
+  }
+  // Only the samples that match the condition's mask.
+  Result<std::vector<Sample<T>>> take(const ReadCondition& condition,
+                                      std::size_t max = kDefaultMax) const {
+    if (condition.reader() != handle()) return make_error_code(DDS_RETCODE_BAD_PARAMETER);
+    return collect(condition.handle(), max, true, DDS_HANDLE_NIL);
+  }
+  Result<std::vector<Sample<T>>> read(const ReadCondition& condition,
+                                      std::size_t max = kDefaultMax) const {
+    if (condition.reader() != handle()) return make_error_code(DDS_RETCODE_BAD_PARAMETER);
+    return collect(condition.handle(), max, false, DDS_HANDLE_NIL);
+  }
+  // Only the samples of one instance (see lookup_instance).
+  Result<std::vector<Sample<T>>> take_instance(dds_instance_handle_t instance,
+                                               std::size_t max = kDefaultMax) const {
+    return collect(handle(), max, true, instance);
+  }
+
+  // The handle of the instance whose key members `key` holds; DDS_HANDLE_NIL
+  // when the reader does not know it.
+  dds_instance_handle_t lookup_instance(const T& key) const noexcept {
+    return dds_lookup_instance(handle(), &key);
+  }
+
+  Result<uint32_t> matched_publications() const noexcept {
+    auto status = subscription_matched();
+    if (!status) return status.error();
+    return status->current_count;
+  }
+
+  // Status getters read and reset the status' "change" counts.
+  Result<dds_subscription_matched_status_t> subscription_matched() const noexcept {
+    dds_subscription_matched_status_t s{};
+    return result(dds_get_subscription_matched_status(handle(), &s), s);
+  }
+  Result<dds_requested_deadline_missed_status_t> requested_deadline_missed() const noexcept {
+    dds_requested_deadline_missed_status_t s{};
+    return result(dds_get_requested_deadline_missed_status(handle(), &s), s);
+  }
+  Result<dds_liveliness_changed_status_t> liveliness_changed() const noexcept {
+    dds_liveliness_changed_status_t s{};
+    return result(dds_get_liveliness_changed_status(handle(), &s), s);
+  }
+  Result<dds_requested_incompatible_qos_status_t> requested_incompatible_qos() const noexcept {
+    dds_requested_incompatible_qos_status_t s{};
+    return result(dds_get_requested_incompatible_qos_status(handle(), &s), s);
+  }
+  Result<dds_sample_lost_status_t> sample_lost() const noexcept {
+    dds_sample_lost_status_t s{};
+    return result(dds_get_sample_lost_status(handle(), &s), s);
+  }
+  Result<dds_sample_rejected_status_t> sample_rejected() const noexcept {
+    dds_sample_rejected_status_t s{};
+    return result(dds_get_sample_rejected_status(handle(), &s), s);
+  }
+
+  static constexpr std::size_t kDefaultMax = 64;
+
+ private:
+  template <class S>
+  static Result<S> result(dds_return_t rc, const S& s) noexcept {
+    if (rc < 0) return make_error_code(rc);
+    return s;
+  }
+
+  // `from` is the reader or one of its read conditions.
+  static Result<std::vector<Sample<T>>> collect(dds_entity_t from, std::size_t max, bool take,
+                                                dds_instance_handle_t instance) {
+    if (max == 0) return std::vector<Sample<T>>{};
+    std::vector<Sample<T>> samples(max);
+    std::vector<void*> buffers(max);
+    std::vector<dds_sample_info_t> infos(max);
+    for (std::size_t i = 0; i < max; ++i) buffers[i] = samples[i].data_.get();
+    const auto n32 = static_cast<uint32_t>(max);
+    dds_return_t n;
+    if (instance != DDS_HANDLE_NIL) {
+      n = take ? dds_take_instance(from, buffers.data(), infos.data(), max, n32, instance)
+               : dds_read_instance(from, buffers.data(), infos.data(), max, n32, instance);
+    } else {
+      n = take ? dds_take(from, buffers.data(), infos.data(), max, n32)
+               : dds_read(from, buffers.data(), infos.data(), max, n32);
+    }
+    if (n < 0) return make_error_code(n);
+    const auto count = static_cast<std::size_t>(n);
+    samples.resize(count);  // the unused ones are still all zero: nothing to free
+    for (std::size_t i = 0; i < count; ++i) samples[i].info_ = SampleInfo(infos[i]);
+    return samples;
+  }
+};
+
+}  // namespace dnbridge::dds

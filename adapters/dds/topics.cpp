@@ -1,0 +1,81 @@
+#include "adapters/dds/topics.hpp"
+
+namespace dnbridge::dds {
+namespace {
+
+// How long a reliable write may wait for room in a full reader history
+// before it fails with DDS_RETCODE_TIMEOUT; short, as writes are made from
+// the bridge's event loop.
+constexpr Duration kMaxBlocking = milliseconds(100);
+
+Qos state_common() {
+  Qos qos;
+  qos.reliable(kMaxBlocking)
+      .durability(Durability::kTransientLocal)
+      .keep_last(1)
+      .liveliness(Liveliness::kAutomatic)
+      .destination_order_by_source_timestamp();
+  return qos;
+}
+
+Qos command_common() {
+  Qos qos;
+  qos.reliable(kMaxBlocking)
+      .durability(Durability::kVolatile)
+      .keep_last(1)
+      .exclusive_ownership()
+      .destination_order_by_source_timestamp();
+  return qos;
+}
+
+Qos explicit_common(Durability durability) {
+  Qos qos;
+  qos.reliable(kMaxBlocking)
+      .durability(durability)
+      .keep_all()
+      .resource_limits(kExplicitMaxSamples, kExplicitMaxInstances, kExplicitMaxSamplesPerInstance);
+  return qos;
+}
+
+}  // namespace
+
+Qos state_writer_qos(Duration deadline) {
+  Qos qos = state_common();
+  qos.deadline(deadline).autodispose_unregistered_instances(false);
+  return qos;
+}
+
+Qos state_reader_qos(std::optional<Duration> deadline) {
+  Qos qos = state_common();
+  qos.deadline(deadline.value_or(kInfinite));
+  return qos;
+}
+
+Qos command_writer_qos(int32_t strength, Duration lease) {
+  Qos qos = command_common();
+  qos.ownership_strength(strength)
+      .liveliness(Liveliness::kAutomatic, lease)
+      .autodispose_unregistered_instances(false);
+  return qos;
+}
+
+Qos command_reader_qos() {
+  Qos qos = command_common();
+  // An infinite requested lease accepts every writer's lease; the writer's
+  // own lease still decides when the reader sees it lose liveliness.
+  qos.liveliness(Liveliness::kAutomatic, kInfinite);
+  return qos;
+}
+
+Qos request_writer_qos() { return explicit_common(Durability::kVolatile); }
+Qos request_reader_qos() { return explicit_common(Durability::kVolatile); }
+
+Qos reply_writer_qos() {
+  Qos qos = explicit_common(Durability::kTransientLocal);
+  qos.durability_service_keep_last(1);
+  return qos;
+}
+
+Qos reply_reader_qos() { return explicit_common(Durability::kTransientLocal); }
+
+}  // namespace dnbridge::dds

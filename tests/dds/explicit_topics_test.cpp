@@ -1,0 +1,112 @@
+// Explicit messaging topics: requests are volatile (a bridge never executes a
+// request written before it was there), replies reach a requester whose
+// reader the bridge discovers late.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+
+#include "dds_fixture.hpp"
+
+namespace dnbridge::dds::testing {
+namespace {
+
+Owned<dnbridge_ExplicitRequest> request(const std::string& requester, std::uint32_t txid) {
+  Owned<dnbridge_ExplicitRequest> r;
+  set_string(r->requester, requester);
+  r->txid = txid;
+  r->command = dnbridge_COMMAND_EXECUTE;
+  return r;
+}
+
+Owned<dnbridge_ExplicitReply> reply(const std::string& requester, std::uint32_t txid) {
+  Owned<dnbridge_ExplicitReply> r;
+  set_string(r->requester, requester);
+  r->txid = txid;
+  r->status = dnbridge_STATUS_SUCCESS;
+  set_string(r->message, "done");
+  return r;
+}
+
+TEST_F(DdsTest, RequestWrittenBeforeTheBridgeIsNeverDelivered) {
+  Topic<dnbridge_ExplicitRequest> topic(participant_);
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  ASSERT_TRUE(client.write(*request(rack_, 1)).ok());
+
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
+  ASSERT_TRUE(client.write(*request(rack_, 2)).ok());
+  ReadCondition any(bridge, DDS_ANY_STATE);
+  ASSERT_TRUE(wait_for(participant_, any));
+  auto taken = bridge.take();
+  ASSERT_TRUE(taken.ok());
+  ASSERT_EQ(taken->size(), 1U);
+  EXPECT_EQ((*taken)[0]->txid, 2U);
+}
+
+TEST_F(DdsTest, RepeatedRequestsOfOneTransactionAreAllKept) {
+  // Keep-all: a repeated request is not overwritten before the bridge takes it.
+  Topic<dnbridge_ExplicitRequest> topic(participant_);
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  ASSERT_TRUE(client.write(*request(rack_, 1)).ok());
+  ASSERT_TRUE(client.write(*request(rack_, 1)).ok());
+  ASSERT_TRUE(client.write(*request(rack_, 2)).ok());
+  ASSERT_TRUE(client.wait_for_acks(kEventTimeout).ok());
+  auto taken = bridge.take();
+  ASSERT_TRUE(taken.ok());
+  EXPECT_EQ(taken->size(), 3U);
+}
+
+TEST_F(DdsTest, FullRequestHistoryPushesBackOnTheRequester) {
+  // Keep-all with resource limits: past kExplicitMaxSamplesPerInstance
+  // untaken samples of one transaction, a write blocks for the reliability
+  // max_blocking_time and then fails; nothing is dropped silently.
+  Topic<dnbridge_ExplicitRequest> topic(participant_);
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  const auto r = request(rack_, 1);
+  for (int32_t i = 0; i < kExplicitMaxSamplesPerInstance; ++i) ASSERT_TRUE(client.write(*r).ok());
+  const Status full = client.write(*r);
+  ASSERT_FALSE(full.ok());
+  EXPECT_EQ(full.error(), make_error_code(DDS_RETCODE_TIMEOUT));
+  EXPECT_EQ(bridge.take()->size(), static_cast<std::size_t>(kExplicitMaxSamplesPerInstance));
+}
+
+TEST_F(DdsTest, UnregisteredTransactionsFreeTheirInstances) {
+  // A reader keeps an instance while a writer has it registered, even with
+  // no sample left: a requester unregisters each finished transaction, or
+  // after kExplicitMaxInstances of them its writes would block.
+  Topic<dnbridge_ExplicitRequest> topic(participant_);
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  ReadCondition not_read(bridge, DDS_NOT_READ_SAMPLE_STATE);
+  int executed = 0;
+  for (std::uint32_t txid = 1; txid <= 2 * kExplicitMaxInstances; ++txid) {
+    const auto r = request(rack_, txid);
+    ASSERT_TRUE(client.write(*r).ok()) << txid;
+    ASSERT_TRUE(client.unregister_instance(*r).ok());
+    ASSERT_TRUE(wait_for(participant_, not_read));
+    auto taken = bridge.take();
+    ASSERT_TRUE(taken.ok());
+    for (const auto& sample : *taken) executed += sample.valid_data() ? 1 : 0;
+  }
+  EXPECT_EQ(executed, 2 * kExplicitMaxInstances);
+}
+
+TEST_F(DdsTest, ReplyReachesARequesterDiscoveredAfterIt) {
+  Topic<dnbridge_ExplicitReply> topic(participant_);
+  Writer<dnbridge_ExplicitReply> bridge(participant_, topic, reply_writer_qos());
+  ASSERT_TRUE(bridge.write(*reply(rack_, 41)).ok());
+  ASSERT_TRUE(bridge.write(*reply(rack_, 42)).ok());
+
+  Reader<dnbridge_ExplicitReply> client(participant_, topic, reply_reader_qos());
+  ReadCondition any(client, DDS_ANY_STATE);
+  ASSERT_TRUE(wait_for(participant_, any));
+  auto taken = client.take();
+  ASSERT_TRUE(taken.ok());
+  ASSERT_EQ(taken->size(), 2U);
+  EXPECT_EQ(view((*taken)[0]->message), "done");
+}
+
+}  // namespace
+}  // namespace dnbridge::dds::testing
