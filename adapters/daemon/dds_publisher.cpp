@@ -71,6 +71,15 @@ void DdsPublisher::explicit_reply(const rack::ExplicitAnswer& answer) {
   check(reply_writer_.write(*sample), "ExplicitReply");
 }
 
+void DdsPublisher::forget_reply(const std::string& requester, std::uint32_t txid) {
+  // Readers keep an instance while any writer has it registered: replies the
+  // bridge no longer keeps are unregistered, or readers fill up.
+  dds::Owned<dnbridge_ExplicitReply> key;
+  dds::set_string(key->requester, requester);
+  key->txid = txid;
+  check(reply_writer_.unregister_instance(*key), "ExplicitReply unregistration");
+}
+
 void DdsPublisher::port_stopped(const std::string& port) {
   // Unregister, never dispose: the last samples (online false, stopped) stay
   // what late readers see until the bridge is back.

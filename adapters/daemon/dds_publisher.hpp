@@ -40,6 +40,7 @@ class DdsPublisher final : public port::PortPublisher {
                    TimePoint source_time) override;
   void port_status(const port::PortStatusView& status, TimePoint source_time) override;
   void explicit_reply(const rack::ExplicitAnswer& answer) override;
+  void forget_reply(const std::string& requester, std::uint32_t txid) override;
   void port_stopped(const std::string& port) override;
 
   // Waits (at most `timeout`) until every reader has acknowledged what was

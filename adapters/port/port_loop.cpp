@@ -89,6 +89,7 @@ bool PortLoop::drain_inbox(TimePoint now) {
       }
     } else if (auto* call = std::get_if<rack::ExplicitCall>(&item)) {
       if (auto answer = gateway_->on_request(*call, now)) publisher_.explicit_reply(*answer);
+      forget_replies();
     } else if (auto* fn = std::get_if<std::function<void(CanBackend&)>>(&item)) {
       (*fn)(*backend_);
     } else {
@@ -229,6 +230,13 @@ void PortLoop::on_device_state(MacId m, std::uint8_t s, TimePoint at) {
 void PortLoop::on_explicit_result(std::uint32_t id, MacId, const devicenet::ExplicitResult& r,
                                   TimePoint at) {
   if (auto answer = gateway_->on_result(id, r, at)) publisher_.explicit_reply(*answer);
+  forget_replies();
+}
+
+void PortLoop::forget_replies() {
+  for (const auto& [requester, txid] : gateway_->take_forgotten()) {
+    publisher_.forget_reply(requester, txid);
+  }
 }
 
 }  // namespace dnbridge::port

@@ -38,6 +38,8 @@ class PortPublisher {
                            const devicenet::Node& node, TimePoint source_time) = 0;
   virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;
   virtual void explicit_reply(const rack::ExplicitAnswer& answer) = 0;
+  // The transaction is forgotten: a repeat would now execute again.
+  virtual void forget_reply(const std::string& requester, std::uint32_t txid) = 0;
   // The port has stopped: its instances are unregistered (never disposed).
   virtual void port_stopped(const std::string& port) = 0;
 };

@@ -76,6 +76,7 @@ std::optional<ExplicitAnswer> ExplicitGateway::on_request(const ExplicitCall& ca
         if (i->first.first == call.requester && i->second.done) {
           done_order_.erase(std::remove(done_order_.begin(), done_order_.end(), i->first),
                             done_order_.end());
+          forgotten_.push_back(i->first);
           i = transactions_.erase(i);
         } else {
           ++i;
@@ -204,6 +205,7 @@ void ExplicitGateway::retain(const Key& key) {
   done_order_.push_back(key);
   while (done_order_.size() > limits_.retained) {
     transactions_.erase(done_order_.front());
+    forgotten_.push_back(done_order_.front());
     done_order_.pop_front();
   }
 }

@@ -91,6 +91,12 @@ class ExplicitGateway {
   std::optional<ExplicitAnswer> on_result(std::uint32_t request_id,
                                           const devicenet::ExplicitResult& result, TimePoint now);
 
+  // Transactions forgotten since the last call (evicted from the retained
+  // replies, or reset by their requester): their reply instances can go.
+  std::vector<std::pair<std::string, std::uint32_t>> take_forgotten() {
+    return std::exchange(forgotten_, {});
+  }
+
   std::size_t in_progress() const { return by_request_id_.size(); }
   std::size_t retained() const { return done_order_.size(); }
 
@@ -110,6 +116,7 @@ class ExplicitGateway {
   std::map<Key, Transaction> transactions_;
   std::map<std::uint32_t, Key> by_request_id_;  // executing
   std::deque<Key> done_order_;                  // completed, oldest first
+  std::vector<Key> forgotten_;
 };
 
 }  // namespace dnbridge::rack

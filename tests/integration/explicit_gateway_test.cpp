@@ -239,6 +239,10 @@ TEST_F(Gateway, CompletedTransactionsAreRetainedWithinTheLimit) {
   for (std::uint32_t t = 1; t <= 10; ++t) harness_.request(get_call(t, 2, 1, 1), now()), run(milliseconds(50));
   run();
   EXPECT_EQ(gateway_->retained(), 4u);
+  const auto forgotten = gateway_->take_forgotten();
+  ASSERT_EQ(forgotten.size(), 6u);
+  EXPECT_EQ(forgotten.front(), (std::pair<std::string, std::uint32_t>{"tester", 1}));
+  EXPECT_TRUE(gateway_->take_forgotten().empty());
   auto status = get_call(1, 2, 1, 1);
   status.command = 2;
   harness_.request(status, now());
