@@ -52,10 +52,12 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
       publisher_(participant_, config_.rack, offered_deadline(config_), Logger(log, "dds")) {
   std::map<std::string, port::PortLoop*> by_name;
   for (const auto& p : config_.ports) {
-    ports_.push_back(std::make_unique<port::PortLoop>(loop_config(p), backends(p), publisher_, log));
+    ports_.push_back(
+        std::make_unique<port::PortLoop>(loop_config(p), backends(p), publisher_, log));
     by_name[p.name] = ports_.back().get();
   }
-  input_.emplace(participant_, publisher_, config_.rack, std::move(by_name), Logger(log, "dds input"));
+  input_.emplace(participant_, publisher_, config_.rack, std::move(by_name),
+                 Logger(log, "dds input"));
 }
 
 Daemon::~Daemon() { stop(); }

@@ -26,7 +26,8 @@ class Daemon {
   // Throws on set-up failures (DDS entities, CAN interfaces, a configuration
   // the master refuses), with a message that says what failed.
   Daemon(DaemonConfig config, LogSink& log, BackendFactory backends);
-  Daemon(DaemonConfig config, LogSink& log) : Daemon(std::move(config), log, default_backend_factory(log)) {}
+  Daemon(DaemonConfig config, LogSink& log)
+      : Daemon(std::move(config), log, default_backend_factory(log)) {}
   ~Daemon();
   Daemon(const Daemon&) = delete;
   Daemon& operator=(const Daemon&) = delete;

@@ -11,8 +11,8 @@ namespace {
 enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3 };
 
 TimePoint steady_now() {
-  return TimePoint(std::chrono::duration_cast<Duration>(
-      std::chrono::steady_clock::now().time_since_epoch()));
+  return TimePoint(
+      std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
 }
 
 }  // namespace
@@ -34,7 +34,9 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
 
 DdsInput::~DdsInput() { stop(); }
 
-void DdsInput::start() { thread_ = std::thread([this] { run(); }); }
+void DdsInput::start() {
+  thread_ = std::thread([this] { run(); });
+}
 
 void DdsInput::stop() {
   if (!thread_.joinable()) return;
@@ -98,9 +100,9 @@ void DdsInput::take_requests() {
     rack::ExplicitCall call = call_of(r);
     port::PortLoop* loop = port_of(call.port);
     if (!loop) {
-      publisher_.explicit_reply(rack::refuse(
-          call, rack::TransactionStatus::kInvalidPort,
-          fmt::format("rack {} has no port \"{}\"", rack_, call.port)));
+      publisher_.explicit_reply(
+          rack::refuse(call, rack::TransactionStatus::kInvalidPort,
+                       fmt::format("rack {} has no port \"{}\"", rack_, call.port)));
       continue;
     }
     loop->explicit_request(std::move(call));

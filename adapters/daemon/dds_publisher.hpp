@@ -35,7 +35,8 @@ class DdsPublisher final : public port::PortPublisher {
   DdsPublisher(const dds::Participant& participant, std::string rack, Duration state_deadline,
                Logger log);
 
-  void pump_state(const std::string& port, const rack::PumpView& pump, TimePoint source_time) override;
+  void pump_state(const std::string& port, const rack::PumpView& pump,
+                  TimePoint source_time) override;
   void node_status(const std::string& port, const rack::PumpView& pump, const devicenet::Node& node,
                    TimePoint source_time) override;
   void port_status(const port::PortStatusView& status, TimePoint source_time) override;

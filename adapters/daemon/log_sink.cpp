@@ -12,10 +12,14 @@ namespace {
 int syslog_priority(LogLevel level) {
   switch (level) {
     case LogLevel::kTrace:
-    case LogLevel::kDebug: return 7;
-    case LogLevel::kInfo: return 6;
-    case LogLevel::kWarn: return 4;
-    case LogLevel::kError: return 3;
+    case LogLevel::kDebug:
+      return 7;
+    case LogLevel::kInfo:
+      return 6;
+    case LogLevel::kWarn:
+      return 4;
+    case LogLevel::kError:
+      return 3;
   }
   return 6;
 }
@@ -30,8 +34,8 @@ void StderrLogSink::write(LogLevel level, std::string_view component, std::strin
   if (journal_) {
     line = fmt::format("<{}>{}: {}\n", syslog_priority(level), component, message);
   } else {
-    const auto now = std::chrono::time_point_cast<std::chrono::milliseconds>(
-        std::chrono::system_clock::now());
+    const auto now =
+        std::chrono::time_point_cast<std::chrono::milliseconds>(std::chrono::system_clock::now());
     line = fmt::format("{:%Y-%m-%dT%H:%M:%S}Z {:<5} {}: {}\n", now, to_string(level), component,
                        message);
   }

@@ -1,15 +1,17 @@
 // dnbridge: the DeviceNet-to-DDS bridge of one equipment rack.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <signal.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
+#include "adapters/dds/loopback.hpp"
 
 namespace {
 
@@ -21,8 +23,8 @@ constexpr int kFailed = 1;
 constexpr int kBadConfiguration = 2;
 
 std::optional<LogLevel> parse_level(const std::string& s) {
-  for (auto level : {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn,
-                     LogLevel::kError}) {
+  for (auto level :
+       {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn, LogLevel::kError}) {
     if (s == to_string(level)) return level;
   }
   return std::nullopt;
@@ -40,15 +42,17 @@ int main(int argc, char** argv) {
   bool simulate = false;
   bool print_default = false;
   std::string level_name;
-  auto* config_opt = app.add_option("-c,--config", config_file, "The rack's configuration file (TOML)")
-                         ->check(CLI::ExistingFile);
+  auto* config_opt =
+      app.add_option("-c,--config", config_file, "The rack's configuration file (TOML)")
+          ->check(CLI::ExistingFile);
   auto* simulate_opt = app.add_flag("--simulate", simulate,
                                     "Run the embedded default: a simulated rack of CDN127 pumps "
                                     "on the in-process bus");
   app.add_option("--check-config", check_file, "Check a configuration file and exit");
   app.add_flag("--print-default-config", print_default,
-                "Print the embedded default configuration and exit");
-  app.add_option("--log-level", level_name, "trace, debug, info, warn or error (default: the file's)")
+               "Print the embedded default configuration and exit");
+  app.add_option("--log-level", level_name,
+                 "trace, debug, info, warn or error (default: the file's)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   config_opt->excludes(simulate_opt);
   CLI11_PARSE(app, argc, argv);
@@ -83,10 +87,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", e.what());
     return kBadConfiguration;
   }
+  // The simulated rack stays on this host unless told otherwise.
+  const bool pinned = simulate && std::getenv("CYCLONEDDS_URI") == nullptr;
+  if (pinned) setenv("CYCLONEDDS_URI", dds::kLoopbackConfig, 0);
+
   daemon::StderrLogSink log(config.log_level);
   if (!level_name.empty()) log.set_level(*parse_level(level_name));
   Logger main_log(log, "dnbridge");
   for (const auto& w : config.warnings) main_log.warn("{}: {}", config.source, w);
+  if (pinned) {
+    main_log.info(
+        "DDS pinned to loopback (CYCLONEDDS_URI was not set; see "
+        "deploy/cyclonedds/loopback.xml)");
+  }
 
   // SIGINT and SIGTERM are taken by sigwait() below: blocked before any
   // thread starts, so no other thread is interrupted by them.

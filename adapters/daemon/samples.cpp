@@ -12,37 +12,56 @@ using dds::set_string;
 
 dnbridge_NodeLifecycle to_idl(devicenet::NodeState s) {
   switch (s) {
-    case devicenet::NodeState::kAbsent: return dnbridge_NODE_ABSENT;
-    case devicenet::NodeState::kIdentifying: return dnbridge_NODE_IDENTIFYING;
-    case devicenet::NodeState::kConfiguring: return dnbridge_NODE_CONFIGURING;
-    case devicenet::NodeState::kVerifying: return dnbridge_NODE_VERIFYING;
-    case devicenet::NodeState::kOnline: return dnbridge_NODE_ONLINE;
-    case devicenet::NodeState::kWrongDevice: return dnbridge_NODE_WRONG_DEVICE;
-    case devicenet::NodeState::kConfigurationFault: return dnbridge_NODE_CONFIGURATION_FAULT;
-    case devicenet::NodeState::kOwnedByOtherMaster: return dnbridge_NODE_OWNED_BY_OTHER_MASTER;
-    case devicenet::NodeState::kStopped: return dnbridge_NODE_STOPPED;
+    case devicenet::NodeState::kAbsent:
+      return dnbridge_NODE_ABSENT;
+    case devicenet::NodeState::kIdentifying:
+      return dnbridge_NODE_IDENTIFYING;
+    case devicenet::NodeState::kConfiguring:
+      return dnbridge_NODE_CONFIGURING;
+    case devicenet::NodeState::kVerifying:
+      return dnbridge_NODE_VERIFYING;
+    case devicenet::NodeState::kOnline:
+      return dnbridge_NODE_ONLINE;
+    case devicenet::NodeState::kWrongDevice:
+      return dnbridge_NODE_WRONG_DEVICE;
+    case devicenet::NodeState::kConfigurationFault:
+      return dnbridge_NODE_CONFIGURATION_FAULT;
+    case devicenet::NodeState::kOwnedByOtherMaster:
+      return dnbridge_NODE_OWNED_BY_OTHER_MASTER;
+    case devicenet::NodeState::kStopped:
+      return dnbridge_NODE_STOPPED;
   }
   return dnbridge_NODE_ABSENT;
 }
 
 dnbridge_PortLifecycle to_idl(devicenet::PortState s) {
   switch (s) {
-    case devicenet::PortState::kStopped: return dnbridge_PORT_STOPPED;
-    case devicenet::PortState::kCheckingMac: return dnbridge_PORT_CHECKING_MAC;
-    case devicenet::PortState::kRunning: return dnbridge_PORT_RUNNING;
-    case devicenet::PortState::kStopping: return dnbridge_PORT_STOPPING;
-    case devicenet::PortState::kDuplicateMac: return dnbridge_PORT_DUPLICATE_MAC;
+    case devicenet::PortState::kStopped:
+      return dnbridge_PORT_STOPPED;
+    case devicenet::PortState::kCheckingMac:
+      return dnbridge_PORT_CHECKING_MAC;
+    case devicenet::PortState::kRunning:
+      return dnbridge_PORT_RUNNING;
+    case devicenet::PortState::kStopping:
+      return dnbridge_PORT_STOPPING;
+    case devicenet::PortState::kDuplicateMac:
+      return dnbridge_PORT_DUPLICATE_MAC;
   }
   return dnbridge_PORT_STOPPED;
 }
 
 dnbridge_BusState to_idl(port::BusState s) {
   switch (s) {
-    case port::BusState::kErrorActive: return dnbridge_BUS_ERROR_ACTIVE;
-    case port::BusState::kErrorWarning: return dnbridge_BUS_ERROR_WARNING;
-    case port::BusState::kErrorPassive: return dnbridge_BUS_ERROR_PASSIVE;
-    case port::BusState::kBusOff: return dnbridge_BUS_OFF;
-    case port::BusState::kUnknown: return dnbridge_BUS_STATE_UNKNOWN;
+    case port::BusState::kErrorActive:
+      return dnbridge_BUS_ERROR_ACTIVE;
+    case port::BusState::kErrorWarning:
+      return dnbridge_BUS_ERROR_WARNING;
+    case port::BusState::kErrorPassive:
+      return dnbridge_BUS_ERROR_PASSIVE;
+    case port::BusState::kBusOff:
+      return dnbridge_BUS_OFF;
+    case port::BusState::kUnknown:
+      return dnbridge_BUS_STATE_UNKNOWN;
   }
   return dnbridge_BUS_STATE_UNKNOWN;
 }
@@ -50,13 +69,20 @@ dnbridge_BusState to_idl(port::BusState s) {
 std::string_view device_state_text(std::uint8_t state) {
   // CDN127 manual, Identity object, "Device State - Attribute 8".
   switch (state) {
-    case 0: return "non-existent";
-    case 1: return "self test";
-    case 2: return "standby";
-    case 3: return "operating";
-    case 4: return "major recoverable fault";
-    case 5: return "major unrecoverable fault";
-    default: return "reserved";
+    case 0:
+      return "non-existent";
+    case 1:
+      return "self test";
+    case 2:
+      return "standby";
+    case 3:
+      return "operating";
+    case 4:
+      return "major recoverable fault";
+    case 5:
+      return "major unrecoverable fault";
+    default:
+      return "reserved";
   }
 }
 
@@ -70,7 +96,8 @@ void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string
 
   const bool inputs = v.online && v.has_inputs;
   out.inputs_valid = inputs && v.inputs.pump.has_value();
-  const cdn127::PumpInputs pump = inputs ? v.inputs.pump.value_or(cdn127::PumpInputs{}) : cdn127::PumpInputs{};
+  const cdn127::PumpInputs pump =
+      inputs ? v.inputs.pump.value_or(cdn127::PumpInputs{}) : cdn127::PumpInputs{};
   out.pump_running = out.inputs_valid && pump.pump_running;
   out.warning_active = out.inputs_valid && pump.warning_active;
   out.alarm_active = out.inputs_valid && pump.alarm_active;
@@ -103,7 +130,8 @@ void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string
   out.n2_ballast_on = applied.n2_ballast_on;
   out.analog_output_raw = applied.analog_out_raw;
   out.analog_output_volts = static_cast<float>(cdn127::raw_to_volts(applied.analog_out_raw));
-  set_string(out.commanded_by, v.outputs_idle ? std::string_view{} : std::string_view(v.commanded_by));
+  set_string(out.commanded_by,
+             v.outputs_idle ? std::string_view{} : std::string_view(v.commanded_by));
 }
 
 void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
@@ -137,9 +165,8 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.consumed_size = static_cast<std::uint16_t>(node.config().profile.consumed_size);
 
   const auto& error = node.last_error();
-  set_string(out.last_error, error.kind == devicenet::NodeError::Kind::kNone
-                                 ? std::string{}
-                                 : error.describe());
+  set_string(out.last_error,
+             error.kind == devicenet::NodeError::Kind::kNone ? std::string{} : error.describe());
   out.last_error_general_status = static_cast<std::uint8_t>(error.general_status);
   out.last_error_additional_status = error.additional_status;
   set_string(out.last_command_refused, v.last_command_refused);

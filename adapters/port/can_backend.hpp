@@ -17,7 +17,13 @@ class FrameReceiver {
 };
 
 // CAN controller state, as the interface reports it.
-enum class BusState : std::uint8_t { kErrorActive, kErrorWarning, kErrorPassive, kBusOff, kUnknown };
+enum class BusState : std::uint8_t {
+  kErrorActive,
+  kErrorWarning,
+  kErrorPassive,
+  kBusOff,
+  kUnknown
+};
 
 struct BusCounters {
   BusState state = BusState::kUnknown;

@@ -51,7 +51,8 @@ bool PortLoop::has_node(MacId mac) const {
                      [&](const rack::PumpConfig& p) { return p.node.mac == mac; });
 }
 
-void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs, std::string issuer) {
+void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs,
+                       std::string issuer) {
   push(Command{mac, outputs, std::move(issuer)});
 }
 void PortLoop::release_command(MacId mac) { push(Release{mac}); }
@@ -118,8 +119,8 @@ void PortLoop::run() {
     publish(now, false);
     if (stopping && (scanner_->stopped() || now >= stop_deadline)) break;
 
-    TimePoint wake = std::min({scanner_->next_deadline(), stop_deadline,
-                               port_status_time_ + config_.status_period});
+    TimePoint wake = std::min(
+        {scanner_->next_deadline(), stop_deadline, port_status_time_ + config_.status_period});
     for (const auto& p : published_) {
       wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
     }
@@ -146,7 +147,8 @@ void PortLoop::publish(TimePoint now, bool force) {
     }
     if (force || !p.status_once || v.status_changes != p.changes ||
         now >= p.status_time + config_.status_period) {
-      publisher_.node_status(config_.port, v, *scanner_->node(v.mac), std::max(source, p.status_time));
+      publisher_.node_status(config_.port, v, *scanner_->node(v.mac),
+                             std::max(source, p.status_time));
       p.changes = v.status_changes;
       p.status_time = now;
       p.status_once = true;
@@ -194,10 +196,10 @@ void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
   }
   metrics_.frames_per_second = static_cast<double>(bus.frames - last_counters_.frames) / elapsed;
   const auto bitrate = backend_->bitrate();
-  metrics_.bus_load_percent =
-      bitrate ? 100.0 * static_cast<double>(bus.bits - last_counters_.bits) /
-                    (static_cast<double>(bitrate) * elapsed)
-              : 0.0;
+  metrics_.bus_load_percent = bitrate
+                                  ? 100.0 * static_cast<double>(bus.bits - last_counters_.bits) /
+                                        (static_cast<double>(bitrate) * elapsed)
+                                  : 0.0;
   metrics_.scan_cycle_ms = cycles ? cycle_sum / cycles : 0.0;
   last_counters_ = bus;
   metrics_time_ = now;
@@ -215,7 +217,8 @@ void PortLoop::on_port_state(devicenet::PortState s, const std::string& r, TimeP
 void PortLoop::on_node_state(MacId m, devicenet::NodeState f, devicenet::NodeState t,
                              const std::string& r, TimePoint at) {
   if (t == devicenet::NodeState::kOnline || f == devicenet::NodeState::kOnline) {
-    log_.info("node {} {} -> {}: {}", m.value(), devicenet::to_string(f), devicenet::to_string(t), r);
+    log_.info("node {} {} -> {}: {}", m.value(), devicenet::to_string(f), devicenet::to_string(t),
+              r);
   }
   rack_.on_node_state(m, f, t, r, at);
   port_dirty_ = true;
@@ -223,7 +226,9 @@ void PortLoop::on_node_state(MacId m, devicenet::NodeState f, devicenet::NodeSta
 void PortLoop::on_node_identity(MacId m, const devicenet::NodeIdentity& i, TimePoint at) {
   rack_.on_node_identity(m, i, at);
 }
-void PortLoop::on_poll_response(MacId m, Bytes d, TimePoint at) { rack_.on_poll_response(m, d, at); }
+void PortLoop::on_poll_response(MacId m, Bytes d, TimePoint at) {
+  rack_.on_poll_response(m, d, at);
+}
 void PortLoop::on_device_state(MacId m, std::uint8_t s, TimePoint at) {
   rack_.on_device_state(m, s, at);
 }

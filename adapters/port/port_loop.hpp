@@ -25,12 +25,12 @@
 namespace dnbridge::port {
 
 struct PortLoopConfig {
-  std::string port;                         // the port's name
-  devicenet::ScannerConfig scanner;         // master MAC and timings; nodes from `pumps`
-  std::vector<rack::PumpConfig> pumps;      // the scan list
-  std::vector<rack::PublishPolicy> publish; // per pump, same order
-  Duration status_period = seconds(1);      // NodeStatus/PortStatus at least this often
-  Duration shutdown_timeout = seconds(3);   // for idling and releasing every node
+  std::string port;                          // the port's name
+  devicenet::ScannerConfig scanner;          // master MAC and timings; nodes from `pumps`
+  std::vector<rack::PumpConfig> pumps;       // the scan list
+  std::vector<rack::PublishPolicy> publish;  // per pump, same order
+  Duration status_period = seconds(1);       // NodeStatus/PortStatus at least this often
+  Duration shutdown_timeout = seconds(3);    // for idling and releasing every node
 };
 
 class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver {
@@ -69,8 +69,8 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     devicenet::MacId mac;
   };
   struct Stop {};
-  using Item = std::variant<Command, Release, rack::ExplicitCall, Stop,
-                            std::function<void(CanBackend&)>>;
+  using Item =
+      std::variant<Command, Release, rack::ExplicitCall, Stop, std::function<void(CanBackend&)>>;
 
   void run();
   void push(Item item);
@@ -84,7 +84,8 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) override;
   void on_node_state(devicenet::MacId m, devicenet::NodeState f, devicenet::NodeState t,
                      const std::string& r, TimePoint at) override;
-  void on_node_identity(devicenet::MacId m, const devicenet::NodeIdentity& i, TimePoint at) override;
+  void on_node_identity(devicenet::MacId m, const devicenet::NodeIdentity& i,
+                        TimePoint at) override;
   void on_poll_response(devicenet::MacId m, Bytes d, TimePoint at) override;
   void on_device_state(devicenet::MacId m, std::uint8_t s, TimePoint at) override;
   void on_explicit_result(std::uint32_t id, devicenet::MacId m, const devicenet::ExplicitResult& r,
@@ -102,10 +103,10 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
 
   struct Published {
     rack::PumpStateGate gate;
-    std::uint64_t changes = ~0ull;   // PumpView::changes at the last NodeStatus
+    std::uint64_t changes = ~0ull;  // PumpView::changes at the last NodeStatus
     TimePoint status_time{};
     bool status_once = false;
-    TimePoint event_time{};          // latest event of this node: the source time
+    TimePoint event_time{};  // latest event of this node: the source time
   };
   std::vector<Published> published_;
   bool port_dirty_ = true;

@@ -33,7 +33,8 @@ class PortPublisher {
   // `source_time` is the monotonic time of the event the sample comes from
   // (a frame's receive time, or a timer's); the publisher maps it to the
   // wall clock DDS timestamps use.
-  virtual void pump_state(const std::string& port, const rack::PumpView& pump, TimePoint source_time) = 0;
+  virtual void pump_state(const std::string& port, const rack::PumpView& pump,
+                          TimePoint source_time) = 0;
   virtual void node_status(const std::string& port, const rack::PumpView& pump,
                            const devicenet::Node& node, TimePoint source_time) = 0;
   virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;

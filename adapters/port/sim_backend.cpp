@@ -11,8 +11,8 @@ namespace dnbridge::port {
 namespace {
 
 TimePoint steady_now() {
-  return TimePoint(std::chrono::duration_cast<Duration>(
-      std::chrono::steady_clock::now().time_since_epoch()));
+  return TimePoint(
+      std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
 }
 
 std::chrono::steady_clock::time_point to_steady(TimePoint t) {
@@ -38,7 +38,8 @@ TimePoint SimBackend::now() const { return steady_now(); }
 
 sim::SimSlave& SimBackend::device(devicenet::MacId mac) {
   auto it = devices_.find(mac.value());
-  if (it == devices_.end()) throw std::out_of_range(fmt::format("no simulated device {}", mac.value()));
+  if (it == devices_.end())
+    throw std::out_of_range(fmt::format("no simulated device {}", mac.value()));
   return *it->second;
 }
 

@@ -29,8 +29,8 @@ SimRack::SimRack(SimRackConfig config, LogSink* log)
 }
 
 SimSlave& SimRack::add_device(SlaveOptions options, std::optional<TimePoint> power_on) {
-  const unsigned mac = options.mac_switch <= devicenet::MacId::kMax ? options.mac_switch
-                                                                    : options.stored_mac;
+  const unsigned mac =
+      options.mac_switch <= devicenet::MacId::kMax ? options.mac_switch : options.stored_mac;
   Logger log = log_ ? Logger(*log_, fmt::format("sim {}", mac)) : Logger();
   auto device = std::make_unique<SimSlave>(world_, std::move(options), power_on, std::move(log));
   auto& ref = *device;
@@ -40,7 +40,8 @@ SimSlave& SimRack::add_device(SlaveOptions options, std::optional<TimePoint> pow
 
 SimSlave& SimRack::device(devicenet::MacId mac) {
   auto it = devices_.find(mac.value());
-  if (it == devices_.end()) throw std::out_of_range(fmt::format("no device at MAC {}", mac.value()));
+  if (it == devices_.end())
+    throw std::out_of_range(fmt::format("no device at MAC {}", mac.value()));
   return *it->second;
 }
 

@@ -11,7 +11,8 @@ class SimSlave final : public SimEndpoint {
  public:
   // Attaches to the world's bus; the device powers up at `power_on` (no
   // value: stays off until power_on() is called).
-  SimSlave(SimWorld& world, SlaveOptions options, std::optional<TimePoint> power_on, Logger log = {});
+  SimSlave(SimWorld& world, SlaveOptions options, std::optional<TimePoint> power_on,
+           Logger log = {});
   ~SimSlave() override;
   SimSlave(const SimSlave&) = delete;
   SimSlave& operator=(const SimSlave&) = delete;

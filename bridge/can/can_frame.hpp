@@ -32,7 +32,8 @@ struct CanFrame {
     std::copy(payload.begin(), payload.end(), f.data.begin());
     return f;
   }
-  static Result<CanFrame> make(std::uint32_t id, std::initializer_list<std::uint8_t> payload) noexcept {
+  static Result<CanFrame> make(std::uint32_t id,
+                               std::initializer_list<std::uint8_t> payload) noexcept {
     return make(id, Bytes(payload.begin(), payload.size()));
   }
 

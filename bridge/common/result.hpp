@@ -25,15 +25,26 @@ class [[nodiscard]] Result {
   explicit operator bool() const noexcept { return ok(); }
   const std::error_code& error() const noexcept { return error_; }
 
-  T& value() & noexcept { assert(ok()); return *value_; }
-  const T& value() const& noexcept { assert(ok()); return *value_; }
-  T&& value() && noexcept { assert(ok()); return std::move(*value_); }
+  T& value() & noexcept {
+    assert(ok());
+    return *value_;
+  }
+  const T& value() const& noexcept {
+    assert(ok());
+    return *value_;
+  }
+  T&& value() && noexcept {
+    assert(ok());
+    return std::move(*value_);
+  }
   T& operator*() & noexcept { return value(); }
   const T& operator*() const& noexcept { return value(); }
   T* operator->() noexcept { return &value(); }
   const T* operator->() const noexcept { return &value(); }
   template <class U>
-  T value_or(U&& fallback) const& { return ok() ? *value_ : T(std::forward<U>(fallback)); }
+  T value_or(U&& fallback) const& {
+    return ok() ? *value_ : T(std::forward<U>(fallback));
+  }
 
  private:
   std::optional<T> value_;
@@ -44,7 +55,7 @@ template <>
 class [[nodiscard]] Result<void> {
  public:
   Result() noexcept = default;
-  Result(std::error_code error) noexcept : error_(error) {}  // NOLINT(implicit)
+  Result(std::error_code error) noexcept : error_(error) {}        // NOLINT(implicit)
   Result(Errc error) noexcept : error_(make_error_code(error)) {}  // NOLINT(implicit)
 
   bool ok() const noexcept { return !error_; }

@@ -34,14 +34,14 @@ enum class Group1Message : std::uint8_t {
 };
 
 enum class Group2Message : std::uint8_t {
-  kMasterBitStrobeCommand = 0,     // MAC = source (master)
-  kMasterMulticastPoll = 1,        // MAC field use UNVERIFIED
-  kMasterCosCyclicAck = 2,         // MAC = destination
-  kSlaveExplicitResponse = 3,      // MAC = source (slave); also unconnected responses
-  kMasterExplicitRequest = 4,      // MAC = destination
-  kMasterIoPoll = 5,               // MAC = destination; also master COS/cyclic
-  kUnconnectedExplicitRequest = 6, // MAC = destination; Group 2 only Allocate/Release
-  kDuplicateMacCheck = 7,          // MAC = the MAC being checked
+  kMasterBitStrobeCommand = 0,      // MAC = source (master)
+  kMasterMulticastPoll = 1,         // MAC field use UNVERIFIED
+  kMasterCosCyclicAck = 2,          // MAC = destination
+  kSlaveExplicitResponse = 3,       // MAC = source (slave); also unconnected responses
+  kMasterExplicitRequest = 4,       // MAC = destination
+  kMasterIoPoll = 5,                // MAC = destination; also master COS/cyclic
+  kUnconnectedExplicitRequest = 6,  // MAC = destination; Group 2 only Allocate/Release
+  kDuplicateMacCheck = 7,           // MAC = the MAC being checked
 };
 
 enum class Group4Message : std::uint8_t {

@@ -104,6 +104,15 @@ class Node final : private ExplicitClient::Listener {
 
   void on_explicit_result(std::uint32_t tag, const ExplicitResult& result, TimePoint now) override;
   void on_step_result(Step step, const ExplicitResult& result, TimePoint now);
+  // One handler per life-cycle phase (node_lifecycle.cpp).
+  void on_allocate_result(const ExplicitResult& r, TimePoint now);
+  void on_identity_result(Step step, const ExplicitResult& r, TimePoint now);
+  void on_identity_info_result(Step step, const ExplicitResult& r, TimePoint now);
+  void on_setting_result(Step step, const ExplicitResult& r, TimePoint now);
+  void on_path_result(Step step, const ExplicitResult& r, TimePoint now);
+  void on_size_result(Step step, const ExplicitResult& r, TimePoint now);
+  void on_epr_result(Step step, const ExplicitResult& r, TimePoint now);
+  void on_keepalive_result(const ExplicitResult& r, TimePoint now);
 
   void issue(Step step, const RequestMessage& request, bool unconnected, TimePoint now,
              std::optional<Duration> timeout = std::nullopt);
@@ -124,7 +133,8 @@ class Node final : private ExplicitClient::Listener {
   void release_for_shutdown(TimePoint now);
   void enter_fault(NodeState fault, std::string reason, TimePoint now);
   void set_state(NodeState next, std::string reason, TimePoint now);
-  void record(NodeError::Kind kind, TimePoint now, std::uint32_t got = 0, std::uint32_t expected = 0);
+  void record(NodeError::Kind kind, TimePoint now, std::uint32_t got = 0,
+              std::uint32_t expected = 0);
   void record_device_error(const ExplicitResult& result, TimePoint now);
 
   void send_poll(TimePoint now);
@@ -142,7 +152,7 @@ class Node final : private ExplicitClient::Listener {
   NodeState state_ = NodeState::kAbsent;
   std::string reason_ = "not started";
   Step step_ = Step::kNone;
-  bool connected_ = false;      // the master holds the node's connections
+  bool connected_ = false;  // the master holds the node's connections
   bool shutting_down_ = false;
   bool started_ = false;
   TimePoint retry_at_ = kNever;
@@ -171,7 +181,7 @@ class Node final : private ExplicitClient::Listener {
   bool poll_outstanding_ = false;
   bool poll_unanswered_ = false;  // the last poll timed out: the next is a retry
   bool outputs_dirty_ = false;
-  bool idle_ = true;              // no outputs until the layer above sets them
+  bool idle_ = true;  // no outputs until the layer above sets them
   unsigned consecutive_errors_ = 0;
   TimePoint last_explicit_answer_{};  // last explicit response, error or not
   InlineBytes<kMaxIoSize> outputs_;

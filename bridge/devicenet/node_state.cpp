@@ -6,36 +6,54 @@ namespace dnbridge::devicenet {
 
 std::string_view to_string(NodeState state) noexcept {
   switch (state) {
-    case NodeState::kAbsent: return "absent";
-    case NodeState::kIdentifying: return "identifying";
-    case NodeState::kConfiguring: return "configuring";
-    case NodeState::kVerifying: return "verifying";
-    case NodeState::kOnline: return "online";
-    case NodeState::kWrongDevice: return "wrong device";
-    case NodeState::kConfigurationFault: return "configuration fault";
-    case NodeState::kOwnedByOtherMaster: return "owned by another master";
-    case NodeState::kStopped: return "stopped";
+    case NodeState::kAbsent:
+      return "absent";
+    case NodeState::kIdentifying:
+      return "identifying";
+    case NodeState::kConfiguring:
+      return "configuring";
+    case NodeState::kVerifying:
+      return "verifying";
+    case NodeState::kOnline:
+      return "online";
+    case NodeState::kWrongDevice:
+      return "wrong device";
+    case NodeState::kConfigurationFault:
+      return "configuration fault";
+    case NodeState::kOwnedByOtherMaster:
+      return "owned by another master";
+    case NodeState::kStopped:
+      return "stopped";
   }
   return "?";
 }
 
 std::string NodeError::describe() const {
   switch (kind) {
-    case Kind::kNone: return "none";
-    case Kind::kPollTimeout: return "poll response timed out";
+    case Kind::kNone:
+      return "none";
+    case Kind::kPollTimeout:
+      return "poll response timed out";
     case Kind::kPollLength:
       return fmt::format("poll response of {} bytes, expected {}", got, expected);
-    case Kind::kPollUnexpected: return "poll response with no poll outstanding";
-    case Kind::kPollMalformed: return "fragmented poll response out of order";
-    case Kind::kExplicitTimeout: return "explicit request timed out";
-    case Kind::kExplicitAborted: return "explicit fragment not acknowledged";
-    case Kind::kExplicitMalformed: return "malformed explicit response";
+    case Kind::kPollUnexpected:
+      return "poll response with no poll outstanding";
+    case Kind::kPollMalformed:
+      return "fragmented poll response out of order";
+    case Kind::kExplicitTimeout:
+      return "explicit request timed out";
+    case Kind::kExplicitAborted:
+      return "explicit fragment not acknowledged";
+    case Kind::kExplicitMalformed:
+      return "malformed explicit response";
     case Kind::kDeviceError: {
       auto name = cip::to_string(general_status);
-      return fmt::format("device error 0x{:02X}/0x{:02X} ({})", static_cast<unsigned>(general_status),
-                         additional_status, name.empty() ? "reserved" : name);
+      return fmt::format("device error 0x{:02X}/0x{:02X} ({})",
+                         static_cast<unsigned>(general_status), additional_status,
+                         name.empty() ? "reserved" : name);
     }
-    case Kind::kConnectionLost: return "connection lost: no poll response for 4 x EPR";
+    case Kind::kConnectionLost:
+      return "connection lost: no poll response for 4 x EPR";
   }
   return "?";
 }

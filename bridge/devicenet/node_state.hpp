@@ -36,15 +36,15 @@ constexpr bool is_fault(NodeState s) noexcept {
 struct NodeError {
   enum class Kind : std::uint8_t {
     kNone,
-    kPollTimeout,         // no poll response before the next poll
-    kPollLength,          // poll response of the wrong size (got/expected)
-    kPollUnexpected,      // poll response with no poll outstanding
-    kPollMalformed,       // fragmented poll response out of order
-    kExplicitTimeout,     // explicit request unanswered
-    kExplicitAborted,     // fragment never acknowledged
-    kExplicitMalformed,   // unparsable explicit response
-    kDeviceError,         // CIP error status (general/additional)
-    kConnectionLost,      // silence for 4 x EPR
+    kPollTimeout,        // no poll response before the next poll
+    kPollLength,         // poll response of the wrong size (got/expected)
+    kPollUnexpected,     // poll response with no poll outstanding
+    kPollMalformed,      // fragmented poll response out of order
+    kExplicitTimeout,    // explicit request unanswered
+    kExplicitAborted,    // fragment never acknowledged
+    kExplicitMalformed,  // unparsable explicit response
+    kDeviceError,        // CIP error status (general/additional)
+    kConnectionLost,     // silence for 4 x EPR
   };
   Kind kind = Kind::kNone;
   TimePoint at{};
@@ -60,10 +60,10 @@ struct NodeCounters {
   std::uint64_t polls = 0;
   std::uint64_t idle_polls = 0;
   std::uint64_t responses = 0;
-  std::uint64_t timeouts = 0;        // polls not answered in time
-  std::uint64_t retries = 0;         // polls sent after an unanswered one
-  std::uint64_t errors = 0;          // bad responses (length, order, late)
-  std::uint64_t reconnects = 0;      // returns from online to allocation
+  std::uint64_t timeouts = 0;    // polls not answered in time
+  std::uint64_t retries = 0;     // polls sent after an unanswered one
+  std::uint64_t errors = 0;      // bad responses (length, order, late)
+  std::uint64_t reconnects = 0;  // returns from online to allocation
   std::uint64_t allocate_attempts = 0;
 };
 

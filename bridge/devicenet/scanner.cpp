@@ -22,11 +22,13 @@ void validate(const ScannerConfig& c) {
   std::array<bool, MacId::kMax + 1> seen{};
   for (const auto& n : c.nodes) {
     const unsigned mac = n.mac.value();
-    if (mac > MacId::kMax) throw std::invalid_argument(fmt::format("node MAC {} out of range", mac));
+    if (mac > MacId::kMax)
+      throw std::invalid_argument(fmt::format("node MAC {} out of range", mac));
     if (n.mac == c.master_mac) {
       throw std::invalid_argument(fmt::format("node {} has the master's MAC", mac));
     }
-    if (seen[mac]) throw std::invalid_argument(fmt::format("MAC {} is in the scan list twice", mac));
+    if (seen[mac])
+      throw std::invalid_argument(fmt::format("MAC {} is in the scan list twice", mac));
     seen[mac] = true;
     if (n.poll_period <= Duration::zero()) {
       throw std::invalid_argument(fmt::format("node {}: poll period must be positive", mac));
@@ -36,8 +38,8 @@ void validate(const ScannerConfig& c) {
           fmt::format("node {}: expected packet rate shorter than the poll period", mac));
     }
     if (n.profile.consumed_size > Node::kMaxIoSize || n.profile.produced_size > Node::kMaxIoSize) {
-      throw std::invalid_argument(fmt::format("node {}: poll messages over {} bytes", mac,
-                                              Node::kMaxIoSize));
+      throw std::invalid_argument(
+          fmt::format("node {}: poll messages over {} bytes", mac, Node::kMaxIoSize));
     }
   }
 }
@@ -46,11 +48,16 @@ void validate(const ScannerConfig& c) {
 
 std::string_view to_string(PortState state) noexcept {
   switch (state) {
-    case PortState::kStopped: return "stopped";
-    case PortState::kCheckingMac: return "checking MAC";
-    case PortState::kRunning: return "running";
-    case PortState::kStopping: return "stopping";
-    case PortState::kDuplicateMac: return "duplicate MAC";
+    case PortState::kStopped:
+      return "stopped";
+    case PortState::kCheckingMac:
+      return "checking MAC";
+    case PortState::kRunning:
+      return "running";
+    case PortState::kStopping:
+      return "stopping";
+    case PortState::kDuplicateMac:
+      return "duplicate MAC";
   }
   return "?";
 }

@@ -38,11 +38,13 @@ struct NodeIdentity {
 class ScannerObserver {
  public:
   virtual ~ScannerObserver() = default;
-  virtual void on_port_state(PortState /*state*/, const std::string& /*reason*/, TimePoint /*at*/) {}
+  virtual void on_port_state(PortState /*state*/, const std::string& /*reason*/, TimePoint /*at*/) {
+  }
   // Every life-cycle transition, with its reason.
   virtual void on_node_state(MacId /*mac*/, NodeState /*from*/, NodeState /*to*/,
                              const std::string& /*reason*/, TimePoint /*at*/) {}
-  virtual void on_node_identity(MacId /*mac*/, const NodeIdentity& /*identity*/, TimePoint /*at*/) {}
+  virtual void on_node_identity(MacId /*mac*/, const NodeIdentity& /*identity*/, TimePoint /*at*/) {
+  }
   // A poll response of the expected size; `rx_time` is the CAN receive time.
   virtual void on_poll_response(MacId /*mac*/, Bytes /*data*/, TimePoint /*rx_time*/) {}
   // Identity object State (attribute 8) read by the keep-alive, when it changes.
@@ -64,7 +66,8 @@ class ObserverFanout final : public ScannerObserver {
   void on_port_state(PortState s, const std::string& r, TimePoint at) override {
     for (auto* o : observers_) o->on_port_state(s, r, at);
   }
-  void on_node_state(MacId m, NodeState f, NodeState t, const std::string& r, TimePoint at) override {
+  void on_node_state(MacId m, NodeState f, NodeState t, const std::string& r,
+                     TimePoint at) override {
     for (auto* o : observers_) o->on_node_state(m, f, t, r, at);
   }
   void on_node_identity(MacId m, const NodeIdentity& i, TimePoint at) override {
@@ -76,7 +79,8 @@ class ObserverFanout final : public ScannerObserver {
   void on_device_state(MacId m, std::uint8_t s, TimePoint at) override {
     for (auto* o : observers_) o->on_device_state(m, s, at);
   }
-  void on_explicit_result(std::uint32_t id, MacId m, const ExplicitResult& r, TimePoint at) override {
+  void on_explicit_result(std::uint32_t id, MacId m, const ExplicitResult& r,
+                          TimePoint at) override {
     for (auto* o : observers_) o->on_explicit_result(id, m, r, at);
   }
 

@@ -10,20 +10,34 @@ using devicenet::NodeState;
 
 std::string_view to_string(TransactionStatus status) noexcept {
   switch (status) {
-    case TransactionStatus::kSuccess: return "transaction completed";
-    case TransactionStatus::kInProgress: return "transaction in progress";
-    case TransactionStatus::kNotInScanList: return "slave not in scan list";
-    case TransactionStatus::kSlaveOffline: return "slave off-line";
-    case TransactionStatus::kPortOffline: return "port disabled or off-line";
-    case TransactionStatus::kTxidUnknown: return "transaction TXID unknown";
-    case TransactionStatus::kInvalidCommand: return "invalid command code";
-    case TransactionStatus::kOutOfBuffers: return "out of buffers";
-    case TransactionStatus::kOtherTransaction: return "other transaction in progress";
-    case TransactionStatus::kCouldNotConnect: return "could not connect to slave";
-    case TransactionStatus::kResponseTooLarge: return "response data too large";
-    case TransactionStatus::kInvalidPort: return "invalid port";
-    case TransactionStatus::kInvalidSize: return "invalid size";
-    case TransactionStatus::kConnectionBusy: return "connection busy";
+    case TransactionStatus::kSuccess:
+      return "transaction completed";
+    case TransactionStatus::kInProgress:
+      return "transaction in progress";
+    case TransactionStatus::kNotInScanList:
+      return "slave not in scan list";
+    case TransactionStatus::kSlaveOffline:
+      return "slave off-line";
+    case TransactionStatus::kPortOffline:
+      return "port disabled or off-line";
+    case TransactionStatus::kTxidUnknown:
+      return "transaction TXID unknown";
+    case TransactionStatus::kInvalidCommand:
+      return "invalid command code";
+    case TransactionStatus::kOutOfBuffers:
+      return "out of buffers";
+    case TransactionStatus::kOtherTransaction:
+      return "other transaction in progress";
+    case TransactionStatus::kCouldNotConnect:
+      return "could not connect to slave";
+    case TransactionStatus::kResponseTooLarge:
+      return "response data too large";
+    case TransactionStatus::kInvalidPort:
+      return "invalid port";
+    case TransactionStatus::kInvalidSize:
+      return "invalid size";
+    case TransactionStatus::kConnectionBusy:
+      return "connection busy";
   }
   return "?";
 }
@@ -89,9 +103,9 @@ std::optional<ExplicitAnswer> ExplicitGateway::on_request(const ExplicitCall& ca
       return a;
     }
   }
-  return refuse(call, TransactionStatus::kInvalidCommand,
-                fmt::format("command {} is not 1 (execute), 2 (get status) or 3 (reset all)",
-                            call.command));
+  return refuse(
+      call, TransactionStatus::kInvalidCommand,
+      fmt::format("command {} is not 1 (execute), 2 (get status) or 3 (reset all)", call.command));
 }
 
 std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call, TimePoint now) {
@@ -181,7 +195,8 @@ std::optional<ExplicitAnswer> ExplicitGateway::on_result(std::uint32_t request_i
     }
   } else if (result.error == Errc::kOutOfRange) {
     a.status = TransactionStatus::kResponseTooLarge;
-    a.message = fmt::format("the device's response is over {} bytes", devicenet::kMaxExplicitMessage);
+    a.message =
+        fmt::format("the device's response is over {} bytes", devicenet::kMaxExplicitMessage);
   } else if (result.error == Errc::kStopped) {
     a.status = TransactionStatus::kPortOffline;
     a.message = "port stopped before the device answered";

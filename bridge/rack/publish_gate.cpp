@@ -37,8 +37,9 @@ bool PumpStateGate::due(const PumpView& view, TimePoint now) const {
     const int after = now_analog[i];
     if ((before < 0) != (after < 0)) return true;  // appeared or disappeared
     if (before < 0) continue;
-    const double delta = std::abs(profiles::cdn127::raw_to_volts(static_cast<std::uint16_t>(after)) -
-                                  profiles::cdn127::raw_to_volts(static_cast<std::uint16_t>(before)));
+    const double delta =
+        std::abs(profiles::cdn127::raw_to_volts(static_cast<std::uint16_t>(after)) -
+                 profiles::cdn127::raw_to_volts(static_cast<std::uint16_t>(before)));
     if (delta > policy_.analog_deadband_volts) return true;
   }
   return false;

@@ -35,8 +35,8 @@ PumpRack::PumpRack(const std::vector<PumpConfig>& pumps) {
   for (const auto& p : pumps) {
     auto format = cdn127::poll_format(p.io);
     if (!format) {
-      throw std::invalid_argument(fmt::format("node {}: invalid I/O configuration",
-                                              p.node.mac.value()));
+      throw std::invalid_argument(
+          fmt::format("node {}: invalid I/O configuration", p.node.mac.value()));
     }
     index_[p.node.mac.value()] = static_cast<int>(views_.size());
     PumpView v;
@@ -88,12 +88,14 @@ Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, std::str
                   fmt::format("from {}: the node's configuration has no pump output", issuer));
   }
   if (outputs.n2_ballast_on && slot.io.num_digital_outputs < 3) {
-    return refuse(*v, Errc::kUnsupported,
-                  fmt::format("from {}: the node's configuration has no N2 ballast output", issuer));
+    return refuse(
+        *v, Errc::kUnsupported,
+        fmt::format("from {}: the node's configuration has no N2 ballast output", issuer));
   }
   std::array<std::uint8_t, 8> buf{};
   auto size = cdn127::encode_poll_request(layout, outputs, MutableBytes(buf));
-  if (!size) return refuse(*v, size.error(), fmt::format("from {}: {}", issuer, size.error().message()));
+  if (!size)
+    return refuse(*v, size.error(), fmt::format("from {}: {}", issuer, size.error().message()));
   if (auto s = scanner_->set_outputs(mac, Bytes(buf.data(), *size), now); !s) {
     return refuse(*v, s, fmt::format("from {}: {}", issuer, s.error().message()));
   }
@@ -147,8 +149,8 @@ void PumpRack::refresh_applied(std::size_t index) {
   if (!node) return;
   v.outputs_idle = node->applied_idle();
   if (!v.outputs_idle) {
-    if (auto out = cdn127::decode_poll_request(slots_[index].format.request,
-                                               node->applied_outputs());
+    if (auto out =
+            cdn127::decode_poll_request(slots_[index].format.request, node->applied_outputs());
         out) {
       v.outputs_applied = *out;
     }

@@ -83,7 +83,8 @@ class PumpRack final : public devicenet::ScannerObserver {
   // is applied. kOutOfRange for a MAC not in the rack.
   Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
                  std::string_view issuer, TimePoint now);
-  Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs, TimePoint now) {
+  Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
+                 TimePoint now) {
     return command(mac, outputs, "local", now);
   }
   // No live commander left: the node goes idle (zero-length polls, so the

@@ -1,0 +1,65 @@
+#pragma once
+// What the three parts of Node (node.cpp, node_lifecycle.cpp, node_poll.cpp)
+// share: the DeviceNet objects the life cycle addresses, and text helpers.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "bridge/cip/general_status.hpp"
+#include "bridge/common/bytes.hpp"
+#include "bridge/common/time.hpp"
+#include "bridge/devicenet/explicit_client.hpp"
+
+namespace dnbridge::devicenet::node_detail {
+
+// The DeviceNet objects the life cycle addresses (ODVA common objects).
+constexpr std::uint16_t kIdentityClass = 0x01;
+constexpr std::uint16_t kConnectionClass = 0x05;
+constexpr std::uint16_t kExplicitConnection = 1;
+constexpr std::uint16_t kPollConnection = 2;
+constexpr std::uint8_t kAttrProducedSize = 7;
+constexpr std::uint8_t kAttrConsumedSize = 8;
+constexpr std::uint8_t kAttrExpectedPacketRate = 9;
+constexpr std::uint8_t kAttrProducedPath = 14;
+constexpr std::uint8_t kAttrConsumedPath = 16;
+constexpr std::uint8_t kIdentityState = 8;
+
+// Life-cycle reads that time out are retried this many times before the node
+// is taken for gone: single lost frames must not cost a reconnection.
+constexpr unsigned kStepTimeoutRetries = 2;
+
+inline std::uint16_t to_ms(Duration d) {
+  const auto ms = std::chrono::duration_cast<milliseconds>(d).count();
+  return static_cast<std::uint16_t>(std::clamp<std::int64_t>(ms, 0, 0xFFFF));
+}
+
+inline std::optional<std::uint32_t> read_uint(Bytes data) {
+  ByteReader r(data);
+  if (data.size() == 1) return r.u8();
+  if (data.size() == 2) return r.u16le();
+  if (data.size() == 4) return r.u32le();
+  return std::nullopt;
+}
+
+inline std::string status_text(const ExplicitResult& r) {
+  if (r.error == Errc::kDeviceError) {
+    auto name = cip::to_string(r.general_status);
+    return fmt::format("{} (0x{:02X}/0x{:02X})", name.empty() ? "reserved status" : name,
+                       static_cast<unsigned>(r.general_status), r.additional_status);
+  }
+  return r.error.message();
+}
+
+inline std::string hex(Bytes b) {
+  std::string s;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (i) s += ' ';
+    s += fmt::format("{:02X}", b[i]);
+  }
+  return s.empty() ? "(empty)" : s;
+}
+
+}  // namespace dnbridge::devicenet::node_detail

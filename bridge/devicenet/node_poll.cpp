@@ -1,0 +1,163 @@
+// Node: the poll connection (scheduling, idle, outputs, responses).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+
+#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/node.hpp"
+#include "bridge/devicenet/node_internal.hpp"
+
+namespace dnbridge::devicenet {
+
+using namespace node_detail;
+
+TimePoint Node::next_poll_slot(TimePoint after) const {
+  // Slots at poll_phase_ + k * period: nodes with the same period but
+  // different phases never poll in the same instant.
+  const Duration period = config_.poll_period;
+  if (after <= poll_phase_) return poll_phase_;
+  const auto k = (after - poll_phase_ + period - Duration(1)) / period;
+  return poll_phase_ + k * period;
+}
+
+void Node::send_poll(TimePoint now) {
+  const std::uint32_t id = group2_id(config_.mac, Group2Message::kMasterIoPoll);
+  const std::size_t size = config_.profile.consumed_size;
+  // A zero-length poll is the idle signal; a connection that consumes nothing
+  // has no idle condition and always polls empty.
+  const bool idle = idle_ || size == 0;
+  if (poll_unanswered_) ++counters_.retries;
+  ++counters_.polls;
+  if (idle) ++counters_.idle_polls;
+  if (idle || size <= can::kMaxDataLength) {
+    can::CanFrame frame;
+    frame.id = id;
+    frame.len = static_cast<std::uint8_t>(idle ? 0 : size);
+    std::copy_n(outputs_.view().begin(), frame.len, frame.data.begin());
+    sink_.send(frame, now);
+  } else {
+    for (std::size_t i = 0; i < io_fragment_count(size); ++i) {
+      can::CanFrame frame;
+      frame.id = id;
+      auto len = io_fragment(outputs_.view(), i, MutableBytes(frame.data));
+      if (!len) break;
+      frame.len = static_cast<std::uint8_t>(*len);
+      sink_.send(frame, now);
+    }
+  }
+  sent_idle_ = idle;
+  sent_outputs_ = outputs_;
+  outputs_dirty_ = false;
+  poll_outstanding_ = true;
+  poll_deadline_ = now + std::min(port_.poll_response_timeout, config_.poll_period);
+}
+
+void Node::on_poll_response(Bytes payload, TimePoint now) {
+  if (state_ != NodeState::kOnline) {
+    // A straggler from before the node went offline, or a device polled by
+    // someone else: not ours to take.
+    bad_poll_response(NodeError::Kind::kPollUnexpected, static_cast<std::uint32_t>(payload.size()),
+                      now);
+    return;
+  }
+  const std::size_t size = config_.profile.produced_size;
+  if (size <= can::kMaxDataLength) {
+    if (payload.size() != size) {
+      bad_poll_response(NodeError::Kind::kPollLength, static_cast<std::uint32_t>(payload.size()),
+                        now);
+      return;
+    }
+    accept_poll_response(payload, now);
+    return;
+  }
+  switch (io_reassembler_.on_fragment(payload)) {
+    case IoReassembler::Outcome::kIncomplete:
+      return;
+    case IoReassembler::Outcome::kComplete: {
+      const Bytes message = io_reassembler_.message();
+      if (message.size() != size) {
+        bad_poll_response(NodeError::Kind::kPollLength, static_cast<std::uint32_t>(message.size()),
+                          now);
+        io_reassembler_.reset();
+        return;
+      }
+      accept_poll_response(message, now);
+      io_reassembler_.reset();
+      return;
+    }
+    default:
+      bad_poll_response(NodeError::Kind::kPollMalformed, static_cast<std::uint32_t>(payload.size()),
+                        now);
+      return;
+  }
+}
+
+void Node::accept_poll_response(Bytes data, TimePoint now) {
+  if (!poll_outstanding_) {
+    // Late: the poll timed out, but the data is the device's and current.
+    ++counters_.errors;
+    record(NodeError::Kind::kPollUnexpected, now);
+  }
+  poll_outstanding_ = false;
+  poll_unanswered_ = false;
+  poll_deadline_ = kNever;
+  consecutive_errors_ = 0;
+  last_response_ = now;
+  ++counters_.responses;
+  applied_idle_ = sent_idle_;
+  applied_outputs_ = sent_outputs_;
+  observer_.on_poll_response(config_.mac, data, now);
+  if (shutting_down_) {
+    if (outputs_dirty_) {
+      send_poll(now);  // the idle poll, after the one that was outstanding
+    } else {
+      release_for_shutdown(now);
+    }
+    return;
+  }
+  if (outputs_dirty_ && config_.immediate_poll_on_change) send_poll(now);
+}
+
+void Node::bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now) {
+  ++counters_.errors;
+  record(kind, now, got, static_cast<std::uint32_t>(config_.profile.produced_size));
+  unsigned suppressed = 0;
+  if (error_log_limit_.allow(now, suppressed)) {
+    log_.warn("{}{}", last_error_.describe(),
+              suppressed ? fmt::format(" ({} similar suppressed)", suppressed) : std::string());
+  }
+  if (state_ != NodeState::kOnline) return;
+  poll_outstanding_ = false;
+  poll_deadline_ = kNever;
+  if (++consecutive_errors_ >= port_.max_consecutive_errors) {
+    lose(fmt::format("{} bad poll responses in a row: {}", consecutive_errors_,
+                     last_error_.describe()),
+         now);
+  }
+}
+
+Status Node::set_outputs(Bytes data, TimePoint now) {
+  if (data.size() != config_.profile.consumed_size) return Errc::kOutOfRange;
+  const bool changed = idle_ || !std::equal(data.begin(), data.end(), outputs_.view().begin(),
+                                            outputs_.view().end());
+  outputs_.assign(data);
+  idle_ = false;
+  if (!changed) return {};
+  outputs_dirty_ = true;
+  if (state_ == NodeState::kOnline && config_.immediate_poll_on_change && !poll_outstanding_) {
+    send_poll(now);
+  }
+  return {};
+}
+
+void Node::set_idle(bool idle, TimePoint now) {
+  if (idle == idle_) return;
+  idle_ = idle;
+  outputs_dirty_ = true;
+  if (state_ == NodeState::kOnline && config_.immediate_poll_on_change && !poll_outstanding_) {
+    send_poll(now);
+  }
+}
+
+}  // namespace dnbridge::devicenet
