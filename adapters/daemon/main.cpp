@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
                  "trace, debug, info, warn or error (default: the file's)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   config_opt->excludes(simulate_opt);
+  app.set_version_flag("--version", "dnbridge " DNBRIDGE_VERSION);
   CLI11_PARSE(app, argc, argv);
 
   if (print_default) {
