@@ -83,10 +83,11 @@ void DdsInput::take_commands() {
     }
     if (s.info().valid_data()) {
       loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
-    } else if (s.info().instance_state() != dds::InstanceState::kAlive) {
-      // No live commander left for this pump (all writers gone, or disposed).
-      loop->release_command(*mac);
     }
+    // No live commander left for this pump (all writers gone, or disposed).
+    // A command taken after its writer left carries that state itself, with
+    // no sample of its own to tell it: it is applied, then released.
+    if (s.info().instance_state() != dds::InstanceState::kAlive) loop->release_command(*mac);
   }
 }
 

@@ -102,6 +102,7 @@ bool PortLoop::drain_inbox(TimePoint now) {
 
 void PortLoop::run() {
   TimePoint now = backend_->now();
+  started_ = now;
   metrics_time_ = now;
   port_status_time_ = now;
   scanner_->start(now);
@@ -138,8 +139,9 @@ void PortLoop::publish(TimePoint now, bool force) {
   for (std::size_t i = 0; i < views.size(); ++i) {
     const rack::PumpView& v = views[i];
     Published& p = published_[i];
-    // The source time is that of the latest event the sample reflects.
-    TimePoint source = v.state_since;
+    // The source time is that of the latest event the sample reflects; a
+    // node nothing has happened to yet has been absent since the loop started.
+    TimePoint source = std::max(v.state_since, started_);
     if (v.has_inputs) source = std::max(source, v.inputs_time);
     if (force || p.gate.due(v, now)) {
       publisher_.pump_state(config_.port, v, source);

@@ -109,6 +109,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     TimePoint event_time{};  // latest event of this node: the source time
   };
   std::vector<Published> published_;
+  TimePoint started_{};              // when run() began
   bool port_dirty_ = true;
   TimePoint port_status_time_{};
   TimePoint port_event_time_{};

@@ -1,0 +1,114 @@
+// The dnbridge executable itself, in a process of its own: the supervisor
+// reaches it across processes over loopback (in-process participants share
+// Cyclone's domain and never touch the network), and SIGTERM stops it in
+// order. Its configuration is the embedded default on this process's domain;
+// CYCLONEDDS_URI (loopback, this process's discovery tag) is inherited.
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "bridge_fixture.hpp"
+
+extern char** environ;
+
+namespace dnbridge::e2e {
+namespace {
+
+// The child process; killed if the test ends before it stopped.
+class Child {
+ public:
+  explicit Child(std::vector<std::string> args) {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+  }
+  ~Child() {
+    if (pid_ > 0) {
+      (void)kill(pid_, SIGKILL);
+      (void)waitpid(pid_, nullptr, 0);
+    }
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  bool running() const { return pid_ > 0; }
+  bool signal(int sig) const { return pid_ > 0 && kill(pid_, sig) == 0; }
+  // Waits for the exit; its status (-1 if it did not exit normally).
+  int wait() {
+    int status = 0;
+    if (pid_ <= 0 || waitpid(pid_, &status, 0) != pid_) return -1;
+    pid_ = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+// `dnbridge --simulate`'s configuration, on `domain`, logging warnings only.
+std::filesystem::path write_config(dds_domainid_t domain) {
+  std::string text(daemon::embedded_default_config_text());
+  const auto replace = [&](std::string_view from, const std::string& to) {
+    const auto at = text.find(from);
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  };
+  replace("domain = 0", "domain = " + std::to_string(domain));
+  replace("log_level = \"info\"", "log_level = \"warn\"");
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("dnbridge-e2e-" + std::to_string(getpid()) + ".toml");
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST_F(BridgeTest, DnbridgeProcessServesTheSupervisorAndStopsInOrderOnSigterm) {
+  const auto config = write_config(test_domain());
+  const auto spawned = SteadyClock::now();
+  Child bridge({DNBRIDGE_BINARY, "--config", config.string()});
+  ASSERT_TRUE(bridge.running());
+
+  ASSERT_TRUE(pumps_.matched(1));
+  report("dnbridge process spawned -> its PumpState writer discovered", ms_since(spawned));
+  auto seen = [&] {
+    for (unsigned mac = 1; mac <= kPumps; ++mac) {
+      if (!pumps_.latest(pump_mac(mac))) return false;
+    }
+    return true;
+  };
+  const auto discovered = SteadyClock::now();
+  ASSERT_TRUE(pumps_.until(seen, seconds(1))) << "not every pump within one publish period";
+  report("dnbridge process: writer discovered -> every pump's PumpState", ms_since(discovered));
+  ASSERT_TRUE(pumps_.until([&] { return all_online(); }, seconds(10)));
+  report("dnbridge process spawned -> every pump online", ms_since(spawned));
+  EXPECT_EQ(writer_participant_name(supervisor_, pumps_.reader()), std::string("dnbridge ") + kRack);
+
+  ASSERT_TRUE(bridge.signal(SIGTERM));
+  auto unregistered = [&] {
+    std::map<unsigned, bool> gone;
+    for (const auto& r : pumps_.history()) {
+      gone[r.sample->mac] =
+          r.sample.info().instance_state() == dds::InstanceState::kNotAliveNoWriters;
+    }
+    if (gone.size() != kPumps) return false;
+    for (const auto& [mac, g] : gone) {
+      if (!g) return false;
+    }
+    return true;
+  };
+  ASSERT_TRUE(pumps_.until(unregistered));
+  for (const auto& r : pumps_.history()) {
+    EXPECT_NE(r.sample.info().instance_state(), dds::InstanceState::kNotAliveDisposed);
+  }
+  for (unsigned mac = 1; mac <= kPumps; ++mac) {
+    EXPECT_FALSE(pumps_.latest(pump_mac(mac))->online) << mac;
+  }
+  EXPECT_EQ(bridge.wait(), 0);
+  std::filesystem::remove(config);
+}
+
+}  // namespace
+}  // namespace dnbridge::e2e
