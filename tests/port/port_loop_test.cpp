@@ -134,7 +134,10 @@ TEST(PortLoop, RunsARackOnItsOwnThread) {
   {
     // Polled every 20 ms: the measured cycle says so.
     ASSERT_TRUE(publisher.wait_for([&] { return publisher.port->scan_cycle_ms > 0; }));
-    EXPECT_NEAR(publisher.port->scan_cycle_ms, 20.0, 5.0);
+    // Real time on a loaded machine (a sanitizer build beside it): polls may
+    // be late, never early, so the bound above is the looser one.
+    EXPECT_GE(publisher.port->scan_cycle_ms, 18.0);
+    EXPECT_LE(publisher.port->scan_cycle_ms, 35.0);
     EXPECT_GT(publisher.port->frames_per_second, 100.0);
     EXPECT_GT(publisher.port->bus_load_percent, 0.0);
   }
