@@ -28,23 +28,27 @@ NodeKey node_key(std::string_view rack, std::string_view port, std::uint8_t mac)
 }
 
 // Moves each taken sample into its instance's slot: the newest valid
-// sample replaces the data; an invalid one only says the writer left.
-template <class T, class K, class KeyOf, class OnValid>
+// sample replaces the data; an invalid one only says the writer left (or
+// came back). `on_update` sees every change.
+template <class T, class K, class KeyOf, class OnUpdate>
 void absorb(std::vector<dds::Sample<T>>& samples, std::map<K, Known<T>>& cache, KeyOf key_of,
-            OnValid on_valid) {
+            OnUpdate on_update) {
   for (auto& s : samples) {
     K key = key_of(s.data());
     const bool alive = s.info().instance_state() == dds::InstanceState::kAlive;
     if (!s.valid_data()) {
       auto it = cache.find(key);
-      if (it != cache.end()) it->second.alive = alive;
+      if (it != cache.end() && it->second.alive != alive) {
+        it->second.alive = alive;
+        on_update(key, it->second);
+      }
       continue;
     }
     Known<T>& k = cache[key];
     std::swap(*k.data, s.data());  // the sample frees what was cached before
     k.alive = alive;
     ++k.samples;
-    on_valid(key, k);
+    on_update(key, k);
   }
 }
 

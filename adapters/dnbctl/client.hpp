@@ -57,7 +57,8 @@ class Client {
   const dds::Participant& participant() const noexcept { return participant_; }
 
   // Takes what arrived into the caches; `on_pump` is called for every valid
-  // PumpState sample, in arrival order (watch prints them).
+  // PumpState sample, in arrival order (watch prints them), and when a
+  // known pump's bridge leaves (alive turns false).
   void refresh(const std::function<void(const NodeKey&, const Known<dnbridge_PumpState>&)>& on_pump = {});
 
   // Waits until something attached has data, `timeout` passes, or an

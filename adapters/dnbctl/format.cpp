@@ -449,9 +449,11 @@ std::string explicit_text(const ExplicitExchange& x, Decoding as,
     o += '\n';
   }
   if (!x.message.empty()) o += fmt::format("message: {}\n", x.message);
-  if (x.succeeded() || !x.data.empty()) {
+  if (!x.data.empty()) {
     o += fmt::format("data ({} byte{}): {}\n", x.data.size(), x.data.size() == 1 ? "" : "s",
                      hex_bytes(x.data));
+  } else if (x.succeeded()) {
+    o += "data: none\n";
   }
   if (decoded) {
     if (decoded->ok()) {
@@ -482,11 +484,16 @@ void explicit_json(JsonWriter& out, const ExplicitExchange& x, Decoding as,
   }
   out.field("data", hex_bytes(x.request_data)).end_object();
   out.field("status", unsigned{x.status})
-      .field("status_text", transaction_status_text(x.status))
-      .field("general_status", unsigned{x.general_status})
-      .field("general_status_text", general_status_text(x.general_status))
-      .field("additional_status", unsigned{x.additional_status})
-      .field("message", x.message)
+      .field("status_text", transaction_status_text(x.status));
+  // The device's status exists only when the bridge completed the transaction.
+  if (x.status == 1) {
+    out.field("general_status", unsigned{x.general_status})
+        .field("general_status_text", general_status_text(x.general_status))
+        .field("additional_status", unsigned{x.additional_status});
+  } else {
+    out.key("general_status").null().key("general_status_text").null().key("additional_status").null();
+  }
+  out.field("message", x.message)
       .field("data", hex_bytes(x.data))
       .field("succeeded", x.succeeded());
   if (decoded) {

@@ -8,6 +8,7 @@
 #include <ctime>
 #include <set>
 
+#include "adapters/dds/fields.hpp"
 #include "adapters/dnbctl/commands.hpp"
 #include "adapters/dnbctl/format.hpp"
 #include "adapters/dnbctl/values.hpp"
@@ -72,7 +73,7 @@ Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
   const auto redraw = [&] {
     std::vector<const dnbridge_PumpState*> rows;
     for (const auto& [k, p] : client.pumps()) {
-      if (wanted(k)) rows.push_back(p.data.get());
+      if (wanted(k) && p.alive) rows.push_back(p.data.get());  // a gone bridge's pumps drop out
     }
     // Home, clear screen, then the table.
     print(fmt::format("\x1b[H\x1b[2Jdnbctl watch: DDS domain {}, {} (Ctrl-C to stop)\n\n{}", o.domain,
@@ -84,6 +85,16 @@ Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
   while (!interrupted()) {
     client.refresh([&](const NodeKey& k, const Known<dnbridge_PumpState>& p) {
       if (!wanted(k) || (args.count != 0 && seen >= args.count)) return;
+      if (!p.alive) {
+        // The bridge left: no new sample follows; its last one is cached.
+        if (table) {
+          dirty = true;
+        } else if (!o.json) {
+          print(fmt::format("{} {} {}: bridge gone\n", clock_text(),
+                            node_name(k.rack, k.port, k.mac), dds::view(p.data->name)));
+        }
+        return;
+      }
       ++seen;
       if (table) {
         dirty = true;

@@ -300,6 +300,24 @@ TEST(Explicit, BridgeStatusWithoutDeviceAnswer) {
   EXPECT_NE(text.find("status: 3 (slave not in scan list)\n"), std::string::npos);
   EXPECT_EQ(text.find("CIP general status"), std::string::npos);  // the device was not asked
   EXPECT_NE(text.find("message: MAC 40 is not in the scan list of port A\n"), std::string::npos);
+  JsonWriter out(false);
+  explicit_json(out, x, Decoding::kNone, std::nullopt);
+  EXPECT_NE(out.str().find(R"("status":3,"status_text":"slave not in scan list","general_status":null,)"
+                           R"("general_status_text":null,"additional_status":null,)"),
+            std::string::npos)
+      << out.str();
+}
+
+TEST(Explicit, SuccessWithoutData) {
+  auto x = get_name();
+  x.service = 0x05;
+  x.attribute.reset();
+  x.data.clear();
+  EXPECT_EQ(explicit_text(x, Decoding::kNone, std::nullopt),
+            "sim-rack/A/3 Reset class 0x01 instance 1\n"
+            "status: 1 (transaction completed)\n"
+            "CIP general status: 0x00 (success)\n"
+            "data: none\n");
 }
 
 }  // namespace
