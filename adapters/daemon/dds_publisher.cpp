@@ -69,9 +69,35 @@ void DdsPublisher::explicit_reply(const rack::ExplicitAnswer& answer) {
   dds::Owned<dnbridge_ExplicitReply> sample;
   fill_explicit_reply(*sample, answer);
   check(reply_writer_.write(*sample), "ExplicitReply");
+  // Completed transactions stay registered until their gateway forgets them
+  // (forget_reply); any other reply is kept for a while, then let go.
+  constexpr std::size_t kPassingReplies = 256;
+  std::vector<std::pair<std::string, std::uint32_t>> expired;
+  {
+    std::lock_guard lock(mutex_);
+    auto key = std::make_pair(answer.requester, answer.txid);
+    if (answer.retained) {
+      retained_replies_.insert(std::move(key));
+    } else {
+      passing_replies_.push_back(std::move(key));
+      while (passing_replies_.size() > kPassingReplies) {
+        if (!retained_replies_.count(passing_replies_.front())) expired.push_back(passing_replies_.front());
+        passing_replies_.pop_front();
+      }
+    }
+  }
+  for (const auto& [requester, txid] : expired) unregister_reply(requester, txid);
 }
 
 void DdsPublisher::forget_reply(const std::string& requester, std::uint32_t txid) {
+  {
+    std::lock_guard lock(mutex_);
+    retained_replies_.erase({requester, txid});
+  }
+  unregister_reply(requester, txid);
+}
+
+void DdsPublisher::unregister_reply(const std::string& requester, std::uint32_t txid) {
   // Readers keep an instance while any writer has it registered: replies the
   // bridge no longer keeps are unregistered, or readers fill up.
   dds::Owned<dnbridge_ExplicitReply> key;

@@ -3,6 +3,7 @@
 // ExplicitReply samples. Called from every port's thread (Cyclone's writers
 // are thread-safe); each sample carries the monotonic event time mapped to
 // the wall clock as its source timestamp.
+#include <deque>
 #include <map>
 #include <mutex>
 #include <set>
@@ -68,8 +69,14 @@ class DdsPublisher final : public port::PortPublisher {
   dds::Writer<dnbridge_PortStatus> port_writer_;
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;
 
+  void unregister_reply(const std::string& requester, std::uint32_t txid);
+
   std::mutex mutex_;
   std::map<std::string, std::set<std::uint8_t>> written_;  // per port, the MACs written
+  // Replies the gateways do not retain (refusals, status answers, resets),
+  // oldest first: unregistered beyond a bound, or readers would fill up.
+  std::deque<std::pair<std::string, std::uint32_t>> passing_replies_;
+  std::set<std::pair<std::string, std::uint32_t>> retained_replies_;
   RateLimiter error_limit_;
 };
 

@@ -15,6 +15,13 @@ class Participant : public Entity {
   // Joins `domain` as "dnbridge <rack>". Throws Error.
   Participant(dds_domainid_t domain, std::string_view rack);
 
+  // A participant that is not a bridge (a client such as dnbctl), named as
+  // given, so that tools never mistake it for a rack's bridge. Throws Error.
+  struct ClientName {
+    std::string_view name;
+  };
+  Participant(dds_domainid_t domain, ClientName client);
+
   dds_domainid_t domain() const noexcept { return domain_; }
 
  private:

@@ -73,9 +73,14 @@ Qos request_reader_qos() { return explicit_common(Durability::kVolatile); }
 Qos reply_writer_qos() {
   Qos qos = explicit_common(Durability::kTransientLocal);
   qos.durability_service_keep_last(1);
+  qos.resource_limits(kReplyMaxSamples, kReplyMaxInstances, kExplicitMaxSamplesPerInstance);
   return qos;
 }
 
-Qos reply_reader_qos() { return explicit_common(Durability::kTransientLocal); }
+Qos reply_reader_qos() {
+  Qos qos = explicit_common(Durability::kTransientLocal);
+  qos.resource_limits(kReplyMaxSamples, kReplyMaxInstances, kExplicitMaxSamplesPerInstance);
+  return qos;
+}
 
 }  // namespace dnbridge::dds

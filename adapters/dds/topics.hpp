@@ -84,6 +84,13 @@ Qos command_reader_qos();
 inline constexpr int32_t kExplicitMaxSamples = 256;
 inline constexpr int32_t kExplicitMaxInstances = 256;
 inline constexpr int32_t kExplicitMaxSamplesPerInstance = 4;
+// Every reply reader receives the replies of every requester, and a bridge
+// keeps the replies of the transactions it remembers registered (256 per
+// port, plus the last 256 refusals and status answers): reply readers take
+// far more instances than request readers, so that a bridge's writer is
+// never pushed back by a reader that is full of other requesters' replies.
+inline constexpr int32_t kReplyMaxInstances = 8192;
+inline constexpr int32_t kReplyMaxSamples = 8192;
 
 // Requests are volatile: a bridge that starts must never execute requests
 // written before it existed (a stale Set_Attribute would be replayed). A

@@ -210,6 +210,7 @@ std::optional<ExplicitAnswer> ExplicitGateway::on_result(std::uint32_t request_i
     transactions_.erase(key);
     return a;
   }
+  a.retained = true;
   t.done = true;
   t.answer = a;
   retain(key);

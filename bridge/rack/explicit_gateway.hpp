@@ -68,6 +68,9 @@ struct ExplicitAnswer {
   std::uint8_t additional_status = cip::kNoAdditionalCode;
   std::vector<std::uint8_t> data;
   std::string message;
+  // The gateway keeps this reply (a completed transaction) until it is
+  // forgotten (take_forgotten); other replies are not kept.
+  bool retained = false;
 };
 
 // A reply that refuses `call` without executing it.

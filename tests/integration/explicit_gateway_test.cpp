@@ -95,6 +95,7 @@ TEST_F(Gateway, ExecuteReturnsTheDevicesDataAndCipStatus) {
   EXPECT_EQ(name->status, TransactionStatus::kSuccess);
   EXPECT_EQ(name->general_status, 0);
   EXPECT_EQ(name->data, (std::vector<std::uint8_t>{6, 'C', 'D', 'N', '1', '2', '7'}));
+  EXPECT_TRUE(name->retained);  // kept to answer repeats
   const auto* bad = harness_.reply(2);
   ASSERT_NE(bad, nullptr);
   // The device answered: the transaction completed, with its error status.
@@ -149,6 +150,7 @@ TEST_F(Gateway, EveryRefusalHasItsStatus) {
   start();
   harness_.request(get_call(2, 40, 1, 1), now());
   EXPECT_EQ(harness_.reply(2)->status, TransactionStatus::kNotInScanList);
+  EXPECT_FALSE(harness_.reply(2)->retained);
   harness_.request(get_call(3, 200, 1, 1), now());
   EXPECT_EQ(harness_.reply(3)->status, TransactionStatus::kNotInScanList);
 

@@ -1,0 +1,74 @@
+#pragma once
+// dnbctl's commands, one group per file: each adds its subcommand(s) to the
+// command line (add_*) and runs when chosen (run_*). A run returns the exit
+// code or throws CommandError; output goes to stdout, errors to stderr.
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "adapters/dnbctl/client.hpp"
+#include "adapters/dnbctl/options.hpp"
+
+namespace dnbridge::dnbctl {
+
+// The client of this process: "dnbctl user@host:pid" on the options' domain.
+Client make_client(const GlobalOptions& options);
+
+// Prints `text` on stdout as it is.
+void print(const std::string& text);
+
+// --- inspect_commands.cpp: list, show -------------------------------------------
+struct ListArgs {
+  bool nodes_only = false;
+  bool ports_only = false;
+};
+CLI::App* add_list(CLI::App& app, ListArgs& args);
+Exit run_list(const GlobalOptions& options, const ListArgs& args);
+
+struct ShowArgs {
+  std::string mac;
+};
+CLI::App* add_show(CLI::App& app, ShowArgs& args);
+Exit run_show(const GlobalOptions& options, const ShowArgs& args);
+
+// --- watch_command.cpp ---------------------------------------------------------------
+struct WatchArgs {
+  std::vector<std::string> macs;
+  bool lines = false;
+  std::uint64_t count = 0;      // 0: no limit
+  double duration_seconds = 0;  // 0: no limit
+};
+CLI::App* add_watch(CLI::App& app, WatchArgs& args);
+Exit run_watch(const GlobalOptions& options, const WatchArgs& args);
+
+// --- output_commands.cpp: pump, ballast, aout --------------------------------------
+enum class Output { kPump, kBallast, kAnalog };
+struct OutputArgs {
+  Output output = Output::kPump;
+  std::string mac;
+  std::string value;  // on|off, or the analog value
+  std::string issuer;  // default "dnbctl user@host"
+  std::int32_t strength = 10;
+  double hold_for_seconds = 0;
+};
+CLI::App* add_output(CLI::App& app, Output output, OutputArgs& args);
+Exit run_output(const GlobalOptions& options, const OutputArgs& args);
+
+// --- explicit_commands.cpp: get, set, service --------------------------------------
+enum class ExplicitKind { kGet, kSet, kService };
+struct ExplicitArgs {
+  ExplicitKind kind = ExplicitKind::kGet;
+  std::string mac;
+  std::string service;
+  std::string class_id;
+  std::string instance_id;
+  std::string attribute;
+  std::string data;
+  std::string as;
+};
+CLI::App* add_explicit(CLI::App& app, ExplicitKind kind, ExplicitArgs& args);
+Exit run_explicit(const GlobalOptions& options, const ExplicitArgs& args);
+
+}  // namespace dnbridge::dnbctl

@@ -1,0 +1,106 @@
+#pragma once
+// How dnbctl shows what it read: readable tables and lines for people, and
+// the same content as JSON for scripts. Pure functions of the IDL structs
+// (idl/dnbridge.idl) and plain values: no DDS entity is touched here.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "adapters/dnbctl/json.hpp"
+#include "adapters/dnbctl/values.hpp"
+#include "dnbridge.h"
+
+namespace dnbridge::dnbctl {
+
+// --- Names --------------------------------------------------------------------
+std::string_view to_text(dnbridge_NodeLifecycle state);  // "online", "wrong device", ...
+std::string_view to_text(dnbridge_PortLifecycle state);  // "running", "duplicate MAC", ...
+std::string_view to_text(dnbridge_BusState state);       // "error active", "bus off", ...
+// An ExplicitReply status (STATUS_*): "transaction completed", ...
+std::string transaction_status_text(std::uint8_t status);
+// A CIP general status: "success", "attribute not supported", or "reserved (0x..)".
+std::string general_status_text(std::uint8_t code);
+// A CIP service: "Get_Attribute_Single", or "service 0x4E".
+std::string service_text(std::uint8_t service);
+// "sim-rack/A/3": how dnbctl names a node.
+std::string node_name(std::string_view rack, std::string_view port, unsigned mac);
+
+// --- Tables ---------------------------------------------------------------------
+// Columns left-aligned and separated by two spaces, a header line first; no
+// trailing blanks.
+class Table {
+ public:
+  explicit Table(std::vector<std::string> headers) : headers_(std::move(headers)) {}
+  void add(std::vector<std::string> row) { rows_.push_back(std::move(row)); }
+  std::string render() const;
+
+ private:
+  std::vector<std::string> headers_;
+  std::vector<std::vector<std::string>> rows_;
+};
+
+// --- list -------------------------------------------------------------------------
+// `alive`: whether the bridge that wrote the sample is still there (a state
+// instance whose writer left stays readable, NOT_ALIVE_NO_WRITERS).
+struct PortRow {
+  const dnbridge_PortStatus* port = nullptr;
+  bool alive = true;
+};
+struct NodeRow {
+  const dnbridge_NodeStatus* node = nullptr;
+  const dnbridge_PumpState* pump = nullptr;  // none when not (yet) seen
+  bool alive = true;
+};
+
+std::string ports_table(std::span<const PortRow> ports);
+std::string nodes_table(std::span<const NodeRow> nodes);
+// {"racks": [{"rack", "bridge_alive", "ports": [{..., "nodes": [...]}]}]}
+// Nodes whose port has no PortStatus are listed under a port of their own
+// with only its name.
+void list_json(JsonWriter& out, std::span<const PortRow> ports, std::span<const NodeRow> nodes);
+
+// --- watch --------------------------------------------------------------------------
+// One line per sample: "12:00:01.250 sim-rack/A/3 pump-3 online running ... | pump on ...".
+std::string pump_line(const dnbridge_PumpState& s, std::string_view time_text);
+std::string pumps_table(std::span<const dnbridge_PumpState* const> pumps);
+void pump_json(JsonWriter& out, const dnbridge_PumpState& s);
+// The outputs as they read: "pump on, N2 ballast off, analog out 2048 (5.001 V)".
+std::string outputs_text(bool pump_on, bool n2_ballast_on, std::uint16_t analog_raw);
+
+// --- show -----------------------------------------------------------------------------
+std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive);
+void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
+               bool alive);
+
+// --- get, set, service --------------------------------------------------------------
+struct ExplicitExchange {
+  // The request.
+  std::string rack;
+  std::string port;
+  std::uint8_t mac = 0;
+  std::uint8_t service = 0;
+  std::uint16_t class_id = 0;
+  std::uint16_t instance_id = 0;
+  std::optional<std::uint8_t> attribute;
+  std::vector<std::uint8_t> request_data;
+  // The reply.
+  std::uint8_t status = 0;
+  std::uint8_t general_status = 0;
+  std::uint8_t additional_status = 0xFF;
+  std::vector<std::uint8_t> data;
+  std::string message;
+
+  // The bridge completed the transaction and the device answered success.
+  bool succeeded() const noexcept { return status == 1 && general_status == 0; }
+};
+
+// `decoded`: the data decoded as asked with --as (none without --as).
+std::string explicit_text(const ExplicitExchange& x, Decoding as,
+                          const std::optional<Parsed<std::string>>& decoded);
+void explicit_json(JsonWriter& out, const ExplicitExchange& x, Decoding as,
+                   const std::optional<Parsed<std::string>>& decoded);
+
+}  // namespace dnbridge::dnbctl

@@ -1,0 +1,135 @@
+// list and show: what the bridges report about their ports and nodes.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "adapters/dds/fields.hpp"
+#include "adapters/dnbctl/commands.hpp"
+#include "adapters/dnbctl/format.hpp"
+#include "adapters/dnbctl/target.hpp"
+#include "adapters/dnbctl/values.hpp"
+
+namespace dnbridge::dnbctl {
+
+Client make_client(const GlobalOptions& options) {
+  return Client(options.domain, fmt::format("dnbctl {}:{}", user_at_host(), getpid()));
+}
+
+void print(const std::string& text) {
+  std::fputs(text.c_str(), stdout);
+  std::fflush(stdout);
+}
+
+namespace {
+
+// Every port the options allow has all its configured nodes in both node
+// topics: nothing more is expected from the bridges heard so far.
+bool complete(const Client& client, const GlobalOptions& o) {
+  for (const auto& [key, port] : client.ports()) {
+    if (!o.matches(key.rack, key.port)) continue;
+    std::size_t nodes = 0;
+    std::size_t pumps = 0;
+    for (const auto& [k, n] : client.nodes()) nodes += (k.rack == key.rack && k.port == key.port);
+    for (const auto& [k, p] : client.pumps()) pumps += (k.rack == key.rack && k.port == key.port);
+    if (nodes < port.data->nodes_configured || pumps < port.data->nodes_configured) return false;
+  }
+  return true;
+}
+
+bool any_port(const Client& client, const GlobalOptions& o) {
+  for (const auto& [key, port] : client.ports()) {
+    if (o.matches(key.rack, key.port)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+CLI::App* add_list(CLI::App& app, ListArgs& args) {
+  auto* cmd = app.add_subcommand(
+      "list",
+      "List the bridges (racks) and their ports (state, bus load, nodes online), and the nodes "
+      "(life-cycle state, reason, name, product, online). Both tables by default; --json gives "
+      "both, as racks > ports > nodes.");
+  auto* nodes = cmd->add_flag("--nodes", args.nodes_only, "Only the nodes' table");
+  auto* ports = cmd->add_flag("--ports", args.ports_only, "Only the ports' table");
+  nodes->excludes(ports);
+  return cmd;
+}
+
+Exit run_list(const GlobalOptions& o, const ListArgs& args) {
+  Client client = make_client(o);
+  const Deadline deadline = deadline_after(o.timeout());
+  if (!client.wait_until(deadline, [&] { return any_port(client, o); })) {
+    throw CommandError(Exit::kNotFound,
+                       fmt::format("no bridge answered on DDS domain {}{} within {:g} s", o.domain,
+                                   o.rack.empty() ? "" : fmt::format(" for rack \"{}\"", o.rack),
+                                   o.timeout_seconds));
+  }
+  // Other bridges get kSettle to be heard; every port's nodes, the timeout.
+  const Deadline settle = std::min(deadline, deadline_after(kSettle));
+  client.wait_until(settle, [] { return false; });
+  if (!client.wait_until(deadline, [&] { return complete(client, o); })) {
+    std::fputs("dnbctl: note: not every configured node was reported within the timeout\n", stderr);
+  }
+
+  std::vector<PortRow> ports;
+  for (const auto& [k, p] : client.ports()) {
+    if (o.matches(k.rack, k.port)) ports.push_back({p.data.get(), p.alive});
+  }
+  std::vector<NodeRow> nodes;
+  for (const auto& [k, n] : client.nodes()) {
+    if (!o.matches(k.rack, k.port)) continue;
+    const auto* pump = client.pump(k);
+    nodes.push_back({n.data.get(), pump ? pump->data.get() : nullptr, n.alive});
+  }
+
+  if (o.json) {
+    JsonWriter out;
+    list_json(out, ports, nodes);
+    print(out.str() + "\n");
+    return Exit::kOk;
+  }
+  std::string text;
+  if (!args.nodes_only) text += ports_table(ports);
+  if (!args.nodes_only && !args.ports_only) text += "\n";
+  if (!args.ports_only) text += nodes_table(nodes);
+  print(text);
+  return Exit::kOk;
+}
+
+CLI::App* add_show(CLI::App& app, ShowArgs& args) {
+  auto* cmd = app.add_subcommand(
+      "show",
+      "Show one node: identity (vendor, product type and code, revision, serial number, product "
+      "name), life-cycle state and reason, device state, poll sizes, expected packet rate, last "
+      "error, last refused command, and counters (NodeStatus).");
+  cmd->add_option("MAC", args.mac, "The node's MAC ID (0..63)")->required();
+  return cmd;
+}
+
+Exit run_show(const GlobalOptions& o, const ShowArgs& args) {
+  auto mac = parse_mac(args.mac);
+  if (!mac) throw CommandError(Exit::kUsage, mac.error());
+  Client client = make_client(o);
+  const NodeKey key = find_node(client, o, *mac);
+  if (!client.wait_until(deadline_after(o.timeout()), [&] { return client.node(key) != nullptr; })) {
+    throw CommandError(Exit::kNotFound,
+                       fmt::format("{}: no NodeStatus within {:g} s",
+                                   node_name(key.rack, key.port, key.mac), o.timeout_seconds));
+  }
+  const auto* node = client.node(key);
+  const auto* pump = client.pump(key);
+  const dnbridge_PumpState* state = pump ? pump->data.get() : nullptr;
+  if (o.json) {
+    JsonWriter out;
+    node_json(out, *node->data, state, node->alive);
+    print(out.str() + "\n");
+  } else {
+    print(node_details(*node->data, state, node->alive));
+  }
+  return Exit::kOk;
+}
+
+}  // namespace dnbridge::dnbctl

@@ -1,0 +1,92 @@
+// dnbctl: the command-line client of dnbridge bridges, for people at a
+// terminal and for scripts.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <exception>
+
+#include "adapters/dds/entity.hpp"
+#include "adapters/dnbctl/commands.hpp"
+
+namespace {
+
+using namespace dnbridge::dnbctl;
+
+constexpr const char* kFooter =
+    "Exit codes: 0 success; 1 the operation failed (refused, not applied, device error status); "
+    "2 usage error; 3 nothing found (no bridge or node answered within the timeout).\n"
+    "Every command has --help. Global options may come before or after the command.";
+
+int code(Exit e) { return static_cast<int>(e); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "dnbctl: inspect and command the pumps of dnbridge bridges (DeviceNet racks) over DDS."};
+  app.footer(kFooter);
+  app.require_subcommand(1);
+  app.fallthrough();  // global options are accepted after the command too
+
+  GlobalOptions options;
+  app.add_option("--domain", options.domain, "DDS domain (default 0, or $DNBCTL_DOMAIN)")
+      ->envname("DNBCTL_DOMAIN")
+      ->check(CLI::Range(0, 232));
+  app.add_option("--rack", options.rack,
+                 "Only this rack (needed when a MAC is on more than one rack)");
+  app.add_option("--port", options.port, "Only this port of the rack(s)");
+  app.add_option("--timeout", options.timeout_seconds,
+                 "Seconds to wait for bridges to answer, and for each wait (default 3)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--json", options.json, "Machine-readable output: one JSON document");
+
+  ListArgs list;
+  ShowArgs show;
+  WatchArgs watch;
+  OutputArgs pump;
+  OutputArgs ballast;
+  OutputArgs aout;
+  ExplicitArgs get;
+  ExplicitArgs set;
+  ExplicitArgs service;
+  auto* list_cmd = add_list(app, list);
+  auto* watch_cmd = add_watch(app, watch);
+  auto* pump_cmd = add_output(app, Output::kPump, pump);
+  auto* ballast_cmd = add_output(app, Output::kBallast, ballast);
+  auto* aout_cmd = add_output(app, Output::kAnalog, aout);
+  auto* get_cmd = add_explicit(app, ExplicitKind::kGet, get);
+  auto* set_cmd = add_explicit(app, ExplicitKind::kSet, set);
+  auto* service_cmd = add_explicit(app, ExplicitKind::kService, service);
+  auto* show_cmd = add_show(app, show);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);  // prints help, or the error with a hint
+    return rc == 0 ? 0 : code(Exit::kUsage);
+  }
+
+  try {
+    Exit rc = Exit::kOk;
+    if (list_cmd->parsed()) rc = run_list(options, list);
+    if (show_cmd->parsed()) rc = run_show(options, show);
+    if (watch_cmd->parsed()) rc = run_watch(options, watch);
+    if (pump_cmd->parsed()) rc = run_output(options, pump);
+    if (ballast_cmd->parsed()) rc = run_output(options, ballast);
+    if (aout_cmd->parsed()) rc = run_output(options, aout);
+    if (get_cmd->parsed()) rc = run_explicit(options, get);
+    if (set_cmd->parsed()) rc = run_explicit(options, set);
+    if (service_cmd->parsed()) rc = run_explicit(options, service);
+    return code(rc);
+  } catch (const CommandError& e) {
+    std::fprintf(stderr, "dnbctl: %s\n", e.what());
+    return code(e.code());
+  } catch (const dnbridge::dds::Error& e) {
+    std::fprintf(stderr, "dnbctl: DDS: %s\n", e.what());
+    return code(Exit::kFailed);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dnbctl: %s\n", e.what());
+    return code(Exit::kFailed);
+  }
+}

@@ -1,0 +1,279 @@
+// The real dnbctl program, run as a child process, against a bridge of the
+// simulated rack (eight CDN127 pumps at MACs 1..8 on port "A") running in
+// this process. Both are pinned to loopback on a domain and discovery tag of
+// this process's own (the child inherits CYCLONEDDS_URI), so parallel test
+// processes never hear each other. Node 3 holds its last outputs when no
+// commander is left, so what one dnbctl run commanded is still applied when
+// the next one reads it.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "adapters/daemon/config.hpp"
+#include "adapters/daemon/daemon.hpp"
+#include "adapters/daemon/log_sink.hpp"
+#include "adapters/dds/fields.hpp"
+#include "adapters/dds/participant.hpp"
+#include "adapters/dds/reader.hpp"
+#include "adapters/dds/topics.hpp"
+#include "adapters/dds/waitset.hpp"
+#include "subprocess.hpp"
+
+namespace dnbridge::dnbctl {
+namespace {
+
+using testing::RunResult;
+
+std::uint32_t test_domain() { return static_cast<std::uint32_t>(100 + getpid() % 100); }
+
+std::string loopback_config() {
+  return "<CycloneDDS><Domain><General>"
+         "<Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
+         "<AllowMulticast>false</AllowMulticast>"
+         "</General><Discovery>"
+         "<ParticipantIndex>auto</ParticipantIndex>"
+         "<MaxAutoParticipantIndex>50</MaxAutoParticipantIndex>"
+         "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
+         "<Tag>dnbctl-test-" +
+         std::to_string(getpid()) +
+         "</Tag>"
+         "</Discovery></Domain></CycloneDDS>";
+}
+
+// Set before any DDS call of the process; dnbctl children inherit it.
+class LoopbackEnvironment : public ::testing::Environment {
+ public:
+  void SetUp() override { ASSERT_EQ(setenv("CYCLONEDDS_URI", loopback_config().c_str(), 1), 0); }
+};
+[[maybe_unused]] const auto* const kEnvironment =
+    ::testing::AddGlobalTestEnvironment(new LoopbackEnvironment);
+
+// Bounds every wait for the bridge; never reached when things work.
+constexpr auto kReady = std::chrono::seconds(10);
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+class DnbctlEndToEnd : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    log_ = std::make_unique<daemon::StderrLogSink>(LogLevel::kWarn);
+    daemon::DaemonConfig config = daemon::embedded_default_config();
+    config.domain_id = test_domain();
+    for (auto& node : config.ports.at(0).nodes) {
+      if (node.mac.value() == 3) node.no_commander = daemon::NoCommanderPolicy::kHoldLastOutputs;
+    }
+    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), *log_);
+    bridge_->start();
+    observer_ = std::make_unique<Observer>();
+  }
+
+  static void TearDownTestSuite() {
+    observer_.reset();
+    if (bridge_) bridge_->stop();
+    bridge_.reset();
+    log_.reset();
+  }
+
+  // What the test sees of the bridge itself: PumpState, and every
+  // PumpCommand any dnbctl wrote.
+  struct Observer {
+    dds::Participant participant{static_cast<dds_domainid_t>(test_domain()),
+                                 dds::Participant::ClientName{"dnbctl test observer"}};
+    dds::Topic<dnbridge_PumpState> pump_topic{participant};
+    dds::Topic<dnbridge_PumpCommand> command_topic{participant};
+    dds::Reader<dnbridge_PumpState> pumps{participant, pump_topic, dds::state_reader_qos()};
+    dds::Reader<dnbridge_PumpCommand> commands{participant, command_topic, dds::command_reader_qos()};
+    dds::WaitSet waitset{participant};
+    std::map<unsigned, dds::Owned<dnbridge_PumpState>> latest;
+    std::vector<std::uint16_t> commanded_analog;  // every command's analog_output_raw
+
+    Observer() {
+      (void)pumps.set_status_mask(DDS_DATA_AVAILABLE_STATUS);
+      waitset.attach(pumps, 1);
+    }
+
+    void take() {
+      if (auto samples = pumps.take()) {
+        for (auto& s : *samples) {
+          if (!s.valid_data()) continue;
+          std::swap(*latest[s->mac], s.data());
+        }
+      }
+      if (auto samples = commands.take()) {
+        for (auto& s : *samples) {
+          if (s.valid_data()) commanded_analog.push_back(s->analog_output_raw);
+        }
+      }
+    }
+
+    // Until the latest PumpState of `mac` satisfies `ok`; false after kReady.
+    template <class Pred>
+    bool wait_pump(unsigned mac, Pred ok) {
+      const auto deadline = std::chrono::steady_clock::now() + kReady;
+      for (;;) {
+        take();
+        auto it = latest.find(mac);
+        if (it != latest.end() && ok(*it->second)) return true;
+        if (std::chrono::steady_clock::now() >= deadline) return false;
+        (void)waitset.wait(milliseconds(100));
+      }
+    }
+  };
+
+  void SetUp() override {
+    ASSERT_TRUE(bridge_);
+    // Ready: every pump online and polled with inputs.
+    for (unsigned mac = 1; mac <= 8; ++mac) {
+      ASSERT_TRUE(observer_->wait_pump(mac, [](const dnbridge_PumpState& s) {
+        return s.online && s.inputs_valid;
+      })) << "pump " << mac << " did not come online";
+    }
+  }
+
+  // dnbctl on this process's domain.
+  static RunResult dnbctl(std::vector<std::string> args) {
+    args.insert(args.begin(), {"--domain", std::to_string(test_domain())});
+    return testing::run(DNBCTL_PATH, args);
+  }
+
+  static std::unique_ptr<daemon::StderrLogSink> log_;
+  static std::unique_ptr<daemon::Daemon> bridge_;
+  static std::unique_ptr<Observer> observer_;
+};
+
+std::unique_ptr<daemon::StderrLogSink> DnbctlEndToEnd::log_;
+std::unique_ptr<daemon::Daemon> DnbctlEndToEnd::bridge_;
+std::unique_ptr<DnbctlEndToEnd::Observer> DnbctlEndToEnd::observer_;
+
+TEST_F(DnbctlEndToEnd, ListShowsTheEightNodesOnline) {
+  const auto json = dnbctl({"list", "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_NE(json.out.find("\"rack\": \"sim-rack\""), std::string::npos) << json.out;
+  EXPECT_NE(json.out.find("\"nodes_online\": 8"), std::string::npos) << json.out;
+  EXPECT_EQ(count(json.out, "\"online\": true"), 8u) << json.out;
+  EXPECT_EQ(count(json.out, "\"product\": \"CDN127\""), 8u) << json.out;
+
+  const auto table = dnbctl({"list"});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find("8/8 online"), std::string::npos) << table.out;
+  EXPECT_EQ(count(table.out, "  online  yes  "), 8u) << table.out;
+}
+
+TEST_F(DnbctlEndToEnd, ShowShowsTheIdentity) {
+  const auto r = dnbctl({"show", "3"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* line : {"node                      sim-rack/A/3 (pump-3)\n",
+                           "state                     online\n", "product name              CDN127\n",
+                           "vendor                    59 (0x003B)\n",
+                           "product code              1888 (0x0760)\n",
+                           "serial number             3 (0x00000003)\n"}) {
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\nin:\n" << r.out;
+  }
+  const auto json = dnbctl({"show", "3", "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_NE(json.out.find("\"product_name\": \"CDN127\""), std::string::npos) << json.out;
+
+  const auto absent = dnbctl({"show", "9", "--timeout", "0.5"});
+  EXPECT_EQ(absent.exit_code, 3);
+  EXPECT_NE(absent.err.find("no bridge reported a node with MAC 9"), std::string::npos) << absent.err;
+}
+
+TEST_F(DnbctlEndToEnd, OutputCommandsAreAppliedAndKeepTheOtherOutputs) {
+  auto r = dnbctl({"pump", "3", "on"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("sim-rack/A/3 (pump-3): applied: pump on"), std::string::npos) << r.out;
+  EXPECT_TRUE(observer_->wait_pump(3, [](const dnbridge_PumpState& s) {
+    return !s.outputs_idle && s.pump_on && dds::view(s.commanded_by).starts_with("dnbctl ");
+  }));
+
+  // 5.0 V: round(5.0 * 4095 / 10) = round(2047.5) = 2048; the pump stays on.
+  r = dnbctl({"aout", "3", "5.0V"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("applied: pump on, N2 ballast off, analog out 2048"), std::string::npos) << r.out;
+  EXPECT_TRUE(observer_->wait_pump(3, [](const dnbridge_PumpState& s) {
+    return !s.outputs_idle && s.pump_on && s.analog_output_raw == 2048;
+  }));
+
+  // Out of range: refused on the command line, nothing sent.
+  r = dnbctl({"aout", "3", "11V"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("analog value 11 V is out of range 0..10 V"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+
+  r = dnbctl({"ballast", "3", "on", "--json", "--issuer", "test bench"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"applied\": true"), std::string::npos) << r.out;
+  EXPECT_TRUE(observer_->wait_pump(3, [](const dnbridge_PumpState& s) {
+    return !s.outputs_idle && s.pump_on && s.n2_ballast_on && s.analog_output_raw == 2048 &&
+           dds::view(s.commanded_by) == "test bench";
+  }));
+
+  // Every command any dnbctl wrote was in range: the 11 V one never left.
+  observer_->take();
+  ASSERT_FALSE(observer_->commanded_analog.empty());
+  for (auto raw : observer_->commanded_analog) EXPECT_LE(raw, 4095);
+  EXPECT_EQ(observer_->commanded_analog.back(), 2048);
+}
+
+TEST_F(DnbctlEndToEnd, ExplicitMessaging) {
+  auto r = dnbctl({"get", "3", "1", "1", "7", "--as", "string"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("status: 1 (transaction completed)\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("data (7 bytes): 06 43 44 4E 31 32 37\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("as string: \"CDN127\"\n"), std::string::npos) << r.out;
+
+  r = dnbctl({"get", "3", "0x01", "1", "1", "--as", "uint", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"value\": 59"), std::string::npos) << r.out;  // vendor ID
+
+  r = dnbctl({"get", "3", "1", "1", "99"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.out.find("CIP general status: 0x14 (attribute not supported)"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.err.find("attribute not supported"), std::string::npos) << r.err;
+
+  r = dnbctl({"get", "40", "1", "1", "1"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.out.find("status: 3 (slave not in scan list)"), std::string::npos) << r.out;
+}
+
+// No bridge needed: these end before (or for lack of) any answer.
+TEST(Dnbctl, UsageErrorsExit2AndNothingFoundExits3) {
+  const std::string domain = std::to_string(test_domain() + 1);  // no bridge there
+  auto r = testing::run(DNBCTL_PATH, {"--domain", domain, "pump", "64", "on"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("MAC ID 64 is out of range 0..63"), std::string::npos) << r.err;
+
+  r = testing::run(DNBCTL_PATH, {"frobnicate"});
+  EXPECT_EQ(r.exit_code, 2);
+  r = testing::run(DNBCTL_PATH, {"get", "3", "1", "1", "7", "--as", "float"});
+  EXPECT_EQ(r.exit_code, 2);
+  r = testing::run(DNBCTL_PATH, {"set", "3", "1", "1", "7", "abc"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("two hex digits"), std::string::npos) << r.err;
+
+  r = testing::run(DNBCTL_PATH, {"--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("Exit codes"), std::string::npos);
+  r = testing::run(DNBCTL_PATH, {"pump", "--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("--hold-for"), std::string::npos);
+  EXPECT_NE(r.out.find("only while a commander is live"), std::string::npos);
+
+  r = testing::run(DNBCTL_PATH, {"--domain", domain, "--timeout", "0.5", "list"});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("no bridge answered on DDS domain " + domain), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace dnbridge::dnbctl
