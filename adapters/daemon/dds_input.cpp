@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <stdexcept>
+
 #include "adapters/daemon/samples.hpp"
 #include "adapters/dds/fields.hpp"
 
@@ -27,6 +29,16 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       requests_(participant, publisher.request_topic(), dds::request_reader_qos()),
       stop_(participant),
       waitset_(participant) {
+  // A reader's status condition stays triggered while any status in its mask
+  // is set, and taking resets only DATA_AVAILABLE: with the default mask
+  // (every status) a matched writer's SUBSCRIPTION_MATCHED, never read here,
+  // would keep the waitset triggered and this thread spinning.
+  for (const dds::Entity* reader : {static_cast<const dds::Entity*>(&commands_),
+                                    static_cast<const dds::Entity*>(&requests_)}) {
+    if (!reader->set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
+      throw std::runtime_error("setting the status mask of a DDS input reader failed");
+    }
+  }
   waitset_.attach(commands_, kCommands);
   waitset_.attach(requests_, kRequests);
   waitset_.attach(stop_, kStop);

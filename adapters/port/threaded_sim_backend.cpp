@@ -1,0 +1,175 @@
+#include "adapters/port/threaded_sim_backend.hpp"
+
+#include <fmt/format.h>
+#include <pthread.h>
+#include <sys/prctl.h>
+
+#include <chrono>
+#include <ctime>
+#include <stdexcept>
+
+#include "adapters/sim/sim_rack.hpp"
+
+namespace dnbridge::port {
+namespace {
+
+TimePoint steady_now() {
+  return TimePoint(
+      std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
+}
+
+std::chrono::steady_clock::time_point to_steady(TimePoint t) {
+  return std::chrono::steady_clock::time_point(
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(t.time_since_epoch()));
+}
+
+}  // namespace
+
+ThreadedSimBackend::ThreadedSimBackend(std::uint32_t bitrate,
+                                       const std::vector<devicenet::MacId>& device_macs,
+                                       LogSink* log)
+    : bitrate_(bitrate),
+      world_(sim::BusConfig{bitrate}, steady_now()),
+      handle_(world_.bus().attach(master_port_)) {
+  for (auto mac : device_macs) {
+    Logger device_log = log ? Logger(*log, fmt::format("sim {}", mac.value())) : Logger();
+    devices_[mac.value()] = std::make_unique<sim::SimSlave>(world_, sim::default_slave_options(mac),
+                                                            world_.now(), std::move(device_log));
+  }
+  to_world_.reserve(64);
+  to_port_.reserve(64);
+  receiving_.reserve(64);
+  delivered_.reserve(64);
+  thread_ = std::thread([this] { run(); });
+  if (pthread_getcpuclockid(thread_.native_handle(), &sim_clock_) != 0) sim_clock_ = -1;
+}
+
+ThreadedSimBackend::~ThreadedSimBackend() {
+  {
+    std::lock_guard lock(world_mutex_);
+    stop_ = true;
+  }
+  world_woken_.notify_one();
+  thread_.join();
+  (void)world_.bus().detach(handle_);
+}
+
+TimePoint ThreadedSimBackend::now() const { return steady_now(); }
+
+sim::SimSlave& ThreadedSimBackend::device(devicenet::MacId mac) {
+  auto it = devices_.find(mac.value());
+  if (it == devices_.end())
+    throw std::out_of_range(fmt::format("no simulated device {}", mac.value()));
+  return *it->second;
+}
+
+void ThreadedSimBackend::MasterSink::send(const can::CanFrame& frame, TimePoint now) {
+  {
+    std::lock_guard lock(owner_.world_mutex_);
+    owner_.to_world_.emplace_back(frame, now);
+  }
+  owner_.world_woken_.notify_one();
+}
+
+void ThreadedSimBackend::MasterPort::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
+  owner_.delivered_.emplace_back(frame, rx_time);
+}
+
+void ThreadedSimBackend::post(std::function<void()> fn) {
+  {
+    std::lock_guard lock(world_mutex_);
+    posted_.push_back(std::move(fn));
+  }
+  world_woken_.notify_one();
+}
+
+void ThreadedSimBackend::hand_over() {
+  if (delivered_.empty()) return;
+  // Stamped when handed over: the master cannot have had the frame earlier,
+  // even when this thread was late for its simulated end of frame.
+  const TimePoint handed = steady_now();
+  {
+    std::lock_guard lock(port_mutex_);
+    for (const auto& [frame, end] : delivered_) to_port_.emplace_back(frame, std::max(end, handed));
+  }
+  delivered_.clear();
+  port_woken_.notify_one();
+}
+
+void ThreadedSimBackend::run() {
+  // Wake-ups at the simulated end of frame are timed waits: without this the
+  // kernel's default timer slack (50 us) would add to every reception.
+  (void)prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  std::vector<std::pair<can::CanFrame, TimePoint>> sending;
+  std::vector<std::function<void()>> running;
+  sending.reserve(64);
+  std::unique_lock lock(world_mutex_);
+  while (!stop_) {
+    sending.swap(to_world_);
+    running.swap(posted_);
+    lock.unlock();
+
+    for (auto& fn : running) fn();
+    running.clear();
+    for (const auto& [frame, at] : sending) {
+      // The world first catches up with the time the master sent at, so the
+      // frame is queued on the bus at that time (or at once, if later).
+      if (at > world_.now()) world_.run_until(at);
+      world_.bus().send(handle_, frame, at);
+    }
+    sending.clear();
+    world_.run_until(std::max(world_.now(), steady_now()));
+    frames_.store(world_.bus().stats().transmitted, std::memory_order_relaxed);
+    bits_.store(world_.bus().stats().bits, std::memory_order_relaxed);
+    hand_over();
+
+    const TimePoint next = world_.next_event();
+    lock.lock();
+    if (stop_ || !to_world_.empty() || !posted_.empty()) continue;
+    if (next == kNever) {
+      world_woken_.wait(lock);
+    } else if (next > steady_now()) {
+      world_woken_.wait_until(lock, to_steady(next));
+    }
+  }
+}
+
+void ThreadedSimBackend::wait(TimePoint deadline, FrameReceiver& receiver) {
+  {
+    std::unique_lock lock(port_mutex_);
+    auto ready = [&] { return wake_ || !to_port_.empty(); };
+    if (deadline == kNever) {
+      port_woken_.wait(lock, ready);
+    } else {
+      port_woken_.wait_until(lock, to_steady(deadline), ready);
+    }
+    wake_ = false;
+    receiving_.swap(to_port_);
+  }
+  for (const auto& [frame, rx] : receiving_) receiver.on_frame(frame, rx);
+  receiving_.clear();
+}
+
+void ThreadedSimBackend::wake() {
+  {
+    std::lock_guard lock(port_mutex_);
+    wake_ = true;
+  }
+  port_woken_.notify_one();
+}
+
+BusCounters ThreadedSimBackend::counters() const {
+  BusCounters c;
+  c.state = BusState::kErrorActive;  // the simulated bus has no error confinement
+  c.frames = frames_.load(std::memory_order_relaxed);
+  c.bits = bits_.load(std::memory_order_relaxed);
+  return c;
+}
+
+Duration ThreadedSimBackend::sim_thread_cpu_time() const {
+  timespec ts{};
+  if (sim_clock_ == -1 || clock_gettime(sim_clock_, &ts) != 0) return Duration::zero();
+  return seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
+}
+
+}  // namespace dnbridge::port

@@ -1,0 +1,1096 @@
+// dnbridge-bench: what the bridge costs in latency and CPU, beside what Cyclone
+// DDS itself costs on the same machine in the same run.
+//
+//   (0) Cyclone's own one-way latency: ddsperf ping and pong (two processes,
+//       waitset mode, on loopback), one-way = round trip / 2.
+//   (1) poll response received by the master -> PumpState taken by a
+//       subscriber in another process: wall clock at take - source timestamp
+//       (the bridge stamps each sample with the CAN receive time of the poll
+//       response it comes from).
+//   (2) PumpCommand written in another process -> the poll frame carrying the
+//       new outputs on the simulated bus: both ends on CLOCK_MONOTONIC, which
+//       the two processes share.
+//   (3) CPU time of the bridge per second of wall time, 4 ports x 63 nodes
+//       polled every 10 ms, the simulated devices' threads left out.
+//
+// The bridge runs in this process (daemon::Daemon, configuration built here,
+// each port on a ThreadedSimBackend: the simulated bus and devices on a
+// thread of their own). The subscriber and commander is this same program
+// re-executed with --client: another process, another DDS participant. Every
+// DDS participant of the run, ddsperf's included, is pinned to the loopback
+// interface with a discovery tag of this run's own.
+//
+// It reports figures; it exits non-zero only when the run itself fails.
+#include <dds/version.h>
+#include <fcntl.h>
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <iterator>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "adapters/daemon/config.hpp"
+#include "adapters/daemon/daemon.hpp"
+#include "adapters/daemon/log_sink.hpp"
+#include "adapters/dds/fields.hpp"
+#include "adapters/dds/participant.hpp"
+#include "adapters/dds/reader.hpp"
+#include "adapters/dds/sample.hpp"
+#include "adapters/dds/topics.hpp"
+#include "adapters/dds/waitset.hpp"
+#include "adapters/dds/writer.hpp"
+#include "adapters/port/threaded_sim_backend.hpp"
+#include "adapters/sim/can_timing.hpp"
+#include "bridge/devicenet/identifier.hpp"
+#include "bridge/profiles/cdn127/io_data.hpp"
+#include "bridge/profiles/cdn127/poll_format.hpp"
+
+namespace dnbridge::bench {
+namespace {
+
+using devicenet::MacId;
+
+// ---------------------------------------------------------------------------
+// Clocks
+
+std::int64_t clock_ns(clockid_t clock) {
+  timespec ts{};
+  clock_gettime(clock, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+std::int64_t monotonic_ns() { return clock_ns(CLOCK_MONOTONIC); }
+std::int64_t realtime_ns() { return clock_ns(CLOCK_REALTIME); }
+std::int64_t process_cpu_ns() { return clock_ns(CLOCK_PROCESS_CPUTIME_ID); }
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// The bridge's receive and frame times are std::chrono::steady_clock (the
+// simulated bus runs on it); the commander stamps its writes with
+// clock_gettime(CLOCK_MONOTONIC). They are one clock if every steady_clock
+// reading falls between two CLOCK_MONOTONIC readings taken around it.
+bool steady_clock_is_monotonic() {
+  for (int i = 0; i < 1000; ++i) {
+    const auto a = monotonic_ns();
+    const auto s = steady_ns();
+    const auto b = monotonic_ns();
+    if (s < a || s > b) return false;
+  }
+  return true;
+}
+
+void sleep_until_monotonic(std::int64_t t) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(t / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(t % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+// Where the process's CPU time goes, thread by thread (/proc: clock ticks,
+// and context switches, i.e. how often each thread slept and was woken or was
+// preempted).
+struct ThreadSample {
+  std::string name;
+  double cpu_s = 0;
+  std::uint64_t switches = 0;
+};
+
+std::map<pid_t, ThreadSample> snapshot_threads() {
+  std::map<pid_t, ThreadSample> out;
+  const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) {
+    const auto tid = static_cast<pid_t>(std::stol(entry.path().filename().string()));
+    ThreadSample t;
+    std::ifstream stat(entry.path() / "stat");
+    std::string line;
+    std::getline(stat, line);
+    const auto open = line.find('('), close = line.rfind(')');
+    if (open == std::string::npos || close == std::string::npos) continue;
+    t.name = line.substr(open + 1, close - open - 1);
+    std::istringstream rest(line.substr(close + 2));
+    std::vector<std::string> fields{std::istream_iterator<std::string>(rest), {}};
+    if (fields.size() < 13) continue;
+    // Fields 14 and 15 of the line (utime, stime) are 12 and 13 after the name.
+    t.cpu_s = (std::stod(fields[11]) + std::stod(fields[12])) / tick;
+    std::ifstream status(entry.path() / "status");
+    while (std::getline(status, line)) {
+      if (line.rfind("voluntary_ctxt_switches:", 0) == 0 ||
+          line.rfind("nonvoluntary_ctxt_switches:", 0) == 0) {
+        t.switches += std::stoull(line.substr(line.find(':') + 1));
+      }
+    }
+    out[tid] = t;
+  }
+  return out;
+}
+
+pid_t this_thread_id() { return static_cast<pid_t>(gettid()); }
+
+std::string load_average() {
+  std::ifstream f("/proc/loadavg");
+  std::string a, b, c;
+  f >> a >> b >> c;
+  return a + " " + b + " " + c;
+}
+
+// ---------------------------------------------------------------------------
+// Statistics (microseconds)
+
+struct Summary {
+  std::size_t count = 0;
+  double p50 = 0, p99 = 0, max = 0, min = 0;
+};
+
+// Nearest-rank percentile of sorted values.
+double percentile(const std::vector<double>& sorted, double p) {
+  if (sorted.empty()) return 0;
+  const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(sorted.size())));
+  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
+}
+
+Summary summarize(std::vector<double> us) {
+  Summary s;
+  s.count = us.size();
+  if (us.empty()) return s;
+  std::sort(us.begin(), us.end());
+  s.p50 = percentile(us, 0.50);
+  s.p99 = percentile(us, 0.99);
+  s.min = us.front();
+  s.max = us.back();
+  return s;
+}
+
+// ---------------------------------------------------------------------------
+// Child processes
+
+struct Child {
+  pid_t pid = -1;
+  int out = -1;  // its standard output, when captured
+};
+
+// Runs `argv` with standard output to a pipe (capture) or /dev/null, standard
+// error inherited. Throws on failure to start.
+Child spawn(const std::vector<std::string>& argv, bool capture) {
+  int fds[2] = {-1, -1};
+  if (capture && pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    if (capture) {
+      dup2(fds[1], STDOUT_FILENO);
+    } else {
+      const int null = open("/dev/null", O_WRONLY);
+      if (null >= 0) dup2(null, STDOUT_FILENO);
+    }
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execvp(args[0], args.data());
+    std::fprintf(stderr, "dnbridge-bench: cannot run %s\n", argv[0].c_str());
+    _exit(127);
+  }
+  Child c;
+  c.pid = pid;
+  if (capture) {
+    close(fds[1]);
+    c.out = fds[0];
+  }
+  return c;
+}
+
+// Exit status of a child (-1 when killed by a signal).
+int wait_child(pid_t pid) {
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Reads a child's output line by line, each read bounded by a deadline.
+class LineReader {
+ public:
+  explicit LineReader(int fd) : fd_(fd) {}
+  // The next line; nullopt at end of file or when `deadline` (monotonic ns)
+  // passes first (timed_out() tells which).
+  std::optional<std::string> next(std::int64_t deadline) {
+    for (;;) {
+      if (auto pos = buffer_.find('\n'); pos != std::string::npos) {
+        std::string line = buffer_.substr(0, pos);
+        buffer_.erase(0, pos + 1);
+        return line;
+      }
+      if (eof_) return std::nullopt;
+      const auto left = deadline - monotonic_ns();
+      if (left <= 0) {
+        timed_out_ = true;
+        return std::nullopt;
+      }
+      pollfd p{fd_, POLLIN, 0};
+      const int n =
+          ::poll(&p, 1, static_cast<int>(std::min<std::int64_t>(left / 1'000'000 + 1, 1000)));
+      if (n <= 0) continue;
+      char chunk[65536];
+      const ssize_t got = ::read(fd_, chunk, sizeof chunk);
+      if (got <= 0) {
+        eof_ = true;
+        continue;
+      }
+      buffer_.append(chunk, static_cast<std::size_t>(got));
+    }
+  }
+  bool timed_out() const { return timed_out_; }
+
+ private:
+  int fd_;
+  std::string buffer_;
+  bool eof_ = false;
+  bool timed_out_ = false;
+};
+
+// ---------------------------------------------------------------------------
+// DDS set-up shared by every process of the run
+
+std::string loopback_config(const std::string& tag) {
+  // deploy/cyclonedds/loopback.xml, plus a discovery tag: participants of
+  // other runs or tests on this machine are never matched.
+  return "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/>"
+         "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
+         "<ParticipantIndex>auto</ParticipantIndex>"
+         "<MaxAutoParticipantIndex>50</MaxAutoParticipantIndex>"
+         "<Peers><Peer address=\"127.0.0.1\"/></Peers><Tag>" +
+         tag + "</Tag></Discovery></Domain></CycloneDDS>";
+}
+
+constexpr const char* kRack = "bench";
+
+// ---------------------------------------------------------------------------
+// (0) Cyclone's own latency: ddsperf
+
+struct DdsperfWindow {
+  double min, p50, p90, p99, max;  // round trip, us
+  double count;
+};
+
+struct DdsperfResult {
+  std::vector<DdsperfWindow> windows;  // the first (warm-up) window left out
+  double rtt_p50 = 0, rtt_p99 = 0, rtt_max = 0;
+  double samples = 0;
+  std::string command;
+};
+
+// ddsperf prints, once a second, the round trips of that second: mean, min,
+// 50 %, 90 %, 99 %, max and count; it prints no figure over the whole run.
+// The run's percentiles are computed from the windows: each window's
+// distribution is taken as piecewise linear between its reported quantiles,
+// the windows are pooled weighted by their counts, and the pooled
+// distribution is inverted.
+double pooled_quantile(const std::vector<DdsperfWindow>& ws, double q) {
+  auto window_cdf = [](const DdsperfWindow& w, double x) {
+    const std::array<double, 5> xs{w.min, w.p50, w.p90, w.p99, w.max};
+    const std::array<double, 5> qs{0.0, 0.5, 0.9, 0.99, 1.0};
+    if (x < xs[0]) return 0.0;
+    if (x >= xs[4]) return 1.0;
+    for (std::size_t i = 1; i < xs.size(); ++i) {
+      if (x < xs[i]) {
+        const double span = xs[i] - xs[i - 1];
+        return span > 0 ? qs[i - 1] + (qs[i] - qs[i - 1]) * (x - xs[i - 1]) / span : qs[i];
+      }
+    }
+    return 1.0;
+  };
+  double lo = ws.front().min, hi = ws.front().max, total = 0;
+  for (const auto& w : ws) {
+    lo = std::min(lo, w.min);
+    hi = std::max(hi, w.max);
+    total += w.count;
+  }
+  for (int i = 0; i < 100; ++i) {
+    const double mid = (lo + hi) / 2;
+    double f = 0;
+    for (const auto& w : ws) f += w.count * window_cdf(w, mid);
+    (f / total < q ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+DdsperfResult run_ddsperf(int domain, int seconds, int rate_hz, int size) {
+  const std::string d = std::to_string(domain);
+  // pong outlives ping; ping waits (initwait) for its pong before it starts.
+  Child pong =
+      spawn({"ddsperf", "-i", d, "-D", std::to_string(seconds + 15), "pong", "waitset"}, false);
+  std::vector<std::string> ping_args{"ddsperf",
+                                     "-i",
+                                     d,
+                                     "-Qminmatch:1",
+                                     "-Qinitwait:10",
+                                     "-D",
+                                     std::to_string(seconds + 1),
+                                     "ping",
+                                     std::to_string(rate_hz) + "Hz",
+                                     "size",
+                                     std::to_string(size),
+                                     "waitset"};
+  Child ping = spawn(ping_args, true);
+  DdsperfResult r;
+  for (std::size_t i = 1; i < ping_args.size(); ++i) r.command += ping_args[i] + " ";
+  LineReader lines(ping.out);
+  const std::regex re(
+      R"(size \d+ mean [\d.]+us min ([\d.]+)us 50% ([\d.]+)us 90% ([\d.]+)us 99% ([\d.]+)us max ([\d.]+)us cnt (\d+))");
+  bool first = true;
+  const auto deadline = monotonic_ns() + static_cast<std::int64_t>(seconds + 30) * 1'000'000'000;
+  while (auto line = lines.next(deadline)) {
+    std::smatch m;
+    if (!std::regex_search(*line, m, re)) continue;
+    if (first) {  // discovery and warm-up
+      first = false;
+      continue;
+    }
+    r.windows.push_back({std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]),
+                         std::stod(m[5]), std::stod(m[6])});
+  }
+  close(ping.out);
+  if (lines.timed_out()) kill(ping.pid, SIGKILL);
+  const int ping_status = wait_child(ping.pid);
+  kill(pong.pid, SIGTERM);
+  (void)wait_child(pong.pid);
+  if (ping_status != 0 || r.windows.empty()) {
+    throw std::runtime_error(
+        fmt::format("ddsperf ping failed (exit {}, {} windows)", ping_status, r.windows.size()));
+  }
+  for (const auto& w : r.windows) {
+    r.samples += w.count;
+    r.rtt_max = std::max(r.rtt_max, w.max);
+  }
+  r.rtt_p50 = pooled_quantile(r.windows, 0.50);
+  r.rtt_p99 = pooled_quantile(r.windows, 0.99);
+  return r;
+}
+
+// ---------------------------------------------------------------------------
+// The client process: subscriber and commander
+
+struct ClientOptions {
+  std::string mode;  // "latency" or "count"
+  int domain = 0;
+  std::vector<std::string> ports;
+  unsigned nodes = 0;           // MACs 1..nodes on each port
+  double seconds = 0;           // measurement window after every node is online
+  int command_interval_us = 0;  // latency: one command every so often
+  bool command_once = false;    // count: one command per node at the start
+};
+
+int run_client(const ClientOptions& o) {
+  dds::Participant participant(static_cast<dds_domainid_t>(o.domain), "bench-client");
+  dds::Topic<dnbridge_PumpState> state_topic(participant);
+  dds::Topic<dnbridge_PumpCommand> command_topic(participant);
+  dds::Reader<dnbridge_PumpState> reader(participant, state_topic, dds::state_reader_qos());
+  dds::Writer<dnbridge_PumpCommand> writer(participant, command_topic,
+                                           dds::command_writer_qos(10, seconds(5)));
+  dds::ReadCondition any(reader, DDS_ANY_STATE);
+  dds::GuardCondition stop(participant);
+  dds::WaitSet waitset(participant);
+  waitset.attach(any, 1);
+  waitset.attach(stop, 2);
+
+  const std::size_t expected = o.ports.size() * o.nodes;
+  auto key_of = [&](const dnbridge_PumpState& s) -> std::optional<std::size_t> {
+    for (std::size_t p = 0; p < o.ports.size(); ++p) {
+      if (dds::view(s.port) == o.ports[p] && s.mac >= 1 && s.mac <= o.nodes) {
+        return p * 64 + s.mac;
+      }
+    }
+    return std::nullopt;
+  };
+
+  std::atomic<std::size_t> ready_count{0};
+  std::atomic<bool> measuring{false};
+  std::atomic<std::uint64_t> taken{0};
+  std::vector<std::int64_t> latencies;  // reader thread until joined
+  latencies.reserve(200000);
+
+  std::thread taker([&] {
+    std::vector<char> ready(o.ports.size() * 64, 0);
+    std::vector<int> last_analog(o.ports.size() * 64, -1);
+    std::size_t ready_n = 0;
+    for (;;) {
+      auto triggered = waitset.wait(milliseconds(200));
+      if (!triggered) continue;
+      bool stopping = false;
+      for (auto t : *triggered) stopping = stopping || t == 2;
+      if (stopping) return;
+      // Few at a time: Reader::take allocates `max` samples and frees the
+      // unused ones, a cost that would be counted in the latency.
+      auto samples = reader.take(any, 8);
+      const auto now = dds::dds_now();
+      if (!samples) continue;
+      const bool counting = measuring.load(std::memory_order_relaxed);
+      for (const auto& s : *samples) {
+        if (!s.valid_data()) continue;
+        const auto& d = s.data();
+        const auto key = key_of(d);
+        if (!key) continue;
+        const bool is_ready = d.online && d.inputs_valid;
+        if (is_ready != static_cast<bool>(ready[*key])) {
+          ready[*key] = is_ready;
+          ready_n = is_ready ? ready_n + 1 : ready_n - 1;
+          ready_count.store(ready_n);
+        }
+        const int analog = d.analog_input_count > 0 ? d.analog_input_raw[0] : -1;
+        const bool fresh = analog != last_analog[*key];
+        last_analog[*key] = analog;
+        if (!counting) continue;
+        taken.fetch_add(1, std::memory_order_relaxed);
+        // A new analog value: the sample of a new poll response.
+        if (o.mode == "latency" && is_ready && fresh) {
+          latencies.push_back((now - s.info().source_timestamp()).count());
+        }
+      }
+    }
+  });
+
+  auto fail = [&](const char* what) {
+    std::fprintf(stderr, "dnbridge-bench client: %s\n", what);
+    (void)stop.trigger();
+    taker.join();
+    return 1;
+  };
+
+  // Every node online and its inputs read, and the bridge's command reader matched.
+  const auto online_deadline = monotonic_ns() + 90'000'000'000;
+  while (ready_count.load() < expected || writer.matched_subscriptions().value_or(0) == 0) {
+    if (monotonic_ns() > online_deadline) return fail("not every node came online within 90 s");
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::printf("ready\n");
+  std::fflush(stdout);
+
+  struct Written {
+    unsigned mac;
+    unsigned value;
+    std::int64_t at;
+  };
+  std::vector<Written> written;
+  auto command = [&](const std::string& port, unsigned mac, bool pump_on, unsigned value) {
+    dds::Owned<dnbridge_PumpCommand> c;
+    dds::set_string(c->rack, kRack);
+    dds::set_string(c->port, port);
+    c->mac = static_cast<std::uint8_t>(mac);
+    c->pump_on = pump_on;
+    c->n2_ballast_on = false;
+    c->analog_output_raw = static_cast<std::uint16_t>(value);
+    dds::set_string(c->issuer, "dnbridge-bench");
+    // The write time, on CLOCK_MONOTONIC; the sample's source timestamp is
+    // Cyclone's wall clock at the same moment.
+    const auto at = monotonic_ns();
+    if (!writer.write(*c)) return false;
+    written.push_back({mac, value, at});
+    return true;
+  };
+
+  const auto start = monotonic_ns();
+  const auto window = static_cast<std::int64_t>(o.seconds * 1e9);
+  measuring = true;
+  if (o.mode == "latency") {
+    // Round robin over the nodes of the first port; each command a new
+    // analog output value for its node (1..4095), so that the poll frame
+    // that carries it is known by its value.
+    std::vector<unsigned> value(64, 0);
+    const std::int64_t interval = static_cast<std::int64_t>(o.command_interval_us) * 1000;
+    std::int64_t next = start;
+    for (unsigned i = 0; monotonic_ns() < start + window; ++i) {
+      const unsigned mac = 1 + i % o.nodes;
+      value[mac] = value[mac] % 4095 + 1;
+      if (!command(o.ports[0], mac, false, value[mac])) return fail("writing a PumpCommand failed");
+      next += interval;
+      sleep_until_monotonic(next);
+    }
+    sleep_until_monotonic(monotonic_ns() + 300'000'000);  // the last commands' polls
+  } else {
+    if (o.command_once) {
+      for (const auto& port : o.ports) {
+        for (unsigned mac = 1; mac <= o.nodes; ++mac) {
+          if (!command(port, mac, true, 2048)) return fail("writing a PumpCommand failed");
+        }
+      }
+    }
+    sleep_until_monotonic(start + window);
+  }
+  measuring = false;
+  const auto elapsed = monotonic_ns() - start;
+  (void)stop.trigger();
+  taker.join();
+
+  std::string out;
+  out.reserve(latencies.size() * 12 + written.size() * 32 + 256);
+  for (auto l : latencies) out += fmt::format("state {}\n", l);
+  if (o.mode == "latency") {
+    for (const auto& w : written) out += fmt::format("cmd {} {} {}\n", w.mac, w.value, w.at);
+  }
+  out += fmt::format("taken {} {}\n", taken.load(), elapsed);
+  out += "done\n";
+  std::fwrite(out.data(), 1, out.size(), stdout);
+  std::fflush(stdout);
+  return 0;
+}
+
+// ---------------------------------------------------------------------------
+// The bridge side
+
+// What the bus tap of one port sees, on that port's world thread.
+struct PortWire {
+  port::ThreadedSimBackend* backend = nullptr;
+  std::uint32_t bitrate = 0;
+  bool ramp = false;            // a new analog input value before every poll
+  bool record_outputs = false;  // the first poll frame of each new output value
+  profiles::cdn127::PollRequestLayout request_layout;
+  std::array<std::uint16_t, 64> ramp_value{};
+  std::array<int, 64> last_output{};
+  std::atomic<std::uint64_t> polls{0};
+  std::atomic<std::uint64_t> responses{0};
+
+  struct OutputFrame {
+    unsigned mac;
+    unsigned value;
+    std::int64_t start;  // on the wire: start and end of frame, steady clock
+    std::int64_t end;
+  };
+  std::mutex mutex;
+  std::vector<OutputFrame> output_frames;
+
+  void on_wire(const sim::WireFrame& wf) {
+    const auto id = devicenet::decode_identifier(wf.frame.id);
+    if (!id) return;
+    if (id->group == devicenet::MessageGroup::k1 &&
+        id->message_id == static_cast<std::uint8_t>(devicenet::Group1Message::kSlavePollResponse)) {
+      responses.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    if (id->group != devicenet::MessageGroup::k2 ||
+        id->message_id != static_cast<std::uint8_t>(devicenet::Group2Message::kMasterIoPoll)) {
+      return;
+    }
+    polls.fetch_add(1, std::memory_order_relaxed);
+    const unsigned mac = id->mac.value();
+    if (ramp) {
+      // The tap runs before any node receives the frame: the device answers
+      // this poll with the new value, so every poll response is a change.
+      ramp_value[mac] = static_cast<std::uint16_t>((ramp_value[mac] + 1) % 4096);
+      (void)backend->device(id->mac).device().pump().set_analog_input(0, ramp_value[mac]);
+    }
+    if (record_outputs && wf.frame.len > 0) {
+      auto outputs = profiles::cdn127::decode_poll_request(request_layout, wf.frame.payload());
+      if (outputs && outputs->analog_out_raw != last_output[mac]) {
+        last_output[mac] = outputs->analog_out_raw;
+        const auto end = wf.end.time_since_epoch().count();
+        const auto start = end - sim::frame_duration(wf.frame, bitrate).count();
+        std::lock_guard lock(mutex);
+        output_frames.push_back({mac, outputs->analog_out_raw, start, end});
+      }
+    }
+  }
+};
+
+struct BridgeSetup {
+  std::vector<std::string> ports;
+  unsigned nodes = 0;
+  std::uint32_t bitrate = sim::kBitrate500k;
+  Duration poll_period = milliseconds(10);
+  rack::PublishPolicy publish;
+  bool ramp = false;
+  bool record_outputs = false;
+};
+
+class Bridge {
+ public:
+  Bridge(const BridgeSetup& s, int domain, LogSink& log) {
+    daemon::DaemonConfig c;
+    c.rack = kRack;
+    c.domain_id = static_cast<std::uint32_t>(domain);
+    c.master_mac = MacId::from(0).value();
+    c.log_level = LogLevel::kWarn;
+    c.source = "dnbridge-bench";
+    for (const auto& name : s.ports) {
+      daemon::PortConfig p;
+      p.name = name;
+      p.interface = std::string(daemon::kSimulatedInterface);
+      p.bitrate = s.bitrate;
+      p.master_mac = c.master_mac;
+      for (unsigned m = 1; m <= s.nodes; ++m) {
+        daemon::NodeSettings n;
+        n.mac = MacId::from(m).value();
+        n.name = fmt::format("pump-{}-{}", name, m);
+        n.poll_period = s.poll_period;
+        n.publish = s.publish;
+        p.nodes.push_back(n);
+      }
+      c.ports.push_back(std::move(p));
+    }
+    const auto layout =
+        profiles::cdn127::poll_format(
+            profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127))
+            .value()
+            .request;
+    auto factory = [this, &s, &log,
+                    layout](const daemon::PortConfig& p) -> std::unique_ptr<port::CanBackend> {
+      std::vector<MacId> macs;
+      for (const auto& n : p.nodes) macs.push_back(n.mac);
+      auto backend = std::make_unique<port::ThreadedSimBackend>(p.bitrate, macs, &log);
+      auto wire = std::make_unique<PortWire>();
+      wire->backend = backend.get();
+      wire->bitrate = p.bitrate;
+      wire->ramp = s.ramp;
+      wire->record_outputs = s.record_outputs;
+      wire->request_layout = layout;
+      wire->last_output.fill(-1);
+      PortWire* w = wire.get();
+      auto* b = backend.get();
+      backend->post(
+          [w, b] { b->world().bus().set_tap([w](const sim::WireFrame& f) { w->on_wire(f); }); });
+      backends_.push_back(b);
+      wires_.push_back(std::move(wire));
+      return backend;
+    };
+    daemon_ = std::make_unique<daemon::Daemon>(std::move(c), log, factory);
+  }
+  ~Bridge() { stop(); }
+
+  void start() { daemon_->start(); }
+  void stop() {
+    if (daemon_) daemon_->stop();
+  }
+
+  // The simulated worlds' threads, together.
+  std::int64_t sim_cpu_ns() const {
+    std::int64_t t = 0;
+    for (auto* b : backends_) t += b->sim_thread_cpu_time().count();
+    return t;
+  }
+  std::uint64_t polls() const {
+    std::uint64_t n = 0;
+    for (const auto& w : wires_) n += w->polls.load();
+    return n;
+  }
+  std::uint64_t responses() const {
+    std::uint64_t n = 0;
+    for (const auto& w : wires_) n += w->responses.load();
+    return n;
+  }
+  std::uint64_t bus_bits() const {
+    std::uint64_t n = 0;
+    for (auto* b : backends_) n += b->counters().bits;
+    return n;
+  }
+  // The threads of the ports' loops and of the simulated worlds.
+  std::set<pid_t> port_threads() {
+    std::set<pid_t> tids;
+    for (const auto& p : daemon_->config().ports) {
+      std::promise<pid_t> tid;
+      daemon_->port(p.name)->post([&tid](port::CanBackend&) { tid.set_value(this_thread_id()); });
+      tids.insert(tid.get_future().get());
+    }
+    return tids;
+  }
+  std::set<pid_t> sim_threads() {
+    std::set<pid_t> tids;
+    for (auto* b : backends_) {
+      std::promise<pid_t> tid;
+      b->post([&tid] { tid.set_value(this_thread_id()); });
+      tids.insert(tid.get_future().get());
+    }
+    return tids;
+  }
+
+  std::vector<PortWire::OutputFrame> output_frames() {
+    std::vector<PortWire::OutputFrame> all;
+    for (auto& w : wires_) {
+      std::lock_guard lock(w->mutex);
+      all.insert(all.end(), w->output_frames.begin(), w->output_frames.end());
+    }
+    return all;
+  }
+
+ private:
+  std::vector<port::ThreadedSimBackend*> backends_;
+  std::vector<std::unique_ptr<PortWire>> wires_;  // outlive the daemon (its backends' taps)
+  std::unique_ptr<daemon::Daemon> daemon_;
+};
+
+struct Options {
+  int ddsperf_seconds = 10;
+  int ddsperf_rate = 500;
+  int ddsperf_size = 128;
+  double latency_seconds = 25;
+  unsigned latency_nodes = 8;
+  int command_interval_ms = 10;
+  double cpu_seconds = 20;
+  double busy_seconds = 10;
+  int domain = -1;
+};
+
+std::vector<std::string> client_args(const std::string& mode, int domain,
+                                     const std::vector<std::string>& ports, unsigned nodes,
+                                     double seconds) {
+  std::string port_list;
+  for (const auto& p : ports) port_list += (port_list.empty() ? "" : ",") + p;
+  return {"/proc/self/exe",
+          "--client",
+          mode,
+          "--domain",
+          std::to_string(domain),
+          "--ports",
+          port_list,
+          "--nodes",
+          std::to_string(nodes),
+          "--seconds",
+          fmt::format("{}", seconds)};
+}
+
+// Reads a client's output to its end; its "ready" line (every node online)
+// calls `on_ready`, its "taken" line (end of its window) `on_end`.
+struct ClientOutput {
+  std::vector<double> state_us;
+  struct Cmd {
+    unsigned mac, value;
+    std::int64_t at;
+  };
+  std::vector<Cmd> commands;
+  std::uint64_t taken = 0;
+  double window_s = 0;
+  bool done = false;
+};
+
+template <class OnReady, class OnEnd>
+ClientOutput read_client(Child child, double seconds, OnReady on_ready, OnEnd on_end) {
+  ClientOutput out;
+  LineReader lines(child.out);
+  const auto deadline = monotonic_ns() + static_cast<std::int64_t>((seconds + 150) * 1e9);
+  while (auto line = lines.next(deadline)) {
+    if (*line == "ready") {
+      on_ready();
+    } else if (line->rfind("state ", 0) == 0) {
+      out.state_us.push_back(std::stod(line->substr(6)) / 1e3);
+    } else if (line->rfind("cmd ", 0) == 0) {
+      ClientOutput::Cmd c{};
+      long long at = 0;
+      if (std::sscanf(line->c_str(), "cmd %u %u %lld", &c.mac, &c.value, &at) == 3) {
+        c.at = at;
+        out.commands.push_back(c);
+      }
+    } else if (line->rfind("taken ", 0) == 0) {
+      on_end();
+      unsigned long long n = 0;
+      long long ns = 0;
+      if (std::sscanf(line->c_str(), "taken %llu %lld", &n, &ns) == 2) {
+        out.taken = n;
+        out.window_s = static_cast<double>(ns) / 1e9;
+      }
+    } else if (*line == "done") {
+      out.done = true;
+    }
+  }
+  if (lines.timed_out()) kill(child.pid, SIGKILL);
+  close(child.out);
+  const int status = wait_child(child.pid);
+  if (status != 0 || !out.done) {
+    throw std::runtime_error(fmt::format("the client process failed (exit {})", status));
+  }
+  return out;
+}
+
+std::string us(double v) { return fmt::format("{:.1f} us", v); }
+
+std::string verdict(bool met) { return met ? "met" : "NOT met"; }
+
+int run_bench(const Options& o) {
+  const int domain = o.domain >= 0 ? o.domain : 200 + static_cast<int>(getpid() % 30);
+  const std::string tag = fmt::format("dnbridge-bench-{}", getpid());
+  setenv("CYCLONEDDS_URI", loopback_config(tag).c_str(), 1);
+  daemon::StderrLogSink log(LogLevel::kWarn);
+
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  fmt::print("dnbridge benchmark, {:%Y-%m-%d %H:%M:%S} UTC, host {}, {} CPU(s)\n",
+             fmt::gmtime(std::time(nullptr)), host, std::thread::hardware_concurrency());
+  fmt::print("DDS: Cyclone DDS {}, loopback only (lo, unicast discovery), domain {}, tag {}\n",
+             DDS_VERSION, domain, tag);
+  // Latencies are only as good as the machine is quiet: say how busy it was.
+  fmt::print("load average at start: {}\n\n", load_average());
+
+  if (!steady_clock_is_monotonic()) {
+    fmt::print(stderr,
+               "std::chrono::steady_clock is not CLOCK_MONOTONIC here: (2) cannot be measured\n");
+    return 1;
+  }
+  fmt::print(
+      "clock check: std::chrono::steady_clock reads CLOCK_MONOTONIC (1000 readings bracketed)\n\n");
+
+  // (0) ---------------------------------------------------------------------
+  if (o.ddsperf_seconds > 0 && o.latency_seconds > 0) {
+    fmt::print("(0) Cyclone DDS one-way latency (ddsperf), {} s ...\n", o.ddsperf_seconds);
+    std::fflush(stdout);
+    const DdsperfResult cyc =
+        run_ddsperf(domain, o.ddsperf_seconds, o.ddsperf_rate, o.ddsperf_size);
+    const double cyc_p50 = cyc.rtt_p50 / 2, cyc_p99 = cyc.rtt_p99 / 2;
+    double window_p99_lo = cyc.windows.front().p99, window_p99_hi = window_p99_lo;
+    for (const auto& w : cyc.windows) {
+      window_p99_lo = std::min(window_p99_lo, w.p99);
+      window_p99_hi = std::max(window_p99_hi, w.p99);
+    }
+    fmt::print("    ddsperf {}(and ddsperf pong waitset)\n", cyc.command);
+    fmt::print("    round trips: {:.0f} in {} one-second windows (first window left out)\n",
+               cyc.samples, cyc.windows.size());
+    fmt::print(
+        "    round trip  p50 {}  p99 {}  max {}  (p99 of single windows {:.1f}..{:.1f} us)\n",
+        us(cyc.rtt_p50), us(cyc.rtt_p99), us(cyc.rtt_max), window_p99_lo, window_p99_hi);
+    fmt::print("    one-way = round trip / 2:  p50 {}  p99 {}\n\n", us(cyc_p50), us(cyc_p99));
+
+    // (1) and (2) -------------------------------------------------------------
+    {
+      BridgeSetup s;
+      s.ports = {"A"};
+      s.nodes = o.latency_nodes;
+      s.bitrate = sim::kBitrate500k;
+      s.publish = {seconds(1), 0.0};
+      s.ramp = true;
+      s.record_outputs = true;
+      fmt::print(
+          "(1)(2) bridge: 1 port, {} CDN127s at 500 kbit/s, polled every 10 ms; every poll "
+          "response\n       carries a new analog input (deadband 0: each one is published); a "
+          "PumpCommand\n       every {} ms, round robin, each a new analog output; {} s ...\n",
+          s.nodes, o.command_interval_ms, o.latency_seconds);
+      std::fflush(stdout);
+      Bridge bridge(s, domain, log);
+      const auto offset_before = realtime_ns() - monotonic_ns();
+      bridge.start();
+      auto args = client_args("latency", domain, s.ports, s.nodes, o.latency_seconds);
+      args.push_back("--command-interval-us");
+      args.push_back(std::to_string(o.command_interval_ms * 1000));
+      ClientOutput out = read_client(
+          spawn(args, true), o.latency_seconds, [] {}, [] {});
+      bridge.stop();
+      const auto offset_after = realtime_ns() - monotonic_ns();
+      const auto drift_us = static_cast<double>(offset_after - offset_before) / 1e3;
+
+      const Summary state = summarize(out.state_us);
+      fmt::print(
+          "\n(1) poll response received by the master -> PumpState taken by the subscriber\n");
+      fmt::print("    samples {}  p50 {}  p99 {}  max {}  min {}\n", state.count, us(state.p50),
+                 us(state.p99), us(state.max), us(state.min));
+      fmt::print(
+          "    wall clock moved {:+.1f} us against CLOCK_MONOTONIC during the run (an error of "
+          "at most that)\n",
+          drift_us);
+      fmt::print("    ratio to Cyclone one-way:  p50 {:.2f}  p99 {:.2f}   target p99 <= 1.5: {}\n",
+                 state.p50 / cyc_p50, state.p99 / cyc_p99, verdict(state.p99 <= 1.5 * cyc_p99));
+
+      std::map<std::pair<unsigned, unsigned>, PortWire::OutputFrame> frames;
+      for (const auto& f : bridge.output_frames())
+        frames.emplace(std::make_pair(f.mac, f.value), f);
+      std::vector<double> to_start, to_end;
+      for (const auto& c : out.commands) {
+        auto it = frames.find({c.mac, c.value});
+        if (it == frames.end()) continue;
+        to_start.push_back(static_cast<double>(it->second.start - c.at) / 1e3);
+        to_end.push_back(static_cast<double>(it->second.end - c.at) / 1e3);
+      }
+      const Summary cmd = summarize(to_start);
+      const Summary cmd_end = summarize(to_end);
+      fmt::print("\n(2) PumpCommand written -> poll frame with the new outputs on the bus\n");
+      fmt::print("    commands written {}, their poll frames found {}\n", out.commands.size(),
+                 cmd.count);
+      fmt::print("    to start of frame:  p50 {}  p99 {}  max {}  min {}\n", us(cmd.p50),
+                 us(cmd.p99), us(cmd.max), us(cmd.min));
+      fmt::print(
+          "    to end of frame:    p50 {}  p99 {}  (adds the frame's own time on a 500 kbit/s "
+          "wire)\n",
+          us(cmd_end.p50), us(cmd_end.p99));
+      fmt::print(
+          "    ratio to Cyclone one-way (start of frame):  p50 {:.2f}  p99 {:.2f}   target p99 "
+          "<= 1.5: {}\n",
+          cmd.p50 / cyc_p50, cmd.p99 / cyc_p99, verdict(cmd.p99 <= 1.5 * cyc_p99));
+      fmt::print("\n");
+      if (state.count == 0 || cmd.count == 0) throw std::runtime_error("no latency was measured");
+    }
+  }
+
+  // (3) ---------------------------------------------------------------------
+  auto cpu_run = [&](const char* title, double window, bool every_poll) {
+    BridgeSetup s;
+    s.ports = {"P1", "P2", "P3", "P4"};
+    s.nodes = 63;
+    s.bitrate = 0;  // ideal bus: see the bus load printed below
+    s.publish = every_poll ? rack::PublishPolicy{seconds(1), 0.0} : rack::PublishPolicy{};
+    s.ramp = every_poll;
+    fmt::print("{}\n", title);
+    std::fflush(stdout);
+    Bridge bridge(s, domain, log);
+    bridge.start();
+    std::int64_t wall0 = 0, cpu0 = 0, sim0 = 0;
+    std::uint64_t polls0 = 0, responses0 = 0, bits0 = 0;
+    const auto online_from = monotonic_ns();
+    double online_s = 0;
+    auto args = client_args("count", domain, s.ports, s.nodes, window);
+    args.push_back("--command-once");
+    const std::set<pid_t> port_tids = bridge.port_threads();
+    const std::set<pid_t> sim_tids = bridge.sim_threads();
+    std::map<pid_t, ThreadSample> threads0, threads1;
+    auto start = [&] {
+      online_s = static_cast<double>(monotonic_ns() - online_from) / 1e9;
+      wall0 = monotonic_ns();
+      cpu0 = process_cpu_ns();
+      sim0 = bridge.sim_cpu_ns();
+      polls0 = bridge.polls();
+      responses0 = bridge.responses();
+      bits0 = bridge.bus_bits();
+      threads0 = snapshot_threads();
+    };
+    double wall = 0, cpu = 0, sim_cpu = 0, polls = 0, responses = 0, bits = 0;
+    auto end = [&] {
+      // The client has taken samples for `window` seconds since it said
+      // ready, and is still subscribed and commanding.
+      wall = static_cast<double>(monotonic_ns() - wall0) / 1e9;
+      cpu = static_cast<double>(process_cpu_ns() - cpu0) / 1e9;
+      sim_cpu = static_cast<double>(bridge.sim_cpu_ns() - sim0) / 1e9;
+      polls = static_cast<double>(bridge.polls() - polls0);
+      responses = static_cast<double>(bridge.responses() - responses0);
+      bits = static_cast<double>(bridge.bus_bits() - bits0);
+      threads1 = snapshot_threads();
+    };
+    ClientOutput out = read_client(spawn(args, true), window, start, end);
+    bridge.stop();
+    if (wall <= 0) throw std::runtime_error("the CPU window was not measured");
+    const double bridge_pct = 100.0 * (cpu - sim_cpu) / wall;
+    fmt::print("    all {} nodes online after {:.1f} s; measured over {:.1f} s of wall time\n",
+               s.ports.size() * s.nodes, online_s, wall);
+    fmt::print(
+        "    polls {:.0f}/s (expected {:.0f}/s), poll responses {:.0f}/s, PumpState samples "
+        "taken by the subscriber {:.0f}/s\n",
+        polls / wall, static_cast<double>(s.ports.size() * s.nodes) * 100.0, responses / wall,
+        static_cast<double>(out.taken) / out.window_s);
+    fmt::print(
+        "    bus: {:.0f} bit/s per port, {:.0f} % of a 500 kbit/s bus: hence the ideal bus\n",
+        bits / wall / 4, 100.0 * bits / wall / 4 / 500000.0);
+    fmt::print(
+        "    CPU: process {:.1f} %, simulated devices' threads {:.1f} %, bridge {:.1f} % of "
+        "one core\n",
+        100.0 * cpu / wall, 100.0 * sim_cpu / wall, bridge_pct);
+    struct Group {
+      const char* name;
+      double cpu_s = 0;
+      double switches = 0;
+      unsigned threads = 0;
+    };
+    std::array<Group, 4> groups{
+        {{"port loops"}, {"DDS input + main"}, {"Cyclone DDS's own"}, {"simulated devices"}}};
+    for (const auto& [tid, t1] : threads1) {
+      auto it = threads0.find(tid);
+      if (it == threads0.end()) continue;
+      Group& g = port_tids.count(tid)                                        ? groups[0]
+                 : sim_tids.count(tid)                                       ? groups[3]
+                 : t1.name != "dnbridge-benc" && t1.name != "dnbridge-bench" ? groups[2]
+                                                                             : groups[1];
+      g.cpu_s += t1.cpu_s - it->second.cpu_s;
+      g.switches += static_cast<double>(t1.switches - it->second.switches);
+      ++g.threads;
+    }
+    fmt::print("    by thread (/proc, 10 ms ticks):");
+    for (const auto& g : groups) {
+      fmt::print(" {} ({}) {:.1f} %, {:.0f} switches/s;", g.name, g.threads, 100.0 * g.cpu_s / wall,
+                 g.switches / wall);
+    }
+    fmt::print("\n");
+    return bridge_pct;
+  };
+
+  const double pct = cpu_run(
+      "(3) CPU: 4 ports x 63 CDN127s, each polled every 10 ms, on an ideal bus (no bit timing);\n"
+      "    publish policy as shipped (on change, 0.05 V deadband, at least once a second); a\n"
+      "    subscriber in another process takes every PumpState; one PumpCommand per pump at the "
+      "start ...",
+      o.cpu_seconds, false);
+  fmt::print("    target < 10 % of one core: {}\n\n", verdict(pct < 10.0));
+  if (o.busy_seconds > 0) {
+    (void)cpu_run(
+        "(3b) the same, but every poll response a new analog input and deadband 0: a PumpState "
+        "per poll ...",
+        o.busy_seconds, true);
+    fmt::print("\n");
+  }
+  fmt::print("load average at end: {}\n", load_average());
+  return 0;
+}
+
+}  // namespace
+}  // namespace dnbridge::bench
+
+int main(int argc, char** argv) {
+  using namespace dnbridge::bench;
+  CLI::App app{"dnbridge-bench: the bridge's latency and CPU time beside Cyclone DDS's own"};
+  Options o;
+  ClientOptions client;
+  std::string ports;
+  app.add_option("--ddsperf-seconds", o.ddsperf_seconds, "ddsperf ping run")->capture_default_str();
+  app.add_option("--ddsperf-rate", o.ddsperf_rate, "ddsperf pings per second")
+      ->capture_default_str();
+  app.add_option("--latency-seconds", o.latency_seconds, "(1) and (2)")->capture_default_str();
+  app.add_option("--latency-nodes", o.latency_nodes, "nodes for (1) and (2)")
+      ->capture_default_str();
+  app.add_option("--command-interval-ms", o.command_interval_ms, "(2)")->capture_default_str();
+  app.add_option("--cpu-seconds", o.cpu_seconds, "(3) measurement window")->capture_default_str();
+  app.add_option("--busy-seconds", o.busy_seconds, "(3b) window, 0 to skip")->capture_default_str();
+  app.add_option("--domain", o.domain, "DDS domain (default: from the process id)");
+  // The client role (re-executed by the benchmark itself).
+  app.add_option("--client", client.mode)->group("");
+  app.add_option("--ports", ports)->group("");
+  app.add_option("--nodes", client.nodes)->group("");
+  app.add_option("--seconds", client.seconds)->group("");
+  app.add_option("--command-interval-us", client.command_interval_us)->group("");
+  app.add_flag("--command-once", client.command_once)->group("");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (!client.mode.empty()) {
+      client.domain = o.domain;
+      for (std::size_t at = 0; at <= ports.size();) {
+        const auto comma = std::min(ports.find(',', at), ports.size());
+        client.ports.push_back(ports.substr(at, comma - at));
+        at = comma + 1;
+      }
+      return run_client(client);
+    }
+    return run_bench(o);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dnbridge-bench: %s\n", e.what());
+    return 1;
+  }
+}
