@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <filesystem>
 #include <chrono>
 #include <stdexcept>
 #include <system_error>
@@ -41,7 +42,16 @@ bool interface_gone(const std::error_code& e) {
   return is(e, ENETDOWN) || is(e, ENODEV) || is(e, ENXIO) || is(e, ENETUNREACH);
 }
 
+// A controller on hardware (USB, PCI, SPI) has a device behind it in sysfs;
+// virtual interfaces (vcan) do not, and have no state, counters or timing
+// to ask libsocketcan for (it would complain on standard error).
+bool has_controller(const std::string& interface) {
+  std::error_code ignored;
+  return std::filesystem::exists("/sys/class/net/" + interface + "/device", ignored);
+}
+
 std::optional<BusState> state_from_netlink(const std::string& interface) {
+  if (!has_controller(interface)) return std::nullopt;
   int state = 0;
   if (::can_get_state(interface.c_str(), &state) != 0) return std::nullopt;
   switch (state) {
@@ -166,12 +176,14 @@ void SocketCanBackend::try_open(TimePoint now) {
   // virtual one (vcan) has none, and stays "unknown".
   bus_.state = state_from_netlink(options_.interface).value_or(BusState::kUnknown);
   can_berr_counter berr{};
-  if (::can_get_berr_counter(options_.interface.c_str(), &berr) == 0) {
+  if (!has_controller(options_.interface)) {
+    // Nothing more to ask a virtual interface.
+  } else if (::can_get_berr_counter(options_.interface.c_str(), &berr) == 0) {
     bus_.tx_errors = berr.txerr;
     bus_.rx_errors = berr.rxerr;
   }
   can_bittiming timing{};
-  if (::can_get_bittiming(options_.interface.c_str(), &timing) == 0 && timing.bitrate != 0 &&
+  if (has_controller(options_.interface) && ::can_get_bittiming(options_.interface.c_str(), &timing) == 0 && timing.bitrate != 0 &&
       timing.bitrate != options_.bitrate) {
     log_.warn("interface {} runs at {} bit/s, the configuration says {}", options_.interface,
               timing.bitrate, options_.bitrate);
@@ -360,7 +372,8 @@ void SocketCanBackend::on_error_frame(const Received& r, TimePoint now) {
     switch (options_.bus_off) {
       case BusOffRecovery::kInterface: {
         std::uint32_t restart_ms = 0;
-        if (::can_get_restart_ms(options_.interface.c_str(), &restart_ms) == 0 && restart_ms == 0) {
+        if (has_controller(options_.interface) &&
+            ::can_get_restart_ms(options_.interface.c_str(), &restart_ms) == 0 && restart_ms == 0) {
           log_.error(
               "bus-off, and interface {} has no restart-ms: it stays off until restarted (ip link "
               "set {} type can restart-ms 100)",
