@@ -77,6 +77,21 @@ port::PortLoop* Daemon::port(std::string_view name) {
   return nullptr;
 }
 
+void Daemon::toggle_candump(const std::string& directory) {
+  for (auto& p : ports_) {
+    const std::string path = fmt::format("{}/dnbridge-{}-candump.log", directory, p->name());
+    p->post([path, this](port::CanBackend& backend) {
+      auto* can = dynamic_cast<socketcan::SocketCanBackend*>(&backend);
+      if (!can) return;  // the simulated bus: nothing to log
+      if (can->candump_logging()) {
+        can->stop_candump_log();
+      } else if (auto s = can->start_candump_log(path); !s) {
+        log_.error("candump log {}: {}", path, s.error().message());
+      }
+    });
+  }
+}
+
 void Daemon::start() {
   if (running_) return;
   running_ = true;

@@ -56,6 +56,10 @@ void Child::send(const std::string& line) {
   }
 }
 
+void Child::signal(int number) {
+  if (pid_ > 0) ::kill(pid_, number);
+}
+
 bool Child::running() {
   if (pid_ <= 0) return false;
   int status = 0;

@@ -42,6 +42,7 @@ class Child {
   // SIGTERM, then SIGKILL after `grace`; the exit status (waitpid's).
   int stop(std::chrono::milliseconds grace = std::chrono::milliseconds(5000));
   bool running();
+  void signal(int number);
   const fs::path& log() const { return log_; }
 
  private:

@@ -3,7 +3,10 @@
 // kernel. run_in_uml.sh runs each test in a kernel of its own.
 #include <fmt/format.h>
 
+#include <signal.h>
+
 #include <cmath>
+#include <regex>
 #include <fstream>
 #include <sstream>
 
@@ -35,6 +38,13 @@ std::string run_output(const std::string& command) {
   return out;
 }
 
+std::size_t count_lines(const fs::path& file, const std::string& containing) {
+  std::ifstream in(file);
+  std::size_t n = 0;
+  for (std::string l; std::getline(in, l);) n += l.find(containing) != std::string::npos;
+  return n;
+}
+
 class SystemTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -62,7 +72,8 @@ class SystemTest : public ::testing::Test {
     const fs::path config = dir_ / "rack.toml";
     std::ofstream(config) << rack_config(rack_, ports);
     children_.push_back(std::make_unique<Child>(
-        std::vector<std::string>{DNBRIDGE_BIN, "--config", config.string()},
+        std::vector<std::string>{DNBRIDGE_BIN, "--config", config.string(), "--candump-dir",
+                                 dir_.string()},
         dir_ / "dnbridge.log"));
     return *children_.back();
   }
@@ -186,6 +197,27 @@ TEST_F(SystemTest, TwoPortsServedByOneBridge) {
   EXPECT_EQ(supervisor().ports().at("A").can_interface, "vcan0");
   EXPECT_EQ(supervisor().ports().at("B").can_interface, "vcan1");
   EXPECT_TRUE(bridge.running());
+
+  // SIGUSR1: a candump -l log per port, for field diagnosis, until the next.
+  bridge.signal(SIGUSR1);
+  const fs::path log_a = dir_ / "dnbridge-A-candump.log";
+  const fs::path log_b = dir_ / "dnbridge-B-candump.log";
+  ASSERT_TRUE(supervisor().wait_until(
+      [&] { return count_lines(log_a, " vcan0 ") > 20 && count_lines(log_b, " vcan1 ") > 20; }, 10s))
+      << "no candump log after SIGUSR1";
+  bridge.signal(SIGUSR1);
+  const auto settled = [&] {
+    const auto a = count_lines(log_a, " vcan0 ");
+    std::this_thread::sleep_for(300ms);
+    return count_lines(log_a, " vcan0 ") == a;
+  };
+  ASSERT_TRUE(supervisor().wait_until(settled, 5s)) << "the second SIGUSR1 did not stop the log";
+  // A line as candump -l writes it: "(1700000000.123456) vcan0 3C5#..."
+  std::ifstream in(log_a);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_TRUE(std::regex_match(line, std::regex(R"(\(\d+\.\d{6}\) vcan0 [0-9A-F]{3}#([0-9A-F]{2})*)")))
+      << line;
 }
 
 // The interface goes down and comes back, then is removed and created again:
