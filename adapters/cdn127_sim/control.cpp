@@ -35,7 +35,8 @@ std::optional<T> number(std::string_view s) {
 std::variant<std::optional<std::uint8_t>, std::string> target(std::string_view s, bool allow_all) {
   if (allow_all && s == "all") return std::optional<std::uint8_t>{};
   auto mac = number<unsigned>(s);
-  if (!mac || *mac > 63) return fmt::format("\"{}\" is not a MAC ID (0..63{})", s, allow_all ? " or all" : "");
+  if (!mac || *mac > 63)
+    return fmt::format("\"{}\" is not a MAC ID (0..63{})", s, allow_all ? " or all" : "");
   return std::optional<std::uint8_t>(static_cast<std::uint8_t>(*mac));
 }
 
@@ -55,7 +56,8 @@ std::variant<std::uint16_t, std::string> analog(std::string_view s) {
     return *raw;
   }
   auto raw = number<unsigned>(s);
-  if (!raw || *raw > 4095) return fmt::format("\"{}\" is neither volts (\"2.5V\") nor counts 0..4095", s);
+  if (!raw || *raw > 4095)
+    return fmt::format("\"{}\" is neither volts (\"2.5V\") nor counts 0..4095", s);
   return static_cast<std::uint16_t>(*raw);
 }
 
@@ -70,7 +72,8 @@ ParseResult parse_control(std::string_view line) {
   auto with_target = [&](Verb v, bool optional_target) -> ParseResult {
     c.verb = v;
     if (w.size() == 1 && optional_target) return c;
-    if (w.size() != 2) return fmt::format("usage: {} {}", verb, optional_target ? "[MAC]" : "MAC|all");
+    if (w.size() != 2)
+      return fmt::format("usage: {} {}", verb, optional_target ? "[MAC]" : "MAC|all");
     auto t = target(w[1], true);
     if (auto* e = std::get_if<std::string>(&t)) return *e;
     c.mac = std::get<std::optional<std::uint8_t>>(t);

@@ -38,7 +38,8 @@ class StderrSink final : public LogSink {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "cdn127-sim: simulated CDN127 DeviceNet pump interfaces (Group 2 only slaves) on a SocketCAN\n"
+      "cdn127-sim: simulated CDN127 DeviceNet pump interfaces (Group 2 only slaves) on a "
+      "SocketCAN\n"
       "interface, one CAN_RAW socket each, as if each were a device on the bus.\n\n"
       "  cdn127-sim --iface vcan0 --mac 5 --mac 6\n\n"
       "Every device powers up at start (duplicate MAC check, then waits for a master), with\n"
@@ -63,8 +64,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   LogLevel level = LogLevel::kInfo;
-  for (auto l : {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn,
-                 LogLevel::kError}) {
+  for (auto l :
+       {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn, LogLevel::kError}) {
     if (level_name == to_string(l)) level = l;
   }
   StderrSink log(level);

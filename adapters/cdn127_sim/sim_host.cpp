@@ -125,8 +125,8 @@ SimHost::SimHost(std::string interface, const std::vector<devicenet::MacId>& mac
     auto d = std::make_unique<SocketDevice>(sim::default_slave_options(macs[i]),
                                             Logger(log, fmt::format("sim {}", macs[i].value())));
     if (auto e = d->open(interface_)) {
-      throw std::system_error(e, fmt::format("opening {} for the device at MAC {}", interface_,
-                                             macs[i].value()));
+      throw std::system_error(
+          e, fmt::format("opening {} for the device at MAC {}", interface_, macs[i].value()));
     }
     epoll_event ev{};
     ev.events = EPOLLIN;
@@ -216,9 +216,10 @@ std::string SimHost::status_line(SocketDevice& d, TimePoint now) {
       d.mac().value(), on_off(d.powered()), sim::to_string(s.network_state()),
       s.owner() == 255 ? std::string("none") : std::to_string(s.owner()),
       s.poll_state() == sim::ConnectionState::kEstablished ? "established" : "not-established",
-      on_off(out.pump_on), on_off(out.n2_ballast_on), out.analog_out_raw, on_off(s.pump().running()),
-      on_off(s.pump().alarm_active()), on_off(s.pump().warning_active()),
-      on_off(s.pump().n2_flow_ok()), on_off(s.pump().interlock_ok()), ain[0], ain[1]);
+      on_off(out.pump_on), on_off(out.n2_ballast_on), out.analog_out_raw,
+      on_off(s.pump().running()), on_off(s.pump().alarm_active()),
+      on_off(s.pump().warning_active()), on_off(s.pump().n2_flow_ok()),
+      on_off(s.pump().interlock_ok()), ain[0], ain[1]);
 }
 
 std::string SimHost::execute(const ControlCommand& c, TimePoint now) {
@@ -293,7 +294,8 @@ void SimHost::run(int control_fd, bool quit_at_end, std::FILE* replies) {
   sigaddset(&set, SIGINT);
   sigaddset(&set, SIGTERM);
   signals_.reset(::signalfd(-1, &set, SFD_NONBLOCK | SFD_CLOEXEC));
-  for (auto [fd, token] : {std::pair{timer_.get(), kTimerToken}, {signals_.get(), kSignalToken},
+  for (auto [fd, token] : {std::pair{timer_.get(), kTimerToken},
+                           {signals_.get(), kSignalToken},
                            {control_fd, kControlToken}}) {
     if (fd < 0) continue;
     epoll_event ev{};

@@ -68,7 +68,7 @@ struct PortConfig {
   std::string interface;           // kSimulatedInterface, or a SocketCAN interface (can0, ...)
   std::uint32_t bitrate = 500000;  // 125000, 250000 or 500000
   BusOffRecovery bus_off_recovery = BusOffRecovery::kInterface;  // SocketCAN only
-  devicenet::MacId master_mac;     // the rack's unless the port gives its own
+  devicenet::MacId master_mac;  // the rack's unless the port gives its own
   // Sent in the duplicate MAC ID check of the master's MAC. dnbridge has no
   // ODVA vendor ID of its own, so the vendor defaults to 0; a site may set
   // its integrator's.

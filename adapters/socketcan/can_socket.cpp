@@ -126,8 +126,8 @@ Result<Received> CanSocket::read() noexcept {
   if (!fd_) return errno_code(EBADF);
   can_frame in{};
   iovec iov{&in, sizeof in};
-  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(scm_timestamping)) +
-                                CMSG_SPACE(sizeof(timeval)) + CMSG_SPACE(sizeof(std::uint32_t))];
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(scm_timestamping)) + CMSG_SPACE(sizeof(timeval)) +
+                                CMSG_SPACE(sizeof(std::uint32_t))];
   msghdr msg{};
   msg.msg_iov = &iov;
   msg.msg_iovlen = 1;
@@ -145,7 +145,8 @@ Result<Received> CanSocket::read() noexcept {
       scm_timestamping ts{};
       std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
       if (ts.ts[0].tv_sec || ts.ts[0].tv_nsec) {
-        r.kernel_time = std::chrono::seconds(ts.ts[0].tv_sec) + std::chrono::nanoseconds(ts.ts[0].tv_nsec);
+        r.kernel_time =
+            std::chrono::seconds(ts.ts[0].tv_sec) + std::chrono::nanoseconds(ts.ts[0].tv_nsec);
       }
     } else if (c->cmsg_type == SO_TIMESTAMP) {
       timeval tv{};

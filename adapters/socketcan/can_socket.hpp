@@ -93,7 +93,8 @@ class CanSocket {
   // Opens a non-blocking CAN_RAW socket bound to `interface`. Errors:
   // EAFNOSUPPORT (no CAN in this kernel), ENODEV (no such interface, or not
   // a CAN interface), and whatever socket options refuse.
-  static Result<CanSocket> open(const std::string& interface, const SocketOptions& options) noexcept;
+  static Result<CanSocket> open(const std::string& interface,
+                                const SocketOptions& options) noexcept;
 
   bool is_open() const noexcept { return fd_.valid(); }
   int fd() const noexcept { return fd_.get(); }

@@ -72,7 +72,8 @@ std::string describe(const ErrorFrameReport& r) {
   if (r.state) add(to_string(*r.state));
   if (r.restarted) add("controller restarted");
   if (r.tx_errors || r.rx_errors) {
-    add(fmt::format("tx errors {}, rx errors {}", r.tx_errors.value_or(0), r.rx_errors.value_or(0)));
+    add(fmt::format("tx errors {}, rx errors {}", r.tx_errors.value_or(0),
+                    r.rx_errors.value_or(0)));
   }
   if (r.no_ack) add("no ACK");
   if (r.tx_timeout) add("transmit timeout");

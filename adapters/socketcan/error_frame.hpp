@@ -18,7 +18,7 @@ struct ErrorFrameReport {
   std::optional<std::uint8_t> tx_errors;
   std::optional<std::uint8_t> rx_errors;
   bool bus_off = false;
-  bool restarted = false;    // the controller was restarted (after bus-off)
+  bool restarted = false;  // the controller was restarted (after bus-off)
   bool tx_timeout = false;
   bool no_ack = false;       // transmitted, nobody acknowledged (alone on the bus?)
   bool protocol = false;     // a protocol violation (bit, stuff, form, ...)

@@ -9,8 +9,8 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <filesystem>
 #include <chrono>
+#include <filesystem>
 #include <stdexcept>
 #include <system_error>
 
@@ -123,8 +123,9 @@ SocketCanBackend::SocketCanBackend(SocketCanOptions options, Logger log)
   bus_.state = BusState::kDown;
   problem_ = fmt::format("{}: not opened yet", options_.interface);
   try_open(now());
-  if (!socket_.is_open()) log_.warn("{}; checked again every {} ms", problem_,
-                                    std::chrono::duration_cast<milliseconds>(options_.reopen_period).count());
+  if (!socket_.is_open())
+    log_.warn("{}; checked again every {} ms", problem_,
+              std::chrono::duration_cast<milliseconds>(options_.reopen_period).count());
 }
 
 SocketCanBackend::~SocketCanBackend() = default;
@@ -183,7 +184,8 @@ void SocketCanBackend::try_open(TimePoint now) {
     bus_.rx_errors = berr.rxerr;
   }
   can_bittiming timing{};
-  if (has_controller(options_.interface) && ::can_get_bittiming(options_.interface.c_str(), &timing) == 0 && timing.bitrate != 0 &&
+  if (has_controller(options_.interface) &&
+      ::can_get_bittiming(options_.interface.c_str(), &timing) == 0 && timing.bitrate != 0 &&
       timing.bitrate != options_.bitrate) {
     log_.warn("interface {} runs at {} bit/s, the configuration says {}", options_.interface,
               timing.bitrate, options_.bitrate);
@@ -260,11 +262,13 @@ void SocketCanBackend::wait(TimePoint deadline, port::FrameReceiver& receiver) {
   for (;;) {
     TimePoint t = now();
     run_timers(t);
-    if (t >= deadline) return;
-    arm_timer(std::min(deadline, own_deadline()));
+    // A deadline already past still gets one look at what is waiting, so
+    // that received frames are never starved by a busy caller.
+    const bool due = t >= deadline;
+    if (!due) arm_timer(std::min(deadline, own_deadline()));
 
     epoll_event events[4];
-    const int n = ::epoll_wait(epoll_.get(), events, 4, -1);
+    const int n = ::epoll_wait(epoll_.get(), events, 4, due ? 0 : -1);
     if (n < 0) {
       if (errno == EINTR) continue;
       log_.error("epoll_wait: {}", errno_code().message());
@@ -290,7 +294,7 @@ void SocketCanBackend::wait(TimePoint deadline, port::FrameReceiver& receiver) {
         }
       }
     }
-    if (delivered || woken) return;
+    if (delivered || woken || due) return;
   }
 }
 
@@ -385,8 +389,9 @@ void SocketCanBackend::on_error_frame(const Received& r, TimePoint now) {
         restart_at_ = now + options_.restart_delay;
         break;
       case BusOffRecovery::kReport:
-        log_.error("bus-off: interface {} stays off until restarted (ip link set {} type can restart)",
-                   options_.interface, options_.interface);
+        log_.error(
+            "bus-off: interface {} stays off until restarted (ip link set {} type can restart)",
+            options_.interface, options_.interface);
         break;
     }
     problem_ = fmt::format("interface {}: bus-off", options_.interface);

@@ -87,9 +87,9 @@ class SocketCanBackend final : public port::CanBackend {
     std::uint64_t transmit_deferred = 0;  // waited in the queue at least once
     std::uint64_t receive_overruns = 0;   // dropped by the socket's receive queue
     std::uint64_t error_frames = 0;
-    std::uint64_t foreign_frames = 0;     // extended or remote frames, ignored
-    std::uint64_t reopens = 0;            // the interface came back
-    std::uint64_t restarts = 0;           // bus-off restarts requested
+    std::uint64_t foreign_frames = 0;  // extended or remote frames, ignored
+    std::uint64_t reopens = 0;         // the interface came back
+    std::uint64_t restarts = 0;        // bus-off restarts requested
   };
   const Stats& stats() const noexcept { return stats_; }
   std::size_t transmit_queued() const noexcept { return queue_.size(); }
@@ -144,8 +144,8 @@ class SocketCanBackend final : public port::CanBackend {
   Stats stats_;
 
   std::deque<can::CanFrame> queue_;
-  bool writable_wanted_ = false;           // EPOLLOUT armed (EAGAIN)
-  TimePoint transmit_retry_at_ = kNever;   // ENOBUFS
+  bool writable_wanted_ = false;          // EPOLLOUT armed (EAGAIN)
+  TimePoint transmit_retry_at_ = kNever;  // ENOBUFS
   Duration transmit_backoff_{};
   TimePoint reopen_at_ = kNever;
   TimePoint restart_at_ = kNever;

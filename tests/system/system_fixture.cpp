@@ -109,8 +109,9 @@ void Capture::run() {
       auto r = socket_.read();
       if (!r) break;
       if (r->kind != socketcan::Received::Kind::kData) continue;
-      const auto wall = r->kernel_time.value_or(std::chrono::duration_cast<std::chrono::nanoseconds>(
-          std::chrono::system_clock::now().time_since_epoch()));
+      const auto wall =
+          r->kernel_time.value_or(std::chrono::duration_cast<std::chrono::nanoseconds>(
+              std::chrono::system_clock::now().time_since_epoch()));
       // TimePoint{} is the writer's start, stamped as the wall time at construction.
       const auto since = std::chrono::duration_cast<Duration>(wall - epoch_);
       writer_.write(r->frame, TimePoint{} + std::max(since, Duration::zero()));

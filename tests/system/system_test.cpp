@@ -2,12 +2,11 @@
 // supervisor as separate processes on vcan interfaces of a User-Mode Linux
 // kernel. run_in_uml.sh runs each test in a kernel of its own.
 #include <fmt/format.h>
-
 #include <signal.h>
 
 #include <cmath>
-#include <regex>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "system_fixture.hpp"
@@ -71,10 +70,10 @@ class SystemTest : public ::testing::Test {
   Child& start_bridge(const std::vector<PortSpec>& ports) {
     const fs::path config = dir_ / "rack.toml";
     std::ofstream(config) << rack_config(rack_, ports);
-    children_.push_back(std::make_unique<Child>(
-        std::vector<std::string>{DNBRIDGE_BIN, "--config", config.string(), "--candump-dir",
-                                 dir_.string()},
-        dir_ / "dnbridge.log"));
+    children_.push_back(
+        std::make_unique<Child>(std::vector<std::string>{DNBRIDGE_BIN, "--config", config.string(),
+                                                         "--candump-dir", dir_.string()},
+                                dir_ / "dnbridge.log"));
     return *children_.back();
   }
 
@@ -176,8 +175,9 @@ TEST_F(SystemTest, RackOnlineStateAndCommandsOnTheWire) {
       run_output(base + " -Y devicenet -T fields -e frame.number 2>/dev/null | wc -l");
   EXPECT_EQ(std::stoull(decoded), frames) << "frames the dissector did not take as DeviceNet";
   const std::string bad = run_output(
-      base + " -Y '_ws.malformed || _ws.expert.severity >= \"warning\"' -T fields -e frame.number "
-             "-e can.id -e _ws.expert.message 2>/dev/null");
+      base +
+      " -Y '_ws.malformed || _ws.expert.severity >= \"warning\"' -T fields -e frame.number "
+      "-e can.id -e _ws.expert.message 2>/dev/null");
   EXPECT_TRUE(bad.empty()) << "frames marked malformed or invalid (frame, id, message):\n"
                            << bad << "capture kept: " << pcap;
   std::printf("captured %llu frames, all decoded as DeviceNet without a warning\n",
@@ -203,7 +203,8 @@ TEST_F(SystemTest, TwoPortsServedByOneBridge) {
   const fs::path log_a = dir_ / "dnbridge-A-candump.log";
   const fs::path log_b = dir_ / "dnbridge-B-candump.log";
   ASSERT_TRUE(supervisor().wait_until(
-      [&] { return count_lines(log_a, " vcan0 ") > 20 && count_lines(log_b, " vcan1 ") > 20; }, 10s))
+      [&] { return count_lines(log_a, " vcan0 ") > 20 && count_lines(log_b, " vcan1 ") > 20; },
+      10s))
       << "no candump log after SIGUSR1";
   bridge.signal(SIGUSR1);
   const auto settled = [&] {
@@ -216,7 +217,8 @@ TEST_F(SystemTest, TwoPortsServedByOneBridge) {
   std::ifstream in(log_a);
   std::string line;
   std::getline(in, line);
-  EXPECT_TRUE(std::regex_match(line, std::regex(R"(\(\d+\.\d{6}\) vcan0 [0-9A-F]{3}#([0-9A-F]{2})*)")))
+  EXPECT_TRUE(
+      std::regex_match(line, std::regex(R"(\(\d+\.\d{6}\) vcan0 [0-9A-F]{3}#([0-9A-F]{2})*)")))
       << line;
 }
 
