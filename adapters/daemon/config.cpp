@@ -262,9 +262,10 @@ constexpr std::array<std::string_view, 7> kIoKeys{
     "analog_inputs", "analog_outputs", "no_nc_mask"};
 constexpr std::array<std::string_view, 3> kIdentityKeys{"vendor_id", "product_type",
                                                         "product_code"};
-constexpr std::array<std::string_view, 13> kPortKeys{"name",
+constexpr std::array<std::string_view, 14> kPortKeys{"name",
                                                      "interface",
                                                      "bitrate",
+                                                     "bus_off_recovery",
                                                      "master_mac",
                                                      "master_vendor_id",
                                                      "master_serial_number",
@@ -602,6 +603,22 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
         r.error(at(n->source()),
                 fmt::format(
                     "bitrate = {} is not a DeviceNet bit rate: use 125000, 250000 or 500000", *v));
+      }
+    }
+  }
+  if (const toml::node* n = t.get("bus_off_recovery")) {
+    if (auto v = read_string(*n, "bus_off_recovery", r)) {
+      if (*v == "interface") {
+        port.bus_off_recovery = BusOffRecovery::kInterface;
+      } else if (*v == "restart") {
+        port.bus_off_recovery = BusOffRecovery::kRestart;
+      } else if (*v == "report") {
+        port.bus_off_recovery = BusOffRecovery::kReport;
+      } else {
+        r.error(at(n->source()),
+                fmt::format("bus_off_recovery = \"{}\" is not a policy: use \"interface\", "
+                            "\"restart\" or \"report\"",
+                            *v));
       }
     }
   }

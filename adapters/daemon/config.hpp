@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "adapters/socketcan/socketcan_backend.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/mac_id.hpp"
@@ -59,11 +60,15 @@ struct ScannerTimings {
 // The interface name of the in-process simulated bus.
 inline constexpr std::string_view kSimulatedInterface = "simulated";
 
+// Who brings a CAN controller back after bus-off.
+using BusOffRecovery = socketcan::BusOffRecovery;
+
 struct PortConfig {
   std::string name;                // DDS key of the port's samples
   std::string interface;           // kSimulatedInterface, or a SocketCAN interface (can0, ...)
   std::uint32_t bitrate = 500000;  // 125000, 250000 or 500000
-  devicenet::MacId master_mac;     // the rack's unless the port gives its own
+  BusOffRecovery bus_off_recovery = BusOffRecovery::kInterface;  // SocketCAN only
+  devicenet::MacId master_mac;  // the rack's unless the port gives its own
   // Sent in the duplicate MAC ID check of the master's MAC. dnbridge has no
   // ODVA vendor ID of its own, so the vendor defaults to 0; a site may set
   // its integrator's.

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "adapters/port/sim_backend.hpp"
+#include "adapters/socketcan/socketcan_backend.hpp"
 
 namespace dnbridge::daemon {
 namespace {
@@ -39,9 +40,16 @@ BackendFactory default_backend_factory(LogSink& log) {
       for (const auto& n : p.nodes) macs.push_back(n.mac);
       return std::make_unique<port::SimBackend>(p.bitrate, macs, &log);
     }
-    throw std::runtime_error(fmt::format(
-        "port {}: interface \"{}\": this build drives only the simulated bus (interface = \"{}\")",
-        p.name, p.interface, kSimulatedInterface));
+    socketcan::SocketCanOptions o;
+    o.interface = p.interface;
+    o.bitrate = p.bitrate;
+    o.bus_off = p.bus_off_recovery;
+    try {
+      return std::make_unique<socketcan::SocketCanBackend>(
+          std::move(o), Logger(log, fmt::format("port {}", p.name)));
+    } catch (const std::exception& e) {
+      throw std::runtime_error(fmt::format("port {}: {}", p.name, e.what()));
+    }
   };
 }
 
@@ -67,6 +75,21 @@ port::PortLoop* Daemon::port(std::string_view name) {
     if (p->name() == name) return p.get();
   }
   return nullptr;
+}
+
+void Daemon::toggle_candump(const std::string& directory) {
+  for (auto& p : ports_) {
+    const std::string path = fmt::format("{}/dnbridge-{}-candump.log", directory, p->name());
+    p->post([path, this](port::CanBackend& backend) {
+      auto* can = dynamic_cast<socketcan::SocketCanBackend*>(&backend);
+      if (!can) return;  // the simulated bus: nothing to log
+      if (can->candump_logging()) {
+        can->stop_candump_log();
+      } else if (auto s = can->start_candump_log(path); !s) {
+        log_.error("candump log {}: {}", path, s.error().message());
+      }
+    });
+  }
 }
 
 void Daemon::start() {

@@ -37,6 +37,11 @@ class Daemon {
   // instances unregistered, the last samples acknowledged (bounded wait).
   void stop();
 
+  // Starts, or stops, a candump -l compatible log of every SocketCAN port's
+  // traffic, one file per port in `directory` (DIR/dnbridge-PORT-candump.log).
+  // Any thread; the ports open and close their files on their own threads.
+  void toggle_candump(const std::string& directory);
+
   const DaemonConfig& config() const { return config_; }
   port::PortLoop* port(std::string_view name);
 

@@ -54,6 +54,11 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", level_name,
                  "trace, debug, info, warn or error (default: the file's)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  std::string candump_dir = "/tmp";
+  app.add_option("--candump-dir", candump_dir,
+                 "Where SIGUSR1 starts (and the next SIGUSR1 stops) a candump -l compatible log "
+                 "of each SocketCAN port's traffic, dnbridge-PORT-candump.log")
+      ->capture_default_str();
   config_opt->excludes(simulate_opt);
   app.set_version_flag("--version", "dnbridge " DNBRIDGE_VERSION);
   CLI11_PARSE(app, argc, argv);
@@ -108,14 +113,20 @@ int main(int argc, char** argv) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGUSR1);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   try {
     daemon::Daemon bridge(config, log);
     bridge.start();
-    main_log.info("running ({}); SIGINT or SIGTERM stops it in order", config.source);
+    main_log.info("running ({}); SIGINT or SIGTERM stops it in order, SIGUSR1 toggles candump logs",
+                  config.source);
     int signal = 0;
-    sigwait(&signals, &signal);
+    for (;;) {
+      sigwait(&signals, &signal);
+      if (signal != SIGUSR1) break;
+      bridge.toggle_candump(candump_dir);
+    }
     main_log.info("{}: stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
     bridge.stop();
   } catch (const std::exception& e) {

@@ -62,6 +62,8 @@ dnbridge_BusState to_idl(port::BusState s) {
       return dnbridge_BUS_OFF;
     case port::BusState::kUnknown:
       return dnbridge_BUS_STATE_UNKNOWN;
+    case port::BusState::kDown:
+      return dnbridge_BUS_DOWN;
   }
   return dnbridge_BUS_STATE_UNKNOWN;
 }

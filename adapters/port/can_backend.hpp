@@ -22,7 +22,8 @@ enum class BusState : std::uint8_t {
   kErrorWarning,
   kErrorPassive,
   kBusOff,
-  kUnknown
+  kUnknown,
+  kDown  // the interface is down or absent: nothing goes out or comes in
 };
 
 struct BusCounters {
@@ -49,6 +50,9 @@ class CanBackend {
   virtual BusCounters counters() const = 0;
   virtual std::string interface_name() const = 0;  // "can0", "simulated"
   virtual std::uint32_t bitrate() const = 0;
+  // What is wrong with the interface, for operators ("vcan0 down: ..."); empty
+  // when nothing is.
+  virtual std::string problem() const { return {}; }
 };
 
 }  // namespace dnbridge::port

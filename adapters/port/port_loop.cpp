@@ -117,6 +117,11 @@ void PortLoop::run() {
       log_.info("stopping: idling and releasing every node");
       scanner_->stop(now);
     }
+    // A change of the bus or interface state is published at once.
+    if (const BusState bus = backend_->counters().state; bus != bus_state_) {
+      port_dirty_ = true;
+      port_event_time_ = now;
+    }
     publish(now, false);
     if (stopping && (scanner_->stopped() || now >= stop_deadline)) break;
 
@@ -168,6 +173,12 @@ void PortLoop::publish_port(TimePoint now) {
   s.state = scanner_->state();
   s.reason = scanner_->reason();
   s.bus = backend_->counters();
+  bus_state_ = s.bus.state;
+  // The interface's trouble first: the master's own state means little
+  // while nothing reaches the bus.
+  if (auto problem = backend_->problem(); !problem.empty()) {
+    s.reason = s.reason.empty() ? problem : fmt::format("{} ({})", problem, s.reason);
+  }
   s.nodes_configured = static_cast<std::uint16_t>(config_.pumps.size());
   for (const auto& p : config_.pumps) {
     if (scanner_->node(p.node.mac)->state() == devicenet::NodeState::kOnline) ++s.nodes_online;

@@ -114,6 +114,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   TimePoint port_status_time_{};
   TimePoint port_event_time_{};
   BusCounters last_counters_{};
+  BusState bus_state_ = BusState::kUnknown;  // as last published
   std::vector<std::uint64_t> last_polls_;
   TimePoint metrics_time_{};
   struct Metrics {

@@ -815,3 +815,21 @@ TEST(ConfigToMaster, EmbeddedDefaultBuildsEightPumps) {
 
 }  // namespace
 }  // namespace dnbridge::daemon
+
+namespace dnbridge::daemon {
+namespace {
+
+TEST(ConfigFile, BusOffRecoveryIsReadAndDefaultsToTheInterface) {
+  const auto read = [](const char* line) {
+    return parse_config(std::string(ONE_PORT) + line, "t.toml").ports.at(0).bus_off_recovery;
+  };
+  EXPECT_EQ(read(""), BusOffRecovery::kInterface);
+  EXPECT_EQ(read("bus_off_recovery = \"interface\"\n"), BusOffRecovery::kInterface);
+  EXPECT_EQ(read("bus_off_recovery = \"restart\"\n"), BusOffRecovery::kRestart);
+  EXPECT_EQ(read("bus_off_recovery = \"report\"\n"), BusOffRecovery::kReport);
+  EXPECT_THAT(problems(ONE_PORT "bus_off_recovery = \"reboot\"\n"),
+              HasSubstr("t.toml:6:20: bus_off_recovery = \"reboot\" is not a policy"));
+}
+
+}  // namespace
+}  // namespace dnbridge::daemon

@@ -1,0 +1,113 @@
+// cdn127-sim: simulated CDN127 DeviceNet pump interfaces on a SocketCAN
+// interface, for trying a dnbridge configuration before the rack exists.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <mutex>
+
+#include "adapters/cdn127_sim/control.hpp"
+#include "adapters/cdn127_sim/sim_host.hpp"
+
+namespace {
+
+using namespace dnbridge;
+
+class StderrSink final : public LogSink {
+ public:
+  explicit StderrSink(LogLevel level) : level_(level) {}
+  bool enabled(LogLevel level) const noexcept override { return level >= level_; }
+  void write(LogLevel level, std::string_view component, std::string_view message) override {
+    std::lock_guard lock(mutex_);
+    fmt::print(stderr, "{:<5} {}: {}\n", to_string(level), component, message);
+    std::fflush(stderr);
+  }
+
+ private:
+  LogLevel level_;
+  std::mutex mutex_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "cdn127-sim: simulated CDN127 DeviceNet pump interfaces (Group 2 only slaves) on a "
+      "SocketCAN\n"
+      "interface, one CAN_RAW socket each, as if each were a device on the bus.\n\n"
+      "  cdn127-sim --iface vcan0 --mac 5 --mac 6\n\n"
+      "Every device powers up at start (duplicate MAC check, then waits for a master), with\n"
+      "the CDN127's identity (vendor 59, product type 27, product code 1888), serial number\n"
+      "0x10000 + MAC and the CDN127 preset configuration.\n\n" +
+      std::string(cdn127_sim::control_help())};
+  std::string interface;
+  std::vector<unsigned> macs;
+  std::string control = "-";
+  std::string level_name = "info";
+  app.add_option("-i,--iface", interface, "SocketCAN interface (vcan0, can0)")->required();
+  app.add_option("-m,--mac", macs, "MAC ID of a simulated device, 0..63 (repeat for more)")
+      ->required()
+      ->check(CLI::Range(0, 63));
+  app.add_option("--control", control,
+                 "Where commands come from: \"-\" standard input (end of input quits), a FIFO "
+                 "path (created if missing; runs until SIGINT/SIGTERM), or \"none\"")
+      ->capture_default_str();
+  app.add_option("--log-level", level_name, "trace, debug, info, warn or error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  LogLevel level = LogLevel::kInfo;
+  for (auto l :
+       {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn, LogLevel::kError}) {
+    if (level_name == to_string(l)) level = l;
+  }
+  StderrSink log(level);
+
+  // SIGINT and SIGTERM are read from a signalfd in the loop.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigprocmask(SIG_BLOCK, &signals, nullptr);
+
+  int control_fd = -1;
+  bool quit_at_end = false;
+  if (control == "-") {
+    control_fd = STDIN_FILENO;
+    quit_at_end = true;
+    (void)::fcntl(control_fd, F_SETFL, ::fcntl(control_fd, F_GETFL) | O_NONBLOCK);
+  } else if (control != "none") {
+    if (::mkfifo(control.c_str(), 0600) < 0 && errno != EEXIST) {
+      std::fprintf(stderr, "cannot create the control FIFO %s: %s\n", control.c_str(),
+                   std::strerror(errno));
+      return 2;
+    }
+    // Read and write: the FIFO never reports end of file when writers come and go.
+    control_fd = ::open(control.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+    if (control_fd < 0) {
+      std::fprintf(stderr, "cannot open the control FIFO %s: %s\n", control.c_str(),
+                   std::strerror(errno));
+      return 2;
+    }
+  }
+
+  try {
+    std::vector<devicenet::MacId> ids;
+    for (auto m : macs) ids.push_back(devicenet::MacId::from_bits(m));
+    cdn127_sim::SimHost host(interface, ids, log);
+    std::printf("ready\n");
+    std::fflush(stdout);
+    host.run(control_fd, quit_at_end, stdout);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cdn127-sim: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

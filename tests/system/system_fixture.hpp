@@ -1,0 +1,149 @@
+#pragma once
+// What the system tests share. They run inside a User-Mode Linux kernel
+// with the CAN modules (run_in_uml.sh boots it, uml_init.sh sets it up):
+// vcan0 and vcan1 exist, DDS is pinned to lo. Each test starts the real
+// programs (dnbridge, cdn127-sim) as child processes and watches the bridge
+// through DDS, as a supervisor would.
+#include <gtest/gtest.h>
+#include <sys/types.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "adapters/dds/participant.hpp"
+#include "adapters/dds/reader.hpp"
+#include "adapters/dds/topics.hpp"
+#include "adapters/dds/waitset.hpp"
+#include "adapters/dds/writer.hpp"
+#include "adapters/sim/pcap_writer.hpp"
+#include "adapters/socketcan/can_socket.hpp"
+
+namespace dnbridge::system_test {
+
+namespace fs = std::filesystem;
+
+// A child process: stdout and stderr to `log`, stdin from a pipe of ours.
+class Child {
+ public:
+  Child(const std::vector<std::string>& argv, const fs::path& log);
+  ~Child();
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  // A line to the child's standard input.
+  void send(const std::string& line);
+  // SIGTERM, then SIGKILL after `grace`; the exit status (waitpid's).
+  int stop(std::chrono::milliseconds grace = std::chrono::milliseconds(5000));
+  bool running();
+  void signal(int number);
+  const fs::path& log() const { return log_; }
+
+ private:
+  pid_t pid_ = -1;
+  int stdin_ = -1;
+  fs::path log_;
+  int status_ = 0;
+};
+
+// Every frame on an interface, into a pcap file, from a thread of its own.
+class Capture {
+ public:
+  Capture(const std::string& interface, const fs::path& file);
+  ~Capture();
+  // Stops and closes; the number of frames written.
+  std::uint64_t stop();
+
+ private:
+  void run();
+  std::chrono::nanoseconds epoch_;  // wall time of the capture's start
+  socketcan::CanSocket socket_;
+  sim::PcapWriter writer_;
+  std::atomic<bool> stop_{false};
+  std::uint64_t frames_ = 0;
+  std::thread thread_;
+};
+
+// The latest samples of the bridge's state topics, by key.
+struct PumpKey {
+  std::string port;
+  unsigned mac;
+  friend auto operator<=>(const PumpKey&, const PumpKey&) = default;
+};
+
+struct PumpSeen {
+  bool online = false;
+  bool pump_running = false;
+  bool alarm_active = false;
+  bool pump_on = false;  // output
+  float analog_in1 = 0;
+  std::string commanded_by;
+  dds::Timestamp source_time{};
+  dds::Timestamp received{};
+};
+
+struct PortSeen {
+  dnbridge_BusState bus_state = dnbridge_BUS_STATE_UNKNOWN;
+  dnbridge_PortLifecycle state = dnbridge_PORT_STOPPED;
+  std::string reason;
+  unsigned nodes_online = 0;
+  unsigned nodes_configured = 0;
+  std::string can_interface;
+};
+
+class Supervisor {
+ public:
+  explicit Supervisor(const std::string& rack);
+
+  // Takes what arrived and folds it into the maps.
+  void update();
+  // Until `done` holds (checked on every arrival and every 200 ms), or
+  // `timeout`.
+  bool wait_until(const std::function<bool()>& done, std::chrono::seconds timeout);
+
+  bool command(const std::string& port, unsigned mac, bool pump_on);
+
+  const std::map<PumpKey, PumpSeen>& pumps() const { return pumps_; }
+  const std::map<std::string, PortSeen>& ports() const { return ports_; }
+  bool online(const std::string& port, unsigned mac) const;
+  bool all_online(const std::string& port, const std::vector<unsigned>& macs) const;
+  std::string describe() const;
+
+ private:
+  std::string rack_;
+  dds::Participant participant_;
+  dds::Topic<dnbridge_PumpState> pump_topic_;
+  dds::Topic<dnbridge_PortStatus> port_topic_;
+  dds::Topic<dnbridge_PumpCommand> command_topic_;
+  dds::Reader<dnbridge_PumpState> pump_reader_;
+  dds::Reader<dnbridge_PortStatus> port_reader_;
+  dds::Writer<dnbridge_PumpCommand> command_writer_;
+  dds::ReadCondition pump_data_;
+  dds::ReadCondition port_data_;
+  dds::WaitSet waitset_;
+  std::map<PumpKey, PumpSeen> pumps_;
+  std::map<std::string, PortSeen> ports_;
+};
+
+// The work directory of this run (DNBRIDGE_SYSTEM_WORK, set by the UML
+// init script), one subdirectory per test.
+fs::path work_dir();
+
+// Runs a shell command; its exit status.
+int shell(const std::string& command);
+
+// A rack configuration: `ports` is {port name, interface, node MACs}.
+struct PortSpec {
+  std::string name;
+  std::string interface;
+  std::vector<unsigned> macs;
+};
+std::string rack_config(const std::string& rack, const std::vector<PortSpec>& ports);
+
+}  // namespace dnbridge::system_test
