@@ -48,6 +48,7 @@ std::string_view to_text(dnbridge_BusState state) {
     case dnbridge_BUS_ERROR_PASSIVE: return "error passive";
     case dnbridge_BUS_OFF: return "bus off";
     case dnbridge_BUS_STATE_UNKNOWN: return "unknown";
+    case dnbridge_BUS_DOWN: return "interface down";
   }
   return "unknown";
 }
