@@ -1,3 +1,4 @@
+#include "adapters/port/steady_time.hpp"
 #include "adapters/cdn127_sim/sim_host.hpp"
 
 #include <fmt/format.h>
@@ -142,10 +143,7 @@ SimHost::SimHost(std::string interface, const std::vector<devicenet::MacId>& mac
 
 SimHost::~SimHost() = default;
 
-TimePoint SimHost::now() const {
-  return TimePoint(
-      std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
-}
+TimePoint SimHost::now() const { return port::steady_now(); }
 
 TimePoint SimHost::next_deadline() const {
   TimePoint t = reopen_at_;

@@ -6,16 +6,12 @@
 
 #include "adapters/daemon/samples.hpp"
 #include "adapters/dds/fields.hpp"
+#include "adapters/port/steady_time.hpp"
 
 namespace dnbridge::daemon {
 namespace {
 
 enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3 };
-
-TimePoint steady_now() {
-  return TimePoint(
-      std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
-}
 
 }  // namespace
 
@@ -33,8 +29,8 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   // is set, and taking resets only DATA_AVAILABLE: with the default mask
   // (every status) a matched writer's SUBSCRIPTION_MATCHED, never read here,
   // would keep the waitset triggered and this thread spinning.
-  for (const dds::Entity* reader : {static_cast<const dds::Entity*>(&commands_),
-                                    static_cast<const dds::Entity*>(&requests_)}) {
+  for (const dds::Entity* reader :
+       {static_cast<const dds::Entity*>(&commands_), static_cast<const dds::Entity*>(&requests_)}) {
     if (!reader->set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
       throw std::runtime_error("setting the status mask of a DDS input reader failed");
     }
@@ -86,7 +82,7 @@ void DdsInput::take_commands() {
     const auto mac = devicenet::MacId::from(c.mac);
     if (!loop || !mac || !loop->has_node(*mac)) {
       unsigned suppressed = 0;
-      if (warn_limit_.allow(steady_now(), suppressed)) {
+      if (warn_limit_.allow(port::steady_now(), suppressed)) {
         log_.warn("command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
                   s.info().valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "",
                   dds::view(c.port), c.mac);

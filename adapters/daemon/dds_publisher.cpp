@@ -3,6 +3,7 @@
 #include "adapters/daemon/samples.hpp"
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/sample.hpp"
+#include "adapters/port/steady_time.hpp"
 
 namespace dnbridge::daemon {
 
@@ -35,9 +36,7 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
 void DdsPublisher::check(Status s, const char* what) {
   if (s) return;
   unsigned suppressed = 0;
-  if (error_limit_.allow(TimePoint(std::chrono::duration_cast<Duration>(
-                             std::chrono::steady_clock::now().time_since_epoch())),
-                         suppressed)) {
+  if (error_limit_.allow(port::steady_now(), suppressed)) {
     log_.error("writing {} failed: {}{}", what, s.error().message(),
                suppressed ? fmt::format(" ({} more suppressed)", suppressed) : std::string());
   }
@@ -81,7 +80,8 @@ void DdsPublisher::explicit_reply(const rack::ExplicitAnswer& answer) {
     } else {
       passing_replies_.push_back(std::move(key));
       while (passing_replies_.size() > kPassingReplies) {
-        if (!retained_replies_.count(passing_replies_.front())) expired.push_back(passing_replies_.front());
+        if (!retained_replies_.count(passing_replies_.front()))
+          expired.push_back(passing_replies_.front());
         passing_replies_.pop_front();
       }
     }

@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
   }
   // The simulated rack stays on this host unless told otherwise.
   const bool pinned = simulate && std::getenv("CYCLONEDDS_URI") == nullptr;
-  if (pinned) setenv("CYCLONEDDS_URI", dds::kLoopbackConfig, 0);
+  if (pinned) setenv("CYCLONEDDS_URI", dds::loopback_config().c_str(), 0);
 
   daemon::StderrLogSink log(config.log_level);
   if (!level_name.empty()) log.set_level(*parse_level(level_name));

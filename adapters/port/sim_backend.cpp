@@ -5,22 +5,10 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "adapters/port/steady_time.hpp"
 #include "adapters/sim/sim_rack.hpp"
 
 namespace dnbridge::port {
-namespace {
-
-TimePoint steady_now() {
-  return TimePoint(
-      std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
-}
-
-std::chrono::steady_clock::time_point to_steady(TimePoint t) {
-  return std::chrono::steady_clock::time_point(
-      std::chrono::duration_cast<std::chrono::steady_clock::duration>(t.time_since_epoch()));
-}
-
-}  // namespace
 
 SimBackend::SimBackend(std::uint32_t bitrate, const std::vector<devicenet::MacId>& device_macs,
                        LogSink* log)

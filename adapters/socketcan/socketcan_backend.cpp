@@ -1,3 +1,4 @@
+#include "adapters/port/steady_time.hpp"
 #include "adapters/socketcan/socketcan_backend.hpp"
 
 #include <fmt/format.h>
@@ -132,8 +133,7 @@ SocketCanBackend::~SocketCanBackend() = default;
 
 TimePoint SocketCanBackend::now() const {
   // steady_clock is CLOCK_MONOTONIC, the timerfd's clock.
-  return TimePoint(
-      std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
+  return port::steady_now();
 }
 
 void SocketCanBackend::wake() {

@@ -56,6 +56,7 @@
 #include <thread>
 #include <vector>
 
+#include "adapters/dds/loopback.hpp"
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
@@ -279,17 +280,6 @@ class LineReader {
 
 // ---------------------------------------------------------------------------
 // DDS set-up shared by every process of the run
-
-std::string loopback_config(const std::string& tag) {
-  // deploy/cyclonedds/loopback.xml, plus a discovery tag: participants of
-  // other runs or tests on this machine are never matched.
-  return "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/>"
-         "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
-         "<ParticipantIndex>auto</ParticipantIndex>"
-         "<MaxAutoParticipantIndex>50</MaxAutoParticipantIndex>"
-         "<Peers><Peer address=\"127.0.0.1\"/></Peers><Tag>" +
-         tag + "</Tag></Discovery></Domain></CycloneDDS>";
-}
 
 constexpr const char* kRack = "bench";
 
@@ -834,7 +824,7 @@ std::string verdict(bool met) { return met ? "met" : "NOT met"; }
 int run_bench(const Options& o) {
   const int domain = o.domain >= 0 ? o.domain : 200 + static_cast<int>(getpid() % 30);
   const std::string tag = fmt::format("dnbridge-bench-{}", getpid());
-  setenv("CYCLONEDDS_URI", loopback_config(tag).c_str(), 1);
+  setenv("CYCLONEDDS_URI", dds::loopback_config(tag).c_str(), 1);
   daemon::StderrLogSink log(LogLevel::kWarn);
 
   char host[256] = {};

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "adapters/dds/loopback.hpp"
 #include "dds_fixture.hpp"
 
 namespace dnbridge::dds::testing {
@@ -20,17 +21,7 @@ namespace {
 // Unicast discovery needs a participant index per process and domain
 // (Cyclone 0.10: 9 at most by default); 50 leaves room for several.
 std::string loopback_config() {
-  return "<CycloneDDS><Domain><General>"
-         "<Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
-         "<AllowMulticast>false</AllowMulticast>"
-         "</General><Discovery>"
-         "<ParticipantIndex>auto</ParticipantIndex>"
-         "<MaxAutoParticipantIndex>50</MaxAutoParticipantIndex>"
-         "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
-         "<Tag>dnbridge-test-" +
-         std::to_string(getpid()) +
-         "</Tag>"
-         "</Discovery></Domain></CycloneDDS>";
+  return dds::loopback_config("dnbridge-test-" + std::to_string(getpid()));
 }
 
 class LoopbackEnvironment : public ::testing::Environment {

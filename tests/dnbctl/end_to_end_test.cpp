@@ -19,6 +19,7 @@
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
 #include "adapters/dds/fields.hpp"
+#include "adapters/dds/loopback.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/reader.hpp"
 #include "adapters/dds/topics.hpp"
@@ -33,17 +34,7 @@ using testing::RunResult;
 std::uint32_t test_domain() { return static_cast<std::uint32_t>(100 + getpid() % 100); }
 
 std::string loopback_config() {
-  return "<CycloneDDS><Domain><General>"
-         "<Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
-         "<AllowMulticast>false</AllowMulticast>"
-         "</General><Discovery>"
-         "<ParticipantIndex>auto</ParticipantIndex>"
-         "<MaxAutoParticipantIndex>50</MaxAutoParticipantIndex>"
-         "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
-         "<Tag>dnbctl-test-" +
-         std::to_string(getpid()) +
-         "</Tag>"
-         "</Discovery></Domain></CycloneDDS>";
+  return dds::loopback_config("dnbctl-test-" + std::to_string(getpid()));
 }
 
 // Set before any DDS call of the process; dnbctl children inherit it.
@@ -92,7 +83,8 @@ class DnbctlEndToEnd : public ::testing::Test {
     dds::Topic<dnbridge_PumpState> pump_topic{participant};
     dds::Topic<dnbridge_PumpCommand> command_topic{participant};
     dds::Reader<dnbridge_PumpState> pumps{participant, pump_topic, dds::state_reader_qos()};
-    dds::Reader<dnbridge_PumpCommand> commands{participant, command_topic, dds::command_reader_qos()};
+    dds::Reader<dnbridge_PumpCommand> commands{participant, command_topic,
+                                               dds::command_reader_qos()};
     dds::WaitSet waitset{participant};
     std::map<unsigned, dds::Owned<dnbridge_PumpState>> latest;
     std::vector<std::uint16_t> commanded_analog;  // every command's analog_output_raw
@@ -134,9 +126,9 @@ class DnbctlEndToEnd : public ::testing::Test {
     ASSERT_TRUE(bridge_);
     // Ready: every pump online and polled with inputs.
     for (unsigned mac = 1; mac <= 8; ++mac) {
-      ASSERT_TRUE(observer_->wait_pump(mac, [](const dnbridge_PumpState& s) {
-        return s.online && s.inputs_valid;
-      })) << "pump " << mac << " did not come online";
+      ASSERT_TRUE(observer_->wait_pump(
+          mac, [](const dnbridge_PumpState& s) { return s.online && s.inputs_valid; }))
+          << "pump " << mac << " did not come online";
     }
   }
 
@@ -172,11 +164,11 @@ TEST_F(DnbctlEndToEnd, ListShowsTheEightNodesOnline) {
 TEST_F(DnbctlEndToEnd, ShowShowsTheIdentity) {
   const auto r = dnbctl({"show", "3"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* line : {"node                      sim-rack/A/3 (pump-3)\n",
-                           "state                     online\n", "product name              CDN127\n",
-                           "vendor                    59 (0x003B)\n",
-                           "product code              1888 (0x0760)\n",
-                           "serial number             3 (0x00000003)\n"}) {
+  for (const char* line :
+       {"node                      sim-rack/A/3 (pump-3)\n", "state                     online\n",
+        "product name              CDN127\n", "vendor                    59 (0x003B)\n",
+        "product code              1888 (0x0760)\n",
+        "serial number             3 (0x00000003)\n"}) {
     EXPECT_NE(r.out.find(line), std::string::npos) << line << "\nin:\n" << r.out;
   }
   const auto json = dnbctl({"show", "3", "--json"});
@@ -185,7 +177,8 @@ TEST_F(DnbctlEndToEnd, ShowShowsTheIdentity) {
 
   const auto absent = dnbctl({"show", "9", "--timeout", "0.5"});
   EXPECT_EQ(absent.exit_code, 3);
-  EXPECT_NE(absent.err.find("no bridge reported a node with MAC 9"), std::string::npos) << absent.err;
+  EXPECT_NE(absent.err.find("no bridge reported a node with MAC 9"), std::string::npos)
+      << absent.err;
 }
 
 TEST_F(DnbctlEndToEnd, OutputCommandsAreAppliedAndKeepTheOtherOutputs) {
@@ -199,7 +192,8 @@ TEST_F(DnbctlEndToEnd, OutputCommandsAreAppliedAndKeepTheOtherOutputs) {
   // 5.0 V: round(5.0 * 4095 / 10) = round(2047.5) = 2048; the pump stays on.
   r = dnbctl({"aout", "3", "5.0V"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("applied: pump on, N2 ballast off, analog out 2048"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("applied: pump on, N2 ballast off, analog out 2048"), std::string::npos)
+      << r.out;
   EXPECT_TRUE(observer_->wait_pump(3, [](const dnbridge_PumpState& s) {
     return !s.outputs_idle && s.pump_on && s.analog_output_raw == 2048;
   }));
