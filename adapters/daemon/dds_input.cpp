@@ -89,13 +89,15 @@ void DdsInput::take_commands() {
       }
       continue;
     }
-    if (s.info().valid_data()) {
-      loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
+    // No live commander left for this pump (all writers gone, or disposed):
+    // idle. A command taken after its writer left carries that state itself,
+    // with no sample of its own to tell it; it is not applied: a commander
+    // that is gone commands nothing, not even for a moment.
+    if (s.info().instance_state() != dds::InstanceState::kAlive) {
+      loop->release_command(*mac);
+      continue;
     }
-    // No live commander left for this pump (all writers gone, or disposed).
-    // A command taken after its writer left carries that state itself, with
-    // no sample of its own to tell it: it is applied, then released.
-    if (s.info().instance_state() != dds::InstanceState::kAlive) loop->release_command(*mac);
+    if (s.info().valid_data()) loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
   }
 }
 
