@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "support/bytes.hpp"
+#include "support/sim_slave_driver.hpp"
 
 namespace dnbridge::sim {
 namespace {
@@ -29,12 +30,7 @@ constexpr std::uint32_t kDupMacId = 0x41F;
 constexpr std::uint32_t kPollResponseId = 0x3C3;
 constexpr std::uint8_t kMaster = 10;  // 0x0A
 
-class RecordingSink : public can::FrameSink {
- public:
-  void send(const can::CanFrame& f, TimePoint) override { frames.push_back(f); }
-  std::vector<can::CanFrame> take() { return std::exchange(frames, {}); }
-  std::vector<can::CanFrame> frames;
-};
+using test::RecordingSink;
 
 can::CanFrame make(std::uint32_t id, const ByteVec& data) {
   return can::CanFrame::make(id, Bytes(data.data(), data.size())).value();
@@ -60,14 +56,7 @@ class Cdn127SlaveTest : public ::testing::Test {
   void SetUp() override { create(); }
 
   // Runs the slave's timers up to now + d, as an event loop would.
-  void advance(Duration d) {
-    const TimePoint end = now_ + d;
-    for (int guard = 0; guard < 10000 && slave_->next_deadline() <= end; ++guard) {
-      now_ = std::max(now_, slave_->next_deadline());
-      slave_->on_timer(now_);
-    }
-    now_ = end;
-  }
+  void advance(Duration d) { test::advance(*slave_, now_, d); }
 
   // Power-up and the 2 s duplicate MAC check.
   void boot() {

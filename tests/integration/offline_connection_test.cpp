@@ -12,6 +12,7 @@
 
 #include "adapters/sim/cdn127_slave.hpp"
 #include "support/bytes.hpp"
+#include "support/sim_slave_driver.hpp"
 
 namespace dnbridge::sim {
 namespace {
@@ -27,12 +28,7 @@ constexpr std::uint32_t kCommFaultedRequest = 0x7ED;
 constexpr std::uint32_t kOwnershipRequest = 0x7EF;
 constexpr std::uint32_t kDupMacMac3 = 0x41F;
 
-class RecordingSink : public can::FrameSink {
- public:
-  void send(const can::CanFrame& f, TimePoint) override { frames.push_back(f); }
-  std::vector<can::CanFrame> take() { return std::exchange(frames, {}); }
-  std::vector<can::CanFrame> frames;
-};
+using test::RecordingSink;
 
 SlaveOptions program_position_options() {
   SlaveOptions o;
@@ -50,14 +46,7 @@ class OfflineConnectionTest : public ::testing::Test {
   }
   void SetUp() override { create(); }
 
-  void advance(Duration d) {
-    const TimePoint end = now_ + d;
-    for (int guard = 0; guard < 10000 && slave_->next_deadline() <= end; ++guard) {
-      now_ = std::max(now_, slave_->next_deadline());
-      slave_->on_timer(now_);
-    }
-    now_ = end;
-  }
+  void advance(Duration d) { test::advance(*slave_, now_, d); }
 
   // Power-up, then another node (vendor 1, serial 99) checks MAC 3 during
   // the first window: Communication Fault.
