@@ -44,6 +44,7 @@ class Daemon {
 
   const DaemonConfig& config() const { return config_; }
   port::PortLoop* port(std::string_view name);
+  const std::vector<std::unique_ptr<port::PortLoop>>& ports() const { return ports_; }
 
  private:
   DaemonConfig config_;

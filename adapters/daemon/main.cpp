@@ -11,6 +11,7 @@
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
+#include "adapters/daemon/service_notify.hpp"
 #include "adapters/dds/loopback.hpp"
 
 namespace {
@@ -119,6 +120,8 @@ int main(int argc, char** argv) {
   try {
     daemon::Daemon bridge(config, log);
     bridge.start();
+    daemon::ServiceNotifier service(bridge, Logger(log, "systemd"));
+    service.start();
     main_log.info("running ({}); SIGINT or SIGTERM stops it in order, SIGUSR1 toggles candump logs",
                   config.source);
     int signal = 0;
@@ -128,6 +131,7 @@ int main(int argc, char** argv) {
       bridge.toggle_candump(candump_dir);
     }
     main_log.info("{}: stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
+    service.stopping();
     bridge.stop();
   } catch (const std::exception& e) {
     main_log.error("{}", e.what());

@@ -109,6 +109,7 @@ void PortLoop::run() {
   bool stopping = false;
   TimePoint stop_deadline = kNever;
   for (;;) {
+    heartbeat_.fetch_add(1, std::memory_order_relaxed);
     now = backend_->now();
     while (scanner_->next_deadline() <= now) scanner_->on_timer(now);
     if (!drain_inbox(now) && !stopping) {
@@ -189,6 +190,7 @@ void PortLoop::publish_port(TimePoint now) {
   s.frames_per_second = metrics_.frames_per_second;
   s.bus_load_percent = metrics_.bus_load_percent;
   s.scan_cycle_ms = metrics_.scan_cycle_ms;
+  nodes_online_.store(s.nodes_online, std::memory_order_relaxed);
   publisher_.port_status(s, std::max(now, port_event_time_));
   port_status_time_ = now;
   port_dirty_ = false;
@@ -224,6 +226,9 @@ void PortLoop::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
 
 void PortLoop::on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) {
   rack_.on_port_state(s, r, at);
+  if (s == devicenet::PortState::kRunning || s == devicenet::PortState::kDuplicateMac) {
+    started_up_.store(true, std::memory_order_relaxed);
+  }
   port_dirty_ = true;
   port_event_time_ = at;
 }

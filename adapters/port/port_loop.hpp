@@ -59,6 +59,17 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   const std::string& name() const { return config_.port; }
   bool has_node(devicenet::MacId mac) const;
 
+  // For a service manager, from any thread. The port has finished its
+  // start-up checks once its master left the duplicate MAC ID check, either
+  // scanning or refusing to send (another node has its MAC).
+  bool started_up() const { return started_up_.load(std::memory_order_relaxed); }
+  // Advances on every iteration of the loop, which wakes at least once per
+  // status period: a value that stops advancing is a stalled loop.
+  std::uint64_t heartbeat() const { return heartbeat_.load(std::memory_order_relaxed); }
+  // Nodes online as of the last PortStatus.
+  std::uint16_t nodes_online() const { return nodes_online_.load(std::memory_order_relaxed); }
+  std::size_t nodes_configured() const { return config_.pumps.size(); }
+
  private:
   struct Command {
     devicenet::MacId mac;
@@ -127,6 +138,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   std::vector<Item> inbox_;
   std::thread thread_;
   std::atomic<bool> running_{false};
+  std::atomic<bool> started_up_{false};
+  std::atomic<std::uint64_t> heartbeat_{0};
+  std::atomic<std::uint16_t> nodes_online_{0};
 };
 
 }  // namespace dnbridge::port
