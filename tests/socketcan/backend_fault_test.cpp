@@ -2,13 +2,12 @@
 // on the host: the backend runs on a FakeIo whose "CAN socket" is one end of
 // an AF_UNIX SOCK_SEQPACKET socketpair (so epoll readiness is real), whose
 // clock is the test's, and whose calls fail on the Nth call as scripted.
+#include <gtest/gtest.h>
 #include <linux/can.h>
 #include <linux/can/error.h>
 #include <linux/can/netlink.h>
 #include <sys/socket.h>
 #include <sys/timerfd.h>
-
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -277,9 +276,8 @@ TEST_F(BackendFault, EnobufsIsRetriedOnABackedOffTimerInOrder) {
   // Retries 1, 2, 4, 8, 16, 32 and 32 (the cap) ms apart; the eighth write
   // succeeds and the two frames behind follow at once.
   const auto at = [](int ms) { return kStart + milliseconds(ms); };
-  EXPECT_EQ(io.write_calls,
-            (std::vector<TimePoint>{at(0), at(1), at(3), at(7), at(15), at(31), at(63), at(95),
-                                    at(95), at(95)}));
+  EXPECT_EQ(io.write_calls, (std::vector<TimePoint>{at(0), at(1), at(3), at(7), at(15), at(31),
+                                                    at(63), at(95), at(95), at(95)}));
   EXPECT_EQ(io.sent_ids(), (std::vector<std::uint32_t>{0x10, 0x11, 0x12}));
   EXPECT_EQ(b.transmit_queued(), 0u);
   EXPECT_EQ(b.transmit_retry_at(), kNever);
@@ -372,8 +370,8 @@ TEST_F(BackendFault, BusOffWithRestartPolicyCallsTheRestartAfterTheDelay) {
   EXPECT_EQ(b.restart_at(), kStart + milliseconds(1200));
   io.restart_errno = 0;
   wait_until(b, kStart + milliseconds(1500));
-  EXPECT_EQ(io.restarts, (std::vector<TimePoint>{kStart + milliseconds(200),
-                                                 kStart + milliseconds(1200)}));
+  EXPECT_EQ(io.restarts,
+            (std::vector<TimePoint>{kStart + milliseconds(200), kStart + milliseconds(1200)}));
   EXPECT_EQ(b.stats().restarts, 2u);
 
   // The controller says it restarted: error-active, nothing more scheduled.
