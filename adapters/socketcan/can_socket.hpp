@@ -89,6 +89,8 @@ struct Received {
 class CanSocket {
  public:
   CanSocket() noexcept = default;
+  // Takes a descriptor already open (a test's socketpair end, for one).
+  explicit CanSocket(FileDescriptor fd) noexcept : fd_(std::move(fd)) {}
 
   // Opens a non-blocking CAN_RAW socket bound to `interface`. Errors:
   // EAFNOSUPPORT (no CAN in this kernel), ENODEV (no such interface, or not
@@ -111,7 +113,6 @@ class CanSocket {
   std::error_code take_error() noexcept;
 
  private:
-  explicit CanSocket(FileDescriptor fd) noexcept : fd_(std::move(fd)) {}
   FileDescriptor fd_;
 };
 

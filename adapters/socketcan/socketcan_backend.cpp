@@ -1,8 +1,6 @@
-#include "adapters/port/steady_time.hpp"
 #include "adapters/socketcan/socketcan_backend.hpp"
 
 #include <fmt/format.h>
-#include <libsocketcan.h>
 #include <linux/can/netlink.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
@@ -11,7 +9,6 @@
 
 #include <cerrno>
 #include <chrono>
-#include <filesystem>
 #include <stdexcept>
 #include <system_error>
 
@@ -43,32 +40,6 @@ bool interface_gone(const std::error_code& e) {
   return is(e, ENETDOWN) || is(e, ENODEV) || is(e, ENXIO) || is(e, ENETUNREACH);
 }
 
-// A controller on hardware (USB, PCI, SPI) has a device behind it in sysfs;
-// virtual interfaces (vcan) do not, and have no state, counters or timing
-// to ask libsocketcan for (it would complain on standard error).
-bool has_controller(const std::string& interface) {
-  std::error_code ignored;
-  return std::filesystem::exists("/sys/class/net/" + interface + "/device", ignored);
-}
-
-std::optional<BusState> state_from_netlink(const std::string& interface) {
-  if (!has_controller(interface)) return std::nullopt;
-  int state = 0;
-  if (::can_get_state(interface.c_str(), &state) != 0) return std::nullopt;
-  switch (state) {
-    case CAN_STATE_ERROR_ACTIVE:
-      return BusState::kErrorActive;
-    case CAN_STATE_ERROR_WARNING:
-      return BusState::kErrorWarning;
-    case CAN_STATE_ERROR_PASSIVE:
-      return BusState::kErrorPassive;
-    case CAN_STATE_BUS_OFF:
-      return BusState::kBusOff;
-    default:
-      return BusState::kUnknown;  // stopped, sleeping
-  }
-}
-
 }  // namespace
 
 const char* to_string(BusOffRecovery r) noexcept {
@@ -98,12 +69,33 @@ std::vector<CanFilter> master_filters() {
           g2(Group2Message::kDuplicateMacCheck), CanFilter{0x7C0, 0x7C0}};
 }
 
+std::optional<BusState> SocketCanBackend::state_from_netlink() {
+  if (!io_->has_controller(options_.interface)) return std::nullopt;
+  int state = 0;
+  if (io_->get_state(options_.interface, &state) != 0) return std::nullopt;
+  switch (state) {
+    case CAN_STATE_ERROR_ACTIVE:
+      return BusState::kErrorActive;
+    case CAN_STATE_ERROR_WARNING:
+      return BusState::kErrorWarning;
+    case CAN_STATE_ERROR_PASSIVE:
+      return BusState::kErrorPassive;
+    case CAN_STATE_BUS_OFF:
+      return BusState::kBusOff;
+    default:
+      return BusState::kUnknown;  // stopped, sleeping
+  }
+}
+
 SocketCanBackend::SocketCanBackend(SocketCanOptions options, Logger log)
-    : options_(std::move(options)), log_(std::move(log)) {
-  if (auto e = can_support()) {
+    : SocketCanBackend(std::move(options), std::move(log), system_can_io()) {}
+
+SocketCanBackend::SocketCanBackend(SocketCanOptions options, Logger log, CanIo& io)
+    : options_(std::move(options)), log_(std::move(log)), io_(&io) {
+  if (auto e = io_->can_support()) {
     throw std::system_error(e, "this kernel has no SocketCAN (socket(AF_CAN))");
   }
-  if (link_state(options_.interface) == LinkState::kNotCan) {
+  if (io_->link_state(options_.interface) == LinkState::kNotCan) {
     throw std::runtime_error(
         fmt::format("interface \"{}\" is not a CAN interface", options_.interface));
   }
@@ -131,10 +123,7 @@ SocketCanBackend::SocketCanBackend(SocketCanOptions options, Logger log)
 
 SocketCanBackend::~SocketCanBackend() = default;
 
-TimePoint SocketCanBackend::now() const {
-  // steady_clock is CLOCK_MONOTONIC, the timerfd's clock.
-  return port::steady_now();
-}
+TimePoint SocketCanBackend::now() const { return io_->now(); }
 
 void SocketCanBackend::wake() {
   const std::uint64_t one = 1;
@@ -146,7 +135,7 @@ void SocketCanBackend::wake() {
 
 void SocketCanBackend::try_open(TimePoint now) {
   reopen_at_ = now + options_.reopen_period;
-  const LinkState link = link_state(options_.interface);
+  const LinkState link = io_->link_state(options_.interface);
   if (link != LinkState::kUp) {
     problem_ = fmt::format("interface {} {}", options_.interface, to_string(link));
     return;
@@ -156,7 +145,7 @@ void SocketCanBackend::try_open(TimePoint now) {
   so.error_frames = true;
   so.timestamps = true;
   so.receive_buffer = options_.receive_buffer;
-  auto opened = CanSocket::open(options_.interface, so);
+  auto opened = io_->open(options_.interface, so);
   if (!opened) {
     problem_ = fmt::format("interface {}: {}", options_.interface, opened.error().message());
     return;
@@ -175,17 +164,17 @@ void SocketCanBackend::try_open(TimePoint now) {
   problem_.clear();
   // A real controller reports its state and counters over netlink; a
   // virtual one (vcan) has none, and stays "unknown".
-  bus_.state = state_from_netlink(options_.interface).value_or(BusState::kUnknown);
+  bus_.state = state_from_netlink().value_or(BusState::kUnknown);
   can_berr_counter berr{};
-  if (!has_controller(options_.interface)) {
+  if (!io_->has_controller(options_.interface)) {
     // Nothing more to ask a virtual interface.
-  } else if (::can_get_berr_counter(options_.interface.c_str(), &berr) == 0) {
+  } else if (io_->get_berr_counter(options_.interface, &berr) == 0) {
     bus_.tx_errors = berr.txerr;
     bus_.rx_errors = berr.rxerr;
   }
   can_bittiming timing{};
-  if (has_controller(options_.interface) &&
-      ::can_get_bittiming(options_.interface.c_str(), &timing) == 0 && timing.bitrate != 0 &&
+  if (io_->has_controller(options_.interface) &&
+      io_->get_bittiming(options_.interface, &timing) == 0 && timing.bitrate != 0 &&
       timing.bitrate != options_.bitrate) {
     log_.warn("interface {} runs at {} bit/s, the configuration says {}", options_.interface,
               timing.bitrate, options_.bitrate);
@@ -224,14 +213,7 @@ TimePoint SocketCanBackend::own_deadline() const {
 void SocketCanBackend::arm_timer(TimePoint at) {
   if (at == armed_) return;
   armed_ = at;
-  itimerspec spec{};
-  if (at != kNever) {
-    // An absolute time of zero disarms: the earliest real time is 1 ns.
-    const auto ns = std::max<std::int64_t>(at.time_since_epoch().count(), 1);
-    spec.it_value.tv_sec = static_cast<time_t>(ns / 1'000'000'000);
-    spec.it_value.tv_nsec = static_cast<long>(ns % 1'000'000'000);
-  }
-  (void)::timerfd_settime(timer_fd_.get(), TFD_TIMER_ABSTIME, &spec, nullptr);
+  io_->set_timer(timer_fd_.get(), at);
 }
 
 void SocketCanBackend::run_timers(TimePoint now) {
@@ -244,7 +226,7 @@ void SocketCanBackend::run_timers(TimePoint now) {
     restart_at_ = kNever;
     if (bus_.state == BusState::kBusOff) {
       ++stats_.restarts;
-      if (::can_do_restart(options_.interface.c_str()) == 0) {
+      if (io_->do_restart(options_.interface) == 0) {
         log_.warn("bus-off: interface {} restarted", options_.interface);
       } else {
         // Not permitted (CAP_NET_ADMIN) or not a controller that restarts:
@@ -268,7 +250,7 @@ void SocketCanBackend::wait(TimePoint deadline, port::FrameReceiver& receiver) {
     if (!due) arm_timer(std::min(deadline, own_deadline()));
 
     epoll_event events[4];
-    const int n = ::epoll_wait(epoll_.get(), events, 4, due ? 0 : -1);
+    const int n = io_->wait(epoll_.get(), events, 4, due ? 0 : -1);
     if (n < 0) {
       if (errno == EINTR) continue;
       log_.error("epoll_wait: {}", errno_code().message());
@@ -305,7 +287,7 @@ void SocketCanBackend::receive(port::FrameReceiver& receiver, bool& delivered, T
   // clock by the offset between the two, read once per batch.
   const auto wall = wall_now();
   for (int i = 0; i < kReadBatch && socket_.is_open(); ++i) {
-    auto r = socket_.read();
+    auto r = io_->read(socket_);
     if (!r) {
       if (is(r.error(), EAGAIN) || is(r.error(), EWOULDBLOCK)) return;
       if (interface_gone(r.error())) {
@@ -318,7 +300,7 @@ void SocketCanBackend::receive(port::FrameReceiver& receiver, bool& delivered, T
                   r.error().message(), suppressed);
       }
       // A pending socket error is cleared by reading it.
-      if (auto e = socket_.take_error(); e && interface_gone(e)) go_down(e.message(), now);
+      if (auto e = io_->take_error(socket_); e && interface_gone(e)) go_down(e.message(), now);
       return;
     }
     if (r->drops && *r->drops != last_drops_) {
@@ -376,8 +358,8 @@ void SocketCanBackend::on_error_frame(const Received& r, TimePoint now) {
     switch (options_.bus_off) {
       case BusOffRecovery::kInterface: {
         std::uint32_t restart_ms = 0;
-        if (has_controller(options_.interface) &&
-            ::can_get_restart_ms(options_.interface.c_str(), &restart_ms) == 0 && restart_ms == 0) {
+        if (io_->has_controller(options_.interface) &&
+            io_->get_restart_ms(options_.interface, &restart_ms) == 0 && restart_ms == 0) {
           log_.error(
               "bus-off, and interface {} has no restart-ms: it stays off until restarted (ip link "
               "set {} type can restart-ms 100)",
@@ -421,7 +403,7 @@ void SocketCanBackend::transmit(const can::CanFrame& frame, TimePoint now) {
 }
 
 bool SocketCanBackend::try_write(const can::CanFrame& frame, TimePoint now) {
-  auto s = socket_.write(frame);
+  auto s = io_->write(socket_, frame);
   if (s) {
     ++stats_.transmitted;
     ++bus_.frames;

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "adapters/port/can_backend.hpp"
+#include "adapters/socketcan/can_io.hpp"
 #include "adapters/socketcan/can_socket.hpp"
 #include "adapters/socketcan/error_frame.hpp"
 #include "bridge/common/log.hpp"
@@ -67,6 +68,9 @@ class SocketCanBackend final : public port::CanBackend {
   // An interface that is absent or down is not an error: the backend starts
   // down and opens it when it appears.
   SocketCanBackend(SocketCanOptions options, Logger log);
+  // The same on `io`'s system calls and clock (tests inject faults there);
+  // `io` outlives the backend.
+  SocketCanBackend(SocketCanOptions options, Logger log, CanIo& io);
   ~SocketCanBackend() override;
   SocketCanBackend(const SocketCanBackend&) = delete;
   SocketCanBackend& operator=(const SocketCanBackend&) = delete;
@@ -93,6 +97,12 @@ class SocketCanBackend final : public port::CanBackend {
   };
   const Stats& stats() const noexcept { return stats_; }
   std::size_t transmit_queued() const noexcept { return queue_.size(); }
+  // When the next transmit retry after ENOBUFS is due (kNever: none).
+  TimePoint transmit_retry_at() const noexcept { return transmit_retry_at_; }
+  // When the next check of an interface that is down is due (kNever: none).
+  TimePoint reopen_at() const noexcept { return reopen_at_; }
+  // When the next bus-off restart is due (kNever: none).
+  TimePoint restart_at() const noexcept { return restart_at_; }
   bool is_up() const noexcept { return socket_.is_open(); }
 
   // A candump -l compatible log of the port's traffic, both ways, from now
@@ -130,9 +140,11 @@ class SocketCanBackend final : public port::CanBackend {
   TimePoint own_deadline() const;
   void arm_timer(TimePoint at);
   void log_frame(const can::CanFrame& frame, std::chrono::nanoseconds wall);
+  std::optional<port::BusState> state_from_netlink();
 
   SocketCanOptions options_;
   Logger log_;
+  CanIo* io_;
   FileDescriptor epoll_;
   FileDescriptor wake_fd_;
   FileDescriptor timer_fd_;
