@@ -348,7 +348,14 @@ void Node::on_size_result(Step step, const ExplicitResult& r, TimePoint now) {
   }
   if (produced) {
     produced_size_ = *value;
-    get(Step::kConsumedSize, kConnectionClass, kPollConnection, kAttrConsumedSize, now);
+    if (fallback) {
+      // A device that refused attribute 7 refuses 8 too: ask the fallback
+      // for the consumed size straight away.
+      const auto& fb = config_.profile.size_fallback;
+      get(Step::kFallbackConsumedSize, fb.class_id, fb.instance_id, fb.consumed_attribute, now);
+    } else {
+      get(Step::kConsumedSize, kConnectionClass, kPollConnection, kAttrConsumedSize, now);
+    }
   } else {
     consumed_size_ = *value;
     check_sizes(now);
