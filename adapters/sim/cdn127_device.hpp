@@ -6,6 +6,7 @@
 // attributes onto this state.
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "adapters/sim/pump_model.hpp"
 #include "bridge/cip/general_status.hpp"
@@ -70,6 +71,13 @@ struct OfflineOptions {
   std::uint8_t set_mac_service = 0x10;
 };
 
+// An instance attribute of a class, on every instance of it.
+struct ClassAttribute {
+  std::uint16_t class_id = 0;
+  std::uint8_t attribute = 0;
+  friend bool operator==(const ClassAttribute&, const ClassAttribute&) = default;
+};
+
 struct SlaveOptions {
   // Front-panel rotary switches, read at power-up only (manual, "Switches"):
   // MAC 0..63 valid, 64..99 the program position (MAC set in software); baud
@@ -104,6 +112,12 @@ struct SlaveOptions {
   Duration duplicate_mac_window = seconds(1);
   Duration fragment_ack_timeout = seconds(1);
   OfflineOptions offline{};
+  // Attributes this device's firmware does not implement although the
+  // manual lists them: Get and Set answer 0x14 (attribute not supported), as
+  // for any attribute a device has not. {{0x05, 7}, {0x05, 8}} is a
+  // firmware without the poll connection's Produced/Consumed Size, which
+  // leaves a master the Configuration object's Number Produced/Consumed.
+  std::vector<ClassAttribute> unsupported_attributes;
 };
 
 // DOP attributes 5..8. The manual's encoding: action 0 = use the value, 1 = hold.

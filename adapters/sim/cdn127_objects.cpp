@@ -607,6 +607,16 @@ const ClassDef kClasses[] = {
     {cls::kConfiguration, "Configuration", kConfigurationClass, kConfigurationAttributes, true, true, true, nullptr, configuration_reset, nullptr, nullptr, single_instance},
 };
 
+// The attribute as this device's firmware has it: nullptr when the tables
+// do not list it or the firmware lacks it (SlaveOptions::unsupported_attributes).
+const AttributeDef* firmware_attribute(const Cdn127Device& device, const ClassDef& c,
+                                       std::uint8_t attribute) noexcept {
+  for (const ClassAttribute& missing : device.options().unsupported_attributes) {
+    if (missing == ClassAttribute{c.id, attribute}) return nullptr;
+  }
+  return find_attribute(c, attribute);
+}
+
 Reply dispatch(Cdn127Device& device, const devicenet::RequestMessage& req, std::uint8_t requester,
                TimePoint now, ByteWriter& w) noexcept {
   const ClassDef* c = find_class(req.class_id);
@@ -629,7 +639,7 @@ Reply dispatch(Cdn127Device& device, const devicenet::RequestMessage& req, std::
         }
         return reply_error(GeneralStatus::kAttributeNotSupported);
       }
-      const AttributeDef* a = find_attribute(*c, *req.attribute);
+      const AttributeDef* a = firmware_attribute(device, *c, *req.attribute);
       if (a == nullptr) return reply_error(GeneralStatus::kAttributeNotSupported);
       return a->get(ctx, w);
     }
@@ -637,7 +647,7 @@ Reply dispatch(Cdn127Device& device, const devicenet::RequestMessage& req, std::
       // No class lists Set at class level.
       if (class_level || !c->instance_set) return not_supported;
       if (!req.attribute) return reply_error(GeneralStatus::kNotEnoughData);
-      const AttributeDef* a = find_attribute(*c, *req.attribute);
+      const AttributeDef* a = firmware_attribute(device, *c, *req.attribute);
       if (a == nullptr) return reply_error(GeneralStatus::kAttributeNotSupported);
       if (a->access != Access::kGetSet || a->set == nullptr) {
         return reply_error(GeneralStatus::kAttributeNotSettable);

@@ -127,6 +127,8 @@ class Node final : private ExplicitClient::Listener {
   void next_setting(TimePoint now);
   void begin_verify(TimePoint now);
   void check_sizes(TimePoint now);
+  // "Connection 2 attribute 7", or the profile's fallback for the same size.
+  std::string size_attribute(bool produced, bool fallback) const;
   void set_poll_epr(TimePoint now);
   void go_online(TimePoint now);
   void lose(std::string reason, TimePoint now);
@@ -166,6 +168,11 @@ class Node final : private ExplicitClient::Listener {
   std::optional<Duration> last_timeout_;
   std::optional<std::uint32_t> produced_size_;
   std::optional<std::uint32_t> consumed_size_;
+  // Where each size was read, and what the device answered where it was
+  // asked first when it refused: both go into the reasons.
+  bool produced_from_fallback_ = false;
+  bool consumed_from_fallback_ = false;
+  std::string size_refusal_;
 
   NodeIdentity identity_;
   std::optional<std::uint8_t> device_state_;

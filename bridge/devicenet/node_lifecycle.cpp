@@ -331,35 +331,55 @@ void Node::on_size_result(Step step, const ExplicitResult& r, TimePoint now) {
   const auto value = r.ok() ? read_uint(r.data.view()) : std::nullopt;
   const bool produced = step == Step::kProducedSize || step == Step::kFallbackProducedSize;
   const bool fallback = step == Step::kFallbackProducedSize || step == Step::kFallbackConsumedSize;
+  const char* which = produced ? "produced" : "consumed";
+  const auto answer = [&] { return r.ok() ? "bad size " + hex(r.data.view()) : status_text(r); };
+  const auto& fb = config_.profile.size_fallback;
   if (!value) {
-    const auto& fb = config_.profile.size_fallback;
     if (!fallback && config_.profile.has_size_fallback) {
-      // Connection 2 attributes 7/8 refused: ask where the profile says
-      // the same sizes are kept.
+      // Connection 2 attributes 7/8 refused (older firmware answers 0x14,
+      // attribute not supported): ask where the profile says the same sizes
+      // are kept.
+      size_refusal_ = fmt::format("{}: {}", size_attribute(produced, false), answer());
+      log_.debug("poll {} size: {}; asking {}", which, size_refusal_,
+                 size_attribute(produced, true));
       get(produced ? Step::kFallbackProducedSize : Step::kFallbackConsumedSize, fb.class_id,
           fb.instance_id, produced ? fb.produced_attribute : fb.consumed_attribute, now);
       return;
     }
     enter_fault(NodeState::kConfigurationFault,
-                fmt::format("cannot read the poll {} size: {}", produced ? "produced" : "consumed",
-                            r.ok() ? "bad size " + hex(r.data.view()) : status_text(r)),
+                fallback ? fmt::format("cannot read the poll {} size: {}; fallback {}: {}", which,
+                                       size_refusal_, size_attribute(produced, true), answer())
+                         : fmt::format("cannot read the poll {} size: {}: {}", which,
+                                       size_attribute(produced, false), answer()),
                 now);
     return;
   }
   if (produced) {
     produced_size_ = *value;
+    produced_from_fallback_ = fallback;
     if (fallback) {
       // A device that refused attribute 7 refuses 8 too: ask the fallback
       // for the consumed size straight away.
-      const auto& fb = config_.profile.size_fallback;
       get(Step::kFallbackConsumedSize, fb.class_id, fb.instance_id, fb.consumed_attribute, now);
     } else {
       get(Step::kConsumedSize, kConnectionClass, kPollConnection, kAttrConsumedSize, now);
     }
   } else {
     consumed_size_ = *value;
+    consumed_from_fallback_ = fallback;
     check_sizes(now);
   }
+}
+
+std::string Node::size_attribute(bool produced, bool fallback) const {
+  if (!fallback) {
+    return fmt::format("Connection {} attribute {}", kPollConnection,
+                       produced ? kAttrProducedSize : kAttrConsumedSize);
+  }
+  const auto& fb = config_.profile.size_fallback;
+  return fmt::format("{} (class 0x{:02X}) instance {} attribute {}",
+                     fb.object_name.empty() ? "object" : fb.object_name, fb.class_id,
+                     fb.instance_id, produced ? fb.produced_attribute : fb.consumed_attribute);
 }
 
 void Node::on_epr_result(Step step, const ExplicitResult& r, TimePoint now) {
@@ -434,18 +454,22 @@ void Node::begin_verify(TimePoint now) {
   set_state(NodeState::kVerifying, "configured: checking the poll connection's sizes", now);
   produced_size_.reset();
   consumed_size_.reset();
+  produced_from_fallback_ = consumed_from_fallback_ = false;
+  size_refusal_.clear();
   get(Step::kProducedSize, kConnectionClass, kPollConnection, kAttrProducedSize, now);
 }
 
 void Node::check_sizes(TimePoint now) {
   const auto& p = config_.profile;
   if (*produced_size_ != p.produced_size || *consumed_size_ != p.consumed_size) {
-    // Never guess which of the two is right: say both.
+    // Never guess which of the two is right: say both, and where the
+    // device's were read.
     enter_fault(NodeState::kConfigurationFault,
-                fmt::format("poll sizes differ: the device produces {} B and consumes {} B; the "
-                            "configuration expects {} B and {} B ({})",
-                            *produced_size_, *consumed_size_, p.produced_size, p.consumed_size,
-                            p.format_description),
+                fmt::format("poll sizes differ: the device produces {} B ({}) and consumes {} B "
+                            "({}); the configuration expects {} B and {} B ({})",
+                            *produced_size_, size_attribute(true, produced_from_fallback_),
+                            *consumed_size_, size_attribute(false, consumed_from_fallback_),
+                            p.produced_size, p.consumed_size, p.format_description),
                 now);
     return;
   }
@@ -476,13 +500,19 @@ void Node::go_online(TimePoint now) {
   next_poll_ = next_poll_slot(now);
   keepalive_at_ = now + explicit_epr_;
   io_reassembler_.reset();
-  set_state(NodeState::kOnline,
-            fmt::format("polled every {} ms; EPR {} ms (explicit {} ms); {} B out, {} B in",
-                        std::chrono::duration_cast<milliseconds>(config_.poll_period).count(),
-                        std::chrono::duration_cast<milliseconds>(poll_epr_).count(),
-                        std::chrono::duration_cast<milliseconds>(explicit_epr_).count(),
-                        config_.profile.consumed_size, config_.profile.produced_size),
-            now);
+  std::string reason =
+      fmt::format("polled every {} ms; EPR {} ms (explicit {} ms); {} B out, {} B in",
+                  std::chrono::duration_cast<milliseconds>(config_.poll_period).count(),
+                  std::chrono::duration_cast<milliseconds>(poll_epr_).count(),
+                  std::chrono::duration_cast<milliseconds>(explicit_epr_).count(),
+                  config_.profile.consumed_size, config_.profile.produced_size);
+  if (produced_from_fallback_ || consumed_from_fallback_) {
+    // Worth knowing about a device: it refused Connection 2 attributes 7/8.
+    reason +=
+        fmt::format(" (sizes read from {} and {})", size_attribute(true, produced_from_fallback_),
+                    size_attribute(false, consumed_from_fallback_));
+  }
+  set_state(NodeState::kOnline, std::move(reason), now);
   // Outputs set before the node came online go out with the first poll.
   send_poll(now);
 }

@@ -40,6 +40,7 @@ struct SizeSource {
   std::uint8_t produced_attribute = 0;
   std::uint8_t consumed_attribute = 0;
   bool one_byte = false;  // USINT rather than UINT
+  std::string object_name;  // for reasons: "Configuration"
 };
 
 // Device-specific knowledge the node life cycle needs, as data: built by a

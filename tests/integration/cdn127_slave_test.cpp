@@ -465,6 +465,24 @@ TEST_F(Cdn127SlaveTest, ConnectionAttributes) {
   EXPECT_EQ(set(0x05, 0x02, 0x0E, {0x20, 0x04, 0x24, 0x01, 0x30, 0x03}), error(0x0C));
 }
 
+// A firmware without the poll connection's Produced/Consumed Size answers
+// them as attributes it has not (0x14), on Get and Set alike; the
+// Configuration object's Number Produced/Consumed still answer, in USINT.
+TEST_F(Cdn127SlaveTest, FirmwareWithoutConnectionSizesRefusesThemWithAttributeNotSupported) {
+  SlaveOptions o = default_options();
+  o.unsupported_attributes = {{0x05, 7}, {0x05, 8}};
+  create(o);
+  boot();
+  allocate();
+  EXPECT_EQ(get(0x05, 0x02, 0x07), error(0x14));
+  EXPECT_EQ(get(0x05, 0x02, 0x08), error(0x14));
+  EXPECT_EQ(get(0x05, 0x01, 0x07), error(0x14));
+  EXPECT_EQ(set(0x05, 0x02, 0x07, {0x06, 0x00}), error(0x14));  // not 0x0E: it has none
+  EXPECT_EQ(get(0x05, 0x02, 0x0D), (ByteVec{0x8E, 0x06}));      // the rest as before
+  EXPECT_EQ(get(0x40, 0x01, 16), (ByteVec{0x8E, 0x06}));        // DSUP DIN AIN AIN
+  EXPECT_EQ(get(0x40, 0x01, 17), (ByteVec{0x8E, 0x04}));        // DOUT PAD AOUT
+}
+
 TEST_F(Cdn127SlaveTest, PollConnectionDoesNotExistBeforeAllocation) {
   boot();
   allocate(0x01);

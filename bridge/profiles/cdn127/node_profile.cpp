@@ -63,8 +63,12 @@ Result<devicenet::NodeProfile> make_node_profile(const IoConfiguration& config) 
   // "Number Produced/Consumed ... Access to this attribute is not dependent
   // on the Poll connection being created" (manual, Configuration object).
   p.has_size_fallback = true;
-  p.size_fallback = {class_id::kConfiguration, 1, configuration_attr::kNumberProduced,
-                     configuration_attr::kNumberConsumed, true};
+  p.size_fallback = {.class_id = class_id::kConfiguration,
+                     .instance_id = 1,
+                     .produced_attribute = configuration_attr::kNumberProduced,
+                     .consumed_attribute = configuration_attr::kNumberConsumed,
+                     .one_byte = true,
+                     .object_name = "Configuration"};
   return p;
 }
 
