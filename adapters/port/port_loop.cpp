@@ -1,6 +1,7 @@
 #include "adapters/port/port_loop.hpp"
 
 #include <fmt/format.h>
+#include <pthread.h>
 
 #include <algorithm>
 
@@ -38,12 +39,20 @@ PortLoop::~PortLoop() {
 void PortLoop::start() {
   running_ = true;
   thread_ = std::thread([this] { run(); });
+  // Named for top -H, gdb and /proc/PID/task/*/comm: "port A" (15 bytes at most).
+  const std::string name = fmt::format("port {}", config_.port).substr(0, 15);
+  (void)pthread_setname_np(thread_.native_handle(), name.c_str());
 }
 
 void PortLoop::stop() { push(Stop{}); }
 
 void PortLoop::join() {
   if (thread_.joinable()) thread_.join();
+}
+
+std::string PortLoop::problem() const {
+  std::lock_guard lock(problem_mutex_);
+  return problem_;
 }
 
 bool PortLoop::has_node(MacId mac) const {
@@ -105,12 +114,12 @@ void PortLoop::run() {
   started_ = now;
   metrics_time_ = now;
   port_status_time_ = now;
-  scanner_->start(now);
   bool stopping = false;
   TimePoint stop_deadline = kNever;
   for (;;) {
     heartbeat_.fetch_add(1, std::memory_order_relaxed);
     now = backend_->now();
+    if (!stopping) start_master_when_up(now);
     while (scanner_->next_deadline() <= now) scanner_->on_timer(now);
     if (!drain_inbox(now) && !stopping) {
       stopping = true;
@@ -138,6 +147,23 @@ void PortLoop::run() {
   publish(backend_->now(), true);
   publisher_.port_stopped(config_.port);
   running_ = false;
+}
+
+void PortLoop::start_master_when_up(TimePoint now) {
+  if (master_started_) return;
+  if (backend_->counters().state != BusState::kDown) {
+    master_started_ = true;
+    scanner_->start(now);
+    return;
+  }
+  if (!started_up_.load(std::memory_order_relaxed)) {
+    // Start-up checks end here for this port; the other ports need not
+    // wait for an interface that may never come.
+    log_.warn(
+        "{}: the master starts (duplicate MAC ID check, then scanning) when the interface is up",
+        backend_->problem());
+    started_up_.store(true, std::memory_order_relaxed);
+  }
 }
 
 void PortLoop::publish(TimePoint now, bool force) {
@@ -177,8 +203,14 @@ void PortLoop::publish_port(TimePoint now) {
   bus_state_ = s.bus.state;
   // The interface's trouble first: the master's own state means little
   // while nothing reaches the bus.
-  if (auto problem = backend_->problem(); !problem.empty()) {
+  if (!master_started_) s.reason = "waiting for the interface to start the MAC check";
+  const std::string problem = backend_->problem();
+  if (!problem.empty()) {
     s.reason = s.reason.empty() ? problem : fmt::format("{} ({})", problem, s.reason);
+  }
+  {
+    std::lock_guard lock(problem_mutex_);
+    if (problem != problem_) problem_ = problem;
   }
   s.nodes_configured = static_cast<std::uint16_t>(config_.pumps.size());
   for (const auto& p : config_.pumps) {

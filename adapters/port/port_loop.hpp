@@ -61,7 +61,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
 
   // For a service manager, from any thread. The port has finished its
   // start-up checks once its master left the duplicate MAC ID check, either
-  // scanning or refusing to send (another node has its MAC).
+  // scanning or refusing to send (another node has its MAC), or once it
+  // found its interface down or absent: then it reports that, and its master
+  // starts (the MAC check first) when the interface is up.
   bool started_up() const { return started_up_.load(std::memory_order_relaxed); }
   // Advances on every iteration of the loop, which wakes at least once per
   // status period: a value that stops advancing is a stalled loop.
@@ -69,6 +71,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // Nodes online as of the last PortStatus.
   std::uint16_t nodes_online() const { return nodes_online_.load(std::memory_order_relaxed); }
   std::size_t nodes_configured() const { return config_.pumps.size(); }
+  // What keeps the port off the bus as of the last PortStatus ("interface
+  // can7 absent"); empty when nothing does.
+  std::string problem() const;
 
  private:
   struct Command {
@@ -84,6 +89,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
       std::variant<Command, Release, rack::ExplicitCall, Stop, std::function<void(CanBackend&)>>;
 
   void run();
+  // Starts the master once the interface is up: its duplicate MAC ID check
+  // must reach the bus to mean anything.
+  void start_master_when_up(TimePoint now);
   void push(Item item);
   bool drain_inbox(TimePoint now);  // false once a Stop was seen
   void publish(TimePoint now, bool force);
@@ -121,6 +129,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   };
   std::vector<Published> published_;
   TimePoint started_{};              // when run() began
+  bool master_started_ = false;
   bool port_dirty_ = true;
   TimePoint port_status_time_{};
   TimePoint port_event_time_{};
@@ -141,6 +150,8 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   std::atomic<bool> started_up_{false};
   std::atomic<std::uint64_t> heartbeat_{0};
   std::atomic<std::uint16_t> nodes_online_{0};
+  mutable std::mutex problem_mutex_;
+  std::string problem_;
 };
 
 }  // namespace dnbridge::port

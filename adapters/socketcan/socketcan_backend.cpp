@@ -92,9 +92,6 @@ SocketCanBackend::SocketCanBackend(SocketCanOptions options, Logger log)
 
 SocketCanBackend::SocketCanBackend(SocketCanOptions options, Logger log, CanIo& io)
     : options_(std::move(options)), log_(std::move(log)), io_(&io) {
-  if (auto e = io_->can_support()) {
-    throw std::system_error(e, "this kernel has no SocketCAN (socket(AF_CAN))");
-  }
   if (io_->link_state(options_.interface) == LinkState::kNotCan) {
     throw std::runtime_error(
         fmt::format("interface \"{}\" is not a CAN interface", options_.interface));
@@ -137,7 +134,13 @@ void SocketCanBackend::try_open(TimePoint now) {
   reopen_at_ = now + options_.reopen_period;
   const LinkState link = io_->link_state(options_.interface);
   if (link != LinkState::kUp) {
-    problem_ = fmt::format("interface {} {}", options_.interface, to_string(link));
+    // A kernel without SocketCAN has no CAN interface either: say why.
+    if (auto e = io_->can_support()) {
+      problem_ = fmt::format("interface {}: this kernel has no SocketCAN (socket(AF_CAN): {})",
+                             options_.interface, e.message());
+    } else {
+      problem_ = fmt::format("interface {} {}", options_.interface, to_string(link));
+    }
     return;
   }
   SocketOptions so;

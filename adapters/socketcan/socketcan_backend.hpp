@@ -15,6 +15,9 @@
 //   the socket writable; when the interface's queue is full (ENOBUFS, which
 //   epoll does not signal) they are retried on a timer that backs off. A
 //   frame never overtakes an earlier one.
+// - Interface absent or down at start, or no SocketCAN in the kernel: the
+//   bus is reported down and the interface checked again periodically, as
+//   below.
 // - Interface down or removed (ENETDOWN, ENODEV): the socket is closed, the
 //   bus reported down, and the interface checked again periodically; when it
 //   is up again a new socket is opened and traffic resumes. The master's
@@ -63,10 +66,11 @@ struct SocketCanOptions {
 
 class SocketCanBackend final : public port::CanBackend {
  public:
-  // Throws std::system_error when the kernel has no SocketCAN, and
-  // std::runtime_error when the interface exists but is not a CAN interface.
-  // An interface that is absent or down is not an error: the backend starts
-  // down and opens it when it appears.
+  // Throws std::runtime_error when the interface exists but is not a CAN
+  // interface (a configuration mistake). An interface that is absent or
+  // down is not an error, nor is a kernel without SocketCAN (the module may
+  // come later): the backend starts down, says why, and opens the interface
+  // when it appears.
   SocketCanBackend(SocketCanOptions options, Logger log);
   // The same on `io`'s system calls and clock (tests inject faults there);
   // `io` outlives the backend.

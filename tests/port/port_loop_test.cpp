@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <condition_variable>
 #include <future>
 #include <map>
@@ -40,6 +41,7 @@ class RecordingPublisher final : public PortPublisher {
   void port_status(const PortStatusView& s, TimePoint) override {
     std::lock_guard lock(mutex_);
     port = s;
+    ++port_samples;
     changed_.notify_all();
   }
   void explicit_reply(const rack::ExplicitAnswer& a) override {
@@ -61,17 +63,72 @@ class RecordingPublisher final : public PortPublisher {
     return changed_.wait_for(lock, timeout, done);
   }
 
+  PortStatusView last_port() {
+    std::lock_guard lock(mutex_);
+    return port.value_or(PortStatusView{});
+  }
+
   std::map<unsigned, rack::PumpView> pumps;
   std::map<unsigned, TimePoint> pump_times;
   std::map<unsigned, devicenet::NodeState> node_states;
   std::optional<PortStatusView> port;
   std::vector<rack::ExplicitAnswer> replies;
-  std::size_t pump_samples = 0, status_samples = 0;
+  std::size_t pump_samples = 0, status_samples = 0, port_samples = 0;
   bool stopped = false;
 
  private:
   std::mutex mutex_;
   std::condition_variable changed_;
+};
+
+// The simulated bus behind an interface that is absent until plug_in(), as
+// the SocketCAN backend reports one: bus down, its problem said, and no frame
+// through either way.
+class UnpluggedBackend final : public CanBackend, private can::FrameSink {
+ public:
+  explicit UnpluggedBackend(std::unique_ptr<SimBackend> bus) : bus_(std::move(bus)) {}
+  // Any thread.
+  void plug_in() {
+    plugged_ = true;
+    bus_->wake();
+  }
+  std::uint64_t dropped() const { return dropped_; }
+
+  can::FrameSink& sink() override { return *this; }
+  TimePoint now() const override { return bus_->now(); }
+  void wait(TimePoint deadline, FrameReceiver& receiver) override {
+    struct Gate final : FrameReceiver {
+      Gate(const UnpluggedBackend& b, FrameReceiver& r) : backend(b), receiver(r) {}
+      void on_frame(const can::CanFrame& f, TimePoint t) override {
+        if (backend.plugged_) receiver.on_frame(f, t);
+      }
+      const UnpluggedBackend& backend;
+      FrameReceiver& receiver;
+    } gate(*this, receiver);
+    bus_->wait(deadline, gate);
+  }
+  void wake() override { bus_->wake(); }
+  BusCounters counters() const override {
+    BusCounters c = bus_->counters();
+    if (!plugged_) c.state = BusState::kDown;
+    return c;
+  }
+  std::string interface_name() const override { return "can7"; }
+  std::uint32_t bitrate() const override { return bus_->bitrate(); }
+  std::string problem() const override { return plugged_ ? "" : "interface can7 absent"; }
+
+ private:
+  void send(const can::CanFrame& frame, TimePoint now) override {
+    if (plugged_) {
+      bus_->sink().send(frame, now);
+    } else {
+      ++dropped_;
+    }
+  }
+
+  std::unique_ptr<SimBackend> bus_;
+  std::atomic<bool> plugged_{false};
+  std::atomic<std::uint64_t> dropped_{0};
 };
 
 PortLoopConfig config_for(const std::vector<unsigned>& macs) {
@@ -215,6 +272,56 @@ TEST(PortLoop, RunsOnTheThreadedSimulatedBus) {
   loop.join();
   EXPECT_TRUE(publisher.stopped);
   for (unsigned m : macs) EXPECT_EQ(publisher.node_states[m], devicenet::NodeState::kStopped) << m;
+}
+
+// An interface absent at start ends the port's start-up checks at once (a
+// service manager need not wait for it) with the port reported down; the
+// master starts, duplicate MAC ID check first, only when the interface is
+// there: a check nobody could hear proves nothing.
+TEST(PortLoop, AnInterfaceAbsentAtStartEndsTheStartUpChecksAndTheMasterWaitsForIt) {
+  RecordingPublisher publisher;
+  auto backend = std::make_unique<UnpluggedBackend>(
+      std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(1)}));
+  UnpluggedBackend* interface = backend.get();
+  PortLoop loop(config_for({1}), std::move(backend), publisher, null_log_sink());
+  EXPECT_FALSE(loop.started_up());
+  loop.start();
+
+  // Three status periods with the interface absent.
+  ASSERT_TRUE(publisher.wait_for([&] { return publisher.port_samples >= 3; }));
+  EXPECT_TRUE(loop.started_up());
+  EXPECT_EQ(loop.problem(), "interface can7 absent");
+  {
+    const PortStatusView port = publisher.last_port();
+    EXPECT_EQ(port.bus.state, BusState::kDown);
+    EXPECT_EQ(port.state, devicenet::PortState::kStopped);
+    EXPECT_EQ(port.reason,
+              "interface can7 absent (waiting for the interface to start the MAC check)");
+  }
+  EXPECT_EQ(interface->dropped(), 0u) << "the master sent while the interface was absent";
+
+  interface->plug_in();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(1) && publisher.pumps[1].online; }));
+  EXPECT_EQ(loop.problem(), "");
+  EXPECT_EQ(interface->dropped(), 0u);
+  loop.stop();
+  loop.join();
+  EXPECT_TRUE(publisher.stopped);
+}
+
+// Asked to stop before its interface ever came: it stops at once.
+TEST(PortLoop, APortWaitingForItsInterfaceStopsAtOnce) {
+  RecordingPublisher publisher;
+  PortLoop loop(config_for({1}),
+                std::make_unique<UnpluggedBackend>(
+                    std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(1)})),
+                publisher, null_log_sink());
+  loop.start();
+  ASSERT_TRUE(publisher.wait_for([&] { return publisher.port_samples >= 1; }));
+  loop.stop();
+  loop.join();
+  EXPECT_TRUE(publisher.stopped);
 }
 
 }  // namespace

@@ -31,6 +31,9 @@ class FakeIo final : public CanIo {
  public:
   // --- the script ---------------------------------------------------------
   LinkState link = LinkState::kUp;
+  // What socket(AF_CAN) fails with: EAFNOSUPPORT on a kernel without
+  // SocketCAN; 0: it works.
+  int kernel_can_errno = 0;
   // The errno of the next write() / read() calls, one per call, front
   // first; 0 (or none left): the real call on the socketpair.
   std::deque<int> write_errors;
@@ -53,7 +56,9 @@ class FakeIo final : public CanIo {
   // The test's end of the current socket.
   FileDescriptor peer;
 
-  std::error_code can_support() override { return {}; }
+  std::error_code can_support() override {
+    return kernel_can_errno ? errno_code(kernel_can_errno) : std::error_code();
+  }
   LinkState link_state(const std::string&) override {
     link_checks.push_back(clock);
     return link;
@@ -457,6 +462,64 @@ TEST_F(BackendFault, EnodevOnReadReportsTheBusDownAndReopensOnItsTimer) {
   io.inject(0x3C3);
   poll(b);
   EXPECT_EQ(rx.ids, (std::vector<std::uint32_t>{0x3C3, 0x3C3}));
+}
+
+// --- (5) nothing to open at start ----------------------------------------------
+
+// A rack service must start with an interface missing: the port reports it
+// and opens the interface when it appears, on the same timer as above.
+TEST_F(BackendFault, AnInterfaceAbsentAtStartIsReportedDownAndOpenedWhenItAppears) {
+  io.link = LinkState::kAbsent;
+  SocketCanBackend b(options(), Logger(), io);
+  EXPECT_FALSE(b.is_up());
+  EXPECT_EQ(b.counters().state, BusState::kDown);
+  EXPECT_EQ(b.problem(), "interface can0 absent");
+  EXPECT_EQ(b.reopen_at(), kStart + milliseconds(500));
+  send(b, 0x40);  // dropped: nowhere to go
+  EXPECT_EQ(b.stats().transmit_dropped, 1u);
+
+  wait_until(b, kStart + milliseconds(1200));
+  // Twice at start (is it CAN at all; can it be opened), then every 500 ms.
+  EXPECT_EQ(io.link_checks, (std::vector<TimePoint>{kStart, kStart, kStart + milliseconds(500),
+                                                    kStart + milliseconds(1000)}));
+  EXPECT_TRUE(io.opens.empty());
+
+  io.link = LinkState::kUp;
+  wait_until(b, kStart + milliseconds(1600));
+  EXPECT_EQ(io.opens, std::vector<TimePoint>{kStart + milliseconds(1500)});
+  EXPECT_TRUE(b.is_up());
+  EXPECT_EQ(b.problem(), "");
+  send(b, 0x41);
+  EXPECT_EQ(io.sent_ids(), std::vector<std::uint32_t>{0x41});
+}
+
+// No AF_CAN at all (this machine's kernel, for one): not a start-up failure
+// either. The port says so, and keeps checking: the module may come later.
+TEST_F(BackendFault, AKernelWithoutSocketCanIsReportedDownAndCheckedAgain) {
+  io.kernel_can_errno = EAFNOSUPPORT;
+  io.link = LinkState::kAbsent;
+  SocketCanBackend b(options(), Logger(), io);
+  EXPECT_FALSE(b.is_up());
+  EXPECT_EQ(b.counters().state, BusState::kDown);
+  EXPECT_EQ(b.problem(), "interface can0: this kernel has no SocketCAN (socket(AF_CAN): " +
+                             errno_code(EAFNOSUPPORT).message() + ")");
+  wait_until(b, kStart + milliseconds(1200));
+  EXPECT_EQ(io.link_checks.size(), 4u);
+  EXPECT_TRUE(io.opens.empty());
+
+  // The module loaded and the interface created and set up.
+  io.kernel_can_errno = 0;
+  io.link = LinkState::kUp;
+  wait_until(b, kStart + milliseconds(1600));
+  EXPECT_EQ(io.opens, std::vector<TimePoint>{kStart + milliseconds(1500)});
+  EXPECT_TRUE(b.is_up());
+  EXPECT_EQ(b.counters().state, BusState::kUnknown);
+}
+
+// An interface that is there but not CAN is a configuration mistake: refused.
+TEST_F(BackendFault, AnInterfaceThatIsNotCanIsRefusedAtStart) {
+  io.link = LinkState::kNotCan;
+  EXPECT_THROW(SocketCanBackend(options(), Logger(), io), std::runtime_error);
 }
 
 }  // namespace
