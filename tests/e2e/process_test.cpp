@@ -3,52 +3,15 @@
 // Cyclone's domain and never touch the network), and SIGTERM stops it in
 // order. Its configuration is the embedded default on this process's domain;
 // CYCLONEDDS_URI (loopback, this process's discovery tag) is inherited.
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-
 #include <filesystem>
 #include <fstream>
 #include <map>
 
 #include "bridge_fixture.hpp"
-
-extern char** environ;
+#include "child_process.hpp"
 
 namespace dnbridge::e2e {
 namespace {
-
-// The child process; killed if the test ends before it stopped.
-class Child {
- public:
-  explicit Child(std::vector<std::string> args) {
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
-  }
-  ~Child() {
-    if (pid_ > 0) {
-      (void)kill(pid_, SIGKILL);
-      (void)waitpid(pid_, nullptr, 0);
-    }
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
-  bool running() const { return pid_ > 0; }
-  bool signal(int sig) const { return pid_ > 0 && kill(pid_, sig) == 0; }
-  // Waits for the exit; its status (-1 if it did not exit normally).
-  int wait() {
-    int status = 0;
-    if (pid_ <= 0 || waitpid(pid_, &status, 0) != pid_) return -1;
-    pid_ = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-};
 
 // `dnbridge --simulate`'s configuration, on `domain`, logging warnings only.
 std::filesystem::path write_config(dds_domainid_t domain) {
@@ -68,7 +31,7 @@ std::filesystem::path write_config(dds_domainid_t domain) {
 TEST_F(BridgeTest, DnbridgeProcessServesTheSupervisorAndStopsInOrderOnSigterm) {
   const auto config = write_config(test_domain());
   const auto spawned = SteadyClock::now();
-  Child bridge({DNBRIDGE_BINARY, "--config", config.string()});
+  ChildProcess bridge({DNBRIDGE_BINARY, "--config", config.string()});
   ASSERT_TRUE(bridge.running());
 
   ASSERT_TRUE(pumps_.matched(1));
