@@ -252,6 +252,32 @@ TEST_F(SystemTest, InterfaceDownAndUpWhileRunning) {
   EXPECT_TRUE(sim.running()) << "cdn127-sim exited";
 }
 
+// A port whose interface does not exist when dnbridge starts: the port says
+// so and waits, its master silent (no MAC check into the void), while the
+// other port runs; once the interface is created its master starts and the
+// nodes come online, without a restart.
+TEST_F(SystemTest, InterfaceAbsentAtStartIsWaitedFor) {
+  ASSERT_EQ(shell("ip link del dev vcan1"), 0);
+  Child& sim0 = start_sim("vcan0", {5});
+  Child& bridge = start_bridge({{"A", "vcan0", {5}}, {"B", "vcan1", {7}}});
+  ASSERT_TRUE(wait_online("A", {5}));
+  ASSERT_TRUE(supervisor().wait_until([&] { return port_bus("B", dnbridge_BUS_DOWN); }, 10s));
+  {
+    const PortSeen& b = supervisor().ports().at("B");
+    EXPECT_EQ(b.state, dnbridge_PORT_STOPPED);
+    EXPECT_NE(b.reason.find("interface vcan1 absent"), std::string::npos) << b.reason;
+    EXPECT_NE(b.reason.find("waiting for the interface"), std::string::npos) << b.reason;
+  }
+
+  ASSERT_EQ(shell("ip link add dev vcan1 type vcan && ip link set up vcan1"), 0);
+  start_sim("vcan1", {7});
+  ASSERT_TRUE(wait_online("B", {7})) << "port B did not start once its interface was there";
+  EXPECT_FALSE(port_bus("B", dnbridge_BUS_DOWN));
+  EXPECT_TRUE(pump("A", 5).online);
+  EXPECT_TRUE(bridge.running()) << "dnbridge exited";
+  EXPECT_TRUE(sim0.running()) << "cdn127-sim exited";
+}
+
 // A simulated device power-cycled (and powered off and on) under cdn127-sim
 // comes back online by itself.
 TEST_F(SystemTest, PowerCycledDeviceComesBack) {
