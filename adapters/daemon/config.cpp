@@ -262,7 +262,7 @@ constexpr std::array<std::string_view, 7> kIoKeys{
     "analog_inputs", "analog_outputs", "no_nc_mask"};
 constexpr std::array<std::string_view, 3> kIdentityKeys{"vendor_id", "product_type",
                                                         "product_code"};
-constexpr std::array<std::string_view, 14> kPortKeys{"name",
+constexpr std::array<std::string_view, 15> kPortKeys{"name",
                                                      "interface",
                                                      "bitrate",
                                                      "bus_off_recovery",
@@ -273,6 +273,7 @@ constexpr std::array<std::string_view, 14> kPortKeys{"name",
                                                      "allocate_retry_max_ms",
                                                      "fault_recheck_ms",
                                                      "poll_response_timeout_ms",
+                                                     "poll_batch_ms",
                                                      "explicit_response_timeout_ms",
                                                      "max_consecutive_errors",
                                                      "node"};
@@ -460,6 +461,7 @@ std::optional<devicenet::ExpectedIdentity> read_identity(const toml::node& n, Re
 // attribute 9); the poll period is bounded by the expected packet rate.
 constexpr std::int64_t kMaxPacketRateMs = 0xFFFF;
 constexpr std::int64_t kMaxPublishPeriodMs = 3'600'000;
+constexpr std::int64_t kMaxPollBatchMs = 1000;  // clamped to half a poll period per node
 constexpr double kAnalogFullScaleVolts = 10.0;
 
 // Reads every setting a node and [defaults] share into `s`, which holds the
@@ -648,6 +650,9 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
   timing("fault_recheck_ms", tm.fault_recheck);
   timing("poll_response_timeout_ms", tm.poll_response_timeout);
   timing("explicit_response_timeout_ms", tm.explicit_response_timeout);
+  if (const toml::node* n = t.get("poll_batch_ms")) {
+    if (auto v = read_ms(*n, "poll_batch_ms", 0, kMaxPollBatchMs, r)) tm.poll_batch_window = *v;
+  }
   if (const toml::node* n = t.get("max_consecutive_errors")) {
     if (auto v = read_int_as<unsigned>(*n, "max_consecutive_errors", {1, 1000}, r)) {
       tm.max_consecutive_errors = *v;
@@ -977,6 +982,7 @@ devicenet::ScannerConfig to_scanner_config(const PortConfig& port) {
   c.fault_recheck = port.timings.fault_recheck;
   c.max_consecutive_errors = port.timings.max_consecutive_errors;
   c.poll_response_timeout = port.timings.poll_response_timeout;
+  c.poll_batch_window = port.timings.poll_batch_window;
   return c;
 }
 

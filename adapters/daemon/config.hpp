@@ -55,6 +55,7 @@ struct ScannerTimings {
   Duration explicit_response_timeout =
       devicenet::ScannerConfig{}.explicit_messaging.response_timeout;
   unsigned max_consecutive_errors = devicenet::ScannerConfig{}.max_consecutive_errors;
+  Duration poll_batch_window = devicenet::ScannerConfig{}.poll_batch_window;
 };
 
 // The interface name of the in-process simulated bus.

@@ -7,6 +7,7 @@
 #include "adapters/daemon/samples.hpp"
 #include "adapters/dds/fields.hpp"
 #include "adapters/port/steady_time.hpp"
+#include "adapters/port/thread_name.hpp"
 
 namespace dnbridge::daemon {
 namespace {
@@ -58,6 +59,7 @@ port::PortLoop* DdsInput::port_of(std::string_view name) {
 }
 
 void DdsInput::run() {
+  port::name_this_thread("dnb dds input");
   for (;;) {
     auto triggered = waitset_.wait(seconds(1));
     if (!triggered) {

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 
+#include "adapters/port/thread_name.hpp"
+
 namespace dnbridge::port {
 
 using devicenet::MacId;
@@ -110,6 +112,7 @@ bool PortLoop::drain_inbox(TimePoint now) {
 }
 
 void PortLoop::run() {
+  name_this_thread("dnb port " + config_.port);
   TimePoint now = backend_->now();
   started_ = now;
   metrics_time_ = now;
@@ -175,9 +178,13 @@ void PortLoop::publish(TimePoint now, bool force) {
     // node nothing has happened to yet has been absent since the loop started.
     TimePoint source = std::max(v.state_since, started_);
     if (v.has_inputs) source = std::max(source, v.inputs_time);
-    if (force || p.gate.due(v, now)) {
-      publisher_.pump_state(config_.port, v, source);
-      p.gate.published(v, now);
+    // Unchanged since the gate was last asked, a pump is due only by time.
+    if (force || v.changes != p.checked || now >= p.gate.deadline()) {
+      p.checked = v.changes;
+      if (force || p.gate.due(v, now)) {
+        publisher_.pump_state(config_.port, v, source);
+        p.gate.published(v, now);
+      }
     }
     if (force || !p.status_once || v.status_changes != p.changes ||
         now >= p.status_time + config_.status_period) {

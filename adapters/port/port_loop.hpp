@@ -122,7 +122,8 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
 
   struct Published {
     rack::PumpStateGate gate;
-    std::uint64_t changes = ~0ull;  // PumpView::changes at the last NodeStatus
+    std::uint64_t checked = ~0ull;  // PumpView::changes when the gate was last asked
+    std::uint64_t changes = ~0ull;  // PumpView::status_changes at the last NodeStatus
     TimePoint status_time{};
     bool status_once = false;
     TimePoint event_time{};  // latest event of this node: the source time

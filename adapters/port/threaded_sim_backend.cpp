@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "adapters/port/steady_time.hpp"
+#include "adapters/port/thread_name.hpp"
 #include "adapters/sim/sim_rack.hpp"
 
 namespace dnbridge::port {
@@ -52,11 +53,12 @@ sim::SimSlave& ThreadedSimBackend::device(devicenet::MacId mac) {
 }
 
 void ThreadedSimBackend::MasterSink::send(const can::CanFrame& frame, TimePoint now) {
-  {
-    std::lock_guard lock(owner_.world_mutex_);
-    owner_.to_world_.emplace_back(frame, now);
-  }
-  owner_.world_woken_.notify_one();
+  // Queued, as in a socket's send buffer; the world is woken for them when
+  // the port waits (see wait()), so the frames of one turn of the port's loop
+  // reach the bus together, at the times they were sent.
+  std::lock_guard lock(owner_.world_mutex_);
+  owner_.to_world_.emplace_back(frame, now);
+  owner_.sent_ = true;
 }
 
 void ThreadedSimBackend::MasterPort::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
@@ -88,6 +90,7 @@ void ThreadedSimBackend::run() {
   // Wake-ups at the simulated end of frame are timed waits: without this the
   // kernel's default timer slack (50 us) would add to every reception.
   (void)prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  name_this_thread("dnb sim bus");
   std::vector<std::pair<can::CanFrame, TimePoint>> sending;
   std::vector<std::function<void()>> running;
   sending.reserve(64);
@@ -123,6 +126,12 @@ void ThreadedSimBackend::run() {
 }
 
 void ThreadedSimBackend::wait(TimePoint deadline, FrameReceiver& receiver) {
+  bool sent = false;
+  {
+    std::lock_guard lock(world_mutex_);
+    std::swap(sent, sent_);
+  }
+  if (sent) world_woken_.notify_one();
   {
     std::unique_lock lock(port_mutex_);
     auto ready = [&] { return wake_ || !to_port_.empty(); };

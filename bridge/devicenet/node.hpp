@@ -58,6 +58,11 @@ class Node final : private ExplicitClient::Listener {
 
   // Poll slot: the node polls at phase + k * poll_period.
   void set_poll_phase(TimePoint phase) { poll_phase_ = phase; }
+  // The slot of the next poll; kNever when the node is not being polled.
+  TimePoint next_poll() const;
+  // Serves the next slot now, ahead of time (the scanner batches polls due
+  // close together); the slot after it is the node's next.
+  void poll_ahead(TimePoint now);
 
   MacId mac() const { return config_.mac; }
   const NodeConfig& config() const { return config_; }

@@ -21,6 +21,17 @@ TimePoint Node::next_poll_slot(TimePoint after) const {
   return poll_phase_ + k * period;
 }
 
+TimePoint Node::next_poll() const {
+  return state_ == NodeState::kOnline && !shutting_down_ ? next_poll_ : kNever;
+}
+
+void Node::poll_ahead(TimePoint now) {
+  if (next_poll() == kNever || now >= next_poll_) return;
+  next_poll_ = next_poll_slot(next_poll_ + Duration(1));
+  // As at the slot itself: a poll still unanswered is not doubled.
+  if (!poll_outstanding_) send_poll(now);
+}
+
 void Node::send_poll(TimePoint now) {
   const std::uint32_t id = group2_id(config_.mac, Group2Message::kMasterIoPoll);
   const std::size_t size = config_.profile.consumed_size;

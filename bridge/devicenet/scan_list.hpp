@@ -91,6 +91,13 @@ struct ScannerConfig {
   unsigned max_consecutive_errors = 10;
   // Outstanding poll given up after this long (or at the next poll, if sooner).
   Duration poll_response_timeout = milliseconds(50);
+  // Polls due within this window of one that is sent now go out with it,
+  // ahead of their slot (by at most a quarter of a node's poll period): one
+  // wake-up of the master serves several nodes, and no node is polled later
+  // than its slot. Zero polls every node exactly at its slot. A batch is
+  // about nodes x window / poll period frames at once: the CAN interface's
+  // transmit queue should hold that many.
+  Duration poll_batch_window = milliseconds(2);
   std::vector<NodeConfig> nodes;
 };
 

@@ -207,8 +207,18 @@ void Scanner::on_timer(TimePoint now) {
     return;
   }
   if (state_ != PortState::kRunning && state_ != PortState::kStopping) return;
+  bool polled = false;
   for (auto& n : nodes_) {
-    if (now >= n->deadline()) n->on_timer(now);
+    if (now < n->deadline()) continue;
+    const std::uint64_t before = n->counters().polls;
+    n->on_timer(now);
+    polled = polled || n->counters().polls != before;
+  }
+  if (polled && config_.poll_batch_window > Duration::zero()) {
+    for (auto& n : nodes_) {
+      const Duration window = std::min(config_.poll_batch_window, n->config().poll_period / 4);
+      if (n->next_poll() <= now + window) n->poll_ahead(now);
+    }
   }
   finish_stopping(now);
 }

@@ -159,6 +159,7 @@ TEST(ConfigFile, MinimalFileTakesTheBuiltInDefaults) {
   EXPECT_EQ(t.poll_response_timeout, scanner_defaults.poll_response_timeout);
   EXPECT_EQ(t.explicit_response_timeout, scanner_defaults.explicit_messaging.response_timeout);
   EXPECT_EQ(t.max_consecutive_errors, scanner_defaults.max_consecutive_errors);
+  EXPECT_EQ(t.poll_batch_window, scanner_defaults.poll_batch_window);
 }
 
 TEST(ConfigFile, NodeSettingsOverrideDefaults) {
@@ -185,6 +186,7 @@ TEST(ConfigFile, NodeSettingsOverrideDefaults) {
       "allocate_retry_max_ms = 800\n"
       "fault_recheck_ms = 3000\n"
       "poll_response_timeout_ms = 20\n"
+      "poll_batch_ms = 0\n"
       "explicit_response_timeout_ms = 1500\n"
       "max_consecutive_errors = 4\n"
       "[[port.node]]\n"
@@ -212,6 +214,7 @@ TEST(ConfigFile, NodeSettingsOverrideDefaults) {
   EXPECT_EQ(p.timings.allocate_retry_max, milliseconds(800));
   EXPECT_EQ(p.timings.fault_recheck, milliseconds(3000));
   EXPECT_EQ(p.timings.poll_response_timeout, milliseconds(20));
+  EXPECT_EQ(p.timings.poll_batch_window, Duration::zero());
   EXPECT_EQ(p.timings.explicit_response_timeout, milliseconds(1500));
   EXPECT_EQ(p.timings.max_consecutive_errors, 4u);
 

@@ -5,6 +5,7 @@
 #include "adapters/port/port_loop.hpp"
 
 #include <gtest/gtest.h>
+#include <pthread.h>
 
 #include <atomic>
 #include <condition_variable>
@@ -267,6 +268,19 @@ TEST(PortLoop, RunsOnTheThreadedSimulatedBus) {
   EXPECT_EQ(applied.get_future().get(), out);
   EXPECT_GT(world->counters().frames, 0u);
   EXPECT_GT(world->sim_thread_cpu_time(), Duration::zero());
+
+  // The threads are named for top -H and debuggers.
+  auto thread_name = [] {
+    char name[16] = {};
+    (void)pthread_getname_np(pthread_self(), name, sizeof name);
+    return std::string(name);
+  };
+  std::promise<std::string> port_thread;
+  loop.post([&](CanBackend&) { port_thread.set_value(thread_name()); });
+  EXPECT_EQ(port_thread.get_future().get(), "dnb port A");
+  std::promise<std::string> world_thread;
+  world->post([&] { world_thread.set_value(thread_name()); });
+  EXPECT_EQ(world_thread.get_future().get(), "dnb sim bus");
 
   loop.stop();
   loop.join();

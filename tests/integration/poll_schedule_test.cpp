@@ -1,0 +1,118 @@
+// The master's poll schedule against simulated CDN127s on an ideal bus (a
+// frame is on the wire the instant it is sent), on a fake clock: every node
+// at its slot, or ahead of it within the batching window, never late.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <vector>
+
+#include "adapters/sim/sim_rack.hpp"
+#include "bridge/devicenet/identifier.hpp"
+#include "integration/rack_fixture.hpp"
+
+namespace dnbridge::test {
+namespace {
+
+using devicenet::Group2Message;
+using devicenet::MessageGroup;
+
+class PollSchedule : public ::testing::Test {
+ protected:
+  void build(std::vector<unsigned> macs, Duration period, Duration window) {
+    sim::SimRackConfig c = rack_config(std::move(macs));
+    c.bus.bitrate = 0;  // ideal: the tap sees each poll at the time it was sent
+    c.port.poll_batch_window = window;
+    for (auto& p : c.pumps) p.node.poll_period = period;
+    rack_ = std::make_unique<sim::SimRack>(std::move(c));
+    rack_->world().bus().set_tap([this](const sim::WireFrame& w) {
+      const auto id = devicenet::decode_identifier(w.frame.id);
+      if (recording_ && id && id->group == MessageGroup::k2 &&
+          id->message_id == static_cast<std::uint8_t>(Group2Message::kMasterIoPoll)) {
+        polls_[id->mac.value()].push_back(w.end);
+      }
+    });
+    rack_->start();
+    ASSERT_TRUE(rack_->world().run_until([&] { return rack_->all_online(); }, seconds(30)));
+  }
+
+  // Polls while the rack runs for `span`, per MAC.
+  void record(Duration span) {
+    recording_ = true;
+    rack_->world().run_for(span);
+    recording_ = false;
+  }
+
+  std::size_t distinct_poll_times() const {
+    std::set<TimePoint> times;
+    for (const auto& [mac, at] : polls_) times.insert(at.begin(), at.end());
+    return times.size();
+  }
+
+  // Shortest and longest gap between two polls of one node, over all nodes.
+  std::pair<Duration, Duration> gap_range() const {
+    Duration shortest = Duration::max();
+    Duration longest = Duration::zero();
+    for (const auto& [mac, at] : polls_) {
+      for (std::size_t i = 1; i < at.size(); ++i) {
+        shortest = std::min(shortest, at[i] - at[i - 1]);
+        longest = std::max(longest, at[i] - at[i - 1]);
+      }
+    }
+    return {shortest, longest};
+  }
+
+  std::unique_ptr<sim::SimRack> rack_;
+  bool recording_ = false;
+  std::map<unsigned, std::vector<TimePoint>> polls_;
+};
+
+TEST_F(PollSchedule, WithoutBatchingEveryNodeIsPolledExactlyAtItsSlot) {
+  build({1, 2, 3, 4, 5, 6, 7, 8}, milliseconds(10), Duration::zero());
+  record(seconds(1));
+  ASSERT_EQ(polls_.size(), 8u);
+  for (const auto& [mac, at] : polls_) EXPECT_EQ(at.size(), 100u) << "MAC " << mac;
+  const auto [shortest, longest] = gap_range();
+  EXPECT_EQ(shortest, milliseconds(10));
+  EXPECT_EQ(longest, milliseconds(10));
+  // Staggered: no two nodes share an instant.
+  EXPECT_EQ(distinct_poll_times(), 800u);
+}
+
+TEST_F(PollSchedule, PollsDueWithinTheWindowGoOutTogetherNeverLate) {
+  // Slots 1.25 ms apart; a 2 ms window serves two slots per wake-up.
+  build({1, 2, 3, 4, 5, 6, 7, 8}, milliseconds(10), milliseconds(2));
+  record(seconds(1));
+  ASSERT_EQ(polls_.size(), 8u);
+  for (const auto& [mac, at] : polls_) {
+    // The slots are unchanged: as many polls as without batching.
+    EXPECT_GE(at.size(), 99u) << "MAC " << mac;
+    EXPECT_LE(at.size(), 101u) << "MAC " << mac;
+  }
+  // Early by at most the window, never late: consecutive polls of a node are
+  // a period apart, give or take the window.
+  const auto [shortest, longest] = gap_range();
+  EXPECT_GE(shortest, milliseconds(8));
+  EXPECT_LE(longest, milliseconds(12));
+  EXPECT_LE(distinct_poll_times(), 400u);
+}
+
+TEST_F(PollSchedule, AWindowLongerThanAQuarterPeriodIsCutToIt) {
+  // 4 ms period: the 2 ms window is cut to 1 ms, so no node is polled more
+  // than 1 ms ahead of its slot.
+  build({1, 2, 3, 4}, milliseconds(4), milliseconds(2));
+  record(seconds(1));
+  ASSERT_EQ(polls_.size(), 4u);
+  for (const auto& [mac, at] : polls_) {
+    EXPECT_GE(at.size(), 249u) << "MAC " << mac;
+    EXPECT_LE(at.size(), 251u) << "MAC " << mac;
+  }
+  const auto [shortest, longest] = gap_range();
+  EXPECT_GE(shortest, milliseconds(3));
+  EXPECT_LE(longest, milliseconds(5));
+  EXPECT_LT(distinct_poll_times(), 1000u);
+}
+
+}  // namespace
+}  // namespace dnbridge::test
