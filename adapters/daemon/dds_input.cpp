@@ -59,7 +59,7 @@ port::PortLoop* DdsInput::port_of(std::string_view name) {
 }
 
 void DdsInput::run() {
-  port::name_this_thread("dnb dds input");
+  port::name_this_thread("dds input");
   for (;;) {
     auto triggered = waitset_.wait(seconds(1));
     if (!triggered) {

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 
-#include "adapters/port/thread_name.hpp"
 
 namespace dnbridge::port {
 
@@ -112,7 +111,6 @@ bool PortLoop::drain_inbox(TimePoint now) {
 }
 
 void PortLoop::run() {
-  name_this_thread("dnb port " + config_.port);
   TimePoint now = backend_->now();
   started_ = now;
   metrics_time_ = now;

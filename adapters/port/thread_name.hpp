@@ -1,7 +1,7 @@
 #pragma once
 // Names the calling thread, so that top -H, ps -L and debuggers tell the
-// bridge's threads apart ("dnb port A", "dnb dds input"). Linux keeps 15
-// characters; the rest is cut.
+// bridge's threads apart ("dds input", "sim bus"; port loops are named
+// "port NAME" by PortLoop). Linux keeps 15 characters; the rest is cut.
 #include <pthread.h>
 
 #include <string>

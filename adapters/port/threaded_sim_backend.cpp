@@ -90,7 +90,7 @@ void ThreadedSimBackend::run() {
   // Wake-ups at the simulated end of frame are timed waits: without this the
   // kernel's default timer slack (50 us) would add to every reception.
   (void)prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
-  name_this_thread("dnb sim bus");
+  name_this_thread("sim bus");
   std::vector<std::pair<can::CanFrame, TimePoint>> sending;
   std::vector<std::function<void()>> running;
   sending.reserve(64);

@@ -277,10 +277,10 @@ TEST(PortLoop, RunsOnTheThreadedSimulatedBus) {
   };
   std::promise<std::string> port_thread;
   loop.post([&](CanBackend&) { port_thread.set_value(thread_name()); });
-  EXPECT_EQ(port_thread.get_future().get(), "dnb port A");
+  EXPECT_EQ(port_thread.get_future().get(), "port A");
   std::promise<std::string> world_thread;
   world->post([&] { world_thread.set_value(thread_name()); });
-  EXPECT_EQ(world_thread.get_future().get(), "dnb sim bus");
+  EXPECT_EQ(world_thread.get_future().get(), "sim bus");
 
   loop.stop();
   loop.join();
