@@ -100,14 +100,6 @@ roster=$out/roster     # "ROLE NAME" per identity of the site
 site_conf=$out/site.conf
 
 # --- the site: its domain and name, kept from the first run ------------------
-if [ "$new_ca" = 1 ] && [ -e "$id_ca" ]; then
-  previous=$out/previous-$(date -u +%Y%m%dT%H%M%SZ)
-  mkdir "$previous"
-  for f in ca hosts governance.xml governance.p7s permissions.xml permissions.p7s; do
-    [ -e "$out/$f" ] && mv "$out/$f" "$previous/"
-  done
-  echo "previous PKI moved to $previous"
-fi
 stored_domain="" stored_site=""
 if [ -f "$site_conf" ]; then
   stored_domain=$(sed -n 's/^domain=//p' "$site_conf")
@@ -123,7 +115,6 @@ if [ -z "$domain" ]; then
 elif [ -n "$stored_domain" ] && [ "$domain" != "$stored_domain" ]; then
   echo "domain changes from $stored_domain to $domain: the documents are made for domain $domain"
 fi
-printf 'site=%s\ndomain=%s\n' "$site" "$domain" >"$site_conf"
 touch "$roster"
 
 # --- the roster: every identity of the site and its role -----------------------
@@ -145,8 +136,18 @@ for i in "${!add_names[@]}"; do
   name=${add_names[$i]}
   [ -n "$(role_of "$name")" ] || echo "${add_roles[$i]} $name" >>"$roster"
 done
+printf 'site=%s\ndomain=%s\n' "$site" "$domain" >"$site_conf"
 
 # --- the CAs -------------------------------------------------------------------
+# --new-ca: the old PKI is kept aside, never deleted.
+if [ "$new_ca" = 1 ] && [ -e "$id_ca" ]; then
+  previous=$out/previous-$(date -u +%Y%m%dT%H%M%SZ)
+  mkdir "$previous"
+  for f in ca hosts governance.xml governance.p7s permissions.xml permissions.p7s; do
+    if [ -e "$out/$f" ]; then mv "$out/$f" "$previous/"; fi
+  done
+  echo "previous PKI moved to $previous"
+fi
 # A self-signed CA certificate and key (prime256v1, which Cyclone's plugins
 # take). The permissions CA signs the documents itself: S/MIME verification
 # wants digitalSignature in its key usage.
