@@ -85,6 +85,9 @@ run --renew rack-A || fail "renewing rack-A: $(cat "$work/out")"
 verify_all
 
 echo "== new CAs"
+if run --new-ca --monitor scada-1; then fail "--new-ca with a role change ran"; fi
+if ls -d "$pki"/previous-* >/dev/null 2>&1; then fail "a refused --new-ca moved the PKI aside"; fi
+[ "$(fingerprint "$pki/ca/identity/ca.pem")" = "$id_ca" ] || fail "a refused --new-ca changed the CA"
 run --new-ca || fail "--new-ca: $(cat "$work/out")"
 [ "$(fingerprint "$pki/ca/identity/ca.pem")" != "$id_ca" ] || fail "--new-ca kept the identity CA"
 ls -d "$pki"/previous-*/ca/identity >/dev/null || fail "the old CAs were not kept aside"
