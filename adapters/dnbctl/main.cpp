@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   app.add_option("--security", security_file,
                  "Join with DDS Security, with the [security] table of FILE (identity_ca, "
                  "certificate, private_key, permissions_ca, governance, permissions; relative "
-                 "paths are relative to FILE; a rack configuration will do). Default "
+                 "paths are relative to FILE). Default "
                  "$DNBCTL_SECURITY; without either, CYCLONEDDS_URI's configuration decides. "
                  "dnbctl refuses to start if a file is missing or wrong")
       ->envname("DNBCTL_SECURITY")
