@@ -5,6 +5,8 @@
 #   /usr/share/dnbridge/idl       the data model, for supervisory programs
 #   /etc/dnbridge                 rack-example.toml and cyclonedds.xml (conffiles)
 #   /usr/share/dnbridge/cyclonedds/loopback.xml   DDS on this host only
+#   /usr/share/dnbridge/security  make-site-pki.sh: a site's DDS Security PKI
+#   /usr/share/doc/dnbridge       README.md; security.md (deploy/security/README.md)
 #   systemd's unit directory      dnbridge@.service (a template: nothing starts
 #                                 until an instance is enabled)
 #   /usr/lib/sysusers.d           the dedicated user dnbridge
@@ -37,6 +39,10 @@ install(FILES ${PROJECT_SOURCE_DIR}/deploy/systemd/dnbridge@.service
 install(FILES ${PROJECT_SOURCE_DIR}/deploy/systemd/dnbridge.sysusers
         DESTINATION ${DNBRIDGE_SYSUSERS_DIR} RENAME dnbridge.conf)
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(PROGRAMS ${PROJECT_SOURCE_DIR}/deploy/security/make-site-pki.sh
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge/security)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/security/README.md
+        DESTINATION ${CMAKE_INSTALL_DOCDIR} RENAME security.md)
 
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME dnbridge)
@@ -61,7 +67,8 @@ endif()
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 # postinst makes the user with systemd-sysusers, or useradd (passwd) without.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "passwd")
-set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "systemd")
+# openssl: make-site-pki.sh, on the host that makes a site's PKI.
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "systemd, openssl")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     "${PROJECT_SOURCE_DIR}/deploy/debian/conffiles;${PROJECT_SOURCE_DIR}/deploy/debian/postinst;${PROJECT_SOURCE_DIR}/deploy/debian/prerm;${PROJECT_SOURCE_DIR}/deploy/debian/postrm")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)

@@ -18,6 +18,8 @@
 #include <tuple>
 #include <utility>
 
+#include "adapters/security/toml_settings.hpp"
+#include "adapters/toml/problems.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
 namespace dnbridge::daemon {
@@ -109,38 +111,13 @@ std::string_view type_name(toml::node_type type) {
   return "an unknown type";
 }
 
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0u : 1u)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
 using KeyList = std::span<const std::string_view>;
 
 // A misspelt key must not fall back silently to a default: every key a table
 // holds must be one it may hold.
 void check_keys(const toml::table& table, std::string_view where, KeyList known, Reporter& r) {
-  for (auto&& [key, value] : table) {
-    const std::string_view name = key.str();
-    if (std::find(known.begin(), known.end(), name) != known.end()) continue;
-    std::string hint;
-    std::size_t best = 3;  // suggest only close matches
-    for (std::string_view k : known) {
-      if (const std::size_t d = edit_distance(name, k); d < best) {
-        best = d;
-        hint = fmt::format(" (did you mean '{}'?)", k);
-      }
-    }
-    r.error(at(key.source()), fmt::format("unknown key '{}' in {}{}", name, where, hint));
+  for (auto& p : toml_config::unknown_keys(table, where, known)) {
+    r.error(at(p.at), std::move(p.text));
   }
 }
 
@@ -277,8 +254,8 @@ constexpr std::array<std::string_view, 15> kPortKeys{"name",
                                                      "explicit_response_timeout_ms",
                                                      "max_consecutive_errors",
                                                      "node"};
-constexpr std::array<std::string_view, 6> kRootKeys{"rack",      "domain",   "master_mac",
-                                                    "log_level", "defaults", "port"};
+constexpr std::array<std::string_view, 7> kRootKeys{"rack",     "domain", "master_mac", "log_level",
+                                                    "defaults", "port",   "security"};
 
 enum class Level { kBuiltIn, kDefaults, kNode };
 
@@ -776,6 +753,12 @@ DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporte
     }
   }
 
+  if (const toml::node* n = root.get("security")) {
+    std::vector<toml_config::Problem> problems;
+    config.security = security::read_table(*n, problems);
+    for (auto& p : problems) r.error(at(p.at), std::move(p.text));
+  }
+
   const toml::table* defaults = nullptr;
   if (const toml::node* n = root.get("defaults")) {
     defaults = n->as_table();
@@ -832,15 +815,6 @@ DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporte
     config.ports.push_back(std::move(port));
   }
   return config;
-}
-
-std::string join_lines(const std::vector<std::string>& lines) {
-  std::string out;
-  for (const auto& l : lines) {
-    if (!out.empty()) out += '\n';
-    out += l;
-  }
-  return out;
 }
 
 // What `dnbridge --simulate` runs; also printed by --print-default-config, so
@@ -901,7 +875,7 @@ bitrate = 500000
 }  // namespace
 
 ConfigError::ConfigError(std::vector<std::string> problems)
-    : std::runtime_error(join_lines(problems)), problems_(std::move(problems)) {}
+    : std::runtime_error(toml_config::join_lines(problems)), problems_(std::move(problems)) {}
 
 std::string_view to_string(NoCommanderPolicy policy) noexcept {
   switch (policy) {
@@ -943,7 +917,12 @@ DaemonConfig load_config_file(const std::filesystem::path& path) {
   if (in.bad()) {
     throw ConfigError({fmt::format("{}: cannot read: {}", path.string(), std::strerror(errno))});
   }
-  return parse_config(text.str(), path.string());
+  DaemonConfig config = parse_config(text.str(), path.string());
+  // [security]'s relative paths are the configuration file's neighbours.
+  if (config.security) {
+    config.security->resolve_relative_to(std::filesystem::absolute(path).parent_path());
+  }
+  return config;
 }
 
 std::string_view embedded_default_config_text() noexcept { return kDefaultConfig; }

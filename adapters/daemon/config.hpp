@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "adapters/security/settings.hpp"
 #include "adapters/socketcan/socketcan_backend.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/common/time.hpp"
@@ -85,6 +86,9 @@ struct DaemonConfig {
   devicenet::MacId master_mac;  // default master MAC of the ports
   std::vector<PortConfig> ports;
   LogLevel log_level = LogLevel::kInfo;
+  // DDS Security of the bridge's participant ([security]); none: Cyclone's
+  // XML configuration decides (CYCLONEDDS_URI), by default no security.
+  std::optional<security::Settings> security;
   std::string source;  // the file it came from, or "embedded default"
   // Things that load but look wrong, "FILE:LINE:COLUMN: text", for the log.
   std::vector<std::string> warnings;

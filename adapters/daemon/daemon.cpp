@@ -56,7 +56,9 @@ BackendFactory default_backend_factory(LogSink& log) {
 Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
     : config_(std::move(config)),
       log_(log, "dnbridge"),
-      participant_(static_cast<dds_domainid_t>(config_.domain_id), config_.rack),
+      participant_(static_cast<dds_domainid_t>(config_.domain_id), config_.rack,
+                   config_.security ? security::participant_properties(*config_.security)
+                                    : dds::Properties{}),
       publisher_(participant_, config_.rack, offered_deadline(config_), Logger(log, "dds")) {
   std::map<std::string, port::PortLoop*> by_name;
   for (const auto& p : config_.ports) {

@@ -13,6 +13,7 @@
 #include "adapters/daemon/log_sink.hpp"
 #include "adapters/daemon/service_notify.hpp"
 #include "adapters/dds/loopback.hpp"
+#include "adapters/security/check.hpp"
 
 namespace {
 
@@ -72,10 +73,16 @@ int main(int argc, char** argv) {
     try {
       auto c = daemon::load_config_file(check_file);
       for (const auto& w : c.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+      std::string security;
+      if (c.security) {
+        const auto identity = security::check(*c.security);
+        security = fmt::format(", DDS Security as {} (certificate valid until {})",
+                               identity.subject, identity.valid_until);
+      }
       std::size_t nodes = 0;
       for (const auto& p : c.ports) nodes += p.nodes.size();
-      std::printf("%s: rack %s, %zu port(s), %zu node(s): OK\n", check_file.c_str(), c.rack.c_str(),
-                  c.ports.size(), nodes);
+      std::printf("%s: rack %s, %zu port(s), %zu node(s)%s: OK\n", check_file.c_str(),
+                  c.rack.c_str(), c.ports.size(), nodes, security.c_str());
       return 0;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "%s\n", e.what());
@@ -88,8 +95,11 @@ int main(int argc, char** argv) {
   }
 
   daemon::DaemonConfig config;
+  std::optional<security::Identity> identity;
   try {
     config = simulate ? daemon::embedded_default_config() : daemon::load_config_file(config_file);
+    // Security asked for and a file wrong: no participant at all.
+    if (config.security) identity = security::check(*config.security);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kBadConfiguration;
@@ -102,6 +112,10 @@ int main(int argc, char** argv) {
   if (!level_name.empty()) log.set_level(*parse_level(level_name));
   Logger main_log(log, "dnbridge");
   for (const auto& w : config.warnings) main_log.warn("{}: {}", config.source, w);
+  if (identity) {
+    main_log.info("DDS Security as {} (certificate valid until {})", identity->subject,
+                  identity->valid_until);
+  }
   if (pinned) {
     main_log.info(
         "DDS pinned to loopback (CYCLONEDDS_URI was not set; see "

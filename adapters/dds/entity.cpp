@@ -18,6 +18,9 @@ std::string describe(std::string_view attempted, dds_return_t code) {
   text += " (";
   text += std::to_string(code);
   text += ")";
+  if (code == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) {
+    text += ": DDS Security, the permissions of this participant's identity do not allow it";
+  }
   return text;
 }
 
@@ -25,6 +28,9 @@ std::string describe(std::string_view attempted, dds_return_t code) {
 
 Error::Error(std::string_view attempted, dds_return_t code)
     : std::runtime_error(describe(attempted, code)), code_(code) {}
+
+Error::Error(std::string_view attempted, dds_return_t code, std::string_view reason)
+    : std::runtime_error(std::string(attempted) + ": " + std::string(reason)), code_(code) {}
 
 const std::error_category& dds_category() noexcept {
   static const DdsCategory category;

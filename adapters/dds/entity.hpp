@@ -18,6 +18,8 @@ namespace dnbridge::dds {
 class Error : public std::runtime_error {
  public:
   Error(std::string_view attempted, dds_return_t code);
+  // With the reason Cyclone gave elsewhere (its log) instead of the code's name.
+  Error(std::string_view attempted, dds_return_t code, std::string_view reason);
   dds_return_t code() const noexcept { return code_; }
 
  private:

@@ -1,26 +1,37 @@
 #pragma once
 // A domain participant of one rack's bridge (or of a client), named through
-// the entity-name QoS policy so that tools show which rack it serves.
+// the entity-name QoS policy so that tools show which rack it serves, with
+// the QoS properties it is given (DDS Security's, adapters/security).
 #include <dds/dds.h>
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "adapters/dds/entity.hpp"
 
 namespace dnbridge::dds {
 
+// A QoS property of a participant (name, value), e.g. "dds.sec.auth.identity_ca".
+struct Property {
+  std::string name;
+  std::string value;
+};
+using Properties = std::vector<Property>;
+
 class Participant : public Entity {
  public:
-  // Joins `domain` as "dnbridge <rack>". Throws Error.
-  Participant(dds_domainid_t domain, std::string_view rack);
+  // Joins `domain` as "dnbridge <rack>". Throws Error; when Cyclone refuses
+  // the participant, the message has the reason Cyclone logged (a DDS
+  // Security plugin's, for instance).
+  Participant(dds_domainid_t domain, std::string_view rack, const Properties& properties = {});
 
   // A participant that is not a bridge (a client such as dnbctl), named as
   // given, so that tools never mistake it for a rack's bridge. Throws Error.
   struct ClientName {
     std::string_view name;
   };
-  Participant(dds_domainid_t domain, ClientName client);
+  Participant(dds_domainid_t domain, ClientName client, const Properties& properties = {});
 
   dds_domainid_t domain() const noexcept { return domain_; }
 

@@ -95,6 +95,11 @@ Qos& Qos::entity_name(const std::string& name) {
   return *this;
 }
 
+Qos& Qos::property(const std::string& name, const std::string& value) {
+  dds_qset_prop(qos_, name.c_str(), value.c_str());
+  return *this;
+}
+
 Qos& Qos::lifespan(Duration d) {
   dds_qset_lifespan(qos_, to_dds(d));
   return *this;

@@ -45,6 +45,8 @@ class Qos {
   // Whether deleting a writer (or unregistering an instance) also disposes.
   Qos& autodispose_unregistered_instances(bool autodispose);
   Qos& userdata(std::span<const std::byte> data);
+  // A property (name, value) of the property policy, e.g. DDS Security's.
+  Qos& property(const std::string& name, const std::string& value);
 
   const dds_qos_t* get() const noexcept { return qos_; }
 

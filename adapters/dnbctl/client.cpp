@@ -64,8 +64,9 @@ void install_interrupt_handlers() {
 
 bool interrupted() noexcept { return g_interrupted != 0; }
 
-Client::Client(std::uint32_t domain, const std::string& name)
-    : participant_(static_cast<dds_domainid_t>(domain), dds::Participant::ClientName{name}),
+Client::Client(std::uint32_t domain, const std::string& name, const dds::Properties& properties)
+    : participant_(static_cast<dds_domainid_t>(domain), dds::Participant::ClientName{name},
+                   properties),
       pump_topic_(participant_),
       node_topic_(participant_),
       port_topic_(participant_),

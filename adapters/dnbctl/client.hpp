@@ -50,9 +50,9 @@ bool interrupted() noexcept;
 
 class Client {
  public:
-  // Joins `domain` as participant `name` (e.g. "dnbctl user@host:pid").
-  // Throws dds::Error.
-  Client(std::uint32_t domain, const std::string& name);
+  // Joins `domain` as participant `name` (e.g. "dnbctl user@host:pid"),
+  // with `properties` (DDS Security's). Throws dds::Error.
+  Client(std::uint32_t domain, const std::string& name, const dds::Properties& properties = {});
 
   const dds::Participant& participant() const noexcept { return participant_; }
 

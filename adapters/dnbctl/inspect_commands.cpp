@@ -13,7 +13,9 @@
 namespace dnbridge::dnbctl {
 
 Client make_client(const GlobalOptions& options) {
-  return Client(options.domain, fmt::format("dnbctl {}:{}", user_at_host(), getpid()));
+  return Client(
+      options.domain, fmt::format("dnbctl {}:{}", user_at_host(), getpid()),
+      options.security ? security::participant_properties(*options.security) : dds::Properties{});
 }
 
 void print(const std::string& text) {

@@ -8,6 +8,8 @@
 
 #include "adapters/dds/entity.hpp"
 #include "adapters/dnbctl/commands.hpp"
+#include "adapters/security/check.hpp"
+#include "adapters/security/toml_settings.hpp"
 
 namespace {
 
@@ -15,7 +17,8 @@ using namespace dnbridge::dnbctl;
 
 constexpr const char* kFooter =
     "Exit codes: 0 success; 1 the operation failed (refused, not applied, device error status); "
-    "2 usage error; 3 nothing found (no bridge or node answered within the timeout).\n"
+    "2 usage error (or a --security file missing or wrong); 3 nothing found (no bridge or node "
+    "answered within the timeout).\n"
     "Every command has --help. Global options may come before or after the command.";
 
 int code(Exit e) { return static_cast<int>(e); }
@@ -40,6 +43,15 @@ int main(int argc, char** argv) {
                  "Seconds to wait for bridges to answer, and for each wait (default 3)")
       ->check(CLI::PositiveNumber);
   app.add_flag("--json", options.json, "Machine-readable output: one JSON document");
+  std::string security_file;
+  app.add_option("--security", security_file,
+                 "Join with DDS Security, with the [security] table of FILE (identity_ca, "
+                 "certificate, private_key, permissions_ca, governance, permissions; relative "
+                 "paths are relative to FILE). Default "
+                 "$DNBCTL_SECURITY; without either, CYCLONEDDS_URI's configuration decides. "
+                 "dnbctl refuses to start if a file is missing or wrong")
+      ->envname("DNBCTL_SECURITY")
+      ->type_name("FILE");
 
   ListArgs list;
   ShowArgs show;
@@ -65,6 +77,16 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);  // prints help, or the error with a hint
     return rc == 0 ? 0 : code(Exit::kUsage);
+  }
+
+  if (!security_file.empty()) {
+    try {
+      options.security = dnbridge::security::load_file(security_file);
+      (void)dnbridge::security::check(*options.security);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "dnbctl: %s\n", e.what());
+      return code(Exit::kUsage);
+    }
   }
 
   try {

@@ -3,10 +3,12 @@
 // the error that ends a command with one of them.
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "adapters/security/settings.hpp"
 #include "bridge/common/time.hpp"
 
 namespace dnbridge::dnbctl {
@@ -37,6 +39,9 @@ struct GlobalOptions {
   std::string port;  // empty: any port
   double timeout_seconds = 3.0;
   bool json = false;
+  // DDS Security of dnbctl's participant (--security FILE, checked); none:
+  // Cyclone's XML configuration decides (CYCLONEDDS_URI).
+  std::optional<security::Settings> security;
 
   Duration timeout() const {
     return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(timeout_seconds));

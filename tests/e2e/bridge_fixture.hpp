@@ -19,11 +19,13 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <ostream>
 #include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "adapters/daemon/config.hpp"
@@ -34,7 +36,16 @@
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
 #include "adapters/port/sim_backend.hpp"
+#include "bridge/profiles/cdn127/io_data.hpp"
 #include "dds/dds_fixture.hpp"
+
+namespace dnbridge::profiles::cdn127 {
+// What a simulated device drives, as test failures print it.
+inline void PrintTo(const PumpOutputs& o, std::ostream* os) {
+  *os << "{pump_on " << o.pump_on << ", n2_ballast_on " << o.n2_ballast_on << ", analog "
+      << o.analog_out_raw << "}";
+}
+}  // namespace dnbridge::profiles::cdn127
 
 namespace dnbridge::e2e {
 
@@ -212,6 +223,29 @@ inline auto pump_mac(unsigned mac) {
   return [mac](const auto& s) { return s.mac == mac; };
 }
 
+// Runs `fn` with a port's simulated backend on the port's thread and returns
+// what it returns. Throws (a test failure) if the thread does not get to it
+// in time.
+template <class F>
+auto on_sim_port(daemon::Daemon& bridge, std::string_view port, F fn) {
+  using R = std::invoke_result_t<F&, port::SimBackend&>;
+  auto done = std::make_shared<std::promise<R>>();
+  auto result = done->get_future();
+  bridge.port(port)->post([done, fn](port::CanBackend& backend) mutable {
+    auto& sim = static_cast<port::SimBackend&>(backend);
+    if constexpr (std::is_void_v<R>) {
+      fn(sim);
+      done->set_value();
+    } else {
+      done->set_value(fn(sim));
+    }
+  });
+  if (result.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
+    throw std::runtime_error("the port's thread did not run the probe");
+  }
+  return result.get();
+}
+
 // The supervisor's side of the six topics, and the bridge it talks to.
 class BridgeTest : public ::testing::Test {
  protected:
@@ -276,27 +310,11 @@ class BridgeTest : public ::testing::Test {
     }
   }
 
-  // Runs `fn` with the port's simulated backend on the port's thread and
-  // returns what it returns. Throws (a test failure) if the thread does not
-  // get to it in time.
+  // Runs `fn` with the port's simulated backend on the port's thread
+  // (on_sim_port above).
   template <class F>
   auto on_port(F fn) {
-    using R = std::invoke_result_t<F&, port::SimBackend&>;
-    auto done = std::make_shared<std::promise<R>>();
-    auto result = done->get_future();
-    bridge_->port(kPort)->post([done, fn](port::CanBackend& backend) mutable {
-      auto& sim = static_cast<port::SimBackend&>(backend);
-      if constexpr (std::is_void_v<R>) {
-        fn(sim);
-        done->set_value();
-      } else {
-        done->set_value(fn(sim));
-      }
-    });
-    if (result.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
-      throw std::runtime_error("the port's thread did not run the probe");
-    }
-    return result.get();
+    return on_sim_port(*bridge_, kPort, std::move(fn));
   }
 
   static sim::SimSlave& slave(port::SimBackend& backend, unsigned mac) {

@@ -3,17 +3,9 @@
 // the idle action once no commander is left; a bad command refused and
 // reported.
 #include <memory>
-#include <ostream>
 
 #include "bridge_fixture.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
-
-namespace dnbridge::profiles::cdn127 {
-inline void PrintTo(const PumpOutputs& o, std::ostream* os) {
-  *os << "{pump_on " << o.pump_on << ", n2_ballast_on " << o.n2_ballast_on << ", analog "
-      << o.analog_out_raw << "}";
-}
-}  // namespace dnbridge::profiles::cdn127
 
 namespace dnbridge::e2e {
 namespace {

@@ -45,14 +45,15 @@ unit_dir=""
 for f in /usr/bin/dnbridge /usr/bin/dnbctl /usr/bin/cdn127-sim \
          /usr/share/dnbridge/idl/dnbridge.idl /usr/share/dnbridge/cyclonedds/loopback.xml \
          /etc/dnbridge/rack-example.toml /etc/dnbridge/cyclonedds.xml \
-         /usr/lib/sysusers.d/dnbridge.conf; do
+         /usr/lib/sysusers.d/dnbridge.conf /usr/share/dnbridge/security/make-site-pki.sh \
+         /usr/share/doc/dnbridge/security.md; do
   [ -f "$f" ] || fail "$f not installed"
 done
 for d in /lib/systemd/system /usr/lib/systemd/system; do
   [ -f "$d/dnbridge@.service" ] && unit_dir=$d && break
 done
 [ -n "$unit_dir" ] || fail "dnbridge@.service not installed"
-for f in /usr/bin/dnbridge /usr/bin/dnbctl /usr/bin/cdn127-sim; do
+for f in /usr/bin/dnbridge /usr/bin/dnbctl /usr/bin/cdn127-sim /usr/share/dnbridge/security/make-site-pki.sh; do
   [ -x "$f" ] || fail "$f not executable"
 done
 conffiles=$(dpkg-query -W -f='${Conffiles}' dnbridge)

@@ -1,0 +1,61 @@
+#include "adapters/toml/problems.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace dnbridge::toml_config {
+namespace {
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0u : 1u)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::vector<Problem> unknown_keys(const toml::table& table, std::string_view where,
+                                  std::span<const std::string_view> known) {
+  std::vector<Problem> out;
+  for (auto&& [key, value] : table) {
+    const std::string_view name = key.str();
+    if (std::find(known.begin(), known.end(), name) != known.end()) continue;
+    std::string hint;
+    std::size_t best = 3;  // suggest only close matches
+    for (std::string_view k : known) {
+      if (const std::size_t d = edit_distance(name, k); d < best) {
+        best = d;
+        hint = fmt::format(" (did you mean '{}'?)", k);
+      }
+    }
+    out.push_back({key.source(), fmt::format("unknown key '{}' in {}{}", name, where, hint)});
+  }
+  return out;
+}
+
+std::string format(std::string_view source, const Problem& problem) {
+  // An empty document has no position; its problems are at its start.
+  return fmt::format("{}:{}:{}: {}", source, std::max<std::uint32_t>(problem.at.begin.line, 1),
+                     std::max<std::uint32_t>(problem.at.begin.column, 1), problem.text);
+}
+
+std::string join_lines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& l : lines) {
+    if (!out.empty()) out += '\n';
+    out += l;
+  }
+  return out;
+}
+
+}  // namespace dnbridge::toml_config

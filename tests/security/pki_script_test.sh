@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# deploy/security/make-site-pki.sh as an administrator uses it, in a
+# temporary directory: first run, run again (nothing reissued), a role
+# change refused, a host added, a host renewed, new CAs; after each, the
+# certificates verify against the identity CA and the documents against the
+# permissions CA as openssl sees them. Fails, never skips.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+script=$here/../../deploy/security/make-site-pki.sh
+fail() { echo "FAIL: $*" >&2; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+pki=$work/pki
+run() { bash "$script" --out "$pki" "$@" >"$work/out" 2>&1; }
+fingerprint() { openssl x509 -in "$1" -noout -fingerprint -sha256; }
+# Every host's certificate verifies against the identity CA, both signed
+# documents against the permissions CA.
+verify_all() {
+  for host in "$pki"/hosts/*/; do
+    openssl verify -CAfile "$pki/ca/identity/ca.pem" "$host/cert.pem" >/dev/null ||
+      fail "$host/cert.pem does not verify against the identity CA"
+    for doc in governance permissions; do
+      cmp -s "$pki/$doc.p7s" "$host/$doc.p7s" || fail "$host/$doc.p7s is not the site's"
+    done
+    cmp -s "$pki/ca/identity/ca.pem" "$host/identity_ca.pem" || fail "$host/identity_ca.pem is not the site's"
+    [ "$(stat -c %a "$host/key.pem")" = 600 ] || fail "$host/key.pem is readable by others"
+  done
+  for doc in governance permissions; do
+    openssl smime -verify -text -in "$pki/$doc.p7s" -CAfile "$pki/ca/permissions/ca.pem" \
+      >"$work/$doc.out" 2>/dev/null || fail "$doc.p7s does not verify against the permissions CA"
+    # S/MIME signs the text with CRLF line ends.
+    tr -d '\r' <"$work/$doc.out" | cmp -s - "$pki/$doc.xml" || fail "$doc.p7s does not sign $doc.xml"
+  done
+  [ "$(stat -c %a "$pki/ca/identity/ca.key")" = 600 ] || fail "the identity CA key is readable by others"
+}
+
+echo "== the first run needs a domain"
+if run --bridge rack-A; then fail "ran without --domain"; fi
+grep -q -- "--domain ID is required" "$work/out" || fail "no clear message: $(cat "$work/out")"
+[ ! -e "$pki/ca/identity/ca.pem" ] || fail "made a CA although the command line was incomplete"
+
+echo "== a site"
+run --domain 17 --site acme --bridge rack-A --supervisor scada-1 --monitor ops-1 --days 30 ||
+  fail "first run: $(cat "$work/out")"
+verify_all
+id_ca=$(fingerprint "$pki/ca/identity/ca.pem")
+rack_a=$(fingerprint "$pki/hosts/rack-A/cert.pem")
+grep -q "<id>17</id>" "$pki/governance.xml" || fail "governance is not for domain 17"
+grep -q "<allow_unauthenticated_participants>false<" "$pki/governance.xml" || fail "unauthenticated participants allowed"
+grep -q "<enable_join_access_control>true<" "$pki/governance.xml" || fail "join access control off"
+[ "$(grep -c "<default>DENY</default>" "$pki/permissions.xml")" = 3 ] || fail "not every grant defaults to DENY"
+subject=$(openssl x509 -in "$pki/hosts/ops-1/cert.pem" -noout -subject -nameopt RFC2253 | sed 's/^subject=//')
+grep -q "<subject_name>$subject</subject_name>" "$pki/permissions.xml" || fail "no grant names $subject"
+# The monitor's grant: PumpState, NodeStatus, PortStatus read; nothing written.
+grant=$(sed -n '/<grant name="monitor-ops-1">/,/<\/grant>/p' "$pki/permissions.xml")
+grep -q "<publish>" <<<"$grant" && fail "the monitor may publish"
+[ "$(grep -c "<topic>" <<<"$grant")" = 3 ] || fail "the monitor reads other than the three state topics"
+days=$(( ( $(date -d "$(openssl x509 -in "$pki/hosts/rack-A/cert.pem" -noout -enddate | cut -d= -f2)" +%s) - $(date +%s) ) / 86400 ))
+[ "$days" -ge 29 ] && [ "$days" -le 30 ] || fail "--days 30 gave a certificate valid $days days"
+
+echo "== the same command again: nothing reissued"
+run --domain 17 --site acme --bridge rack-A --supervisor scada-1 --monitor ops-1 || fail "second run: $(cat "$work/out")"
+[ "$(fingerprint "$pki/ca/identity/ca.pem")" = "$id_ca" ] || fail "the identity CA changed"
+[ "$(fingerprint "$pki/hosts/rack-A/cert.pem")" = "$rack_a" ] || fail "rack-A was reissued"
+verify_all
+
+echo "== a name keeps its role"
+cp "$pki/roster" "$work/roster.before"
+if run --bridge rack-B --monitor scada-1; then fail "scada-1 became a monitor"; fi
+grep -q "scada-1 is already a supervisor" "$work/out" || fail "no clear message: $(cat "$work/out")"
+cmp -s "$pki/roster" "$work/roster.before" || fail "a refused run changed the roster"
+[ ! -e "$pki/hosts/rack-B" ] || fail "a refused run issued rack-B"
+
+echo "== a host added, the site's domain kept"
+run --bridge rack-B || fail "adding rack-B: $(cat "$work/out")"
+[ "$(fingerprint "$pki/hosts/rack-A/cert.pem")" = "$rack_a" ] || fail "adding rack-B reissued rack-A"
+grep -q "<subject_name>CN=rack-B,OU=bridge,O=acme</subject_name>" "$pki/permissions.xml" || fail "no grant for rack-B"
+grep -q "<id>17</id>" "$pki/permissions.xml" || fail "the domain was not kept"
+verify_all
+
+echo "== a host renewed"
+run --renew rack-A || fail "renewing rack-A: $(cat "$work/out")"
+[ "$(fingerprint "$pki/hosts/rack-A/cert.pem")" != "$rack_a" ] || fail "--renew kept the certificate"
+[ "$(fingerprint "$pki/ca/identity/ca.pem")" = "$id_ca" ] || fail "--renew changed the CA"
+verify_all
+
+echo "== new CAs"
+if run --new-ca --monitor scada-1; then fail "--new-ca with a role change ran"; fi
+if ls -d "$pki"/previous-* >/dev/null 2>&1; then fail "a refused --new-ca moved the PKI aside"; fi
+[ "$(fingerprint "$pki/ca/identity/ca.pem")" = "$id_ca" ] || fail "a refused --new-ca changed the CA"
+run --new-ca || fail "--new-ca: $(cat "$work/out")"
+[ "$(fingerprint "$pki/ca/identity/ca.pem")" != "$id_ca" ] || fail "--new-ca kept the identity CA"
+ls -d "$pki"/previous-*/ca/identity >/dev/null || fail "the old CAs were not kept aside"
+[ "$(ls "$pki/hosts" | wc -l)" = 4 ] || fail "not every identity was issued again: $(ls "$pki/hosts")"
+verify_all
+echo "OK"
