@@ -6,6 +6,7 @@
 #   /etc/dnbridge                 rack-example.toml and cyclonedds.xml (conffiles)
 #   /usr/share/dnbridge/cyclonedds/loopback.xml   DDS on this host only
 #   /usr/share/dnbridge/networkd  systemd-networkd examples for the CAN interfaces
+#   /usr/share/doc/dnbridge       README.md, operations.md (deploy/README.md)
 #   systemd's unit directory      dnbridge@.service (a template: nothing starts
 #                                 until an instance is enabled)
 #   /usr/lib/sysusers.d           the dedicated user dnbridge
@@ -38,6 +39,8 @@ install(FILES ${PROJECT_SOURCE_DIR}/deploy/systemd/dnbridge@.service
 install(FILES ${PROJECT_SOURCE_DIR}/deploy/systemd/dnbridge.sysusers
         DESTINATION ${DNBRIDGE_SYSUSERS_DIR} RENAME dnbridge.conf)
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR}
+        RENAME operations.md)
 file(GLOB DNBRIDGE_NETWORKD_EXAMPLES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/deploy/networkd/*.network)
 install(FILES ${DNBRIDGE_NETWORKD_EXAMPLES} DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge/networkd)
 
