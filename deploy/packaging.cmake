@@ -6,7 +6,9 @@
 #   /etc/dnbridge                 rack-example.toml and cyclonedds.xml (conffiles)
 #   /usr/share/dnbridge/cyclonedds/loopback.xml   DDS on this host only
 #   /usr/share/dnbridge/security  make-site-pki.sh: a site's DDS Security PKI
-#   /usr/share/doc/dnbridge       README.md; security.md (deploy/security/README.md)
+#   /usr/share/dnbridge/networkd  systemd-networkd examples for the CAN interfaces
+#   /usr/share/doc/dnbridge       README.md; operations.md (deploy/README.md);
+#                                 security.md (deploy/security/README.md)
 #   systemd's unit directory      dnbridge@.service (a template: nothing starts
 #                                 until an instance is enabled)
 #   /usr/lib/sysusers.d           the dedicated user dnbridge
@@ -43,6 +45,10 @@ install(PROGRAMS ${PROJECT_SOURCE_DIR}/deploy/security/make-site-pki.sh
         DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge/security)
 install(FILES ${PROJECT_SOURCE_DIR}/deploy/security/README.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR} RENAME security.md)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR}
+        RENAME operations.md)
+file(GLOB DNBRIDGE_NETWORKD_EXAMPLES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/deploy/networkd/*.network)
+install(FILES ${DNBRIDGE_NETWORKD_EXAMPLES} DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge/networkd)
 
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME dnbridge)

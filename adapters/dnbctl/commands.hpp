@@ -19,13 +19,17 @@ Client make_client(const GlobalOptions& options);
 // Prints `text` on stdout as it is.
 void print(const std::string& text);
 
-// --- inspect_commands.cpp: list, show -------------------------------------------
+// --- inspect_commands.cpp: list, racks, show ------------------------------------
 struct ListArgs {
   bool nodes_only = false;
   bool ports_only = false;
 };
 CLI::App* add_list(CLI::App& app, ListArgs& args);
 Exit run_list(const GlobalOptions& options, const ListArgs& args);
+
+// racks: takes only the global options.
+CLI::App* add_racks(CLI::App& app);
+Exit run_racks(const GlobalOptions& options);
 
 struct ShowArgs {
   std::string mac;

@@ -133,18 +133,19 @@ std::string nodes_table(std::span<const NodeRow> nodes) {
   Table t({"RACK", "PORT", "MAC", "NAME", "STATE", "ONLINE", "PRODUCT", "REASON"});
   for (const auto& r : nodes) {
     const auto& n = *r.node;
-    const bool online = r.alive && (r.pump ? r.pump->online : n.state == dnbridge_NODE_ONLINE);
     t.add({std::string(view(n.rack)), std::string(view(n.port)), fmt::format("{}", n.mac),
-           std::string(view(n.name)), std::string(to_text(n.state)), yes_no(online),
+           std::string(view(n.name)), std::string(to_text(n.state)), yes_no(node_online(r)),
            std::string(view(n.product_name)),
            r.alive ? std::string(view(n.reason)) : "bridge gone: " + std::string(view(n.reason))});
   }
   return t.render();
 }
 
-namespace {
+bool node_online(const NodeRow& r) {
+  return r.alive && (r.pump ? r.pump->online : r.node->state == dnbridge_NODE_ONLINE);
+}
 
-void port_members(JsonWriter& out, const dnbridge_PortStatus& p) {
+void port_json_members(JsonWriter& out, const dnbridge_PortStatus& p) {
   out.field("port", view(p.port))
       .field("state", to_text(p.state))
       .field("reason", view(p.reason))
@@ -161,15 +162,16 @@ void port_members(JsonWriter& out, const dnbridge_PortStatus& p) {
       .field("nodes_configured", unsigned{p.nodes_configured});
 }
 
+namespace {
+
 void node_list_members(JsonWriter& out, const NodeRow& r) {
   const auto& n = *r.node;
-  const bool online = r.alive && (r.pump ? r.pump->online : n.state == dnbridge_NODE_ONLINE);
   out.field("mac", unsigned{n.mac})
       .field("name", view(n.name))
       .field("state", to_text(n.state))
       .field("reason", view(n.reason))
       .field("product", view(n.product_name))
-      .field("online", online);
+      .field("online", node_online(r));
 }
 
 }  // namespace
@@ -195,7 +197,7 @@ void list_json(JsonWriter& out, std::span<const PortRow> ports, std::span<const 
     for (auto& [name, e] : rack_ports) {
       out.begin_object();
       if (e.row) {
-        port_members(out, *e.row->port);
+        port_json_members(out, *e.row->port);
       } else {
         out.field("port", name);
       }

@@ -55,6 +55,12 @@ struct NodeRow {
   bool alive = true;
 };
 
+// Whether a node is online as dnbctl shows it: its bridge is there, and it
+// is polled (PumpState's `online`, else the NodeStatus state).
+bool node_online(const NodeRow& row);
+// The members of a port's JSON object (list, racks).
+void port_json_members(JsonWriter& out, const dnbridge_PortStatus& p);
+
 std::string ports_table(std::span<const PortRow> ports);
 std::string nodes_table(std::span<const NodeRow> nodes);
 // {"racks": [{"rack", "bridge_alive", "ports": [{..., "nodes": [...]}]}]}

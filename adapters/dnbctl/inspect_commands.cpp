@@ -1,12 +1,14 @@
-// list and show: what the bridges report about their ports and nodes.
+// list, racks and show: what the bridges report about their ports and nodes.
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <cstdio>
 
 #include "adapters/dds/fields.hpp"
+#include "adapters/dnbctl/bridges.hpp"
 #include "adapters/dnbctl/commands.hpp"
 #include "adapters/dnbctl/format.hpp"
+#include "adapters/dnbctl/rack_summary.hpp"
 #include "adapters/dnbctl/target.hpp"
 #include "adapters/dnbctl/values.hpp"
 
@@ -46,6 +48,49 @@ bool any_port(const Client& client, const GlobalOptions& o) {
   return false;
 }
 
+// Waits as list and racks do: until `found` (else kNotFound), then kSettle
+// for other bridges to be heard, then until nothing is `missing` or the
+// timeout (then a note on stderr says what is missing; what was heard is
+// shown all the same).
+void gather(Client& client, const GlobalOptions& o, const std::function<bool()>& found,
+            const std::function<std::string()>& missing) {
+  const Deadline deadline = deadline_after(o.timeout());
+  if (!client.wait_until(deadline, found)) {
+    throw CommandError(Exit::kNotFound,
+                       fmt::format("no bridge answered on DDS domain {}{} within {:g} s", o.domain,
+                                   o.rack.empty() ? "" : fmt::format(" for rack \"{}\"", o.rack),
+                                   o.timeout_seconds));
+  }
+  const Deadline settle = std::min(deadline, deadline_after(kSettle));
+  client.wait_until(settle, [] { return false; });
+  if (!client.wait_until(deadline, [&] { return missing().empty(); })) {
+    std::fprintf(stderr, "dnbctl: note: %s within the timeout\n", missing().c_str());
+  }
+}
+
+std::string nodes_missing(const Client& client, const GlobalOptions& o) {
+  return complete(client, o) ? std::string() : "not every configured node was reported";
+}
+
+// The rows list and racks show: what the options allow.
+std::vector<PortRow> port_rows(const Client& client, const GlobalOptions& o) {
+  std::vector<PortRow> ports;
+  for (const auto& [k, p] : client.ports()) {
+    if (o.matches(k.rack, k.port)) ports.push_back({p.data.get(), p.alive});
+  }
+  return ports;
+}
+
+std::vector<NodeRow> node_rows(const Client& client, const GlobalOptions& o) {
+  std::vector<NodeRow> nodes;
+  for (const auto& [k, n] : client.nodes()) {
+    if (!o.matches(k.rack, k.port)) continue;
+    const auto* pump = client.pump(k);
+    nodes.push_back({n.data.get(), pump ? pump->data.get() : nullptr, n.alive});
+  }
+  return nodes;
+}
+
 }  // namespace
 
 CLI::App* add_list(CLI::App& app, ListArgs& args) {
@@ -62,30 +107,11 @@ CLI::App* add_list(CLI::App& app, ListArgs& args) {
 
 Exit run_list(const GlobalOptions& o, const ListArgs& args) {
   Client client = make_client(o);
-  const Deadline deadline = deadline_after(o.timeout());
-  if (!client.wait_until(deadline, [&] { return any_port(client, o); })) {
-    throw CommandError(Exit::kNotFound,
-                       fmt::format("no bridge answered on DDS domain {}{} within {:g} s", o.domain,
-                                   o.rack.empty() ? "" : fmt::format(" for rack \"{}\"", o.rack),
-                                   o.timeout_seconds));
-  }
-  // Other bridges get kSettle to be heard; every port's nodes, the timeout.
-  const Deadline settle = std::min(deadline, deadline_after(kSettle));
-  client.wait_until(settle, [] { return false; });
-  if (!client.wait_until(deadline, [&] { return complete(client, o); })) {
-    std::fputs("dnbctl: note: not every configured node was reported within the timeout\n", stderr);
-  }
+  const auto found = [&] { return any_port(client, o); };
+  gather(client, o, found, [&] { return nodes_missing(client, o); });
 
-  std::vector<PortRow> ports;
-  for (const auto& [k, p] : client.ports()) {
-    if (o.matches(k.rack, k.port)) ports.push_back({p.data.get(), p.alive});
-  }
-  std::vector<NodeRow> nodes;
-  for (const auto& [k, n] : client.nodes()) {
-    if (!o.matches(k.rack, k.port)) continue;
-    const auto* pump = client.pump(k);
-    nodes.push_back({n.data.get(), pump ? pump->data.get() : nullptr, n.alive});
-  }
+  const std::vector<PortRow> ports = port_rows(client, o);
+  const std::vector<NodeRow> nodes = node_rows(client, o);
 
   if (o.json) {
     JsonWriter out;
@@ -98,6 +124,56 @@ Exit run_list(const GlobalOptions& o, const ListArgs& args) {
   if (!args.nodes_only && !args.ports_only) text += "\n";
   if (!args.ports_only) text += nodes_table(nodes);
   print(text);
+  return Exit::kOk;
+}
+
+CLI::App* add_racks(CLI::App& app) {
+  return app.add_subcommand(
+      "racks",
+      "Find every bridge on the domain and summarize each rack: its bridge (live, no status yet, "
+      "gone), ports running, and how many nodes are online, idle (no commander), starting, "
+      "absent, faulted (wrong device, configuration fault), owned by another master, stopped or "
+      "unknown (no longer published); then the ports that need attention and every node that is "
+      "not online, with the reason. A bridge is found by its participant (\"dnbridge <rack>\") "
+      "even before it publishes anything. --json gives every node with its class.");
+}
+
+Exit run_racks(const GlobalOptions& o) {
+  Client client = make_client(o);
+  Bridges bridges(client);
+  const auto bridge_racks = [&] {
+    bridges.refresh();
+    std::map<std::string, unsigned> racks = bridges.live();
+    std::erase_if(racks, [&](const auto& r) { return !o.rack.empty() && r.first != o.rack; });
+    return racks;
+  };
+  const auto has_status = [&](const std::string& rack) {
+    for (const auto& [k, p] : client.ports()) {
+      if (k.rack == rack) return true;
+    }
+    return false;
+  };
+  gather(
+      client, o, [&] { return any_port(client, o) || !bridge_racks().empty(); },
+      [&] {
+        std::string silent;
+        for (const auto& [rack, count] : bridge_racks()) {
+          if (!has_status(rack)) silent += (silent.empty() ? "" : ", ") + rack;
+        }
+        if (!silent.empty()) return "no status from the bridge of " + silent;
+        return nodes_missing(client, o);
+      });
+
+  const std::vector<PortRow> ports = port_rows(client, o);
+  const std::vector<NodeRow> nodes = node_rows(client, o);
+  const std::vector<RackSummary> racks = summarize_racks(ports, nodes, bridge_racks());
+  if (o.json) {
+    JsonWriter out;
+    racks_json(out, racks);
+    print(out.str() + "\n");
+  } else {
+    print(racks_text(racks));
+  }
   return Exit::kOk;
 }
 

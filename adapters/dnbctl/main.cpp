@@ -63,6 +63,7 @@ int main(int argc, char** argv) {
   ExplicitArgs set;
   ExplicitArgs service;
   auto* list_cmd = add_list(app, list);
+  auto* racks_cmd = add_racks(app);
   auto* watch_cmd = add_watch(app, watch);
   auto* pump_cmd = add_output(app, Output::kPump, pump);
   auto* ballast_cmd = add_output(app, Output::kBallast, ballast);
@@ -92,6 +93,7 @@ int main(int argc, char** argv) {
   try {
     Exit rc = Exit::kOk;
     if (list_cmd->parsed()) rc = run_list(options, list);
+    if (racks_cmd->parsed()) rc = run_racks(options);
     if (show_cmd->parsed()) rc = run_show(options, show);
     if (watch_cmd->parsed()) rc = run_watch(options, watch);
     if (pump_cmd->parsed()) rc = run_output(options, pump);

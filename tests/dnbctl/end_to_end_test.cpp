@@ -1,15 +1,12 @@
 // The real dnbctl program, run as a child process, against a bridge of the
 // simulated rack (eight CDN127 pumps at MACs 1..8 on port "A") running in
 // this process. Both are pinned to loopback on a domain and discovery tag of
-// this process's own (the child inherits CYCLONEDDS_URI), so parallel test
-// processes never hear each other. Node 3 holds its last outputs when no
+// this process's own (test_domain.hpp). Node 3 holds its last outputs when no
 // commander is left, so what one dnbctl run commanded is still applied when
 // the next one reads it.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <map>
 #include <memory>
 #include <string>
@@ -19,31 +16,18 @@
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
 #include "adapters/dds/fields.hpp"
-#include "adapters/dds/loopback.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/reader.hpp"
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "subprocess.hpp"
+#include "test_domain.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
 
 using testing::RunResult;
-
-std::uint32_t test_domain() { return static_cast<std::uint32_t>(100 + getpid() % 100); }
-
-std::string loopback_config() {
-  return dds::loopback_config("dnbctl-test-" + std::to_string(getpid()));
-}
-
-// Set before any DDS call of the process; dnbctl children inherit it.
-class LoopbackEnvironment : public ::testing::Environment {
- public:
-  void SetUp() override { ASSERT_EQ(setenv("CYCLONEDDS_URI", loopback_config().c_str(), 1), 0); }
-};
-[[maybe_unused]] const auto* const kEnvironment =
-    ::testing::AddGlobalTestEnvironment(new LoopbackEnvironment);
+using testing::test_domain;
 
 // Bounds every wait for the bridge; never reached when things work.
 constexpr auto kReady = std::chrono::seconds(10);
@@ -265,6 +249,9 @@ TEST(Dnbctl, UsageErrorsExit2AndNothingFoundExits3) {
   EXPECT_NE(r.out.find("only while a commander is live"), std::string::npos);
 
   r = testing::run(DNBCTL_PATH, {"--domain", domain, "--timeout", "0.5", "list"});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("no bridge answered on DDS domain " + domain), std::string::npos) << r.err;
+  r = testing::run(DNBCTL_PATH, {"--domain", domain, "--timeout", "0.5", "racks"});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("no bridge answered on DDS domain " + domain), std::string::npos) << r.err;
 }

@@ -46,7 +46,9 @@ for f in /usr/bin/dnbridge /usr/bin/dnbctl /usr/bin/cdn127-sim \
          /usr/share/dnbridge/idl/dnbridge.idl /usr/share/dnbridge/cyclonedds/loopback.xml \
          /etc/dnbridge/rack-example.toml /etc/dnbridge/cyclonedds.xml \
          /usr/lib/sysusers.d/dnbridge.conf /usr/share/dnbridge/security/make-site-pki.sh \
-         /usr/share/doc/dnbridge/security.md; do
+         /usr/share/doc/dnbridge/security.md /usr/share/doc/dnbridge/operations.md \
+         /usr/share/dnbridge/networkd/80-dnbridge-can0.network \
+         /usr/share/dnbridge/networkd/80-dnbridge-can1.network; do
   [ -f "$f" ] || fail "$f not installed"
 done
 for d in /lib/systemd/system /usr/lib/systemd/system; do
