@@ -438,7 +438,7 @@ std::optional<devicenet::ExpectedIdentity> read_identity(const toml::node& n, Re
 // attribute 9); the poll period is bounded by the expected packet rate.
 constexpr std::int64_t kMaxPacketRateMs = 0xFFFF;
 constexpr std::int64_t kMaxPublishPeriodMs = 3'600'000;
-constexpr std::int64_t kMaxPollBatchMs = 1000;  // clamped to half a poll period per node
+constexpr std::int64_t kMaxPollBatchMs = 1000;  // cut to a quarter of each node's poll period
 constexpr double kAnalogFullScaleVolts = 10.0;
 
 // Reads every setting a node and [defaults] share into `s`, which holds the

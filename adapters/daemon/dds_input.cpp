@@ -45,6 +45,7 @@ DdsInput::~DdsInput() { stop(); }
 
 void DdsInput::start() {
   thread_ = std::thread([this] { run(); });
+  port::name_thread(thread_, "dds input");
 }
 
 void DdsInput::stop() {
@@ -59,7 +60,6 @@ port::PortLoop* DdsInput::port_of(std::string_view name) {
 }
 
 void DdsInput::run() {
-  port::name_this_thread("dds input");
   for (;;) {
     auto triggered = waitset_.wait(seconds(1));
     if (!triggered) {

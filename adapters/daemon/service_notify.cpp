@@ -1,7 +1,6 @@
 #include "adapters/daemon/service_notify.hpp"
 
 #include <fmt/format.h>
-#include <pthread.h>
 #include <systemd/sd-daemon.h>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 
 #include "adapters/daemon/watchdog.hpp"
 #include "adapters/port/steady_time.hpp"
+#include "adapters/port/thread_name.hpp"
 
 namespace dnbridge::daemon {
 namespace {
@@ -55,7 +55,7 @@ ServiceNotifier::~ServiceNotifier() { join(); }
 void ServiceNotifier::start() {
   if (!enabled_ || thread_.joinable()) return;
   thread_ = std::thread([this] { run(); });
-  (void)pthread_setname_np(thread_.native_handle(), "sd_notify");
+  port::name_thread(thread_, "sd_notify");
 }
 
 void ServiceNotifier::join() {

@@ -1,9 +1,10 @@
 #include "adapters/port/port_loop.hpp"
 
 #include <fmt/format.h>
-#include <pthread.h>
 
 #include <algorithm>
+
+#include "adapters/port/thread_name.hpp"
 
 
 namespace dnbridge::port {
@@ -40,9 +41,7 @@ PortLoop::~PortLoop() {
 void PortLoop::start() {
   running_ = true;
   thread_ = std::thread([this] { run(); });
-  // Named for top -H, gdb and /proc/PID/task/*/comm: "port A" (15 bytes at most).
-  const std::string name = fmt::format("port {}", config_.port).substr(0, 15);
-  (void)pthread_setname_np(thread_.native_handle(), name.c_str());
+  name_thread(thread_, "port " + config_.port);
 }
 
 void PortLoop::stop() { push(Stop{}); }

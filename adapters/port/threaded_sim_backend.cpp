@@ -30,6 +30,7 @@ ThreadedSimBackend::ThreadedSimBackend(std::uint32_t bitrate,
   receiving_.reserve(64);
   delivered_.reserve(64);
   thread_ = std::thread([this] { run(); });
+  name_thread(thread_, "sim bus");
   if (pthread_getcpuclockid(thread_.native_handle(), &sim_clock_) != 0) sim_clock_ = -1;
 }
 
@@ -90,12 +91,14 @@ void ThreadedSimBackend::run() {
   // Wake-ups at the simulated end of frame are timed waits: without this the
   // kernel's default timer slack (50 us) would add to every reception.
   (void)prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
-  name_this_thread("sim bus");
   std::vector<std::pair<can::CanFrame, TimePoint>> sending;
   std::vector<std::function<void()>> running;
   sending.reserve(64);
   std::unique_lock lock(world_mutex_);
-  while (!stop_) {
+  for (;;) {
+    // Frames the port sent before the stop still reach the bus: the pass
+    // that sees the stop sends them, then the thread ends.
+    const bool last = stop_;
     sending.swap(to_world_);
     running.swap(posted_);
     lock.unlock();
@@ -116,6 +119,7 @@ void ThreadedSimBackend::run() {
 
     const TimePoint next = world_.next_event();
     lock.lock();
+    if (last) break;
     if (stop_ || !to_world_.empty() || !posted_.empty()) continue;
     if (next == kNever) {
       world_woken_.wait(lock);

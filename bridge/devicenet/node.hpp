@@ -61,7 +61,8 @@ class Node final : private ExplicitClient::Listener {
   // The slot of the next poll; kNever when the node is not being polled.
   TimePoint next_poll() const;
   // Serves the next slot now, ahead of time (the scanner batches polls due
-  // close together); the slot after it is the node's next.
+  // close together); the slot after it is the node's next. Nothing while a
+  // poll is unanswered: the slot is then served at its time.
   void poll_ahead(TimePoint now);
 
   MacId mac() const { return config_.mac; }

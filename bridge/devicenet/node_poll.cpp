@@ -26,10 +26,11 @@ TimePoint Node::next_poll() const {
 }
 
 void Node::poll_ahead(TimePoint now) {
-  if (next_poll() == kNever || now >= next_poll_) return;
+  // A poll still unanswered leaves the slot to on_timer(), which gives that
+  // poll up at its deadline and then serves the slot on time.
+  if (next_poll() == kNever || now >= next_poll_ || poll_outstanding_) return;
   next_poll_ = next_poll_slot(next_poll_ + Duration(1));
-  // As at the slot itself: a poll still unanswered is not doubled.
-  if (!poll_outstanding_) send_poll(now);
+  send_poll(now);
 }
 
 void Node::send_poll(TimePoint now) {

@@ -587,9 +587,9 @@ struct PortWire {
     unsigned mac;
     unsigned value;
     std::int64_t at;  // written to the CAN interface by the master, steady clock
-    // Written in the turn of the port's loop that handed the master the
-    // node's poll response: the outputs waited for the poll in flight (a poll
-    // connection carries one poll at a time).
+    // Written while the master was handling the node's poll response: the
+    // outputs waited for the poll in flight (a poll connection carries one
+    // poll at a time).
     bool after_response;
   };
   std::mutex mutex;
@@ -618,21 +618,22 @@ struct PortWire {
     if (!out || static_cast<int>(out->second) == last_written[out->first]) return;
     last_written[out->first] = static_cast<int>(out->second);
     std::lock_guard lock(mutex);
-    written_frames.push_back(
-        {out->first, out->second, at.time_since_epoch().count(), answered_this_turn[out->first]});
+    written_frames.push_back({out->first, out->second, at.time_since_epoch().count(),
+                              static_cast<int>(out->first) == answering_mac});
   }
 
-  // On the port's thread: a turn of its loop begins (wait() returns), and the
-  // master is handed a frame.
-  std::array<bool, 64> answered_this_turn{};
-  void on_turn() { answered_this_turn.fill(false); }
-  void on_received(const can::CanFrame& frame) {
+  // On the port's thread: the MAC whose poll response the master is being
+  // handed, while it is (-1 otherwise). A frame written then was sent in
+  // answer to it.
+  int answering_mac = -1;
+  void on_receiving(const can::CanFrame& frame) {
     const auto id = devicenet::decode_identifier(frame.id);
-    if (id && id->group == devicenet::MessageGroup::k1 &&
-        id->message_id == static_cast<std::uint8_t>(devicenet::Group1Message::kSlavePollResponse)) {
-      answered_this_turn[id->mac.value()] = true;
-    }
+    const bool response =
+        id && id->group == devicenet::MessageGroup::k1 &&
+        id->message_id == static_cast<std::uint8_t>(devicenet::Group1Message::kSlavePollResponse);
+    answering_mac = response ? id->mac.value() : -1;
   }
+  void on_received() { answering_mac = -1; }
 
   void on_wire(const sim::WireFrame& wf) {
     const auto id = devicenet::decode_identifier(wf.frame.id);
@@ -677,7 +678,6 @@ class WrittenFramesBackend final : public port::CanBackend {
   can::FrameSink& sink() override { return sink_; }
   TimePoint now() const override { return inner_->now(); }
   void wait(TimePoint deadline, port::FrameReceiver& receiver) override {
-    wire_.on_turn();
     Receiver noting{receiver, wire_};
     inner_->wait(deadline, noting);
   }
@@ -703,8 +703,9 @@ class WrittenFramesBackend final : public port::CanBackend {
    public:
     Receiver(port::FrameReceiver& inner, PortWire& wire) : inner_(inner), wire_(wire) {}
     void on_frame(const can::CanFrame& frame, TimePoint rx_time) override {
-      wire_.on_received(frame);
+      wire_.on_receiving(frame);
       inner_.on_frame(frame, rx_time);
+      wire_.on_received();
     }
 
    private:

@@ -26,11 +26,13 @@ class PollSchedule : public ::testing::Test {
     c.port.poll_batch_window = window;
     for (auto& p : c.pumps) p.node.poll_period = period;
     rack_ = std::make_unique<sim::SimRack>(std::move(c));
-    rack_->world().bus().set_tap([this](const sim::WireFrame& w) {
+    rack_->world().bus().set_tap([this, period](const sim::WireFrame& w) {
       const auto id = devicenet::decode_identifier(w.frame.id);
       if (recording_ && id && id->group == MessageGroup::k2 &&
           id->message_id == static_cast<std::uint8_t>(Group2Message::kMasterIoPoll)) {
         polls_[id->mac.value()].push_back(w.end);
+        // The slot this poll served: the one before the node's next.
+        slots_[id->mac.value()].push_back(rack_->scanner().node(id->mac)->next_poll() - period);
       }
     });
     rack_->start();
@@ -63,9 +65,21 @@ class PollSchedule : public ::testing::Test {
     return {shortest, longest};
   }
 
+  // Every poll at its slot or ahead of it by at most `window`.
+  void expect_within_slots(Duration window) const {
+    for (const auto& [mac, at] : polls_) {
+      const auto& slot = slots_.at(mac);
+      for (std::size_t i = 0; i < at.size(); ++i) {
+        EXPECT_LE(at[i], slot[i]) << "MAC " << mac << " poll " << i << " late";
+        EXPECT_GE(at[i], slot[i] - window) << "MAC " << mac << " poll " << i << " too early";
+      }
+    }
+  }
+
   std::unique_ptr<sim::SimRack> rack_;
   bool recording_ = false;
   std::map<unsigned, std::vector<TimePoint>> polls_;
+  std::map<unsigned, std::vector<TimePoint>> slots_;
 };
 
 TEST_F(PollSchedule, WithoutBatchingEveryNodeIsPolledExactlyAtItsSlot) {
@@ -78,6 +92,7 @@ TEST_F(PollSchedule, WithoutBatchingEveryNodeIsPolledExactlyAtItsSlot) {
   EXPECT_EQ(longest, milliseconds(10));
   // Staggered: no two nodes share an instant.
   EXPECT_EQ(distinct_poll_times(), 800u);
+  expect_within_slots(Duration::zero());
 }
 
 TEST_F(PollSchedule, PollsDueWithinTheWindowGoOutTogetherNeverLate) {
@@ -96,6 +111,7 @@ TEST_F(PollSchedule, PollsDueWithinTheWindowGoOutTogetherNeverLate) {
   EXPECT_GE(shortest, milliseconds(8));
   EXPECT_LE(longest, milliseconds(12));
   EXPECT_LE(distinct_poll_times(), 400u);
+  expect_within_slots(milliseconds(2));
 }
 
 TEST_F(PollSchedule, AWindowLongerThanAQuarterPeriodIsCutToIt) {
@@ -112,6 +128,44 @@ TEST_F(PollSchedule, AWindowLongerThanAQuarterPeriodIsCutToIt) {
   EXPECT_GE(shortest, milliseconds(3));
   EXPECT_LE(longest, milliseconds(5));
   EXPECT_LT(distinct_poll_times(), 1000u);
+  expect_within_slots(milliseconds(1));
+}
+
+TEST_F(PollSchedule, AnUnansweredPollLeavesTheNextSlotOnTime) {
+  // Node 2's slots lie 1.25 ms after node 1's: batches of (1, 2) go out at
+  // node 1's slot, node 2's poll 1.25 ms early. A command sent just after
+  // such a batch is polled at once; that poll's response is lost, and it is
+  // given up a period later, after the next batch has gone out. Node 2's slot
+  // in that batch is then served at its own time, not skipped.
+  build({1, 2, 3, 4, 5, 6, 7, 8}, milliseconds(10), milliseconds(2));
+  record(milliseconds(100));
+  const TimePoint batch = polls_.at(2).back() + milliseconds(10);
+  ASSERT_LT(rack_->now(), batch);
+  rack_->world().run_for(batch + microseconds(300) - rack_->now());
+  ASSERT_EQ(rack_->now(), batch + microseconds(300));
+  ASSERT_EQ(rack_->scanner().node(mac(2))->counters().polls,
+            rack_->scanner().node(mac(2))->counters().responses)
+      << "node 2's batch poll is answered before the command";
+  auto lose_one = sim::FaultRule::drop(
+      devicenet::group1_id(devicenet::Group1Message::kSlavePollResponse, mac(2)));
+  lose_one.count = 1;
+  rack_->world().bus().faults().add(lose_one);
+  polls_.clear();
+  slots_.clear();
+  recording_ = true;
+  profiles::cdn127::PumpOutputs out;
+  out.pump_on = true;
+  ASSERT_TRUE(rack_->pumps().command(mac(2), out, rack_->now()).ok());
+  rack_->world().run_for(milliseconds(50));
+  recording_ = false;
+
+  const auto& at = polls_.at(2);
+  ASSERT_GE(at.size(), 5u);
+  EXPECT_EQ(at[0], batch + microseconds(300)) << "the command's poll goes out at once";
+  for (std::size_t i = 1; i < at.size(); ++i) {
+    EXPECT_LE(at[i] - at[i - 1], milliseconds(12)) << "gap before poll " << i;
+  }
+  EXPECT_EQ(rack_->scanner().node(mac(2))->counters().timeouts, 1u);
 }
 
 }  // namespace
