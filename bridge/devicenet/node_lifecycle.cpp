@@ -346,9 +346,15 @@ void Node::on_size_result(Step step, const ExplicitResult& r, TimePoint now) {
           fb.instance_id, produced ? fb.produced_attribute : fb.consumed_attribute, now);
       return;
     }
+    // The consumed size's own attribute was not asked when the produced
+    // size's was refused: say so rather than name the other's refusal.
+    const std::string first =
+        !produced && produced_from_fallback_
+            ? fmt::format("{} not asked ({})", size_attribute(false, false), size_refusal_)
+            : size_refusal_;
     enter_fault(NodeState::kConfigurationFault,
                 fallback ? fmt::format("cannot read the poll {} size: {}; fallback {}: {}", which,
-                                       size_refusal_, size_attribute(produced, true), answer())
+                                       first, size_attribute(produced, true), answer())
                          : fmt::format("cannot read the poll {} size: {}: {}", which,
                                        size_attribute(produced, false), answer()),
                 now);

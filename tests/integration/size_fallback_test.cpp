@@ -93,6 +93,24 @@ TEST_F(SizeFallback, FallbackRefusedTooIsAConfigurationFaultNamingBothAttributes
   EXPECT_NE(view().state, NodeState::kOnline);
 }
 
+// Attribute 7 refused, 16 answered, 17 refused: the consumed size's own
+// attribute (8) was never asked, and the reason says that rather than
+// naming attribute 7's refusal as if it were 8's.
+TEST_F(SizeFallback, ConsumedFallbackRefusedSaysItsOwnAttributeWasNotAsked) {
+  build({{0x05, 7}, {0x05, 8}, {0x40, 17}});
+  ASSERT_TRUE(run_until(NodeState::kConfigurationFault)) << view().reason;
+  const std::string& reason = view().reason;
+  EXPECT_NE(reason.find("cannot read the poll consumed size: Connection 2 attribute 8 not asked "
+                        "(Connection 2 attribute 7: attribute not supported (0x14/0xFF))"),
+            std::string::npos)
+      << reason;
+  EXPECT_NE(reason.find(std::string("fallback ") + kConsumedFallback +
+                        ": attribute not supported (0x14/0xFF)"),
+            std::string::npos)
+      << reason;
+  EXPECT_EQ(node().counters().polls, 0u);
+}
+
 TEST_F(SizeFallback, FallbackSizeThatDiffersIsAConfigurationFaultSayingWhereItWasRead) {
   // Expect one byte more than the device produces, as a scan list written
   // for another reading of the manual would.
