@@ -32,6 +32,12 @@ std::optional<LogLevel> parse_level(const std::string& s) {
   return std::nullopt;
 }
 
+// Who the bridge is on DDS, as --check-config and the log say it.
+std::string security_text(const security::Identity& identity) {
+  return fmt::format("DDS Security as {} (certificate valid until {})", identity.subject,
+                     identity.valid_until);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -75,9 +81,7 @@ int main(int argc, char** argv) {
       for (const auto& w : c.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
       std::string security;
       if (c.security) {
-        const auto identity = security::check(*c.security);
-        security = fmt::format(", DDS Security as {} (certificate valid until {})",
-                               identity.subject, identity.valid_until);
+        security = ", " + security_text(security::check(*c.security));
       }
       std::size_t nodes = 0;
       for (const auto& p : c.ports) nodes += p.nodes.size();
@@ -113,8 +117,7 @@ int main(int argc, char** argv) {
   Logger main_log(log, "dnbridge");
   for (const auto& w : config.warnings) main_log.warn("{}: {}", config.source, w);
   if (identity) {
-    main_log.info("DDS Security as {} (certificate valid until {})", identity->subject,
-                  identity->valid_until);
+    main_log.info("{}", security_text(*identity));
   }
   if (pinned) {
     main_log.info(

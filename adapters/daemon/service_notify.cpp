@@ -19,8 +19,12 @@ namespace {
 // How often readiness and the status line are looked at.
 constexpr Duration kTick = milliseconds(250);
 // A port loop wakes at least once per status period (1 s); a watchdog check
-// interval shorter than this would take an idle loop for a stalled one.
+// interval shorter than this (1 s and a margin) would take an idle loop for
+// a stalled one.
 constexpr Duration kLongestLoopSleep = milliseconds(1500);
+// The loops are checked every half period (WATCHDOG_USEC / 2): the
+// shortest WatchdogSec= that does not take idle loops for stalled ones.
+constexpr Duration kShortestWatchdog = 2 * kLongestLoopSleep;
 
 void notify(const std::string& state) { sd_notify(0, state.c_str()); }
 
@@ -78,9 +82,12 @@ void ServiceNotifier::run() {
   std::uint64_t watchdog_usec = 0;
   const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
   const Duration interval = std::chrono::microseconds(watchdog_usec / 2);
-  if (watchdog && interval < kLongestLoopSleep) {
-    log_.warn("WatchdogSec={} ms is too short for port loops that sleep up to 1 s; use 4 s or more",
-              watchdog_usec / 1000);
+  if (watchdog && std::chrono::microseconds(watchdog_usec) < kShortestWatchdog) {
+    log_.warn(
+        "WatchdogSec={} ms is too short: the port loops are checked every half period, and an "
+        "idle one may go {:g} s without a round; use {:g} s or more",
+        watchdog_usec / 1000, std::chrono::duration<double>(kLongestLoopSleep).count(),
+        std::chrono::duration<double>(kShortestWatchdog).count());
   }
 
   const auto& ports = daemon_.ports();

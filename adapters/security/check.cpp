@@ -7,6 +7,7 @@
 #include <openssl/pkcs7.h>
 #include <openssl/x509.h>
 #include <openssl/x509_vfy.h>
+#include <openssl/x509v3.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -80,6 +81,16 @@ std::string utc(const ASN1_TIME* t) {
   return text;
 }
 
+// A certificate's date against `now`: negative before it, positive after.
+// X509_cmp_time's 0 is not "equal" but "cannot compare" (a date OpenSSL
+// parsed but cannot read as a time): refused, not taken as valid.
+int compare_date(const ASN1_TIME* date, std::string_view field, std::time_t now,
+                 const std::filesystem::path& file, std::string_view what) {
+  const int order = X509_cmp_time(date, &now);
+  if (order == 0) fail(file, fmt::format("{} has an unreadable {} date", what, field));
+  return order;
+}
+
 // A PEM certificate valid at `now`; `what` names it in the message.
 Owned<X509> read_certificate(const std::filesystem::path& file, std::string_view what,
                              std::time_t now) {
@@ -90,12 +101,13 @@ Owned<X509> read_certificate(const std::filesystem::path& file, std::string_view
     ERR_clear_error();
     fail(file, fmt::format("is not a PEM certificate (the {} is one)", what));
   }
-  if (X509_cmp_time(X509_get0_notBefore(cert.get()), &now) > 0) {
-    fail(file,
-         fmt::format("{} is not valid before {}", what, utc(X509_get0_notBefore(cert.get()))));
+  const ASN1_TIME* not_before = X509_get0_notBefore(cert.get());
+  if (compare_date(not_before, "notBefore", now, file, what) > 0) {
+    fail(file, fmt::format("{} is not valid before {}", what, utc(not_before)));
   }
-  if (X509_cmp_time(X509_get0_notAfter(cert.get()), &now) < 0) {
-    fail(file, fmt::format("{} expired on {}", what, utc(X509_get0_notAfter(cert.get()))));
+  const ASN1_TIME* not_after = X509_get0_notAfter(cert.get());
+  if (compare_date(not_after, "notAfter", now, file, what) < 0) {
+    fail(file, fmt::format("{} expired on {}", what, utc(not_after)));
   }
   return cert;
 }
@@ -121,6 +133,18 @@ void check_signed_by(X509* cert, const std::filesystem::path& file, X509* ca,
     fail(file, fmt::format("identity certificate is not signed by the identity CA {} ({})",
                            ca_file.string(), X509_verify_cert_error_string(error)));
   }
+}
+
+// A participant's identity is an end entity. X509_verify_cert takes the
+// identity CA's own certificate, and any CA certificate it issued, as signed
+// by the identity CA: both refused here.
+void check_not_a_ca(X509* cert, const std::filesystem::path& file, X509* ca) {
+  constexpr std::string_view kNotAnIdentity =
+      "identity certificate is a CA certificate, not a participant's identity";
+  if (X509_cmp(cert, ca) == 0) {
+    fail(file, fmt::format("{} (it is the identity CA itself)", kNotAnIdentity));
+  }
+  if (X509_check_ca(cert) != 0) fail(file, kNotAnIdentity);
 }
 
 // OpenSSL asks for a pass phrase when a key is encrypted: none is given, and
@@ -206,6 +230,7 @@ void check_plugins(const Settings& s) {
 Identity check(const Settings& s, std::time_t now) {
   auto identity_ca = read_certificate(s.identity_ca, "identity CA", now);
   auto cert = read_certificate(s.certificate, "identity certificate", now);
+  check_not_a_ca(cert.get(), s.certificate, identity_ca.get());
   check_signed_by(cert.get(), s.certificate, identity_ca.get(), s.identity_ca, now);
   check_private_key(s.private_key, cert.get(), s.certificate);
   auto permissions_ca = read_certificate(s.permissions_ca, "permissions CA", now);

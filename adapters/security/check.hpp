@@ -7,12 +7,14 @@
 //
 // Checked, in this order: each file can be read; the identity CA, the
 // identity certificate and the permissions CA are PEM certificates valid at
-// `now`; the certificate is signed by the identity CA; the private key is a
-// PEM key (not encrypted) and is the certificate's; the governance and
-// permissions documents are S/MIME signed by the permissions CA and hold
-// what their names say; the plugin libraries exist. Not checked (Cyclone
-// DDS reports them when it creates the participant): whether the documents
-// cover the participant's domain and whether a grant names its subject.
+// `now` (a date OpenSSL cannot read is an error, not a pass); the
+// certificate is not a CA certificate (nor the identity CA itself) and is
+// signed by the identity CA; the private key is a PEM key (not encrypted)
+// and is the certificate's; the governance and permissions documents are
+// S/MIME signed by the permissions CA and hold what their names say; the
+// plugin libraries exist. Not checked (Cyclone DDS reports them when it
+// creates the participant): whether the documents cover the participant's
+// domain and whether a grant names its subject.
 #include <ctime>
 #include <stdexcept>
 #include <string>

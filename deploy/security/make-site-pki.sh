@@ -20,7 +20,9 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
   --out DIR           where the PKI lives (created if absent)
   --domain ID         the DDS domain, 0..232 (required on the first run; later
                       runs keep the site's unless given)
-  --site NAME         organisation in every subject (default: dnbridge-site)
+  --site NAME         organisation in every subject (default: dnbridge-site;
+                      later runs keep the site's, which changes only with
+                      --new-ca)
   --bridge NAME       a rack's bridge: publishes PumpState, NodeStatus,
                       PortStatus and ExplicitReply, reads PumpCommand and
                       ExplicitRequest
@@ -91,22 +93,25 @@ if [ -n "$domain" ]; then
   [[ $domain =~ ^[0-9]{1,3}$ ]] && [ "$domain" -le 232 ] || fail "--domain $domain: a DDS domain ID is 0..232"
 fi
 
-umask 077  # private keys readable by their owner only
-mkdir -p "$out"
-out=$(cd "$out" && pwd)
+# Nothing is written before every check has passed: a refused run leaves DIR
+# as it was (absent, on a first run).
+out=$(realpath -m -- "$out")
+[ ! -e "$out" ] || [ -d "$out" ] || fail "--out $out: exists and is not a directory"
 id_ca=$out/ca/identity
 perm_ca=$out/ca/permissions
 roster=$out/roster     # "ROLE NAME" per identity of the site
 site_conf=$out/site.conf
 
 # --- the site: its domain and name, kept from the first run ------------------
+# The name is in every subject: it changes only with new CAs, which issue
+# every identity of the site again.
 stored_domain="" stored_site=""
 if [ -f "$site_conf" ]; then
   stored_domain=$(sed -n 's/^domain=//p' "$site_conf")
   stored_site=$(sed -n 's/^site=//p' "$site_conf")
 fi
-if [ -n "$stored_site" ] && [ -n "$site" ] && [ "$site" != "$stored_site" ]; then
-  fail "$out belongs to site '$stored_site', not '$site' (subjects cannot change without new CAs)"
+if [ -n "$stored_site" ] && [ -n "$site" ] && [ "$site" != "$stored_site" ] && [ "$new_ca" = 0 ]; then
+  fail "$out belongs to site '$stored_site', not '$site' (the site name is in every subject: it changes only with --new-ca)"
 fi
 site=${site:-${stored_site:-dnbridge-site}}
 if [ -z "$domain" ]; then
@@ -115,11 +120,9 @@ if [ -z "$domain" ]; then
 elif [ -n "$stored_domain" ] && [ "$domain" != "$stored_domain" ]; then
   echo "domain changes from $stored_domain to $domain: the documents are made for domain $domain"
 fi
-touch "$roster"
 
 # --- the roster: every identity of the site and its role -----------------------
-# Everything is checked before the roster changes.
-role_of() { awk -v n="$1" '$2 == n { print $1 }' "$roster"; }
+role_of() { [ ! -f "$roster" ] || awk -v n="$1" '$2 == n { print $1 }' "$roster"; }
 declare -A asked=()
 for i in "${!add_names[@]}"; do
   name=${add_names[$i]} role=${add_roles[$i]}
@@ -132,6 +135,17 @@ done
 for name in "${renew[@]}"; do
   [ -n "${asked[$name]:-$(role_of "$name")}" ] || fail "--renew $name: no such identity in $roster"
 done
+if [ "$new_ca" = 0 ]; then
+  for dir in "$id_ca" "$perm_ca"; do
+    if [ -f "$dir/ca.pem" ] && [ ! -f "$dir/ca.key" ]; then
+      fail "$dir/ca.pem exists without its ca.key: refusing to go on (--new-ca makes new CAs)"
+    fi
+  done
+fi
+
+umask 077  # private keys readable by their owner only
+mkdir -p "$out"
+touch "$roster"
 for i in "${!add_names[@]}"; do
   name=${add_names[$i]}
   [ -n "$(role_of "$name")" ] || echo "${add_roles[$i]} $name" >>"$roster"
@@ -139,8 +153,9 @@ done
 printf 'site=%s\ndomain=%s\n' "$site" "$domain" >"$site_conf"
 
 # --- the CAs -------------------------------------------------------------------
-# --new-ca: the old PKI is kept aside, never deleted.
-if [ "$new_ca" = 1 ] && [ -e "$id_ca" ]; then
+# --new-ca: the old PKI is kept aside, never deleted; every identity is
+# issued again.
+if [ "$new_ca" = 1 ] && { [ -e "$out/ca" ] || [ -e "$out/hosts" ]; }; then
   previous=$out/previous-$(date -u +%Y%m%dT%H%M%SZ)
   mkdir "$previous"
   for f in ca hosts governance.xml governance.p7s permissions.xml permissions.p7s; do
@@ -154,8 +169,7 @@ fi
 make_ca() {
   local dir=$1 cn=$2 usage=$3
   if [ -f "$dir/ca.pem" ]; then
-    [ -f "$dir/ca.key" ] || fail "$dir/ca.pem exists without its ca.key: refusing to go on (--new-ca makes new CAs)"
-    return
+    return  # its key is there: checked before anything was written
   fi
   mkdir -p "$dir/issued"
   openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:prime256v1 -out "$dir/ca.key" 2>/dev/null

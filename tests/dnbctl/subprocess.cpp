@@ -1,5 +1,6 @@
 #include "subprocess.hpp"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
@@ -18,8 +19,11 @@ RunResult run(const std::string& program, const std::vector<std::string>& args,
   RunResult result;
   int out_pipe[2];
   int err_pipe[2];
-  if (pipe(out_pipe) != 0) return result;
-  if (pipe(err_pipe) != 0) {
+  // Close-on-exec: a child that another thread spawns meanwhile must not
+  // hold this child's pipes open (its output would then never end). The
+  // child's own stdout and stderr, dup2()ed from them, stay open.
+  if (pipe2(out_pipe, O_CLOEXEC) != 0) return result;
+  if (pipe2(err_pipe, O_CLOEXEC) != 0) {
     close(out_pipe[0]);
     close(out_pipe[1]);
     return result;

@@ -2,7 +2,8 @@
 // Runs a program as a child process, with this process's environment, and
 // collects its exit code, stdout and stderr. A child that outlives
 // `timeout` is killed (and reported as exit code -1): a hung client fails
-// the test instead of hanging it.
+// the test instead of hanging it. Children may be run from several threads
+// at once.
 #include <chrono>
 #include <string>
 #include <vector>

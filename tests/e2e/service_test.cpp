@@ -65,7 +65,9 @@ struct Notification {
 // The manager's side: the notification socket, the child, its stderr.
 class ServiceManager {
  public:
-  explicit ServiceManager(std::vector<std::string> dnbridge_args) {
+  // WATCHDOG_USEC is `watchdog`.
+  explicit ServiceManager(std::vector<std::string> dnbridge_args,
+                          std::chrono::microseconds watchdog = kWatchdog) {
     path_ = std::filesystem::temp_directory_path() /
             ("dnbridge-notify-" + std::to_string(getpid()) + "-" + std::to_string(++count_));
     std::filesystem::remove(path_);
@@ -85,7 +87,7 @@ class ServiceManager {
     args.insert(args.end(), dnbridge_args.begin(), dnbridge_args.end());
     ChildOptions options;
     options.env = {"NOTIFY_SOCKET=" + path_.string(),
-                   "WATCHDOG_USEC=" + std::to_string(std::chrono::microseconds(kWatchdog).count())};
+                   "WATCHDOG_USEC=" + std::to_string(watchdog.count())};
     options.capture_stderr = true;
     child_.emplace(std::move(args), options);
   }
@@ -258,6 +260,7 @@ TEST(ServiceNotify, ReadyStatusWatchdogAndStoppingFromTheDnbridgeProcess) {
     EXPECT_LT(gap, std::chrono::duration_cast<Clock::duration>(kWatchdog)) << "feed " << i;
   }
   EXPECT_EQ(manager.count("READY=1"), 1u);
+  EXPECT_FALSE(manager.logged("is too short")) << manager.log();
 
   ASSERT_TRUE(manager.child().signal(SIGTERM));
   ASSERT_TRUE(manager.until([&] { return manager.first("STOPPING=1") >= 0; }, 10s))
@@ -269,6 +272,20 @@ TEST(ServiceNotify, ReadyStatusWatchdogAndStoppingFromTheDnbridgeProcess) {
   for (std::size_t i = stopping; i < manager.notifications().size(); ++i) {
     EXPECT_FALSE(manager.notifications()[i].has("WATCHDOG=1")) << "fed after STOPPING=1";
   }
+}
+
+// Just under 3 s: warned, with the shortest period the bridge takes (3 s
+// itself, which the other tests use, is taken without a word).
+TEST(ServiceNotify, AWatchdogPeriodUnderThreeSecondsIsWarnedOf) {
+  ServiceManager manager({"--simulate"}, kWatchdog - 1us);
+  ASSERT_TRUE(manager.child().running());
+  ASSERT_TRUE(manager.until([&] { return manager.logged("or more"); }, 15s)) << manager.log();
+  EXPECT_TRUE(manager.logged(
+      "systemd: WatchdogSec=2999 ms is too short: the port loops are checked every half "
+      "period, and an idle one may go 1.5 s without a round; use 3 s or more"))
+      << manager.log();
+  ASSERT_TRUE(manager.child().signal(SIGTERM));
+  EXPECT_EQ(manager.child().wait(), 0);
 }
 
 TEST(ServiceNotify, AStalledPortLoopStarvesTheWatchdogUntilItAdvancesAgain) {

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # deploy/security/make-site-pki.sh as an administrator uses it, in a
-# temporary directory: first run, run again (nothing reissued), a role
-# change refused, a host added, a host renewed, new CAs; after each, the
+# temporary directory: refused first runs (nothing left behind), first run,
+# run again (nothing reissued), a role change and a site change refused, a
+# host added, a host renewed, new CAs with a new site name; after each, the
 # certificates verify against the identity CA and the documents against the
 # permissions CA as openssl sees them. Fails, never skips.
 set -euo pipefail
@@ -34,10 +35,13 @@ verify_all() {
   [ "$(stat -c %a "$pki/ca/identity/ca.key")" = 600 ] || fail "the identity CA key is readable by others"
 }
 
-echo "== the first run needs a domain"
+echo "== the first run needs a domain; a refused first run leaves nothing behind"
 if run --bridge rack-A; then fail "ran without --domain"; fi
 grep -q -- "--domain ID is required" "$work/out" || fail "no clear message: $(cat "$work/out")"
-[ ! -e "$pki/ca/identity/ca.pem" ] || fail "made a CA although the command line was incomplete"
+[ ! -e "$pki" ] || fail "a first run refused for its domain left $pki behind: $(ls -A "$pki")"
+if run --domain 17 --bridge twice --monitor twice; then fail "one name got two roles"; fi
+grep -q "twice is already a bridge" "$work/out" || fail "no clear message: $(cat "$work/out")"
+[ ! -e "$pki" ] || fail "a first run refused for a role left $pki behind: $(ls -A "$pki")"
 
 echo "== a site"
 run --domain 17 --site acme --bridge rack-A --supervisor scada-1 --monitor ops-1 --days 30 ||
@@ -71,6 +75,13 @@ grep -q "scada-1 is already a supervisor" "$work/out" || fail "no clear message:
 cmp -s "$pki/roster" "$work/roster.before" || fail "a refused run changed the roster"
 [ ! -e "$pki/hosts/rack-B" ] || fail "a refused run issued rack-B"
 
+echo "== the site name is kept"
+if run --site other-name --bridge rack-B; then fail "the site name changed without new CAs"; fi
+grep -q "belongs to site 'acme', not 'other-name' (.*it changes only with --new-ca)" "$work/out" ||
+  fail "no clear message: $(cat "$work/out")"
+cmp -s "$pki/roster" "$work/roster.before" || fail "a refused site change changed the roster"
+grep -q "^site=acme$" "$pki/site.conf" || fail "a refused site change changed site.conf"
+
 echo "== a host added, the site's domain kept"
 run --bridge rack-B || fail "adding rack-B: $(cat "$work/out")"
 [ "$(fingerprint "$pki/hosts/rack-A/cert.pem")" = "$rack_a" ] || fail "adding rack-B reissued rack-A"
@@ -88,9 +99,18 @@ echo "== new CAs"
 if run --new-ca --monitor scada-1; then fail "--new-ca with a role change ran"; fi
 if ls -d "$pki"/previous-* >/dev/null 2>&1; then fail "a refused --new-ca moved the PKI aside"; fi
 [ "$(fingerprint "$pki/ca/identity/ca.pem")" = "$id_ca" ] || fail "a refused --new-ca changed the CA"
-run --new-ca || fail "--new-ca: $(cat "$work/out")"
+run --new-ca --site acme-2 || fail "--new-ca: $(cat "$work/out")"
 [ "$(fingerprint "$pki/ca/identity/ca.pem")" != "$id_ca" ] || fail "--new-ca kept the identity CA"
 ls -d "$pki"/previous-*/ca/identity >/dev/null || fail "the old CAs were not kept aside"
 [ "$(ls "$pki/hosts" | wc -l)" = 4 ] || fail "not every identity was issued again: $(ls "$pki/hosts")"
 verify_all
+# The new site name, everywhere.
+grep -q "^site=acme-2$" "$pki/site.conf" || fail "site.conf kept the old site name"
+for cert in "$pki"/ca/*/ca.pem "$pki"/hosts/*/cert.pem; do
+  openssl x509 -in "$cert" -noout -subject -nameopt RFC2253 | grep -q ",O=acme-2$" ||
+    fail "$cert is not of site acme-2: $(openssl x509 -in "$cert" -noout -subject)"
+done
+grep -q "<subject_name>CN=rack-A,OU=bridge,O=acme-2</subject_name>" "$pki/permissions.xml" ||
+  fail "the grants do not name the new subjects"
+if grep -q "O=acme<" "$pki/permissions.xml"; then fail "a grant names an old subject"; fi
 echo "OK"
