@@ -6,7 +6,6 @@
 
 #include "adapters/port/thread_name.hpp"
 
-
 namespace dnbridge::port {
 
 using devicenet::MacId;
