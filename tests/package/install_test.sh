@@ -48,7 +48,8 @@ for f in /usr/bin/dnbridge /usr/bin/dnbctl /usr/bin/cdn127-sim \
          /usr/lib/sysusers.d/dnbridge.conf /usr/share/dnbridge/security/make-site-pki.sh \
          /usr/share/doc/dnbridge/security.md /usr/share/doc/dnbridge/operations.md \
          /usr/share/dnbridge/networkd/80-dnbridge-can0.network \
-         /usr/share/dnbridge/networkd/80-dnbridge-can1.network; do
+         /usr/share/dnbridge/networkd/80-dnbridge-can1.network \
+         /usr/share/dnbridge/networkd/70-dnbridge-can.link; do
   [ -f "$f" ] || fail "$f not installed"
 done
 for d in /lib/systemd/system /usr/lib/systemd/system; do
