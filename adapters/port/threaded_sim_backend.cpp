@@ -59,7 +59,6 @@ void ThreadedSimBackend::MasterSink::send(const can::CanFrame& frame, TimePoint 
   // reach the bus together, at the times they were sent.
   std::lock_guard lock(owner_.world_mutex_);
   owner_.to_world_.emplace_back(frame, now);
-  owner_.sent_ = true;
 }
 
 void ThreadedSimBackend::MasterPort::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
@@ -130,12 +129,13 @@ void ThreadedSimBackend::run() {
 }
 
 void ThreadedSimBackend::wait(TimePoint deadline, FrameReceiver& receiver) {
-  bool sent = false;
+  // Frames the world has not taken yet: wake it for them.
+  bool queued = false;
   {
     std::lock_guard lock(world_mutex_);
-    std::swap(sent, sent_);
+    queued = !to_world_.empty();
   }
-  if (sent) world_woken_.notify_one();
+  if (queued) world_woken_.notify_one();
   {
     std::unique_lock lock(port_mutex_);
     auto ready = [&] { return wake_ || !to_port_.empty(); };

@@ -92,7 +92,6 @@ class ThreadedSimBackend final : public CanBackend {
   std::condition_variable world_woken_;
   std::vector<std::pair<can::CanFrame, TimePoint>> to_world_;
   std::vector<std::function<void()>> posted_;
-  bool sent_ = false;  // frames queued since the world was last woken for them
   bool stop_ = false;
 
   // World -> port.
