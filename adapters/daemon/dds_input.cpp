@@ -14,6 +14,26 @@ namespace {
 
 enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3 };
 
+// Samples taken at a time.
+constexpr std::size_t kBatch = 32;
+
+// Takes every sample the reader holds, a buffer at a time (taking resets
+// DATA_AVAILABLE while samples may remain, so a full buffer is followed by
+// another take), and hands each to `fn`.
+template <class T, class Fn>
+void take_all(const dds::Reader<T>& reader, dds::TakeBuffer<T>& buffer, Logger& log,
+              const char* what, Fn fn) {
+  for (;;) {
+    auto taken = reader.take(buffer);
+    if (!taken) {
+      log.error("taking {} failed: {}", what, taken.error().message());
+      return;
+    }
+    for (std::size_t i = 0; i < *taken; ++i) fn(buffer.data(i), buffer.info(i));
+    if (*taken < buffer.capacity()) return;
+  }
+}
+
 }  // namespace
 
 DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
@@ -24,6 +44,8 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       log_(std::move(log)),
       commands_(participant, publisher.command_topic(), dds::command_reader_qos()),
       requests_(participant, publisher.request_topic(), dds::request_reader_qos()),
+      command_buffer_(kBatch),
+      request_buffer_(kBatch),
       stop_(participant),
       waitset_(participant) {
   // A reader's status condition stays triggered while any status in its mask
@@ -75,51 +97,54 @@ void DdsInput::run() {
 }
 
 void DdsInput::take_commands() {
-  auto samples = commands_.take();
-  if (!samples) return;
-  for (const auto& s : *samples) {
-    const dnbridge_PumpCommand& c = s.data();
-    if (dds::view(c.rack) != rack_) continue;  // another bridge's pump
-    port::PortLoop* loop = port_of(dds::view(c.port));
-    const auto mac = devicenet::MacId::from(c.mac);
-    if (!loop || !mac || !loop->has_node(*mac)) {
-      unsigned suppressed = 0;
-      if (warn_limit_.allow(port::steady_now(), suppressed)) {
-        log_.warn("command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
-                  s.info().valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "",
-                  dds::view(c.port), c.mac);
-      }
-      continue;
+  take_all(commands_, command_buffer_, log_, "pump commands",
+           [this](const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
+             on_command(c, info);
+           });
+}
+
+void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
+  if (dds::view(c.rack) != rack_) return;  // another bridge's pump
+  port::PortLoop* loop = port_of(dds::view(c.port));
+  const auto mac = devicenet::MacId::from(c.mac);
+  if (!loop || !mac || !loop->has_node(*mac)) {
+    unsigned suppressed = 0;
+    if (warn_limit_.allow(port::steady_now(), suppressed)) {
+      log_.warn("command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
+                info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "",
+                dds::view(c.port), c.mac);
     }
-    // No live commander left for this pump (all writers gone, or disposed):
-    // idle. A command taken after its writer left carries that state itself,
-    // with no sample of its own to tell it; it is not applied: a commander
-    // that is gone commands nothing, not even for a moment.
-    if (s.info().instance_state() != dds::InstanceState::kAlive) {
-      loop->release_command(*mac);
-      continue;
-    }
-    if (s.info().valid_data()) loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
+    return;
   }
+  // No live commander left for this pump (all writers gone, or disposed):
+  // idle. A command taken after its writer left carries that state itself,
+  // with no sample of its own to tell it; it is not applied: a commander
+  // that is gone commands nothing, not even for a moment.
+  if (info.instance_state() != dds::InstanceState::kAlive) {
+    loop->release_command(*mac);
+    return;
+  }
+  if (info.valid_data()) loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
 }
 
 void DdsInput::take_requests() {
-  auto samples = requests_.take();
-  if (!samples) return;
-  for (const auto& s : *samples) {
-    if (!s.info().valid_data()) continue;
-    const dnbridge_ExplicitRequest& r = s.data();
-    if (dds::view(r.rack) != rack_) continue;
-    rack::ExplicitCall call = call_of(r);
-    port::PortLoop* loop = port_of(call.port);
-    if (!loop) {
-      publisher_.explicit_reply(
-          rack::refuse(call, rack::TransactionStatus::kInvalidPort,
-                       fmt::format("rack {} has no port \"{}\"", rack_, call.port)));
-      continue;
-    }
-    loop->explicit_request(std::move(call));
+  take_all(requests_, request_buffer_, log_, "explicit requests",
+           [this](const dnbridge_ExplicitRequest& r, const dds::SampleInfo& info) {
+             if (info.valid_data()) on_request(r);
+           });
+}
+
+void DdsInput::on_request(const dnbridge_ExplicitRequest& r) {
+  if (dds::view(r.rack) != rack_) return;
+  rack::ExplicitCall call = call_of(r);
+  port::PortLoop* loop = port_of(call.port);
+  if (!loop) {
+    publisher_.explicit_reply(rack::refuse(call, rack::TransactionStatus::kInvalidPort,
+                                           fmt::format("rack {} has no port \"{}\"", rack_,
+                                                       call.port)));
+    return;
   }
+  loop->explicit_request(std::move(call));
 }
 
 }  // namespace dnbridge::daemon

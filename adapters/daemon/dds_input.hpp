@@ -30,6 +30,8 @@ class DdsInput {
   void run();
   void take_commands();
   void take_requests();
+  void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
+  void on_request(const dnbridge_ExplicitRequest& r);
   port::PortLoop* port_of(std::string_view name);
 
   std::string rack_;
@@ -38,6 +40,8 @@ class DdsInput {
   Logger log_;
   dds::Reader<dnbridge_PumpCommand> commands_;
   dds::Reader<dnbridge_ExplicitRequest> requests_;
+  dds::TakeBuffer<dnbridge_PumpCommand> command_buffer_;
+  dds::TakeBuffer<dnbridge_ExplicitRequest> request_buffer_;
   dds::GuardCondition stop_;
   dds::WaitSet waitset_;
   std::thread thread_;

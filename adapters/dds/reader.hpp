@@ -1,7 +1,7 @@
 #pragma once
 // A typed data reader. Samples are taken (or read) into owned copies: Cyclone
-// deserialises straight into zeroed structs of ours, whose strings and
-// sequences Sample<T> frees, so no loan is ever outstanding.
+// deserialises straight into structs of ours, whose strings and sequences
+// Sample<T> (or TakeBuffer<T>) frees, so no loan is ever outstanding.
 // Creation throws Error; every operation after that returns a Status or Result.
 #include <dds/dds.h>
 
@@ -34,6 +34,39 @@ class ReadCondition : public Entity {
 };
 
 template <class T>
+class Reader;
+
+// Storage a reader takes into again and again, for a reader on a hot path:
+// its samples keep their strings and sequences from one take to the next,
+// Cyclone deserialises into them (reallocating only a member that grows), so
+// once the buffer has held samples of every size a take allocates nothing.
+// A sample stays valid until the next take into the buffer.
+template <class T>
+class TakeBuffer {
+ public:
+  explicit TakeBuffer(std::size_t capacity)
+      : samples_(capacity), buffers_(capacity), infos_(capacity) {
+    for (std::size_t i = 0; i < capacity; ++i) buffers_[i] = samples_[i].get();
+  }
+  TakeBuffer(const TakeBuffer&) = delete;
+  TakeBuffer& operator=(const TakeBuffer&) = delete;
+
+  std::size_t capacity() const noexcept { return samples_.size(); }
+  // The samples of the last take.
+  std::size_t size() const noexcept { return count_; }
+  // For a sample without valid data only the key members are current.
+  const T& data(std::size_t i) const noexcept { return *samples_[i]; }
+  SampleInfo info(std::size_t i) const noexcept { return SampleInfo(infos_[i]); }
+
+ private:
+  friend class Reader<T>;
+  std::vector<Owned<T>> samples_;
+  std::vector<void*> buffers_;
+  std::vector<dds_sample_info_t> infos_;
+  std::size_t count_ = 0;
+};
+
+template <class T>
 class Reader : public Entity {
  public:
   Reader(const Participant& participant, const Topic<T>& topic, const Qos& qos)
@@ -43,6 +76,16 @@ class Reader : public Entity {
   // Up to `max` samples, removed from the reader.
   Result<std::vector<Sample<T>>> take(std::size_t max = kDefaultMax) const {
     return collect(handle(), max, true, DDS_HANDLE_NIL);
+  }
+  // Up to into.capacity() samples, removed from the reader, into `into`
+  // (replacing what it held); the number taken.
+  Result<std::size_t> take(TakeBuffer<T>& into) const {
+    const auto cap = static_cast<uint32_t>(into.capacity());
+    into.count_ = 0;
+    const dds_return_t n = dds_take(handle(), into.buffers_.data(), into.infos_.data(), cap, cap);
+    if (n < 0) return make_error_code(n);
+    into.count_ = static_cast<std::size_t>(n);
+    return into.count_;
   }
   // Up to `max` samples, left in the reader (marked read).
   Result<std::vector<Sample<T>>> read(std::size_t max = kDefaultMax) const {

@@ -2,7 +2,11 @@
 // DDS itself costs on the same machine in the same run.
 //
 //   (0) Cyclone's own one-way latency: ddsperf ping and pong (two processes,
-//       waitset mode, on loopback), one-way = round trip / 2.
+//       waitset mode, on loopback), one-way = round trip / 2, run beside each
+//       latency measurement below, over the same seconds.
+//   (0b) Cyclone alone on the path of a command: PumpCommands written by the
+//       commander process, taken here on a waitset thread, nothing behind
+//       it; one way, measured on CLOCK_MONOTONIC at both ends.
 //   (1) poll response received by the master -> PumpState taken by a
 //       subscriber in another process: wall clock at take - source timestamp
 //       (the bridge stamps each sample with the CAN receive time of the poll
@@ -12,7 +16,8 @@
 //       of frame on the simulated bus (after any frame already on the wire
 //       and arbitration): both ends on CLOCK_MONOTONIC, which the two
 //       processes share. Commands come at random gaps, so that they meet the
-//       poll schedule at every phase.
+//       poll schedule at every phase. (1) and (2) are measured with polls
+//       every 10 ms and every 100 ms (the shipped default).
 //   (3) CPU time of the bridge per second of wall time, 4 ports x 63 nodes
 //       polled every 10 ms, the simulated devices' threads left out.
 //
@@ -21,7 +26,10 @@
 // thread of their own). The subscriber and commander is this same program
 // re-executed with --client: another process, another DDS participant. Every
 // DDS participant of the run, ddsperf's included, is pinned to the loopback
-// interface with a discovery tag of this run's own.
+// interface with a discovery tag of this run's own. The measured process
+// (this one; ddsperf pong) and its peer (the client; ddsperf ping) each run
+// on a CPU of their own, and CPUs are held out of idle halts for the run
+// (see --help to change either).
 //
 // It reports figures; it exits non-zero only when the run itself fails.
 #include <dds/version.h>
@@ -29,6 +37,7 @@
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -203,14 +212,41 @@ struct Child {
   int out = -1;  // its standard output, when captured
 };
 
-// Runs `argv` with standard output to a pipe (capture) or /dev/null, standard
-// error inherited. Throws on failure to start.
-Child spawn(const std::vector<std::string>& argv, bool capture) {
+// Keeps the calling thread, and the threads and processes it starts after,
+// on one CPU (none: -1).
+bool pin_to_cpu(int cpu) {
+  if (cpu < 0) return true;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(static_cast<std::size_t>(cpu), &set);
+  return sched_setaffinity(0, sizeof set, &set) == 0;
+}
+
+// Asks the kernel to keep every CPU out of idle states that take longer than
+// 0 us to leave, for as long as the returned descriptor is open (the PM QoS
+// interface that latency tools such as cyclictest use): a CPU woken from a
+// halt, on a virtual machine above all, adds tens of microseconds to a
+// hand-over between threads, whatever the software. -1 when refused.
+int hold_cpus_awake() {
+  const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  const std::int32_t zero = 0;
+  if (write(fd, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Runs `argv` on CPU `cpu` (any: -1) with standard output to a pipe (capture)
+// or /dev/null, standard error inherited. Throws on failure to start.
+Child spawn(const std::vector<std::string>& argv, bool capture, int cpu) {
   int fds[2] = {-1, -1};
   if (capture && pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
+    if (!pin_to_cpu(cpu)) _exit(126);
     if (capture) {
       dup2(fds[1], STDOUT_FILENO);
     } else {
@@ -337,58 +373,98 @@ double pooled_quantile(const std::vector<DdsperfWindow>& ws, double q) {
   return hi;
 }
 
-DdsperfResult run_ddsperf(int domain, int seconds, int rate_hz, int size) {
-  const std::string d = std::to_string(domain);
-  // pong outlives ping; ping waits (initwait) for its pong before it starts.
-  Child pong =
-      spawn({"ddsperf", "-i", d, "-D", std::to_string(seconds + 15), "pong", "waitset"}, false);
-  std::vector<std::string> ping_args{"ddsperf",
-                                     "-i",
-                                     d,
-                                     "-Qminmatch:1",
-                                     "-Qinitwait:10",
-                                     "-D",
-                                     std::to_string(seconds + 1),
-                                     "ping",
-                                     std::to_string(rate_hz) + "Hz",
-                                     "size",
-                                     std::to_string(size),
-                                     "waitset"};
-  Child ping = spawn(ping_args, true);
-  DdsperfResult r;
-  for (std::size_t i = 1; i < ping_args.size(); ++i) r.command += ping_args[i] + " ";
-  LineReader lines(ping.out);
-  const std::regex re(
-      R"(size \d+ mean [\d.]+us min ([\d.]+)us 50% ([\d.]+)us 90% ([\d.]+)us 99% ([\d.]+)us max ([\d.]+)us cnt (\d+))");
-  bool first = true;
-  const auto deadline = monotonic_ns() + static_cast<std::int64_t>(seconds + 30) * 1'000'000'000;
-  while (auto line = lines.next(deadline)) {
-    std::smatch m;
-    if (!std::regex_search(*line, m, re)) continue;
-    if (first) {  // discovery and warm-up
-      first = false;
-      continue;
+// Which CPU the measured process (the bridge; ddsperf pong) and its peer (the
+// subscriber and commander; ddsperf ping) run on; -1: wherever the kernel
+// puts them.
+struct Placement {
+  int tested = -1;
+  int peer = -1;
+};
+
+// ddsperf ping and pong, run beside a measurement of the bridge: started when
+// the measurement starts, read when it ends, so that both see the same
+// machine at the same time.
+class Ddsperf {
+ public:
+  Ddsperf(int domain, double seconds, int rate_hz, int size, Placement cpus) {
+    const std::string d = std::to_string(domain);
+    const auto run_s = static_cast<int>(std::ceil(seconds)) + 2;
+    // pong outlives ping; ping waits (initwait) for its pong before it starts.
+    pong_ = spawn({"ddsperf", "-i", d, "-D", std::to_string(run_s + 15), "pong", "waitset"}, false,
+                  cpus.tested);
+    std::vector<std::string> ping_args{"ddsperf",
+                                       "-i",
+                                       d,
+                                       "-Qminmatch:1",
+                                       "-Qinitwait:10",
+                                       "-D",
+                                       std::to_string(run_s),
+                                       "ping",
+                                       std::to_string(rate_hz) + "Hz",
+                                       "size",
+                                       std::to_string(size),
+                                       "waitset"};
+    for (std::size_t i = 1; i < ping_args.size(); ++i) command_ += ping_args[i] + " ";
+    ping_ = spawn(ping_args, true, cpus.peer);
+    deadline_ = monotonic_ns() + static_cast<std::int64_t>((run_s + 30) * 1e9);
+  }
+  Ddsperf(const Ddsperf&) = delete;
+  Ddsperf& operator=(const Ddsperf&) = delete;
+  ~Ddsperf() {
+    if (ping_.pid > 0) {
+      kill(ping_.pid, SIGKILL);
+      (void)wait_child(ping_.pid);
+      close(ping_.out);
     }
-    r.windows.push_back({std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]),
-                         std::stod(m[5]), std::stod(m[6])});
+    if (pong_.pid > 0) {
+      kill(pong_.pid, SIGKILL);
+      (void)wait_child(pong_.pid);
+    }
   }
-  close(ping.out);
-  if (lines.timed_out()) kill(ping.pid, SIGKILL);
-  const int ping_status = wait_child(ping.pid);
-  kill(pong.pid, SIGTERM);
-  (void)wait_child(pong.pid);
-  if (ping_status != 0 || r.windows.empty()) {
-    throw std::runtime_error(
-        fmt::format("ddsperf ping failed (exit {}, {} windows)", ping_status, r.windows.size()));
+
+  // Reads ping's report to its end (the run's length) and stops pong.
+  DdsperfResult finish() {
+    DdsperfResult r;
+    r.command = command_;
+    LineReader lines(ping_.out);
+    const std::regex re(
+        R"(size \d+ mean [\d.]+us min ([\d.]+)us 50% ([\d.]+)us 90% ([\d.]+)us 99% ([\d.]+)us max ([\d.]+)us cnt (\d+))");
+    bool first = true;
+    while (auto line = lines.next(deadline_)) {
+      std::smatch m;
+      if (!std::regex_search(*line, m, re)) continue;
+      if (first) {  // discovery and warm-up
+        first = false;
+        continue;
+      }
+      r.windows.push_back({std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]),
+                           std::stod(m[5]), std::stod(m[6])});
+    }
+    close(ping_.out);
+    if (lines.timed_out()) kill(ping_.pid, SIGKILL);
+    const int ping_status = wait_child(ping_.pid);
+    ping_.pid = -1;
+    kill(pong_.pid, SIGTERM);
+    (void)wait_child(pong_.pid);
+    pong_.pid = -1;
+    if (ping_status != 0 || r.windows.empty()) {
+      throw std::runtime_error(
+          fmt::format("ddsperf ping failed (exit {}, {} windows)", ping_status, r.windows.size()));
+    }
+    for (const auto& w : r.windows) {
+      r.samples += w.count;
+      r.rtt_max = std::max(r.rtt_max, w.max);
+    }
+    r.rtt_p50 = pooled_quantile(r.windows, 0.50);
+    r.rtt_p99 = pooled_quantile(r.windows, 0.99);
+    return r;
   }
-  for (const auto& w : r.windows) {
-    r.samples += w.count;
-    r.rtt_max = std::max(r.rtt_max, w.max);
-  }
-  r.rtt_p50 = pooled_quantile(r.windows, 0.50);
-  r.rtt_p99 = pooled_quantile(r.windows, 0.99);
-  return r;
-}
+
+ private:
+  Child pong_, ping_;
+  std::string command_;
+  std::int64_t deadline_ = 0;
+};
 
 // ---------------------------------------------------------------------------
 // The client process: subscriber and commander
@@ -416,7 +492,9 @@ int run_client(const ClientOptions& o) {
   waitset.attach(any, 1);
   waitset.attach(stop, 2);
 
-  const std::size_t expected = o.ports.size() * o.nodes;
+  // "oneway": no bridge, only a reader of the commands to match.
+  const bool commanding = o.mode == "latency" || o.mode == "oneway";
+  const std::size_t expected = o.mode == "oneway" ? 0 : o.ports.size() * o.nodes;
   auto key_of = [&](const dnbridge_PumpState& s) -> std::optional<std::size_t> {
     for (std::size_t p = 0; p < o.ports.size(); ++p) {
       if (dds::view(s.port) == o.ports[p] && s.mac >= 1 && s.mac <= o.nodes) {
@@ -514,7 +592,7 @@ int run_client(const ClientOptions& o) {
   const auto start = monotonic_ns();
   const auto window = static_cast<std::int64_t>(o.seconds * 1e9);
   measuring = true;
-  if (o.mode == "latency") {
+  if (commanding) {
     // Round robin over the nodes of the first port; each command a new
     // analog output value for its node (1..4095), so that the poll frame
     // that carries it is known by its value. The gaps are drawn uniformly
@@ -552,7 +630,7 @@ int run_client(const ClientOptions& o) {
   std::string out;
   out.reserve(latencies.size() * 12 + written.size() * 32 + 256);
   for (auto l : latencies) out += fmt::format("state {}\n", l);
-  if (o.mode == "latency") {
+  if (commanding) {
     for (const auto& w : written) out += fmt::format("cmd {} {} {}\n", w.mac, w.value, w.at);
   }
   out += fmt::format("taken {} {}\n", taken.load(), elapsed);
@@ -853,15 +931,20 @@ class Bridge {
 };
 
 struct Options {
-  int ddsperf_seconds = 10;
   int ddsperf_rate = 500;
   int ddsperf_size = 128;
   double latency_seconds = 25;
+  double direct_seconds = 15;
+  std::vector<int> latency_poll_ms{10, 100};
   unsigned latency_nodes = 8;
   int command_interval_ms = 10;
   double cpu_seconds = 20;
   double busy_seconds = 10;
   int domain = -1;
+  bool pin = true;
+  bool hold_awake = true;
+  int bridge_cpu = 1;
+  int peer_cpu = 0;
 };
 
 std::vector<std::string> client_args(const std::string& mode, int domain,
@@ -936,6 +1019,66 @@ ClientOutput read_client(Child child, double seconds, OnReady on_ready, OnEnd on
 
 std::string us(double v) { return fmt::format("{:.1f} us", v); }
 
+// Cyclone DDS alone on the path of a command: the commander process writes
+// PumpCommands as in (2), at the same gaps, with the same QoS, and a reader
+// in this process takes them on a waitset thread, as the bridge's DDS input
+// does, with nothing behind it. Write (CLOCK_MONOTONIC in the commander) ->
+// take (CLOCK_MONOTONIC here): one way, measured, not halved from a round
+// trip.
+template <class OnReady>
+std::vector<double> direct_oneway(int domain, Placement cpus, double seconds, int interval_us,
+                                  unsigned nodes, OnReady on_ready) {
+  dds::Participant participant(static_cast<dds_domainid_t>(domain), "bench-direct");
+  dds::Topic<dnbridge_PumpCommand> topic(participant);
+  dds::Reader<dnbridge_PumpCommand> reader(participant, topic, dds::command_reader_qos());
+  if (!reader.set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
+    throw std::runtime_error("setting the reader's status mask failed");
+  }
+  dds::GuardCondition stop(participant);
+  dds::WaitSet waitset(participant);
+  waitset.attach(reader, 1);
+  waitset.attach(stop, 2);
+  std::map<std::pair<unsigned, unsigned>, std::int64_t> taken_at;
+  std::thread taker([&] {
+    for (;;) {
+      auto triggered = waitset.wait(milliseconds(200));
+      const auto now = monotonic_ns();
+      if (!triggered) continue;
+      for (auto t : *triggered) {
+        if (t == 2) return;
+      }
+      auto samples = reader.take();
+      if (!samples) continue;
+      for (const auto& sample : *samples) {
+        if (!sample.info().valid_data()) continue;
+        taken_at.emplace(std::make_pair(unsigned{sample.data().mac},
+                                        unsigned{sample.data().analog_output_raw}),
+                         now);
+      }
+    }
+  });
+  auto args = client_args("oneway", domain, {"A"}, nodes, seconds);
+  args.push_back("--command-interval-us");
+  args.push_back(std::to_string(interval_us));
+  ClientOutput out;
+  try {
+    out = read_client(spawn(args, true, cpus.peer), seconds, on_ready, [] {});
+  } catch (...) {
+    (void)stop.trigger();
+    taker.join();
+    throw;
+  }
+  (void)stop.trigger();
+  taker.join();
+  std::vector<double> us;
+  for (const auto& c : out.commands) {
+    auto it = taken_at.find({c.mac, c.value});
+    if (it != taken_at.end()) us.push_back(static_cast<double>(it->second - c.at) / 1e3);
+  }
+  return us;
+}
+
+
 std::string verdict(bool met) { return met ? "met" : "NOT met"; }
 
 int run_bench(const Options& o) {
@@ -951,7 +1094,37 @@ int run_bench(const Options& o) {
   fmt::print("DDS: Cyclone DDS {}, loopback only (lo, unicast discovery), domain {}, tag {}\n",
              DDS_VERSION, domain, tag);
   // Latencies are only as good as the machine is quiet: say how busy it was.
-  fmt::print("load average at start: {}\n\n", load_average());
+  fmt::print("load average at start: {}\n", load_average());
+
+  const int awake = o.hold_awake ? hold_cpus_awake() : -1;
+  if (awake >= 0) {
+    fmt::print("CPU idle: /dev/cpu_dma_latency held at 0 us for the whole run (no CPU halts)\n");
+  } else {
+    fmt::print("CPU idle: {}\n", o.hold_awake ? "/dev/cpu_dma_latency could not be held (not root?): "
+                                               "CPUs halt when idle"
+                                             : "CPUs halt when idle (--allow-idle)");
+  }
+
+  // The measured process on one CPU, its peer on another, for the bridge as
+  // for ddsperf: a hand-over between threads of one process then stays on
+  // its CPU (on a virtual machine waking another, idle, CPU can cost tens of
+  // microseconds), and each pair is measured in the same layout.
+  Placement cpus;
+  const int online = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
+  if (o.pin && o.bridge_cpu != o.peer_cpu && std::max(o.bridge_cpu, o.peer_cpu) < online &&
+      std::min(o.bridge_cpu, o.peer_cpu) >= 0) {
+    cpus = {o.bridge_cpu, o.peer_cpu};
+    if (!pin_to_cpu(cpus.tested)) {
+      throw std::runtime_error(fmt::format("cannot keep the benchmark on CPU {}", cpus.tested));
+    }
+    fmt::print(
+        "CPUs: the bridge (this process, every thread) and ddsperf pong on CPU {}; the "
+        "subscriber/commander\n      process and ddsperf ping on CPU {}\n\n",
+        cpus.tested, cpus.peer);
+  } else {
+    fmt::print("CPUs: every process and thread where the kernel puts it{}\n\n",
+               o.pin ? " (two distinct online CPUs are needed to pin)" : "");
+  }
 
   if (!steady_clock_is_monotonic()) {
     fmt::print(stderr,
@@ -961,125 +1134,155 @@ int run_bench(const Options& o) {
   fmt::print(
       "clock check: std::chrono::steady_clock reads CLOCK_MONOTONIC (1000 readings bracketed)\n\n");
 
-  // (0) ---------------------------------------------------------------------
-  if (o.ddsperf_seconds > 0 && o.latency_seconds > 0) {
-    fmt::print("(0) Cyclone DDS one-way latency (ddsperf), {} s ...\n", o.ddsperf_seconds);
-    std::fflush(stdout);
-    const DdsperfResult cyc =
-        run_ddsperf(domain, o.ddsperf_seconds, o.ddsperf_rate, o.ddsperf_size);
-    const double cyc_p50 = cyc.rtt_p50 / 2, cyc_p99 = cyc.rtt_p99 / 2;
+  // (0), (1), (2) -------------------------------------------------------------
+  // Each measurement has ddsperf running beside it: Cyclone's own latency and
+  // the bridge's are taken over the same seconds, on the same CPUs.
+  auto start_ddsperf = [&](std::optional<Ddsperf>& d) {
+    d.emplace(domain, o.latency_seconds, o.ddsperf_rate, o.ddsperf_size, cpus);
+  };
+  struct Reference {
+    double p50 = 0, p99 = 0;  // one-way, us
+  };
+  auto report_ddsperf = [&](std::optional<Ddsperf>& d) {
+    if (!d) throw std::runtime_error("the measurement ended before it started");
+    const DdsperfResult cyc = d->finish();
+    d.reset();
     double window_p99_lo = cyc.windows.front().p99, window_p99_hi = window_p99_lo;
     for (const auto& w : cyc.windows) {
       window_p99_lo = std::min(window_p99_lo, w.p99);
       window_p99_hi = std::max(window_p99_hi, w.p99);
     }
-    fmt::print("    ddsperf {}(and ddsperf pong waitset)\n", cyc.command);
-    fmt::print("    round trips: {:.0f} in {} one-second windows (first window left out)\n",
-               cyc.samples, cyc.windows.size());
+    fmt::print("(0) Cyclone DDS, beside it: ddsperf {}(and ddsperf pong waitset)\n",
+               cyc.command);
     fmt::print(
-        "    round trip  p50 {}  p99 {}  max {}  (p99 of single windows {:.1f}..{:.1f} us)\n",
-        us(cyc.rtt_p50), us(cyc.rtt_p99), us(cyc.rtt_max), window_p99_lo, window_p99_hi);
-    fmt::print("    one-way = round trip / 2:  p50 {}  p99 {}\n\n", us(cyc_p50), us(cyc_p99));
+        "    round trips {:.0f} in {} one-second windows (the first left out)  p50 {}  p99 {}  "
+        "max {}\n    (p99 of single windows {:.1f}..{:.1f} us)\n",
+        cyc.samples, cyc.windows.size(), us(cyc.rtt_p50), us(cyc.rtt_p99), us(cyc.rtt_max),
+        window_p99_lo, window_p99_hi);
+    const Reference ref{cyc.rtt_p50 / 2, cyc.rtt_p99 / 2};
+    fmt::print("    one-way = round trip / 2:  p50 {}  p99 {}\n", us(ref.p50), us(ref.p99));
+    return ref;
+  };
 
-    // (1) and (2) -------------------------------------------------------------
-    {
-      BridgeSetup s;
-      s.ports = {"A"};
-      s.nodes = o.latency_nodes;
-      s.bitrate = sim::kBitrate500k;
-      s.publish = {seconds(1), 0.0};
-      s.ramp = true;
-      s.record_outputs = true;
-      fmt::print(
-          "(1)(2) bridge: 1 port, {} CDN127s at 500 kbit/s, polled every 10 ms; every poll "
-          "response\n       carries a new analog input (deadband 0: each one is published); a "
-          "PumpCommand\n       every {} ms, round robin, each a new analog output; {} s ...\n",
-          s.nodes, o.command_interval_ms, o.latency_seconds);
-      std::fflush(stdout);
-      Bridge bridge(s, domain, log);
-      const auto offset_before = realtime_ns() - monotonic_ns();
-      bridge.start();
-      auto args = client_args("latency", domain, s.ports, s.nodes, o.latency_seconds);
-      args.push_back("--command-interval-us");
-      args.push_back(std::to_string(o.command_interval_ms * 1000));
-      ClientOutput out = read_client(
-          spawn(args, true), o.latency_seconds, [] {}, [] {});
-      bridge.stop();
-      const auto offset_after = realtime_ns() - monotonic_ns();
-      const auto drift_us = static_cast<double>(offset_after - offset_before) / 1e3;
+  if (o.latency_seconds > 0 && o.direct_seconds > 0) {
+    fmt::print(
+        "(0b) Cyclone DDS alone on the path of a command: PumpCommands written as in (2) by the\n"
+        "     commander process, taken in this process by a reader on a waitset thread, as the\n"
+        "     bridge takes them, with nothing behind it; one way, measured ({} s) ...\n",
+        o.direct_seconds);
+    std::fflush(stdout);
+    std::optional<Ddsperf> ddsperf;
+    const Summary d = summarize(direct_oneway(domain, cpus, o.direct_seconds,
+                                              o.command_interval_ms * 1000, o.latency_nodes,
+                                              [&] { start_ddsperf(ddsperf); }));
+    const Reference ref = report_ddsperf(ddsperf);
+    fmt::print("(0b) write -> take, one way: samples {}  p50 {}  p99 {}  max {}\n", d.count,
+               us(d.p50), us(d.p99), us(d.max));
+    fmt::print("     ratio to ddsperf's one-way:  p50 {:.2f}  p99 {:.2f}\n\n", d.p50 / ref.p50,
+               d.p99 / ref.p99);
+  }
 
-      const Summary state = summarize(out.state_us);
-      fmt::print(
-          "\n(1) poll response received by the master -> PumpState taken by the subscriber\n");
-      fmt::print("    samples {}  p50 {}  p99 {}  max {}  min {}\n", state.count, us(state.p50),
-                 us(state.p99), us(state.max), us(state.min));
-      fmt::print(
-          "    wall clock moved {:+.1f} us against CLOCK_MONOTONIC during the run (an error of "
-          "at most that)\n",
-          drift_us);
-      fmt::print("    ratio to Cyclone one-way:  p50 {:.2f}  p99 {:.2f}   target p99 <= 1.5: {}\n",
-                 state.p50 / cyc_p50, state.p99 / cyc_p99, verdict(state.p99 <= 1.5 * cyc_p99));
+  for (const int poll_ms : o.latency_poll_ms) {
+    if (o.latency_seconds <= 0) break;
+    BridgeSetup s;
+    s.ports = {"A"};
+    s.nodes = o.latency_nodes;
+    s.bitrate = sim::kBitrate500k;
+    s.poll_period = milliseconds(poll_ms);
+    s.publish = {seconds(1), 0.0};
+    s.ramp = true;
+    s.record_outputs = true;
+    fmt::print(
+        "(1)(2) bridge: 1 port, {} CDN127s at 500 kbit/s, polled every {} ms{}; every poll "
+        "response\n       carries a new analog input (deadband 0: each one is published); a "
+        "PumpCommand\n       every {} ms on average, round robin, each a new analog output; {} "
+        "s ...\n",
+        s.nodes, poll_ms, poll_ms == 100 ? " (as shipped)" : "", o.command_interval_ms,
+        o.latency_seconds);
+    std::fflush(stdout);
+    Bridge bridge(s, domain, log);
+    const auto offset_before = realtime_ns() - monotonic_ns();
+    bridge.start();
+    auto args = client_args("latency", domain, s.ports, s.nodes, o.latency_seconds);
+    args.push_back("--command-interval-us");
+    args.push_back(std::to_string(o.command_interval_ms * 1000));
+    std::optional<Ddsperf> ddsperf;
+    ClientOutput out = read_client(
+        spawn(args, true, cpus.peer), o.latency_seconds, [&] { start_ddsperf(ddsperf); },
+        [] {});
+    bridge.stop();
+    const auto offset_after = realtime_ns() - monotonic_ns();
+    const auto drift_us = static_cast<double>(offset_after - offset_before) / 1e3;
+    const Reference cyc = report_ddsperf(ddsperf);
 
-      std::map<std::pair<unsigned, unsigned>, PortWire::OutputFrame> frames;
-      for (const auto& f : bridge.output_frames())
-        frames.emplace(std::make_pair(f.mac, f.value), f);
-      std::map<std::pair<unsigned, unsigned>, PortWire::WrittenFrame> written;
-      for (const auto& f : bridge.written_frames())
-        written.emplace(std::make_pair(f.mac, f.value), f);
-      std::vector<double> to_write, to_start, to_end, to_write_free;
-      std::size_t waited = 0;
-      for (const auto& c : out.commands) {
-        auto it = frames.find({c.mac, c.value});
-        auto wr = written.find({c.mac, c.value});
-        if (it == frames.end() || wr == written.end()) continue;
-        const double write_us = static_cast<double>(wr->second.at - c.at) / 1e3;
-        to_write.push_back(write_us);
-        if (wr->second.after_response) {
-          ++waited;
-        } else {
-          to_write_free.push_back(write_us);
-        }
-        to_start.push_back(static_cast<double>(it->second.start - c.at) / 1e3);
-        to_end.push_back(static_cast<double>(it->second.end - c.at) / 1e3);
+    const Summary state = summarize(out.state_us);
+    fmt::print("(1) poll response received by the master -> PumpState taken by the subscriber\n");
+    fmt::print("    samples {}  p50 {}  p99 {}  max {}  min {}\n", state.count, us(state.p50),
+               us(state.p99), us(state.max), us(state.min));
+    fmt::print(
+        "    wall clock moved {:+.1f} us against CLOCK_MONOTONIC during the run (an error of "
+        "at most that)\n",
+        drift_us);
+    fmt::print("    ratio to Cyclone one-way:  p50 {:.2f}  p99 {:.2f}   target p99 <= 1.5: {}\n",
+               state.p50 / cyc.p50, state.p99 / cyc.p99, verdict(state.p99 <= 1.5 * cyc.p99));
+
+    std::map<std::pair<unsigned, unsigned>, PortWire::OutputFrame> frames;
+    for (const auto& f : bridge.output_frames()) frames.emplace(std::make_pair(f.mac, f.value), f);
+    std::map<std::pair<unsigned, unsigned>, PortWire::WrittenFrame> written;
+    for (const auto& f : bridge.written_frames())
+      written.emplace(std::make_pair(f.mac, f.value), f);
+    std::vector<double> to_write, to_start, to_end, to_write_free;
+    std::size_t waited = 0;
+    for (const auto& c : out.commands) {
+      auto it = frames.find({c.mac, c.value});
+      auto wr = written.find({c.mac, c.value});
+      if (it == frames.end() || wr == written.end()) continue;
+      const double write_us = static_cast<double>(wr->second.at - c.at) / 1e3;
+      to_write.push_back(write_us);
+      if (wr->second.after_response) {
+        ++waited;
+      } else {
+        to_write_free.push_back(write_us);
       }
-      const Summary cmd_write = summarize(to_write);
-      const Summary cmd_write_free = summarize(to_write_free);
-      const Summary cmd = summarize(to_start);
-      const Summary cmd_end = summarize(to_end);
-      fmt::print("\n(2) PumpCommand written -> poll frame with the new outputs\n");
-      fmt::print("    commands written {}, their poll frames found {}\n", out.commands.size(),
-                 cmd.count);
-      fmt::print(
-          "    to the frame written to the CAN interface:  p50 {}  p99 {}  max {}  min {}\n",
-          us(cmd_write.p50), us(cmd_write.p99), us(cmd_write.max), us(cmd_write.min));
-      fmt::print(
-          "    {} of them ({:.1f} %) came while the node's previous poll was unanswered and\n"
-          "    went out with its response (one poll at a time on a poll connection); the "
-          "others:\n"
-          "                                                p50 {}  p99 {}  max {}\n",
-          waited, 100.0 * static_cast<double>(waited) / static_cast<double>(to_write.size()),
-          us(cmd_write_free.p50), us(cmd_write_free.p99), us(cmd_write_free.max));
-      fmt::print(
-          "    to its start of frame on the bus:           p50 {}  p99 {}  max {}  min {}\n"
-          "      (adds waiting for a frame already on the 500 kbit/s wire, and arbitration)\n",
-          us(cmd.p50), us(cmd.p99), us(cmd.max), us(cmd.min));
-      fmt::print("    to its end of frame:                        p50 {}  p99 {}\n",
-                 us(cmd_end.p50), us(cmd_end.p99));
-      fmt::print(
-          "    ratio to Cyclone one-way, written:          p50 {:.2f}  p99 {:.2f}   target p99 "
-          "<= 1.5: {}\n",
-          cmd_write.p50 / cyc_p50, cmd_write.p99 / cyc_p99,
-          verdict(cmd_write.p99 <= 1.5 * cyc_p99));
-      fmt::print(
-          "    ratio to Cyclone one-way, written, no poll in flight:  p50 {:.2f}  p99 {:.2f}\n",
-          cmd_write_free.p50 / cyc_p50, cmd_write_free.p99 / cyc_p99);
-      fmt::print(
-          "    ratio to Cyclone one-way, start of frame:   p50 {:.2f}  p99 {:.2f}   target p99 "
-          "<= 1.5: {}\n",
-          cmd.p50 / cyc_p50, cmd.p99 / cyc_p99, verdict(cmd.p99 <= 1.5 * cyc_p99));
-      fmt::print("\n");
-      if (state.count == 0 || cmd.count == 0) throw std::runtime_error("no latency was measured");
+      to_start.push_back(static_cast<double>(it->second.start - c.at) / 1e3);
+      to_end.push_back(static_cast<double>(it->second.end - c.at) / 1e3);
     }
+    const Summary cmd_write = summarize(to_write);
+    const Summary cmd_write_free = summarize(to_write_free);
+    const Summary cmd = summarize(to_start);
+    const Summary cmd_end = summarize(to_end);
+    fmt::print("(2) PumpCommand written -> poll frame with the new outputs\n");
+    fmt::print("    commands written {}, their poll frames found {}\n", out.commands.size(),
+               cmd.count);
+    fmt::print(
+        "    to the frame written to the CAN interface:  p50 {}  p99 {}  max {}  min {}\n",
+        us(cmd_write.p50), us(cmd_write.p99), us(cmd_write.max), us(cmd_write.min));
+    fmt::print(
+        "    {} of them ({:.1f} %) came while the node's previous poll was unanswered and\n"
+        "    went out with its response (one poll at a time on a poll connection); the "
+        "others:\n"
+        "                                                p50 {}  p99 {}  max {}\n",
+        waited, 100.0 * static_cast<double>(waited) / static_cast<double>(to_write.size()),
+        us(cmd_write_free.p50), us(cmd_write_free.p99), us(cmd_write_free.max));
+    fmt::print(
+        "    to its start of frame on the bus:           p50 {}  p99 {}  max {}  min {}\n"
+        "      (adds waiting for a frame already on the 500 kbit/s wire, and arbitration)\n",
+        us(cmd.p50), us(cmd.p99), us(cmd.max), us(cmd.min));
+    fmt::print("    to its end of frame:                        p50 {}  p99 {}\n", us(cmd_end.p50),
+               us(cmd_end.p99));
+    fmt::print(
+        "    ratio to Cyclone one-way, written:          p50 {:.2f}  p99 {:.2f}   target p99 "
+        "<= 1.5: {}\n",
+        cmd_write.p50 / cyc.p50, cmd_write.p99 / cyc.p99, verdict(cmd_write.p99 <= 1.5 * cyc.p99));
+    fmt::print(
+        "    ratio to Cyclone one-way, written, no poll in flight:  p50 {:.2f}  p99 {:.2f}\n",
+        cmd_write_free.p50 / cyc.p50, cmd_write_free.p99 / cyc.p99);
+    fmt::print(
+        "    ratio to Cyclone one-way, start of frame:   p50 {:.2f}  p99 {:.2f}   target p99 "
+        "<= 1.5: {}\n\n",
+        cmd.p50 / cyc.p50, cmd.p99 / cyc.p99, verdict(cmd.p99 <= 1.5 * cyc.p99));
+    std::fflush(stdout);
+    if (state.count == 0 || cmd.count == 0) throw std::runtime_error("no latency was measured");
   }
 
   // (3) ---------------------------------------------------------------------
@@ -1125,7 +1328,7 @@ int run_bench(const Options& o) {
       bits = static_cast<double>(bridge.bus_bits() - bits0);
       threads1 = snapshot_threads();
     };
-    ClientOutput out = read_client(spawn(args, true), window, start, end);
+    ClientOutput out = read_client(spawn(args, true, cpus.peer), window, start, end);
     bridge.stop();
     if (wall <= 0) throw std::runtime_error("the CPU window was not measured");
     const double bridge_pct = 100.0 * (cpu - sim_cpu) / wall;
@@ -1198,16 +1401,25 @@ int main(int argc, char** argv) {
   Options o;
   ClientOptions client;
   std::string ports;
-  app.add_option("--ddsperf-seconds", o.ddsperf_seconds, "ddsperf ping run")->capture_default_str();
   app.add_option("--ddsperf-rate", o.ddsperf_rate, "ddsperf pings per second")
       ->capture_default_str();
-  app.add_option("--latency-seconds", o.latency_seconds, "(1) and (2)")->capture_default_str();
+  app.add_option("--latency-seconds", o.latency_seconds, "(1) and (2), each run; 0 to skip")
+      ->capture_default_str();
+  app.add_option("--direct-seconds", o.direct_seconds, "(0b); 0 to skip")->capture_default_str();
+  app.add_option("--latency-poll-ms", o.latency_poll_ms, "a run of (1) and (2) per poll period")
+      ->capture_default_str();
   app.add_option("--latency-nodes", o.latency_nodes, "nodes for (1) and (2)")
       ->capture_default_str();
   app.add_option("--command-interval-ms", o.command_interval_ms, "(2)")->capture_default_str();
   app.add_option("--cpu-seconds", o.cpu_seconds, "(3) measurement window")->capture_default_str();
   app.add_option("--busy-seconds", o.busy_seconds, "(3b) window, 0 to skip")->capture_default_str();
   app.add_option("--domain", o.domain, "DDS domain (default: from the process id)");
+  app.add_option("--bridge-cpu", o.bridge_cpu, "CPU of the bridge and of ddsperf pong")
+      ->capture_default_str();
+  app.add_option("--peer-cpu", o.peer_cpu, "CPU of the subscriber/commander and of ddsperf ping")
+      ->capture_default_str();
+  app.add_flag("!--no-pin", o.pin, "let the kernel place every process and thread");
+  app.add_flag("!--allow-idle", o.hold_awake, "do not hold /dev/cpu_dma_latency at 0");
   // The client role (re-executed by the benchmark itself).
   app.add_option("--client", client.mode)->group("");
   app.add_option("--ports", ports)->group("");
