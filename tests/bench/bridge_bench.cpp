@@ -907,24 +907,24 @@ class Bridge {
     return tids;
   }
 
-  std::vector<PortWire::OutputFrame> output_frames() {
-    std::vector<PortWire::OutputFrame> all;
-    for (auto& w : wires_) {
-      std::lock_guard lock(w->mutex);
-      all.insert(all.end(), w->output_frames.begin(), w->output_frames.end());
-    }
-    return all;
-  }
+  std::vector<PortWire::OutputFrame> output_frames() { return gather(&PortWire::output_frames); }
   std::vector<PortWire::WrittenFrame> written_frames() {
-    std::vector<PortWire::WrittenFrame> all;
+    return gather(&PortWire::written_frames);
+  }
+
+ private:
+  // One record of every port's wire, in port order.
+  template <class Frame>
+  std::vector<Frame> gather(std::vector<Frame> PortWire::*record) {
+    std::vector<Frame> all;
     for (auto& w : wires_) {
       std::lock_guard lock(w->mutex);
-      all.insert(all.end(), w->written_frames.begin(), w->written_frames.end());
+      const auto& frames = (*w).*record;
+      all.insert(all.end(), frames.begin(), frames.end());
     }
     return all;
   }
 
- private:
   std::vector<port::ThreadedSimBackend*> backends_;
   std::vector<std::unique_ptr<PortWire>> wires_;  // outlive the daemon (its backends' taps)
   std::unique_ptr<daemon::Daemon> daemon_;
