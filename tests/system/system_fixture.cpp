@@ -7,6 +7,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
@@ -177,7 +179,7 @@ void Supervisor::update() {
 }
 
 bool Supervisor::wait_until(const std::function<bool()>& done, std::chrono::seconds timeout) {
-  const auto until = std::chrono::steady_clock::now() + timeout;
+  const auto until = std::chrono::steady_clock::now() + patience(timeout);
   for (;;) {
     update();
     if (done()) return true;
@@ -225,8 +227,21 @@ std::string Supervisor::describe() const {
 
 // --- helpers ---------------------------------------------------------------
 
+double guest_slowdown() {
+  const char* s = std::getenv("DNBRIDGE_SYSTEM_SLOWDOWN");
+  double factor = s ? std::strtod(s, nullptr) : 1.0;
+  // A factor outside [1, 50] is a measurement gone wrong, not a machine.
+  return std::isfinite(factor) ? std::clamp(factor, 1.0, 50.0) : 1.0;
+}
+
+std::chrono::milliseconds patience(std::chrono::milliseconds base) {
+  static const double factor = guest_slowdown();
+  return std::chrono::milliseconds(
+      static_cast<std::chrono::milliseconds::rep>(std::ceil(static_cast<double>(base.count()) * factor)));
+}
+
 fs::path work_dir() {
-  // run_in_uml.sh gives each test a directory of its own.
+  // run_in_vm.sh gives each test a directory of its own.
   const char* w = std::getenv("DNBRIDGE_SYSTEM_WORK");
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   fs::path dir = w ? fs::path(w)

@@ -1,7 +1,7 @@
 #pragma once
-// What the system tests share. They run inside a User-Mode Linux kernel
-// with the CAN modules (run_in_uml.sh boots it, uml_init.sh sets it up):
-// vcan0 and vcan1 exist, DDS is pinned to lo. Each test starts the real
+// What the system tests share. They run inside a kernel of their own with
+// the CAN modules, User-Mode Linux or QEMU (run_in_vm.sh boots it,
+// guest_init.sh sets it up): vcan0 and vcan1 exist, DDS is pinned to lo. Each test starts the real
 // programs (dnbridge, cdn127-sim) as child processes and watches the bridge
 // through DDS, as a supervisor would.
 #include <gtest/gtest.h>
@@ -104,7 +104,8 @@ class Supervisor {
   // Takes what arrived and folds it into the maps.
   void update();
   // Until `done` holds (checked on every arrival and every 200 ms), or
-  // `timeout`.
+  // `timeout` scaled by patience(): how long the test waits, not a bound
+  // the product must meet.
   bool wait_until(const std::function<bool()>& done, std::chrono::seconds timeout);
 
   bool command(const std::string& port, unsigned mac, bool pump_on);
@@ -131,7 +132,14 @@ class Supervisor {
   std::map<std::string, PortSeen> ports_;
 };
 
-// The work directory of this run (DNBRIDGE_SYSTEM_WORK, set by the UML
+// The guest's speed factor against the machine that runs the tests
+// (DNBRIDGE_SYSTEM_SLOWDOWN, measured by guest_init.sh; 1 when unset), and a
+// wait of the test's own scaled by it. Bounds the product must meet (fault
+// detection within 4 x EPR, say) are never scaled.
+double guest_slowdown();
+std::chrono::milliseconds patience(std::chrono::milliseconds base);
+
+// The work directory of this run (DNBRIDGE_SYSTEM_WORK, set by the guest's
 // init script), one subdirectory per test.
 fs::path work_dir();
 

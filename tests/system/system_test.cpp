@@ -1,6 +1,6 @@
 // dnbridge on a real Linux CAN stack: the bridge, cdn127-sim and a DDS
-// supervisor as separate processes on vcan interfaces of a User-Mode Linux
-// kernel. run_in_uml.sh runs each test in a kernel of its own.
+// supervisor as separate processes on vcan interfaces of a kernel of their
+// own. run_in_vm.sh runs each test in User-Mode Linux or QEMU.
 #include <fmt/format.h>
 #include <signal.h>
 
@@ -50,8 +50,8 @@ class SystemTest : public ::testing::Test {
  protected:
   void SetUp() override {
     ASSERT_EQ(socketcan::link_state("vcan0"), socketcan::LinkState::kUp)
-        << "vcan0 is not up: the system tests run inside User-Mode Linux (ctest runs them "
-           "through tests/system/run_in_uml.sh)";
+        << "vcan0 is not up: the system tests run inside a virtual machine (ctest runs them "
+           "through tests/system/run_in_vm.sh)";
     dir_ = work_dir();
     rack_ = ::testing::UnitTest::GetInstance()->current_test_info()->name();
   }
@@ -327,7 +327,7 @@ TEST_F(SystemTest, NetworkdExamplesBringTheCanLinksUp) {
                               log));
   Child& networkd = *children_.back();
 
-  const auto deadline = std::chrono::steady_clock::now() + 15s;
+  const auto deadline = std::chrono::steady_clock::now() + patience(15s);
   const auto up = [] {
     return socketcan::link_state("vcan0") == socketcan::LinkState::kUp &&
            socketcan::link_state("vcan1") == socketcan::LinkState::kUp;
