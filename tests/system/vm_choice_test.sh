@@ -6,6 +6,8 @@
 # machine and refuses what it does not know.
 #   vm_choice_test.sh WORK_DIR
 set -uo pipefail
+# The automatic choice is under test: whatever the caller forced does not apply.
+unset DNBRIDGE_VM
 here=$(cd "$(dirname "$0")" && pwd)
 work=$1
 rm -rf "$work/fake-uml" "$work/probe/uml"
