@@ -7,6 +7,7 @@
 #   /usr/share/dnbridge/cyclonedds/loopback.xml   DDS on this host only
 #   /usr/share/dnbridge/security  make-site-pki.sh: a site's DDS Security PKI
 #   /usr/share/dnbridge/networkd  systemd-networkd examples for the CAN interfaces
+#   /usr/share/dnbridge/cdn127-sim-example.toml   cdn127-sim's device readings
 #   /usr/share/doc/dnbridge       README.md; operations.md (deploy/README.md);
 #                                 security.md (deploy/security/README.md)
 #   systemd's unit directory      dnbridge@.service (a template: nothing starts
@@ -50,6 +51,8 @@ install(FILES ${PROJECT_SOURCE_DIR}/deploy/README.md DESTINATION ${CMAKE_INSTALL
 file(GLOB DNBRIDGE_NETWORKD_EXAMPLES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/deploy/networkd/*.network
      ${PROJECT_SOURCE_DIR}/deploy/networkd/*.link)
 install(FILES ${DNBRIDGE_NETWORKD_EXAMPLES} DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge/networkd)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/config/cdn127-sim-example.toml
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge)
 
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME dnbridge)

@@ -13,11 +13,16 @@
 #include <mutex>
 
 #include "adapters/cdn127_sim/control.hpp"
+#include "adapters/cdn127_sim/device_config.hpp"
 #include "adapters/cdn127_sim/sim_host.hpp"
 
 namespace {
 
 using namespace dnbridge;
+
+// A device configuration that cannot be used: every problem printed,
+// FILE:LINE:COLUMN each (as dnbridge does for its own).
+constexpr int kBadConfiguration = 2;
 
 class StderrSink final : public LogSink {
  public:
@@ -44,16 +49,45 @@ int main(int argc, char** argv) {
       "  cdn127-sim --iface vcan0 --mac 5 --mac 6\n\n"
       "Every device powers up at start (duplicate MAC check, then waits for a master), with\n"
       "the CDN127's identity (vendor 59, product type 27, product code 1888), serial number\n"
-      "0x10000 + MAC and the CDN127 preset configuration.\n\n" +
+      "0x10000 + MAC and the CDN127 preset configuration.\n\n"
+      "Where the CDN127 manual can be read more than one way, devices in the field differ;\n"
+      "by default every device takes the simulator's lenient reading. --reading field gives\n"
+      "every device the strictest one, --device-config FILE chooses per device (TOML; keys\n"
+      "below, the file's [defaults] apply to every device, those given only with --mac too):\n"
+      "  [[device]]\n"
+      "  mac = 5                                          # also simulates MAC 5\n"
+      "  configuration_locked_while_poll_allocated = true # Configuration Set/Reset: 0x0C\n"
+      "                                                   # while the poll connection exists\n"
+      "  poll_paths_fixed = true          # Connection 2 attributes 14/16 Get only (0x0E)\n"
+      "  idle_poll_answered_empty = true  # idle poll answered with 0 bytes\n"
+      "  no_ack_of_last_request_fragment = true  # the response answers the last fragment\n"
+      "  explicit_response_delay_ms = 300 # explicit and Allocate/Release answers this late\n"
+      "  poll_response_delay_ms = 3       # poll responses this late\n"
+      "  serial_number_bytes = 2          # Identity serial: 2 (UINT) or 4 (UDINT)\n"
+      "  identity_state_supported = false # Identity attribute 8 answers 0x14\n"
+      "  epr_resolution_ms = 100          # expected packet rates rounded up to this\n"
+      "--reading field is all of these as shown. A device's options: --reading, then\n"
+      "[defaults], then its [[device]] (deploy/config/cdn127-sim-example.toml).\n\n" +
       std::string(cdn127_sim::control_help())};
   std::string interface;
   std::vector<unsigned> macs;
   std::string control = "-";
   std::string level_name = "info";
+  std::string device_config_file;
+  std::string reading_name = "lenient";
   app.add_option("-i,--iface", interface, "SocketCAN interface (vcan0, can0)")->required();
-  app.add_option("-m,--mac", macs, "MAC ID of a simulated device, 0..63 (repeat for more)")
-      ->required()
+  app.add_option("-m,--mac", macs,
+                 "MAC ID of a simulated device, 0..63 (repeat for more; required unless "
+                 "--device-config has [[device]] tables)")
       ->check(CLI::Range(0, 63));
+  app.add_option("--device-config", device_config_file,
+                 "TOML file of per-device readings of the manual ([defaults], [[device]])");
+  app.add_option("--reading", reading_name,
+                 "lenient: the simulator's own reading; field: the strictest device (every "
+                 "reading above, explicit responses 300 ms and polls 3 ms late, 2-byte serial, "
+                 "no Identity State, EPR in steps of 100 ms)")
+      ->check(CLI::IsMember({"lenient", "field"}))
+      ->capture_default_str();
   app.add_option("--control", control,
                  "Where commands come from: \"-\" standard input (end of input quits), a FIFO "
                  "path (created if missing; runs until SIGINT/SIGTERM), or \"none\"")
@@ -62,6 +96,25 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+
+  std::vector<sim::SlaveOptions> devices;
+  try {
+    cdn127_sim::DeviceConfig config;
+    if (!device_config_file.empty()) config = cdn127_sim::load_device_config(device_config_file);
+    std::vector<devicenet::MacId> ids;
+    ids.reserve(macs.size());
+    for (auto m : macs) ids.push_back(devicenet::MacId::from_bits(m));
+    const auto reading =
+        reading_name == "field" ? cdn127_sim::Reading::kField : cdn127_sim::Reading::kLenient;
+    devices = cdn127_sim::device_options(ids, config, reading);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kBadConfiguration;
+  }
+  if (devices.empty()) {
+    std::fprintf(stderr, "no device: give --mac, or [[device]] in --device-config (--help)\n");
+    return kBadConfiguration;
+  }
 
   LogLevel level = LogLevel::kInfo;
   for (auto l :
@@ -99,9 +152,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    std::vector<devicenet::MacId> ids;
-    for (auto m : macs) ids.push_back(devicenet::MacId::from_bits(m));
-    cdn127_sim::SimHost host(interface, ids, log);
+    cdn127_sim::SimHost host(interface, std::move(devices), log);
     std::printf("ready\n");
     std::fflush(stdout);
     host.run(control_fd, quit_at_end, stdout);

@@ -1,4 +1,3 @@
-#include "adapters/port/steady_time.hpp"
 #include "adapters/cdn127_sim/sim_host.hpp"
 
 #include <fmt/format.h>
@@ -14,6 +13,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "adapters/cdn127_sim/device_config.hpp"
+#include "adapters/port/steady_time.hpp"
 #include "adapters/sim/sim_rack.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 
@@ -106,15 +107,36 @@ void SocketDevice::flush(TimePoint now) {
 
 // --- the host ----------------------------------------------------------------
 
+namespace {
+
+std::vector<sim::SlaveOptions> factory_options(const std::vector<devicenet::MacId>& macs) {
+  std::vector<sim::SlaveOptions> out;
+  out.reserve(macs.size());
+  for (auto mac : macs) out.push_back(sim::default_slave_options(mac));
+  return out;
+}
+
+devicenet::MacId device_mac(const sim::SlaveOptions& o) {
+  return devicenet::MacId::from_bits(o.mac_switch <= devicenet::MacId::kMax ? o.mac_switch
+                                                                            : o.stored_mac);
+}
+
+}  // namespace
+
 SimHost::SimHost(std::string interface, const std::vector<devicenet::MacId>& macs, LogSink& log)
+    : SimHost(std::move(interface), factory_options(macs), log) {}
+
+SimHost::SimHost(std::string interface, std::vector<sim::SlaveOptions> devices, LogSink& log)
     : interface_(std::move(interface)), log_(log, "cdn127-sim") {
   if (auto e = socketcan::can_support()) {
     throw std::system_error(e, "this kernel has no SocketCAN (socket(AF_CAN))");
   }
+  std::vector<devicenet::MacId> macs;
   std::set<unsigned> seen;
-  for (auto mac : macs) {
-    if (!seen.insert(mac.value()).second) {
-      throw std::invalid_argument(fmt::format("MAC {} given twice", mac.value()));
+  for (const auto& o : devices) {
+    macs.push_back(device_mac(o));
+    if (!seen.insert(macs.back().value()).second) {
+      throw std::invalid_argument(fmt::format("MAC {} given twice", macs.back().value()));
     }
   }
   epoll_.reset(::epoll_create1(EPOLL_CLOEXEC));
@@ -123,7 +145,8 @@ SimHost::SimHost(std::string interface, const std::vector<devicenet::MacId>& mac
 
   const TimePoint t = now();
   for (std::size_t i = 0; i < macs.size(); ++i) {
-    auto d = std::make_unique<SocketDevice>(sim::default_slave_options(macs[i]),
+    log_.info("device {}: {}", macs[i].value(), describe_readings(devices[i]));
+    auto d = std::make_unique<SocketDevice>(std::move(devices[i]),
                                             Logger(log, fmt::format("sim {}", macs[i].value())));
     if (auto e = d->open(interface_)) {
       throw std::system_error(

@@ -61,7 +61,11 @@ class SimHost {
   // Opens a socket per device on `interface` and powers every device on.
   // Throws std::system_error when the kernel has no SocketCAN or the
   // interface cannot be opened, std::invalid_argument for a repeated MAC.
+  // Each device as sim::default_slave_options(mac) has it:
   SimHost(std::string interface, const std::vector<devicenet::MacId>& macs, LogSink& log);
+  // Each device with its own options (the MAC of its switch, or its stored
+  // MAC when the switch is in the program position):
+  SimHost(std::string interface, std::vector<sim::SlaveOptions> devices, LogSink& log);
   ~SimHost();
   SimHost(const SimHost&) = delete;
   SimHost& operator=(const SimHost&) = delete;

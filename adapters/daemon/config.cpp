@@ -18,6 +18,7 @@
 #include <tuple>
 #include <utility>
 
+#include "adapters/daemon/host_identity.hpp"
 #include "adapters/security/toml_settings.hpp"
 #include "adapters/toml/problems.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
@@ -26,6 +27,7 @@ namespace dnbridge::daemon {
 
 namespace cdn127 = profiles::cdn127;
 using devicenet::MacId;
+using toml_config::type_name;
 
 namespace {
 
@@ -84,32 +86,6 @@ class Reporter {
 
 // ---------------------------------------------------------------------------
 // Keys and typed values.
-
-std::string_view type_name(toml::node_type type) {
-  switch (type) {
-    case toml::node_type::none:
-      return "nothing";
-    case toml::node_type::table:
-      return "a table";
-    case toml::node_type::array:
-      return "an array";
-    case toml::node_type::string:
-      return "a string";
-    case toml::node_type::integer:
-      return "an integer";
-    case toml::node_type::floating_point:
-      return "a floating-point number";
-    case toml::node_type::boolean:
-      return "a boolean";
-    case toml::node_type::date:
-      return "a date";
-    case toml::node_type::time:
-      return "a time";
-    case toml::node_type::date_time:
-      return "a date-time";
-  }
-  return "an unknown type";
-}
 
 using KeyList = std::span<const std::string_view>;
 
@@ -220,8 +196,9 @@ std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Reporte
 constexpr std::string_view kProfileCdn127 = "cdn127";
 
 // Every key of a node; [defaults] takes all but mac and name.
-constexpr std::array<std::string_view, 12> kNodeKeys{"mac",
+constexpr std::array<std::string_view, 15> kNodeKeys{"mac",
                                                      "name",
+                                                     "serial",
                                                      "profile",
                                                      "io",
                                                      "identity",
@@ -231,8 +208,11 @@ constexpr std::array<std::string_view, 12> kNodeKeys{"mac",
                                                      "immediate_poll",
                                                      "publish_max_period_ms",
                                                      "analog_deadband_volts",
-                                                     "no_commander"};
-constexpr KeyList kDefaultsKeys = KeyList(kNodeKeys).subspan(2);
+                                                     "no_commander",
+                                                     "explicit_response_timeout_ms",
+                                                     "poll_response_timeout_ms"};
+// [defaults] takes every key of a node but its MAC, name and serial number.
+constexpr KeyList kDefaultsKeys = KeyList(kNodeKeys).subspan(3);
 
 constexpr std::array<std::string_view, 7> kIoKeys{
     "preset",        "mode",           "digital_inputs", "digital_outputs",
@@ -438,7 +418,9 @@ std::optional<devicenet::ExpectedIdentity> read_identity(const toml::node& n, Re
 // attribute 9); the poll period is bounded by the expected packet rate.
 constexpr std::int64_t kMaxPacketRateMs = 0xFFFF;
 constexpr std::int64_t kMaxPublishPeriodMs = 3'600'000;
-constexpr std::int64_t kMaxPollBatchMs = 1000;  // cut to a quarter of each node's poll period
+constexpr std::int64_t kMaxPollBatchMs = 1000;
+constexpr std::int64_t kMaxResponseTimeoutMs =
+    60'000;  // cut to a quarter of each node's poll period
 constexpr double kAnalogFullScaleVolts = 10.0;
 
 // Reads every setting a node and [defaults] share into `s`, which holds the
@@ -517,6 +499,16 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
       } else {
         s.publish.analog_deadband_volts = *v;
       }
+    }
+  }
+  if (Found f = layers.find("explicit_response_timeout_ms"); f.value) {
+    if (auto v = read_ms(*f.value, "explicit_response_timeout_ms", 1, kMaxResponseTimeoutMs, r)) {
+      s.explicit_response_timeout = *v;
+    }
+  }
+  if (Found f = layers.find("poll_response_timeout_ms"); f.value) {
+    if (auto v = read_ms(*f.value, "poll_response_timeout_ms", 1, kMaxResponseTimeoutMs, r)) {
+      s.poll_response_timeout = *v;
     }
   }
   if (Found f = layers.find("no_commander"); f.value) {
@@ -690,6 +682,13 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
       }
     } else {
       ok = false;
+    }
+    if (const toml::node* serial = nt.get("serial")) {
+      if (auto v = read_int_as<std::uint32_t>(*serial, "serial", {0, 0xFFFF'FFFF}, r)) {
+        s.serial_number = *v;
+      } else {
+        ok = false;
+      }
     }
     if (name) {
       s.name = *name;
@@ -937,6 +936,9 @@ rack::PumpConfig to_pump_config(const NodeSettings& node) {
   p.node.expected_packet_rate = node.expected_packet_rate;
   p.node.explicit_packet_rate = node.explicit_packet_rate;
   p.node.immediate_poll_on_change = node.immediate_poll_on_change;
+  p.node.serial_number = node.serial_number;
+  p.node.explicit_response_timeout = node.explicit_response_timeout;
+  p.node.poll_response_timeout = node.poll_response_timeout;
   p.io = node.io;
   p.identity = node.identity;
   p.no_commander = node.no_commander;
@@ -950,11 +952,11 @@ std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port) {
   return out;
 }
 
-devicenet::ScannerConfig to_scanner_config(const PortConfig& port) {
+devicenet::ScannerConfig to_scanner_config(const PortConfig& port, std::string_view host_id) {
   devicenet::ScannerConfig c;
   c.master_mac = port.master_mac;
   c.vendor_id = port.master_vendor_id;
-  c.serial_number = port.master_serial_number;
+  c.serial_number = port.master_serial_number.value_or(derived_master_serial(host_id, port.name));
   c.explicit_messaging.response_timeout = port.timings.explicit_response_timeout;
   c.allocate_retry_min = port.timings.allocate_retry_min;
   c.allocate_retry_max = port.timings.allocate_retry_max;

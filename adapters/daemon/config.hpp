@@ -45,6 +45,13 @@ struct NodeSettings {
   bool immediate_poll_on_change = devicenet::NodeConfig{}.immediate_poll_on_change;
   PublishPolicy publish;
   NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
+  // The serial number the device must have (a swapped module or a misset
+  // MAC switch is then a wrong device); without it the first one seen is
+  // recorded and a change warned of.
+  std::optional<std::uint32_t> serial_number;
+  // For a slow device: its own timeouts, else the port's.
+  std::optional<Duration> explicit_response_timeout;
+  std::optional<Duration> poll_response_timeout;
 };
 
 // The master's timings on one port; defaults are devicenet::ScannerConfig's.
@@ -75,7 +82,9 @@ struct PortConfig {
   // ODVA vendor ID of its own, so the vendor defaults to 0; a site may set
   // its integrator's.
   std::uint16_t master_vendor_id = 0;
-  std::uint32_t master_serial_number = 0;
+  // Unset: derived from the host's identifier and the port's name
+  // (host_identity.hpp), so that bridges on one bus differ.
+  std::optional<std::uint32_t> master_serial_number;
   ScannerTimings timings;
   std::vector<NodeSettings> nodes;
 };
@@ -126,7 +135,8 @@ std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port);
 // The port's master: MAC, duplicate MAC identity and timings. The nodes are
 // left empty: rack::PumpRack::scanner_config(to_scanner_config(...),
 // to_pump_configs(port)) fills them. The loader has already resolved what
-// the port takes from the rack (the master MAC).
-devicenet::ScannerConfig to_scanner_config(const PortConfig& port);
+// the port takes from the rack (the master MAC). `host_id` (read_host_id())
+// gives the master's serial number where the port sets none.
+devicenet::ScannerConfig to_scanner_config(const PortConfig& port, std::string_view host_id);
 
 }  // namespace dnbridge::daemon

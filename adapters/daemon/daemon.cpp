@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "adapters/daemon/host_identity.hpp"
 #include "adapters/port/sim_backend.hpp"
 #include "adapters/socketcan/socketcan_backend.hpp"
 
@@ -22,10 +23,10 @@ Duration offered_deadline(const DaemonConfig& c) {
   return 2 * longest;
 }
 
-port::PortLoopConfig loop_config(const PortConfig& p) {
+port::PortLoopConfig loop_config(const PortConfig& p, std::string_view host_id) {
   port::PortLoopConfig c;
   c.port = p.name;
-  c.scanner = to_scanner_config(p);
+  c.scanner = to_scanner_config(p, host_id);
   c.pumps = to_pump_configs(p);
   for (const auto& n : p.nodes) c.publish.push_back(n.publish);
   return c;
@@ -61,9 +62,14 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
                                     : dds::Properties{}),
       publisher_(participant_, config_.rack, offered_deadline(config_), Logger(log, "dds")) {
   std::map<std::string, port::PortLoop*> by_name;
+  const std::string host_id = read_host_id();
   for (const auto& p : config_.ports) {
+    const devicenet::ScannerConfig scanner = to_scanner_config(p, host_id);
+    log_.info("port {}: master MAC {}, duplicate MAC ID identity vendor {} serial 0x{:08X}{}",
+              p.name, scanner.master_mac.value(), scanner.vendor_id, scanner.serial_number,
+              p.master_serial_number ? "" : " (derived from this host's identifier)");
     ports_.push_back(
-        std::make_unique<port::PortLoop>(loop_config(p), backends(p), publisher_, log));
+        std::make_unique<port::PortLoop>(loop_config(p, host_id), backends(p), publisher_, log));
     by_name[p.name] = ports_.back().get();
   }
   input_.emplace(participant_, publisher_, config_.rack, std::move(by_name),

@@ -183,6 +183,10 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.counters.poll_errors = c.errors;
   out.counters.reconnects = c.reconnects;
   out.counters.allocate_attempts = c.allocate_attempts;
+  out.counters.idle_empty_responses = c.idle_empty_responses;
+  out.counters.settings_written = c.settings_written;
+  out.counters.explicit_retries = c.explicit_retries;
+  out.counters.explicit_responses_before_final_ack = e.responses_before_final_ack;
   out.counters.explicit_requests = e.requests;
   out.counters.explicit_timeouts = e.timeouts;
   out.counters.explicit_device_errors = e.device_errors;

@@ -347,9 +347,13 @@ std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState*
   counter("poll errors", c.poll_errors);
   counter("reconnects", c.reconnects);
   counter("allocate attempts", c.allocate_attempts);
+  counter("idle empty responses", c.idle_empty_responses);
+  counter("settings written", c.settings_written);
   counter("explicit requests", c.explicit_requests);
+  counter("explicit retries", c.explicit_retries);
   counter("explicit timeouts", c.explicit_timeouts);
   counter("explicit device errors", c.explicit_device_errors);
+  counter("last fragment unacked", c.explicit_responses_before_final_ack);
   counter("commands accepted", c.commands_accepted);
   counter("commands refused", c.commands_refused);
   return o;
@@ -404,9 +408,14 @@ void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_Pum
       .field("poll_errors", std::uint64_t{c.poll_errors})
       .field("reconnects", std::uint64_t{c.reconnects})
       .field("allocate_attempts", std::uint64_t{c.allocate_attempts})
+      .field("idle_empty_responses", std::uint64_t{c.idle_empty_responses})
+      .field("settings_written", std::uint64_t{c.settings_written})
       .field("explicit_requests", std::uint64_t{c.explicit_requests})
+      .field("explicit_retries", std::uint64_t{c.explicit_retries})
       .field("explicit_timeouts", std::uint64_t{c.explicit_timeouts})
       .field("explicit_device_errors", std::uint64_t{c.explicit_device_errors})
+      .field("explicit_responses_before_final_ack",
+             std::uint64_t{c.explicit_responses_before_final_ack})
       .field("commands_accepted", std::uint64_t{c.commands_accepted})
       .field("commands_refused", std::uint64_t{c.commands_refused})
       .end_object();

@@ -8,6 +8,12 @@
 
 namespace dnbridge::port {
 
+namespace {
+
+bool bus_lost(BusState b) { return b == BusState::kDown || b == BusState::kBusOff; }
+
+}  // namespace
+
 using devicenet::MacId;
 
 PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
@@ -125,6 +131,15 @@ void PortLoop::run() {
       stop_deadline = now + config_.shutdown_timeout;
       log_.info("stopping: idling and releasing every node");
       scanner_->stop(now);
+    }
+    // A bus that comes back (bus-off recovered, the interface up again):
+    // the master checks its own MAC again before it scans.
+    if (const BusState bus = backend_->counters().state; bus != bus_seen_) {
+      if (bus_lost(bus_seen_) && !bus_lost(bus) && master_started_ && !stopping) {
+        scanner_->recheck_mac(
+            bus_seen_ == BusState::kDown ? "the interface is up again" : "bus-off recovered", now);
+      }
+      bus_seen_ = bus;
     }
     // A change of the bus or interface state is published at once.
     if (const BusState bus = backend_->counters().state; bus != bus_state_) {

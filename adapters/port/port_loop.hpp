@@ -136,6 +136,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   TimePoint port_event_time_{};
   BusCounters last_counters_{};
   BusState bus_state_ = BusState::kUnknown;  // as last published
+  BusState bus_seen_ = BusState::kUnknown;   // as last seen by the loop
   std::vector<std::uint64_t> last_polls_;
   TimePoint metrics_time_{};
   struct Metrics {

@@ -46,6 +46,22 @@ std::uint16_t aop_action(std::uint8_t state, std::uint16_t value, std::uint16_t 
 
 }  // namespace
 
+void apply_field_reading(SlaveOptions& o) {
+  o.configuration_locked_while_poll_allocated = true;
+  o.poll_paths_fixed = true;
+  o.idle_poll_answered_empty = true;
+  o.no_ack_of_last_request_fragment = true;
+  o.explicit_response_delay = milliseconds(300);
+  o.poll_response_delay = milliseconds(3);
+  o.serial_number_udint = false;
+  const ClassAttribute identity_state{profiles::cdn127::class_id::kIdentity, 8};
+  if (std::find(o.unsupported_attributes.begin(), o.unsupported_attributes.end(), identity_state) ==
+      o.unsupported_attributes.end()) {
+    o.unsupported_attributes.push_back(identity_state);
+  }
+  o.timer_resolution = milliseconds(100);
+}
+
 Cdn127Device::Cdn127Device(const SlaveOptions& options) noexcept
     : options_(options),
       e2_(initial_e2(options)),
@@ -337,8 +353,13 @@ PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {
   // are updated after the response (manual, Mode Byte). Otherwise the I/O is
   // updated during poll processing, so the response sees the new outputs.
   const bool no_poll_update = (e2_.configuration.mode & profiles::cdn127::mode::kNoPollUpdate) != 0;
+  // A device that answers the idle condition with no data.
+  const bool answer_empty =
+      result.outcome == PollOutcome::kIdle && options_.idle_poll_answered_empty;
   if (!no_poll_update) apply();
-  result.response.resize(build_produced(*response_layout, result.response.storage()));
+  if (!answer_empty) {
+    result.response.resize(build_produced(*response_layout, result.response.storage()));
+  }
   if (no_poll_update) apply();
   return result;
 }
@@ -409,10 +430,12 @@ void Cdn127Device::apply_idle_actions(TimePoint now) noexcept {
 }
 
 Reply Cdn127Device::set_configuration(const profiles::cdn127::IoConfiguration& config) noexcept {
-  // "may only be set when the POLL connection is not in the RUNNING state"
-  if (poll_.state == ConnectionState::kEstablished) {
-    return reply_error(GeneralStatus::kObjectStateConflict);
-  }
+  // "may only be set when the POLL connection is not in the RUNNING state":
+  // Established, or, read strictly, allocated in any state.
+  const bool locked = options_.configuration_locked_while_poll_allocated
+                          ? poll_.state != ConnectionState::kNonExistent
+                          : poll_.state == ConnectionState::kEstablished;
+  if (locked) return reply_error(GeneralStatus::kObjectStateConflict);
   // Mode bits 3..5 "should be set to 0"; counts within the device's maxima.
   if ((config.mode & 0x38) != 0 || !profiles::cdn127::validate(config).ok()) {
     return reply_error(GeneralStatus::kInvalidAttributeValue);

@@ -92,8 +92,9 @@ struct SlaveOptions {
   std::uint8_t revision_minor = 5;
   std::uint8_t hardware_major = 1;
   std::uint8_t hardware_minor = 0;
-  // The manual types Identity attribute 6 as UINT (2 bytes); the ODVA
-  // Identity object has UDINT (4 bytes). The duplicate MAC message carries 4.
+  // The manual types Identity attribute 6 as UINT (2 bytes): false, the low
+  // 16 bits of serial_number; the ODVA Identity object has UDINT (4 bytes):
+  // true. The duplicate MAC message carries 4 either way.
   std::uint32_t serial_number = 0x00001234;
   bool serial_number_udint = false;
   // Device Supervisor attribute 12 bit 7 "1 == Expanded Mode", also in the
@@ -102,7 +103,8 @@ struct SlaveOptions {
   // The manual lists the explicit connection's attribute 12 as Get, "fixed
   // value" 1; some devices accept 1 or 3.
   bool explicit_timeout_action_settable = false;
-  // Expected packet rates are rounded up to this (devicenet-facts §5).
+  // Expected packet rates are rounded up to this (devicenet-facts §5); the
+  // Set answers the rate kept (2 bytes). 100 ms: a coarse device.
   Duration timer_resolution = milliseconds(10);
   // Configuration object values in E2 before the first power-up.
   profiles::cdn127::IoConfiguration configuration =
@@ -116,9 +118,56 @@ struct SlaveOptions {
   // manual lists them: Get and Set answer 0x14 (attribute not supported), as
   // for any attribute a device has not. {{0x05, 7}, {0x05, 8}} is a
   // firmware without the poll connection's Produced/Consumed Size, which
-  // leaves a master the Configuration object's Number Produced/Consumed.
+  // leaves a master the Configuration object's Number Produced/Consumed;
+  // {{0x01, 8}} one without the Identity's State.
   std::vector<ClassAttribute> unsupported_attributes;
+
+  // --- Readings of the manual that field devices took. Each off (zero) by
+  // default: the reading this simulator takes otherwise.
+
+  // Configuration object NOTE 1, "may only be set when the POLL connection
+  // is not in the RUNNING state", read strictly: Set_Attribute_Single of its
+  // attributes 1..5 and 10 and its Reset are refused with 0x0C (object state
+  // conflict) while the poll connection exists at all (allocated, in any
+  // state but Non-existent). Off: refused only while it is Established.
+  bool configuration_locked_while_poll_allocated = false;
+  // The Connection object's instance 2 table lists attributes 14 (produced
+  // path) and 16 (consumed path) as Get: a Set of either answers 0x0E
+  // (attribute not settable) in every state, and the poll connection keeps
+  // the default assemblies (103 produced, 104 consumed) whose formats follow
+  // the Configuration object. Off: settable while Configuring, as the
+  // Assembly section's "by writing the corresponding DeviceNet Path
+  // information" reads.
+  bool poll_paths_fixed = false;
+  // A poll command shorter than the consumed size (the idle condition,
+  // manual "Poll Packet Sizes") applies the idle actions and is answered
+  // with a zero-length poll response. Off: answered with the full produced
+  // data, as any poll.
+  bool idle_poll_answered_empty = false;
+  // A request in acknowledged fragments: every fragment is acked but the
+  // last, which the response itself answers (sent at once, no ack before
+  // it). Off: the last fragment is acked too, then the response follows
+  // (devicenet-facts §3: "the receiver acks every fragment, the last
+  // included").
+  bool no_ack_of_last_request_fragment = false;
+  // A slow device: every explicit response (success or error, on the
+  // explicit connection or the unconnected port: Allocate/Release answers
+  // included) goes out this long after its request arrived, and every poll
+  // response this long after its poll command; in order. The request itself
+  // takes effect on arrival; fragment acks and the later fragments of a
+  // fragmented response (which answer the master's acks) are not delayed.
+  // Zero: at once.
+  Duration explicit_response_delay = Duration::zero();
+  Duration poll_response_delay = Duration::zero();
 };
+
+// Every reading above at once, the strictest device a master may meet:
+// configuration locked while the poll connection exists, fixed poll paths,
+// idle polls answered empty, no ack of a request's last fragment, explicit
+// responses 300 ms and poll responses 3 ms late, the 2-byte (UINT) serial
+// number, no Identity State attribute (0x01/8), expected packet rates in
+// steps of 100 ms. What `cdn127-sim --reading field` runs.
+void apply_field_reading(SlaveOptions& options);
 
 // DOP attributes 5..8. The manual's encoding: action 0 = use the value, 1 = hold.
 struct DopSettings {
@@ -180,6 +229,7 @@ enum class PollOutcome : std::uint8_t {
   kOversize,        // ignored: longer than the consumed size
   kApplied,         // outputs updated, response built
   kIdle,            // shorter than the consumed size: idle actions, response built
+                    // (empty with SlaveOptions::idle_poll_answered_empty)
   kInvalid,         // full size but an analog value over 4095: outputs kept, response built
 };
 
@@ -267,7 +317,9 @@ class Cdn127Device {
 
   // --- Configuration object ---
   const profiles::cdn127::IoConfiguration& configuration() const noexcept { return e2_.configuration; }
-  // Refused with 0x0C while the poll connection is established (manual, NOTE 1).
+  // Refused with 0x0C while the poll connection is established (manual,
+  // NOTE 1), or while it exists at all with
+  // SlaveOptions::configuration_locked_while_poll_allocated.
   Reply set_configuration(const profiles::cdn127::IoConfiguration& config) noexcept;
 
   // --- Identity / Device Supervisor ---

@@ -271,9 +271,12 @@ Reply put_path(const RequestContext& c, ByteWriter& w, bool produced) noexcept {
 }
 // The Connection table lists 14/16 as Get, but the Assembly section selects the
 // poll assemblies "by writing the corresponding DeviceNet Path information" to
-// them: settable on the poll connection while it is Configuring.
+// them: settable on the poll connection while it is Configuring. A device
+// that follows the table (SlaveOptions::poll_paths_fixed) refuses them always.
 Reply set_path(const RequestContext& c, Bytes data, bool produced) noexcept {
-  if (is_explicit(c)) return reply_error(GeneralStatus::kAttributeNotSettable);
+  if (is_explicit(c) || c.device.options().poll_paths_fixed) {
+    return reply_error(GeneralStatus::kAttributeNotSettable);
+  }
   auto path = cip::decode_epath(data);
   if (!path.ok() || path->class_id != std::optional<std::uint32_t>(cls::kAssembly) ||
       !path->instance_id || *path->instance_id > 0xFF || path->connection_point ||

@@ -68,6 +68,7 @@ void Cdn127Slave::power_on(TimePoint now) noexcept {
   device_.power_up(now);
   reassembler_.reset();
   sender_.cancel();
+  drop_delayed();
   offline_owner_ = {};
   dup_check_ = DuplicateMacCheck(device_.mac(), duplicate_mac_config(device_.options()));
   network_ = NetworkState::kDuplicateMacCheck;
@@ -89,10 +90,16 @@ void Cdn127Slave::enter_communication_fault() noexcept {
   network_ = NetworkState::kCommunicationFault;
   sender_.cancel();
   reassembler_.reset();
+  drop_delayed();
   log_.debug("duplicate MAC {} detected: communication fault", device_.mac().value());
 }
 
 void Cdn127Slave::restart(TimePoint now) noexcept { power_on(now); }
+
+void Cdn127Slave::drop_delayed() noexcept {
+  delayed_responses_.clear();
+  delayed_polls_.clear();
+}
 
 // ---------------------------------------------------------------------------
 
@@ -113,6 +120,7 @@ void Cdn127Slave::on_timer(TimePoint now) noexcept {
     }
     return;
   }
+  if (!send_due(now)) return;
   if (sender_.active() && now >= sender_.deadline()) {
     switch (sender_.on_timer(now)) {
       case ExplicitFragmentSender::Step::kSend:
@@ -153,7 +161,8 @@ TimePoint Cdn127Slave::next_deadline() const noexcept {
     case NetworkState::kOnline:
       break;
   }
-  return std::min({t, sender_.deadline(), device_.next_deadline()});
+  return std::min({t, sender_.deadline(), device_.next_deadline(), delayed_responses_.deadline(),
+                   delayed_polls_.deadline()});
 }
 
 // ---------------------------------------------------------------------------
@@ -251,12 +260,7 @@ void Cdn127Slave::on_unconnected(const can::CanFrame& frame, TimePoint now) noex
   if (n > 0 && out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
     ++counters_.requests_refused;
   }
-  std::array<std::uint8_t, 8> payload{};
-  payload[0] = header;
-  const std::size_t len = std::min<std::size_t>(n, devicenet::kMaxUnfragmentedMessage);
-  std::copy_n(out.begin(), len, payload.begin() + 1);
-  send(response_id(), Bytes(payload.data(), len + 1), now);
-  after_response(now);
+  respond(true, header, Bytes(out.data(), n), now);
 }
 
 void Cdn127Slave::on_explicit(const can::CanFrame& frame, TimePoint now) noexcept {
@@ -296,8 +300,16 @@ void Cdn127Slave::on_explicit(const can::CanFrame& frame, TimePoint now) noexcep
     case ExplicitReassembler::Outcome::kDropped:
       ++counters_.frames_ignored;
       break;
-    case ExplicitReassembler::Outcome::kAccepted:
     case ExplicitReassembler::Outcome::kRepeated:
+      // The last fragment again (its ack lost, for the reassembler): a
+      // device that never acks the last fragment does not ack it now either.
+      if (!reassembler_.in_progress() && device_.options().no_ack_of_last_request_fragment) {
+        ++counters_.frames_ignored;
+        break;
+      }
+      send(response_id(), reassembler_.ack(), now);
+      break;
+    case ExplicitReassembler::Outcome::kAccepted:
     case ExplicitReassembler::Outcome::kOverflow:
       send(response_id(), reassembler_.ack(), now);
       break;
@@ -309,7 +321,10 @@ void Cdn127Slave::on_explicit(const can::CanFrame& frame, TimePoint now) noexcep
       }
       break;
     case ExplicitReassembler::Outcome::kComplete:
-      send(response_id(), reassembler_.ack(), now);
+      // Some devices answer the last fragment with the response alone.
+      if (!device_.options().no_ack_of_last_request_fragment) {
+        send(response_id(), reassembler_.ack(), now);
+      }
       handle_explicit_message(header, reassembler_.message(), now);
       break;
   }
@@ -334,8 +349,60 @@ void Cdn127Slave::handle_explicit_message(std::uint8_t header, Bytes message, Ti
   if (n > 0 && out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
     ++counters_.requests_refused;
   }
-  send_explicit_response(header, Bytes(out.data(), n), now);
-  after_response(now);
+  respond(false, header, Bytes(out.data(), n), now);
+}
+
+void Cdn127Slave::respond(bool unconnected, std::uint8_t header, Bytes message,
+                          TimePoint now) noexcept {
+  // What the request left to do (a restart) waits for its response.
+  const PendingAction then = device_.take_pending_action();
+  const Duration delay = device_.options().explicit_response_delay;
+  if (delay <= Duration::zero()) {
+    transmit_response(unconnected, header, message, now);
+    after_response(then, now);
+    return;
+  }
+  DelayedResponse r;
+  r.unconnected = unconnected;
+  r.header = header;
+  r.then = then;
+  if (r.message.assign(message) && delayed_responses_.push(now + delay, r)) return;
+  ++counters_.responses_dropped;
+  log_.debug("response to header {:#04x} dropped: {} responses already wait", header,
+             delayed_responses_.size());
+  after_response(then, now);
+}
+
+void Cdn127Slave::transmit_response(bool unconnected, std::uint8_t header, Bytes message,
+                                    TimePoint now) noexcept {
+  if (!unconnected) {
+    send_explicit_response(header, message, now);
+    return;
+  }
+  // The unconnected port's responses are never fragmented.
+  std::array<std::uint8_t, 8> payload{};
+  payload[0] = static_cast<std::uint8_t>(header & 0x7F);
+  const std::size_t len = std::min<std::size_t>(message.size(), devicenet::kMaxUnfragmentedMessage);
+  std::copy_n(message.begin(), len, payload.begin() + 1);
+  send(response_id(), Bytes(payload.data(), len + 1), now);
+}
+
+bool Cdn127Slave::send_due(TimePoint now) noexcept {
+  if (std::min(delayed_polls_.deadline(), delayed_responses_.deadline()) > now) return true;
+  // The earlier of the two queues first: what is due leaves in time order.
+  InlineBytes<8> poll;
+  DelayedResponse r;
+  for (;;) {
+    if (delayed_polls_.deadline() <= delayed_responses_.deadline()) {
+      if (!delayed_polls_.pop_due(now, poll)) return true;
+      send_poll_response(poll.view(), now);
+      continue;
+    }
+    if (!delayed_responses_.pop_due(now, r)) return true;
+    transmit_response(r.unconnected, r.header, r.message.view(), now);
+    after_response(r.then, now);
+    if (network_ != NetworkState::kOnline) return false;
+  }
 }
 
 // Responses echo the request's XID and MAC (request[0] & 0x7F); longer than
@@ -357,8 +424,8 @@ void Cdn127Slave::send_explicit_response(std::uint8_t header, Bytes message, Tim
   }
 }
 
-void Cdn127Slave::after_response(TimePoint now) noexcept {
-  switch (device_.take_pending_action()) {
+void Cdn127Slave::after_response(PendingAction action, TimePoint now) noexcept {
+  switch (action) {
     case PendingAction::kNone:
       return;
     case PendingAction::kRestartFactoryDefaults:
@@ -390,7 +457,16 @@ void Cdn127Slave::on_poll(const can::CanFrame& frame, TimePoint now) noexcept {
       ++counters_.polls_invalid;
       break;
   }
-  send(devicenet::group1_id(Group1Message::kSlavePollResponse, device_.mac()), r.response.view(), now);
+  const Duration delay = device_.options().poll_response_delay;
+  if (delay <= Duration::zero()) {
+    send_poll_response(r.response.view(), now);
+  } else if (!delayed_polls_.push(now + delay, r.response)) {
+    ++counters_.responses_dropped;
+  }
+}
+
+void Cdn127Slave::send_poll_response(Bytes payload, TimePoint now) noexcept {
+  send(devicenet::group1_id(Group1Message::kSlavePollResponse, device_.mac()), payload, now);
 }
 
 // ---------------------------------------------------------------------------

@@ -36,11 +36,24 @@
 // Not done, for want of a source: other services (e.g. the baud change the
 // ICP DAS manual mentions), staggered identify responses, ownership timeouts.
 // Outside Communication Fault the set is ignored.
+//
+// Readings of the manual some field devices took are options (SlaveOptions,
+// each documented there); the two on the frame path are done here:
+// - no_ack_of_last_request_fragment: the last fragment of a request is not
+//   acked (nor a resend of it); the response answers it.
+// - explicit_response_delay / poll_response_delay: responses wait in a
+//   queue until due; next_deadline() includes them, on_timer() sends them.
+//   What a request does (Allocate, Reset, ...) happens on arrival; a restart
+//   that waits for its response (Identity Reset, a new MAC) comes after the
+//   delayed response. A power cycle, restart or Communication Fault drops
+//   what is still queued.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 
 #include "adapters/sim/cdn127_device.hpp"
 #include "adapters/sim/cdn127_objects.hpp"
+#include "adapters/sim/delay_queue.hpp"
 #include "adapters/sim/pump_model.hpp"
 #include "bridge/can/frame_sink.hpp"
 #include "bridge/common/log.hpp"
@@ -63,7 +76,14 @@ struct SlaveCounters {
   std::uint32_t fragment_transfers_failed = 0;
   std::uint32_t restarts = 0;              // power-ups, Identity Reset, MAC change
   std::uint32_t offline_responses = 0;     // Group 4 responses sent
+  std::uint32_t responses_dropped = 0;     // delayed responses not kept: the queue was full
 };
+
+// Responses a slow device may hold at once (SlaveOptions::*_response_delay):
+// a master has one explicit request outstanding (and maybe an Allocate), and
+// polls a few milliseconds apart at most.
+inline constexpr std::size_t kMaxDelayedResponses = 8;
+inline constexpr std::size_t kMaxDelayedPolls = 16;
 
 class Cdn127Slave {
  public:
@@ -119,8 +139,17 @@ class Cdn127Slave {
   void on_comm_faulted(const devicenet::CommFaultedMessage& m, TimePoint now) noexcept;
   bool names_this_node(std::uint16_t vendor_id, std::uint32_t serial_number) const noexcept;
   void handle_explicit_message(std::uint8_t header, Bytes message, TimePoint now) noexcept;
+  // A response message (service byte first) to a request on the explicit
+  // connection or the unconnected port: sent now, or queued for the delay.
+  void respond(bool unconnected, std::uint8_t header, Bytes message, TimePoint now) noexcept;
+  void transmit_response(bool unconnected, std::uint8_t header, Bytes message,
+                         TimePoint now) noexcept;
   void send_explicit_response(std::uint8_t header, Bytes message, TimePoint now) noexcept;
-  void after_response(TimePoint now) noexcept;
+  void send_poll_response(Bytes payload, TimePoint now) noexcept;
+  // Sends the delayed responses due at `now`; false if one's restart took the node offline.
+  bool send_due(TimePoint now) noexcept;
+  void after_response(PendingAction action, TimePoint now) noexcept;
+  void drop_delayed() noexcept;
   void restart(TimePoint now) noexcept;
   void enter_communication_fault() noexcept;
   std::uint32_t response_id() const noexcept;
@@ -140,6 +169,16 @@ class Cdn127Slave {
     std::uint32_t serial_number = 0;
   };
   OfflineOwner offline_owner_;
+  // A response held back by SlaveOptions::explicit_response_delay, with
+  // what its request left to do once it is sent.
+  struct DelayedResponse {
+    bool unconnected = false;
+    std::uint8_t header = 0;
+    InlineBytes<devicenet::kMaxExplicitMessage> message;  // service byte first
+    PendingAction then = PendingAction::kNone;
+  };
+  DelayQueue<DelayedResponse, kMaxDelayedResponses> delayed_responses_;
+  DelayQueue<InlineBytes<8>, kMaxDelayedPolls> delayed_polls_;
 };
 
 const char* to_string(Cdn127Slave::NetworkState s) noexcept;

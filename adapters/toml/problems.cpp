@@ -43,6 +43,32 @@ std::vector<Problem> unknown_keys(const toml::table& table, std::string_view whe
   return out;
 }
 
+std::string_view type_name(toml::node_type type) {
+  switch (type) {
+    case toml::node_type::none:
+      return "nothing";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a floating-point number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::date:
+      return "a date";
+    case toml::node_type::time:
+      return "a time";
+    case toml::node_type::date_time:
+      return "a date-time";
+  }
+  return "an unknown type";
+}
+
 std::string format(std::string_view source, const Problem& problem) {
   // An empty document has no position; its problems are at its start.
   return fmt::format("{}:{}:{}: {}", source, std::max<std::uint32_t>(problem.at.begin.line, 1),

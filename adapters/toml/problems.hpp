@@ -21,6 +21,10 @@ struct Problem {
 std::vector<Problem> unknown_keys(const toml::table& table, std::string_view where,
                                   std::span<const std::string_view> known);
 
+// What a value is, for "KEY must be ..., not a string": "a string",
+// "an integer", "a table", ...
+std::string_view type_name(toml::node_type type);
+
 // "FILE:LINE:COLUMN: text" (lines and columns from 1).
 std::string format(std::string_view source, const Problem& problem);
 

@@ -100,10 +100,11 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
     return;
   }
   if (!header.frag) {
-    if (sender_.active() || header.xid != xid_) {
+    if (header.xid != xid_) {
       ++counters_.unexpected_frames;
       return;
     }
+    end_request_transfer();
     handle_response(payload.subspan(1), now);
     return;
   }
@@ -138,10 +139,11 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
     return;
   }
   // A fragment of the response.
-  if (sender_.active() || header.xid != xid_) {
+  if (header.xid != xid_) {
     ++counters_.unexpected_frames;
     return;
   }
+  end_request_transfer();
   const auto outcome = reassembler_.on_fragment(payload);
   // The reassembler says which fragments are acknowledged (an empty ack()
   // means none); acks go back on the explicit connection.
@@ -175,6 +177,17 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
       ++counters_.malformed_frames;
       break;
   }
+}
+
+// A response that comes before (or without) the acknowledge of the request's
+// last fragment ends the transaction all the same: the device answers only a
+// request it has (some devices never acknowledge the last fragment and send
+// the response instead). Counted, as it departs from the acknowledged
+// fragmentation protocol.
+void ExplicitClient::end_request_transfer() noexcept {
+  if (!sender_.active()) return;
+  sender_.cancel();
+  ++counters_.responses_before_final_ack;
 }
 
 // The slave resends the last fragment of a response when it misses the ack

@@ -44,6 +44,7 @@ struct ExplicitCounters {
   std::uint64_t fragment_aborts = 0;
   std::uint64_t unexpected_frames = 0;  // answers with no request, wrong XID or service
   std::uint64_t malformed_frames = 0;
+  std::uint64_t responses_before_final_ack = 0;  // request fragments left unacknowledged
 };
 
 class ExplicitClient {
@@ -106,6 +107,7 @@ class ExplicitClient {
   void send_message(TimePoint now) noexcept;
   void send_payload(std::uint32_t can_id, Bytes payload, TimePoint now) noexcept;
   void handle_response(Bytes message, TimePoint now) noexcept;
+  void end_request_transfer() noexcept;
   bool reack_final_fragment(Bytes payload, TimePoint now) noexcept;
   void finish(const ExplicitResult& result, TimePoint now) noexcept;
   void fail(Errc reason, TimePoint now) noexcept;

@@ -12,6 +12,18 @@ namespace dnbridge::devicenet {
 
 using namespace node_detail;
 
+namespace {
+
+// The node's explicit messaging: the port's, with the node's own response
+// timeout for a slow device.
+ExplicitClient::Config client_config(const NodeConfig& node, const ScannerConfig& port) {
+  ExplicitClient::Config c = port.explicit_messaging;
+  if (node.explicit_response_timeout) c.response_timeout = *node.explicit_response_timeout;
+  return c;
+}
+
+}  // namespace
+
 Node::Node(const NodeConfig& config, const ScannerConfig& port, can::FrameSink& sink,
            ScannerObserver& observer, Logger log)
     : config_(config),
@@ -19,8 +31,9 @@ Node::Node(const NodeConfig& config, const ScannerConfig& port, can::FrameSink& 
       sink_(sink),
       observer_(observer),
       log_(std::move(log)),
-      client_(port.master_mac, config.mac, port.explicit_messaging, sink, *this),
+      client_(port.master_mac, config.mac, client_config(config, port), sink, *this),
       retry_delay_(port.allocate_retry_min),
+      jitter_state_(0x9E3779B9u ^ (static_cast<std::uint32_t>(config.mac.value()) * 0x85EBCA6Bu)),
       poll_epr_(config.expected_packet_rate),
       explicit_epr_(config.explicit_packet_rate) {}
 
@@ -48,20 +61,31 @@ void Node::set_state(NodeState next, std::string reason, TimePoint now) {
 
 void Node::lose(std::string reason, TimePoint now) {
   if (state_ == NodeState::kOnline) ++counters_.reconnects;
-  connected_ = false;
-  step_ = Step::kNone;
-  client_.cancel_all(Errc::kNotConnected, now);
-  poll_outstanding_ = false;
-  next_poll_ = kNever;
-  poll_deadline_ = kNever;
-  keepalive_at_ = kNever;
+  forget_connections(Errc::kNotConnected, now);
   if (shutting_down_) {
     set_state(NodeState::kStopped, "stopped: " + reason, now);
     return;
   }
   set_state(NodeState::kAbsent, std::move(reason), now);
-  retry_at_ = now + port_.allocate_retry_min;
-  retry_delay_ = port_.allocate_retry_min;
+  // The delay grows with every loss until the node is online again: a node
+  // that drops out repeatedly during start-up is not re-allocated in a loop.
+  retry_at_ = now + next_backoff();
+}
+
+Duration Node::next_backoff() {
+  const Duration base = retry_delay_;
+  retry_delay_ = std::min(retry_delay_ * 2, port_.allocate_retry_max);
+  // Jitter of -25..+25 %: nodes that failed together do not retry together.
+  jitter_state_ ^= jitter_state_ << 13;
+  jitter_state_ ^= jitter_state_ >> 17;
+  jitter_state_ ^= jitter_state_ << 5;
+  const auto span = base.count() / 2;
+  if (span <= 0) return base;
+  const auto offset =
+      static_cast<Duration::rep>(
+          jitter_state_ % static_cast<std::uint32_t>(std::min<Duration::rep>(span, 0xFFFFFFFF))) -
+      span / 2;
+  return base + Duration(offset);
 }
 
 void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
@@ -73,7 +97,7 @@ void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
   retry_at_ = now + port_.fault_recheck;
   // Leave a device that is not ours to poll unowned, so that its own
   // connection timeout puts it in its safe state.
-  if (connected_) release(Step::kReleaseFault, now);
+  if (connected_) release(Step::kReleaseFault, held_connections(), now);
 }
 
 void Node::record(NodeError::Kind kind, TimePoint now, std::uint32_t got, std::uint32_t expected) {
@@ -108,7 +132,7 @@ void Node::begin_shutdown(TimePoint now) {
     return;
   }
   if (connected_) {
-    release(Step::kReleaseShutdown, now);
+    release(Step::kReleaseShutdown, held_connections(), now);
     return;
   }
   set_state(NodeState::kStopped, "orderly shutdown", now);
@@ -118,19 +142,31 @@ void Node::release_for_shutdown(TimePoint now) {
   if (step_ == Step::kReleaseShutdown || state_ == NodeState::kStopped) return;
   poll_outstanding_ = false;
   poll_deadline_ = kNever;
-  release(Step::kReleaseShutdown, now);
+  release(Step::kReleaseShutdown, held_connections(), now);
 }
 
-void Node::halt(std::string_view reason, TimePoint now) {
-  shutting_down_ = true;
+void Node::forget_connections(Errc why, TimePoint now) {
   retry_at_ = kNever;
   next_poll_ = kNever;
   poll_deadline_ = kNever;
   keepalive_at_ = kNever;
+  poll_outstanding_ = false;
   step_ = Step::kNone;
   connected_ = false;
-  client_.cancel_all(Errc::kStopped, now);
+  poll_allocated_ = false;
+  client_.cancel_all(why, now);
+}
+
+void Node::halt(std::string_view reason, TimePoint now) {
+  shutting_down_ = true;
+  forget_connections(Errc::kStopped, now);
   set_state(NodeState::kStopped, std::string(reason), now);
+}
+
+void Node::suspend(std::string_view reason, TimePoint now) {
+  if (state_ == NodeState::kOnline) ++counters_.reconnects;
+  forget_connections(Errc::kNotConnected, now);
+  set_state(NodeState::kAbsent, std::string(reason), now);
 }
 
 void Node::on_explicit_frame(Bytes payload, TimePoint now) {
@@ -190,7 +226,12 @@ void Node::on_timer(TimePoint now) {
     keepalive_at_ = now + explicit_epr_;
     // Any explicit traffic keeps the explicit connection alive; only an idle
     // connection needs the keep-alive request.
-    if (client_.idle()) get(Step::kKeepAlive, kIdentityClass, 1, kIdentityState, now);
+    // Identity.State where the device has it (it tells the device's own
+    // state), Identity.Status otherwise.
+    if (client_.idle()) {
+      get(Step::kKeepAlive,
+          identity_state_supported_ ? cip::identity::kState : cip::identity::kStatus, now);
+    }
   }
 }
 

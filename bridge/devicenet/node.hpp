@@ -11,6 +11,7 @@
 #include <string>
 
 #include "bridge/can/frame_sink.hpp"
+#include "bridge/cip/objects.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/common/result.hpp"
@@ -40,6 +41,9 @@ class Node final : private ExplicitClient::Listener {
   void begin_shutdown(TimePoint now);
   // Stops at once without sending anything (the port lost its MAC).
   void halt(std::string_view reason, TimePoint now);
+  // Forgets its connections without sending anything and waits for start()
+  // (the bus was lost; the master checks its MAC again first).
+  void suspend(std::string_view reason, TimePoint now);
 
   void on_explicit_frame(Bytes payload, TimePoint now);  // Group 2 message 3
   void on_poll_response(Bytes payload, TimePoint now);   // Group 1 message 15
@@ -83,67 +87,131 @@ class Node final : private ExplicitClient::Listener {
   bool stopped() const { return state_ == NodeState::kStopped; }
 
  private:
+  // The life-cycle steps, in start-up order; kStartup in node_lifecycle.cpp
+  // says for each what it asks and where each answer leads.
   enum class Step : std::uint8_t {
     kNone,
-    kAllocate,
-    kReleaseStale,  // Release after "already allocated", then Allocate again
+    kAllocateExplicit,  // DeviceNet.Allocate(explicit)
+    kReleaseStale,      // DeviceNet.Release(explicit) after "already allocated"
+    kAllocationInfo,    // what the device has allocated besides
+    kReleaseStalePoll,  // DeviceNet.Release(poll) left from before
     kVendor,
     kProductType,
     kProductCode,
     kRevision,
     kSerial,
     kName,
-    kReadSetting,
-    kWriteSetting,
-    kProducedPath,
-    kConsumedPath,
+    kIdentityStatus,
+    kIdentityState,
+    kReadSetting,             // the profile's settings: Get,
+    kWriteSetting,            // Set only where it differs,
+    kReleasePollForSetting,   // (a device that refuses while a poll connection exists)
+    kVerifySetting,           // Get again
+    kAllocatePoll,            // DeviceNet.Allocate(poll)
+    kReleasePollForAllocate,  // DeviceNet.Release(poll) after "already allocated"
+    kGetProducedPath,
+    kSetProducedPath,
+    kGetConsumedPath,
+    kSetConsumedPath,
     kProducedSize,
     kConsumedSize,
     kFallbackProducedSize,
     kFallbackConsumedSize,
     kExplicitEpr,
     kPollEpr,
+    kOnline,  // not a request: the poll connection starts
+    // Outside start-up.
     kKeepAlive,
     kReleaseFault,     // Release after a fault, then wait for the recheck
     kReleaseShutdown,  // Release at orderly shutdown
   };
+  enum class Verb : std::uint8_t { kGet, kSet, kAllocate, kRelease };
+  // What a refusal (a CIP error reply) of a step leads to.
+  enum class OnRefusal : std::uint8_t {
+    kFault,        // configuration fault naming object, attribute, status, expectation
+    kWrongDevice,  // the identity the scan list expects cannot be read
+    kGoOn,         // information only: the next step all the same
+    kHandler,      // the step's handler decides (allocation, paths, sizes)
+  };
+  // One row of the start-up table.
+  struct StepRow {
+    Step step;
+    NodeState phase;  // the state reported while it runs
+    Verb verb;
+    cip::AttributeRef target;  // Get/Set: the attribute; a profile's from the profile
+    std::uint8_t choice;       // Allocate/Release: allocation choice bits
+    OnRefusal on_refusal;
+    Step next;  // after a good answer, unless the handler chooses
+    // Checks a good answer (and, with kHandler, a refusal); returns the next
+    // step, or kNone when it has moved the node itself (a fault, a wait).
+    Step (Node::*handler)(const ExplicitResult&, TimePoint);
+  };
+  static const StepRow kStartup[];
+  static const StepRow& row(Step step);
 
   void on_explicit_result(std::uint32_t tag, const ExplicitResult& result, TimePoint now) override;
   void on_step_result(Step step, const ExplicitResult& result, TimePoint now);
-  // One handler per life-cycle phase (node_lifecycle.cpp).
-  void on_allocate_result(const ExplicitResult& r, TimePoint now);
-  void on_identity_result(Step step, const ExplicitResult& r, TimePoint now);
-  void on_identity_info_result(Step step, const ExplicitResult& r, TimePoint now);
-  void on_setting_result(Step step, const ExplicitResult& r, TimePoint now);
-  void on_path_result(Step step, const ExplicitResult& r, TimePoint now);
-  void on_size_result(Step step, const ExplicitResult& r, TimePoint now);
-  void on_epr_result(Step step, const ExplicitResult& r, TimePoint now);
+  // Runs a start-up step: builds its request from its row.
+  void run(Step step, TimePoint now);
+  void advance(Step next, TimePoint now);
+  // The attribute a step addresses (a profile's from the profile).
+  cip::AttributeRef target_of(Step step) const;
+
+  // The handlers of the start-up table (node_lifecycle.cpp).
+  Step after_allocate_explicit(const ExplicitResult& r, TimePoint now);
+  Step after_allocation_info(const ExplicitResult& r, TimePoint now);
+  Step after_identity_match(const ExplicitResult& r, TimePoint now);
+  Step after_revision(const ExplicitResult& r, TimePoint now);
+  Step after_serial(const ExplicitResult& r, TimePoint now);
+  Step after_name(const ExplicitResult& r, TimePoint now);
+  Step after_identity_status(const ExplicitResult& r, TimePoint now);
+  Step after_identity_state(const ExplicitResult& r, TimePoint now);
+  Step after_read_setting(const ExplicitResult& r, TimePoint now);
+  Step after_write_setting(const ExplicitResult& r, TimePoint now);
+  Step after_release_for_setting(const ExplicitResult& r, TimePoint now);
+  Step after_verify_setting(const ExplicitResult& r, TimePoint now);
+  Step after_allocate_poll(const ExplicitResult& r, TimePoint now);
+  Step after_get_path(const ExplicitResult& r, TimePoint now);
+  Step after_set_path(const ExplicitResult& r, TimePoint now);
+  Step after_size(const ExplicitResult& r, TimePoint now);
+  Step after_epr(const ExplicitResult& r, TimePoint now);
   void on_keepalive_result(const ExplicitResult& r, TimePoint now);
 
   void issue(Step step, const RequestMessage& request, bool unconnected, TimePoint now,
              std::optional<Duration> timeout = std::nullopt);
   void resend_step(TimePoint now);
-  void get(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, TimePoint now);
-  void set(Step step, std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, Bytes value,
-           TimePoint now, std::optional<Duration> timeout = std::nullopt);
+  void get(Step step, const cip::AttributeRef& target, TimePoint now);
+  // The allocation choice of what the master holds (for Release).
+  std::uint8_t held_connections() const;
 
   void attempt_allocate(TimePoint now);
-  void release(Step step, TimePoint now);
-  void begin_identify(TimePoint now);
-  void next_setting(TimePoint now);
-  void begin_verify(TimePoint now);
-  void check_sizes(TimePoint now);
+  void release(Step step, std::uint8_t choice, TimePoint now);
+  // The setting in hand (setting_index_), or the poll connection after the last.
+  Step first_setting_step();
+  // The path a step reads or writes, and the one the profile needs.
+  bool path_step_produced(Step step) const;
+  Bytes wanted_path(bool produced) const;
+  Step after_path(bool produced, TimePoint now);
+  Step begin_verify(TimePoint now);
+  Step check_sizes(TimePoint now);
   // "Connection 2 attribute 7", or the profile's fallback for the same size.
   std::string size_attribute(bool produced, bool fallback) const;
-  void set_poll_epr(TimePoint now);
   void go_online(TimePoint now);
   void lose(std::string reason, TimePoint now);
+  // Timers stopped, connections and requests dropped, nothing sent.
+  void forget_connections(Errc why, TimePoint now);
   void release_for_shutdown(TimePoint now);
   void enter_fault(NodeState fault, std::string reason, TimePoint now);
   void set_state(NodeState next, std::string reason, TimePoint now);
   void record(NodeError::Kind kind, TimePoint now, std::uint32_t got = 0,
               std::uint32_t expected = 0);
   void record_device_error(const ExplicitResult& result, TimePoint now);
+  Duration explicit_response_timeout() const {
+    return config_.explicit_response_timeout.value_or(port_.explicit_messaging.response_timeout);
+  }
+  // Retry delay of the allocation and release paths: doubles up to the
+  // port's maximum, with jitter, so that a broken node never floods the bus.
+  Duration next_backoff();
 
   void send_poll(TimePoint now);
   void accept_poll_response(Bytes data, TimePoint now);
@@ -160,18 +228,28 @@ class Node final : private ExplicitClient::Listener {
   NodeState state_ = NodeState::kAbsent;
   std::string reason_ = "not started";
   Step step_ = Step::kNone;
-  bool connected_ = false;  // the master holds the node's connections
+  bool connected_ = false;       // the master holds the explicit connection
+  bool poll_allocated_ = false;  // ... and the poll connection
   bool shutting_down_ = false;
   bool started_ = false;
   TimePoint retry_at_ = kNever;
   Duration retry_delay_{};
+  std::uint32_t jitter_state_ = 0;  // xorshift state, seeded from the MAC
   std::size_t setting_index_ = 0;
+  bool setting_retried_ = false;     // a refused Set retried once after releasing the poll
+  bool poll_release_tried_ = false;  // the poll Allocate retried once after a Release
+  InlineBytes<16> setting_found_;    // what the device had before the Set
   unsigned step_timeouts_ = 0;  // consecutive timeouts of the current life-cycle step
   Step last_step_ = Step::kNone;
   RequestMessage last_request_;
   InlineBytes<64> last_request_data_;
   bool last_unconnected_ = false;
   std::optional<Duration> last_timeout_;
+  // The poll connection's paths as the device has them, and whether a Set of
+  // them was refused: the sizes then decide whether what it has serves.
+  InlineBytes<16> produced_path_in_force_;
+  InlineBytes<16> consumed_path_in_force_;
+  std::string path_refusal_;
   std::optional<std::uint32_t> produced_size_;
   std::optional<std::uint32_t> consumed_size_;
   // Where each size was read, and what the device answered where it was
@@ -179,6 +257,11 @@ class Node final : private ExplicitClient::Listener {
   bool produced_from_fallback_ = false;
   bool consumed_from_fallback_ = false;
   std::string size_refusal_;
+  // The serial number first seen at this MAC (when none is pinned).
+  std::optional<std::uint32_t> first_serial_;
+  // Identity.State answers: the keep-alive reads it; otherwise Identity.Status.
+  bool identity_state_supported_ = true;
+  bool epr_warned_ = false;
 
   NodeIdentity identity_;
   std::optional<std::uint8_t> device_state_;

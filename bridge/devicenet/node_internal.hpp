@@ -15,18 +15,6 @@
 
 namespace dnbridge::devicenet::node_detail {
 
-// The DeviceNet objects the life cycle addresses (ODVA common objects).
-constexpr std::uint16_t kIdentityClass = 0x01;
-constexpr std::uint16_t kConnectionClass = 0x05;
-constexpr std::uint16_t kExplicitConnection = 1;
-constexpr std::uint16_t kPollConnection = 2;
-constexpr std::uint8_t kAttrProducedSize = 7;
-constexpr std::uint8_t kAttrConsumedSize = 8;
-constexpr std::uint8_t kAttrExpectedPacketRate = 9;
-constexpr std::uint8_t kAttrProducedPath = 14;
-constexpr std::uint8_t kAttrConsumedPath = 16;
-constexpr std::uint8_t kIdentityState = 8;
-
 // Life-cycle reads that time out are retried this many times before the node
 // is taken for gone: single lost frames must not cost a reconnection.
 constexpr unsigned kStepTimeoutRetries = 2;

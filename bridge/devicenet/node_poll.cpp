@@ -62,7 +62,9 @@ void Node::send_poll(TimePoint now) {
   sent_outputs_ = outputs_;
   outputs_dirty_ = false;
   poll_outstanding_ = true;
-  poll_deadline_ = now + std::min(port_.poll_response_timeout, config_.poll_period);
+  poll_deadline_ =
+      now + std::min(config_.poll_response_timeout.value_or(port_.poll_response_timeout),
+                     config_.poll_period);
 }
 
 void Node::on_poll_response(Bytes payload, TimePoint now) {
@@ -74,6 +76,14 @@ void Node::on_poll_response(Bytes payload, TimePoint now) {
     return;
   }
   const std::size_t size = config_.profile.produced_size;
+  if (payload.empty() && sent_idle_ && size != 0) {
+    // An idle poll may be answered with no data as well as with the full
+    // response (the manual leaves it open): a valid answer that keeps the
+    // connection alive, and carries no inputs.
+    ++counters_.idle_empty_responses;
+    accept_poll_response(payload, now);
+    return;
+  }
   if (size <= can::kMaxDataLength) {
     if (payload.size() != size) {
       bad_poll_response(NodeError::Kind::kPollLength, static_cast<std::uint32_t>(payload.size()),

@@ -65,6 +65,9 @@ struct NodeCounters {
   std::uint64_t errors = 0;      // bad responses (length, order, late)
   std::uint64_t reconnects = 0;  // returns from online to allocation
   std::uint64_t allocate_attempts = 0;
+  std::uint64_t idle_empty_responses = 0;  // idle polls answered with no data (valid)
+  std::uint64_t explicit_retries = 0;      // life-cycle requests sent again after no answer
+  std::uint64_t settings_written = 0;      // attributes the start-up had to change
 };
 
 }  // namespace dnbridge::devicenet

@@ -2,6 +2,7 @@
 // What the master is told to scan: per port, the master's own MAC and the
 // nodes it owns, each with what it must be and how it is configured.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,13 @@ struct NodeConfig {
   Duration explicit_packet_rate = milliseconds(2500);
   // Poll at once when new outputs are set, rather than on the next period.
   bool immediate_poll_on_change = true;
+  // The serial number the device must have (Identity.SerialNumber): another
+  // one (a swapped module, a misset MAC switch) is a wrong device. Without
+  // it the first serial seen is recorded and a change is warned of.
+  std::optional<std::uint32_t> serial_number;
+  // This node's own timeouts, for slow devices; the port's otherwise.
+  std::optional<Duration> explicit_response_timeout;
+  std::optional<Duration> poll_response_timeout;
 };
 
 struct ScannerConfig {

@@ -105,6 +105,18 @@ void Scanner::begin_scanning(TimePoint now) {
   }
 }
 
+void Scanner::recheck_mac(std::string_view why, TimePoint now) {
+  if (state_ != PortState::kRunning) return;
+  // Whatever the nodes had is gone with the bus: they are allocated afresh
+  // once the master's MAC is checked again.
+  for (auto& n : nodes_) n->suspend(fmt::format("{}: the master checks its MAC again", why), now);
+  set_state(PortState::kCheckingMac,
+            fmt::format("{}: checking again that no other node has MAC {}", why,
+                        config_.master_mac.value()),
+            now);
+  sink_.send(mac_check_.start(now), now);
+}
+
 void Scanner::stop(TimePoint now) {
   if (state_ == PortState::kRunning) {
     set_state(PortState::kStopping, "orderly shutdown: idling and releasing nodes", now);

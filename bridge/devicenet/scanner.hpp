@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bridge/can/can_frame.hpp"
@@ -45,6 +46,11 @@ class Scanner {
   void start(TimePoint now);
   // Orderly shutdown: idle polls and Release for every node; stopped() when done.
   void stop(TimePoint now);
+  // The bus came back (bus-off recovered, the interface up again): every node
+  // is taken as lost, and the master checks its own MAC again before it
+  // scans (a node must not talk on a bus it rejoins before that check).
+  // Only while running.
+  void recheck_mac(std::string_view why, TimePoint now);
 
   void on_frame(const can::CanFrame& frame, TimePoint rx_time);
   void on_timer(TimePoint now);

@@ -3,6 +3,7 @@
 // event handling (on the port's own thread): implementations copy what they
 // need and return; they must not call back into the scanner.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,10 @@ struct NodeIdentity {
   std::uint8_t minor_revision = 0;
   std::uint32_t serial_number = 0;
   std::string product_name;
+  // Identity.Status and Identity.State as read at start-up; empty where the
+  // device does not support them ("state unknown").
+  std::optional<std::uint16_t> status;
+  std::optional<std::uint8_t> state;
 };
 
 class ScannerObserver {

@@ -163,6 +163,13 @@ void PumpRack::on_poll_response(MacId mac, Bytes data, TimePoint rx_time) {
   const auto index = static_cast<std::size_t>(i);
   PumpView& v = views_[index];
   const Slot& slot = slots_[index];
+  if (data.empty()) {
+    // An idle poll answered with no data: the device applied its idle
+    // outputs; its inputs keep the time of the last response that had them.
+    refresh_applied(index);
+    ++v.changes;
+    return;
+  }
   auto inputs = cdn127::decode_poll_response(slot.format.response, slot.io.no_nc_mask, data);
   if (!inputs) return;  // the master checked the size; values out of range are dropped
   v.inputs = *inputs;

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "adapters/daemon/host_identity.hpp"
 #include "bridge/profiles/cdn127/node_profile.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 #include "bridge/rack/pump_rack.hpp"
@@ -61,7 +62,7 @@ TEST(ConfigFile, ExampleLoadsWithEveryValueWhereItWasWritten) {
   EXPECT_EQ(a.bitrate, 500000u);
   EXPECT_EQ(a.master_mac, mac(0));
   EXPECT_EQ(a.master_vendor_id, 0u);
-  EXPECT_EQ(a.master_serial_number, 0u);
+  EXPECT_EQ(a.master_serial_number, std::nullopt);  // derived from the host
   ASSERT_EQ(a.nodes.size(), 3u);
   EXPECT_EQ(a.nodes[0].mac, mac(1));
   EXPECT_EQ(a.nodes[0].name, "chamber-1-dry-pump");
@@ -384,6 +385,48 @@ TEST(ConfigErrors, MacAndNameOnlyInNodesNotInDefaults) {
                               "name = \"x\"\n"),
             "t.toml:10:1: unknown key 'mac' in [defaults]\n"
             "t.toml:11:1: unknown key 'name' in [defaults]");
+}
+
+// A serial number belongs to one device: never in [defaults].
+TEST(ConfigErrors, SerialOnlyInNodesNotInDefaults) {
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "serial = 0x1_0000_0000\n"
+                              "[defaults]\n"
+                              "serial = 3\n"),
+            "t.toml:9:10: serial = 4294967296 is out of range (0..4294967295)\n"
+            "t.toml:11:1: unknown key 'serial' in [defaults]");
+}
+
+TEST(ConfigFile, SerialAndTimeoutsOfASlowDevice) {
+  const DaemonConfig c = parse_config(ONE_PORT
+                                      "explicit_response_timeout_ms = 1500\n"
+                                      "[defaults]\n"
+                                      "poll_response_timeout_ms = 30\n"
+                                      "[[port.node]]\n"
+                                      "mac = 1\n"
+                                      "name = \"p\"\n"
+                                      "serial = 0x1234\n"
+                                      "explicit_response_timeout_ms = 2500\n"
+                                      "[[port.node]]\n"
+                                      "mac = 2\n"
+                                      "name = \"q\"\n",
+                                      "t.toml");
+  const auto& nodes = c.ports.at(0).nodes;
+  ASSERT_EQ(nodes.size(), 2u);
+  EXPECT_EQ(nodes[0].serial_number, 0x1234u);
+  EXPECT_EQ(nodes[0].explicit_response_timeout, milliseconds(2500));
+  EXPECT_EQ(nodes[0].poll_response_timeout, milliseconds(30));
+  EXPECT_EQ(nodes[1].serial_number, std::nullopt);
+  // Node 2 keeps the port's explicit timeout (no override of its own).
+  EXPECT_EQ(nodes[1].explicit_response_timeout, std::nullopt);
+  EXPECT_EQ(nodes[1].poll_response_timeout, milliseconds(30));
+  EXPECT_EQ(c.ports.at(0).timings.explicit_response_timeout, milliseconds(1500));
+  const rack::PumpConfig p = to_pump_config(nodes[0]);
+  EXPECT_EQ(p.node.serial_number, 0x1234u);
+  EXPECT_EQ(p.node.explicit_response_timeout, milliseconds(2500));
+  EXPECT_EQ(p.node.poll_response_timeout, milliseconds(30));
 }
 
 TEST(ConfigErrors, WrongTypes) {
@@ -751,7 +794,7 @@ TEST(ConfigToMaster, ScannerConfigCarriesThePortsMasterAndTimings) {
       "master_mac = 60\n"
       "[[port.node]]\nmac = 1\nname = \"p\"\n",
       "t.toml");
-  const devicenet::ScannerConfig a = to_scanner_config(c.ports.at(0));
+  const devicenet::ScannerConfig a = to_scanner_config(c.ports.at(0), "host-1");
   EXPECT_EQ(a.master_mac, mac(5));
   EXPECT_EQ(a.vendor_id, 777u);
   EXPECT_EQ(a.serial_number, 123456789u);
@@ -764,10 +807,15 @@ TEST(ConfigToMaster, ScannerConfigCarriesThePortsMasterAndTimings) {
   EXPECT_EQ(a.duplicate_mac_window, devicenet::ScannerConfig{}.duplicate_mac_window);
   EXPECT_TRUE(a.nodes.empty());
 
-  const devicenet::ScannerConfig b = to_scanner_config(c.ports.at(1));
+  const devicenet::ScannerConfig b = to_scanner_config(c.ports.at(1), "host-1");
   EXPECT_EQ(b.master_mac, mac(60));
   EXPECT_EQ(b.vendor_id, 0u);  // dnbridge has no vendor ID of its own
-  EXPECT_EQ(b.serial_number, 0u);
+  // No serial given: derived from the host and the port, stable, and
+  // different for another host and for another port.
+  EXPECT_EQ(b.serial_number, derived_master_serial("host-1", "B"));
+  EXPECT_EQ(to_scanner_config(c.ports.at(1), "host-1").serial_number, b.serial_number);
+  EXPECT_NE(to_scanner_config(c.ports.at(1), "host-2").serial_number, b.serial_number);
+  EXPECT_NE(derived_master_serial("host-1", "A"), b.serial_number);
   EXPECT_EQ(b.allocate_retry_min, devicenet::ScannerConfig{}.allocate_retry_min);
 }
 
@@ -777,7 +825,7 @@ TEST(ConfigToMaster, ScanListOfTheExampleFileIsWhatTheRackBuilds) {
     SCOPED_TRACE(port.name);
     const auto pumps = to_pump_configs(port);
     const devicenet::ScannerConfig scan =
-        rack::PumpRack::scanner_config(to_scanner_config(port), pumps);
+        rack::PumpRack::scanner_config(to_scanner_config(port, "host-1"), pumps);
     EXPECT_EQ(scan.master_mac, port.master_mac);
     ASSERT_EQ(scan.nodes.size(), port.nodes.size());
     for (std::size_t i = 0; i < port.nodes.size(); ++i) {
@@ -807,7 +855,7 @@ TEST(ConfigToMaster, ScanListOfTheExampleFileIsWhatTheRackBuilds) {
 TEST(ConfigToMaster, EmbeddedDefaultBuildsEightPumps) {
   const DaemonConfig c = embedded_default_config();
   const devicenet::ScannerConfig scan = rack::PumpRack::scanner_config(
-      to_scanner_config(c.ports.at(0)), to_pump_configs(c.ports[0]));
+      to_scanner_config(c.ports.at(0), "host-1"), to_pump_configs(c.ports[0]));
   ASSERT_EQ(scan.nodes.size(), 8u);
   // CDN127 preset: 4 bytes out, 6 in; CDN118: 3 out, 2 in (README).
   EXPECT_EQ(scan.nodes[0].profile.consumed_size, 4u);

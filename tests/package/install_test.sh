@@ -49,7 +49,8 @@ for f in /usr/bin/dnbridge /usr/bin/dnbctl /usr/bin/cdn127-sim \
          /usr/share/doc/dnbridge/security.md /usr/share/doc/dnbridge/operations.md \
          /usr/share/dnbridge/networkd/80-dnbridge-can0.network \
          /usr/share/dnbridge/networkd/80-dnbridge-can1.network \
-         /usr/share/dnbridge/networkd/70-dnbridge-can.link; do
+         /usr/share/dnbridge/networkd/70-dnbridge-can.link \
+         /usr/share/dnbridge/cdn127-sim-example.toml; do
   [ -f "$f" ] || fail "$f not installed"
 done
 for d in /lib/systemd/system /usr/lib/systemd/system; do

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <pthread.h>
 
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <future>
@@ -41,6 +42,7 @@ class RecordingPublisher final : public PortPublisher {
   }
   void port_status(const PortStatusView& s, TimePoint) override {
     std::lock_guard lock(mutex_);
+    if (port_reasons.empty() || port_reasons.back() != s.reason) port_reasons.push_back(s.reason);
     port = s;
     ++port_samples;
     changed_.notify_all();
@@ -73,6 +75,7 @@ class RecordingPublisher final : public PortPublisher {
   std::map<unsigned, TimePoint> pump_times;
   std::map<unsigned, devicenet::NodeState> node_states;
   std::optional<PortStatusView> port;
+  std::vector<std::string> port_reasons;  // each new one
   std::vector<rack::ExplicitAnswer> replies;
   std::size_t pump_samples = 0, status_samples = 0, port_samples = 0;
   bool stopped = false;
@@ -91,6 +94,10 @@ class UnpluggedBackend final : public CanBackend, private can::FrameSink {
   // Any thread.
   void plug_in() {
     plugged_ = true;
+    bus_->wake();
+  }
+  void unplug() {
+    plugged_ = false;
     bus_->wake();
   }
   std::uint64_t dropped() const { return dropped_; }
@@ -322,6 +329,35 @@ TEST(PortLoop, AnInterfaceAbsentAtStartEndsTheStartUpChecksAndTheMasterWaitsForI
   loop.stop();
   loop.join();
   EXPECT_TRUE(publisher.stopped);
+}
+
+// The interface goes away while the rack runs and comes back: the master
+// checks its own MAC again before it scans, and the node comes back online.
+TEST(PortLoop, AnInterfaceBackUpMakesTheMasterCheckItsMacAgain) {
+  RecordingPublisher publisher;
+  auto backend = std::make_unique<UnpluggedBackend>(
+      std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(1)}));
+  UnpluggedBackend* interface = backend.get();
+  interface->plug_in();
+  PortLoop loop(config_for({1}), std::move(backend), publisher, null_log_sink());
+  loop.start();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(1) && publisher.pumps[1].online; }));
+
+  interface->unplug();
+  ASSERT_TRUE(publisher.wait_for([&] {
+    return publisher.port && publisher.port->bus.state == BusState::kDown &&
+           !publisher.pumps[1].online;
+  }));
+  interface->plug_in();
+  ASSERT_TRUE(publisher.wait_for([&] {
+    return std::find(publisher.port_reasons.begin(), publisher.port_reasons.end(),
+                     "the interface is up again: checking again that no other node has MAC 0") !=
+           publisher.port_reasons.end();
+  }));
+  ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps[1].online; }));
+  loop.stop();
+  loop.join();
 }
 
 // Asked to stop before its interface ever came: it stops at once.

@@ -117,7 +117,7 @@ void Capture::run() {
       // TimePoint{} is the writer's start, stamped as the wall time at construction.
       const auto since = std::chrono::duration_cast<Duration>(wall - epoch_);
       writer_.write(r->frame, TimePoint{} + std::max(since, Duration::zero()));
-      ++frames_;
+      frames_.push_back(r->frame);
     }
   }
 }
@@ -128,7 +128,7 @@ std::uint64_t Capture::stop() {
     thread_.join();
     writer_.close();
   }
-  return frames_;
+  return frames_.size();
 }
 
 // --- Supervisor ------------------------------------------------------------

@@ -59,6 +59,8 @@ class Capture {
   ~Capture();
   // Stops and closes; the number of frames written.
   std::uint64_t stop();
+  // Every frame captured, in order; after stop().
+  const std::vector<can::CanFrame>& frames() const { return frames_; }
 
  private:
   void run();
@@ -66,7 +68,7 @@ class Capture {
   socketcan::CanSocket socket_;
   sim::PcapWriter writer_;
   std::atomic<bool> stop_{false};
-  std::uint64_t frames_ = 0;
+  std::vector<can::CanFrame> frames_;
   std::thread thread_;
 };
 

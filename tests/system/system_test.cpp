@@ -2,10 +2,12 @@
 // supervisor as separate processes on vcan interfaces of a kernel of their
 // own. run_in_vm.sh runs each test in User-Mode Linux or QEMU.
 #include <fmt/format.h>
+#include <poll.h>
 #include <signal.h>
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -79,12 +81,14 @@ class SystemTest : public ::testing::Test {
     return *children_.back();
   }
 
-  Child& start_sim(const std::string& interface, const std::vector<unsigned>& macs) {
+  Child& start_sim(const std::string& interface, const std::vector<unsigned>& macs,
+                   const std::vector<std::string>& options = {}) {
     std::vector<std::string> argv{CDN127_SIM_BIN, "--iface", interface};
     for (auto m : macs) {
       argv.push_back("--mac");
       argv.push_back(std::to_string(m));
     }
+    argv.insert(argv.end(), options.begin(), options.end());
     children_.push_back(
         std::make_unique<Child>(argv, dir_ / fmt::format("cdn127-sim-{}.log", interface)));
     return *children_.back();
@@ -108,6 +112,27 @@ class SystemTest : public ::testing::Test {
   bool port_bus(const std::string& port, dnbridge_BusState state) {
     auto it = supervisor().ports().find(port);
     return it != supervisor().ports().end() && it->second.bus_state == state;
+  }
+
+  // Wireshark's DeviceNet dissector on a whole capture: every frame taken
+  // as DeviceNet, none marked malformed or invalid.
+  void expect_clean_under_tshark(const fs::path& pcap, std::uint64_t frames) {
+    ASSERT_GT(frames, 100u) << "too little traffic captured";
+    const std::string tshark = DNBRIDGE_TSHARK;
+    ASSERT_FALSE(tshark.empty()) << "tshark not found at configure time (bash .ci/deps)";
+    const std::string base =
+        fmt::format("'{}' -n -r '{}' -d can.subdissector,devicenet", tshark, pcap.string());
+    const std::string decoded =
+        run_output(base + " -Y devicenet -T fields -e frame.number 2>/dev/null | wc -l");
+    EXPECT_EQ(std::stoull(decoded), frames) << "frames the dissector did not take as DeviceNet";
+    const std::string bad = run_output(
+        base +
+        " -Y '_ws.malformed || _ws.expert.severity >= \"warning\"' -T fields -e frame.number "
+        "-e can.id -e _ws.expert.message 2>/dev/null");
+    EXPECT_TRUE(bad.empty()) << "frames marked malformed or invalid (frame, id, message):\n"
+                             << bad << "capture kept: " << pcap;
+    std::printf("captured %llu frames, all decoded as DeviceNet without a warning\n",
+                static_cast<unsigned long long>(frames));
   }
 
   fs::path dir_;
@@ -168,22 +193,53 @@ TEST_F(SystemTest, RackOnlineStateAndCommandsOnTheWire) {
   const std::uint64_t frames = capture->stop();
   ASSERT_GT(frames, 100u) << "too little traffic captured";
 
-  // Wireshark's DeviceNet dissector on the whole capture (devicenet-facts §9).
-  const std::string tshark = DNBRIDGE_TSHARK;
-  ASSERT_FALSE(tshark.empty()) << "tshark not found at configure time (bash .ci/deps)";
-  const std::string base =
-      fmt::format("'{}' -n -r '{}' -d can.subdissector,devicenet", tshark, pcap.string());
-  const std::string decoded =
-      run_output(base + " -Y devicenet -T fields -e frame.number 2>/dev/null | wc -l");
-  EXPECT_EQ(std::stoull(decoded), frames) << "frames the dissector did not take as DeviceNet";
-  const std::string bad = run_output(
-      base +
-      " -Y '_ws.malformed || _ws.expert.severity >= \"warning\"' -T fields -e frame.number "
-      "-e can.id -e _ws.expert.message 2>/dev/null");
-  EXPECT_TRUE(bad.empty()) << "frames marked malformed or invalid (frame, id, message):\n"
-                           << bad << "capture kept: " << pcap;
-  std::printf("captured %llu frames, all decoded as DeviceNet without a warning\n",
-              static_cast<unsigned long long>(frames));
+  expect_clean_under_tshark(pcap, frames);
+}
+
+// cdn127-sim devices with every reading of the manual that field devices
+// took (--reading field: configuration locked while a poll connection
+// exists, fixed poll paths, idle polls answered empty, no ack of a
+// request's last fragment, explicit answers 300 ms and poll answers 3 ms
+// late, a 2-byte serial number, no Identity State, expected packet rates in
+// steps of 100 ms): every node online with one allocation of each
+// connection, a command applied, the whole traffic clean under tshark.
+TEST_F(SystemTest, RackOnlineWithFieldReadingDevices) {
+  const fs::path pcap = dir_ / "vcan0.pcap";
+  auto capture = std::make_unique<Capture>("vcan0", pcap);
+  start_sim("vcan0", {5, 6, 7}, {"--reading", "field"});
+  Child& bridge = start_bridge({{"A", "vcan0", {5, 6, 7}}});
+  ASSERT_TRUE(wait_online("A", {5, 6, 7})) << "not every node came online";
+  ASSERT_TRUE(supervisor().command("A", 6, true));
+  ASSERT_TRUE(supervisor().wait_until([&] { return pump("A", 6).pump_on; }, 10s));
+  // Idle polls answered empty keep the other two online: samples of all
+  // three keep coming, online, for three seconds more (the bridge publishes
+  // each pump at least once a second).
+  const dds::Timestamp since = pump("A", 6).received;
+  ASSERT_TRUE(supervisor().wait_until(
+      [&] {
+        for (unsigned mac : {5u, 6u, 7u}) {
+          if (!pump("A", mac).online || pump("A", mac).received < since + 3s) return false;
+        }
+        return true;
+      },
+      10s));
+  EXPECT_TRUE(pump("A", 6).pump_on);
+
+  const int status = bridge.stop(10000ms);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "dnbridge status " << status;
+  const std::uint64_t frames = capture->stop();
+  // Allocate on Group 2 message 6: [hdr][4B][03][01][choice][master MAC].
+  for (unsigned mac : {5u, 6u, 7u}) {
+    unsigned explicit_allocations = 0, poll_allocations = 0;
+    for (const can::CanFrame& f : capture->frames()) {
+      if (f.id != 0x406u + (mac << 3) || f.len != 6 || f.data[1] != 0x4B) continue;
+      explicit_allocations += f.data[4] == 0x01;
+      poll_allocations += f.data[4] == 0x02;
+    }
+    EXPECT_EQ(explicit_allocations, 1u) << "MAC " << mac;
+    EXPECT_EQ(poll_allocations, 1u) << "MAC " << mac;
+  }
+  expect_clean_under_tshark(pcap, frames);
 }
 
 // One bridge, two ports, each on its own interface and bus.
@@ -296,6 +352,108 @@ TEST_F(SystemTest, PowerCycledDeviceComesBack) {
   EXPECT_TRUE(supervisor().online("A", 6));
   sim.send("power-on 5");
   ASSERT_TRUE(wait_online("A", {5, 6})) << "node 5 did not come back after power-on";
+}
+
+// The test as the master, on a raw CAN socket: a request out, the first
+// frame with the identifier it waits for, and when it came.
+class RawMaster {
+ public:
+  explicit RawMaster(const std::string& interface) {
+    socketcan::SocketOptions o;
+    o.timestamps = false;
+    auto s = socketcan::CanSocket::open(interface, o);
+    if (s) socket_ = std::move(*s);
+  }
+  bool ok() const { return socket_.is_open(); }
+
+  struct Answer {
+    can::CanFrame frame;
+    std::chrono::steady_clock::duration after{};
+  };
+  std::optional<Answer> exchange(std::uint32_t id, std::vector<std::uint8_t> data,
+                                 std::uint32_t answer_id, std::chrono::milliseconds timeout) {
+    auto frame = can::CanFrame::make(id, Bytes(data.data(), data.size()));
+    if (!frame.ok()) return std::nullopt;
+    const auto sent = std::chrono::steady_clock::now();
+    if (!socket_.write(*frame)) return std::nullopt;
+    const auto deadline = sent + timeout;
+    for (auto now = sent; now < deadline; now = std::chrono::steady_clock::now()) {
+      pollfd p{socket_.fd(), POLLIN, 0};
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now);
+      (void)::poll(&p, 1, static_cast<int>(left.count()) + 1);
+      for (auto r = socket_.read(); r; r = socket_.read()) {
+        if (r->kind == socketcan::Received::Kind::kData && r->frame.id == answer_id) {
+          return Answer{r->frame, std::chrono::steady_clock::now() - sent};
+        }
+      }
+    }
+    return std::nullopt;
+  }
+
+ private:
+  socketcan::CanSocket socket_;
+};
+
+std::string hex(const can::CanFrame& f) {
+  std::string s;
+  for (std::size_t i = 0; i < f.len; ++i) s += fmt::format("{}{:02X}", i ? " " : "", f.data[i]);
+  return s;
+}
+
+// cdn127-sim --reading field on a real CAN stack: the strictest device's
+// answers, late by the wall clock as the in-process tests show them late by
+// the fake one. The delays are the device's, never scaled: at least 300 ms
+// and 3 ms, at most that plus the test's patience.
+TEST_F(SystemTest, FieldReadingDeviceAnswersLateOnTheWire) {
+  Child& sim = start_sim("vcan0", {5}, {"--reading", "field"});
+  RawMaster master("vcan0");
+  ASSERT_TRUE(master.ok());
+  constexpr std::uint8_t kMaster = 10;
+  // MAC 5: 0x42B explicit response, 0x42C request, 0x42D poll, 0x42E
+  // Allocate/Release, 0x3C5 poll response.
+  const std::vector<std::uint8_t> allocate{kMaster, 0x4B, 0x03, 0x01, 0x03, kMaster};
+  std::optional<RawMaster::Answer> a;
+  // Unanswered until its duplicate MAC check is over.
+  const auto online_by = std::chrono::steady_clock::now() + patience(10s);
+  while (!a && std::chrono::steady_clock::now() < online_by) {
+    a = master.exchange(0x42E, allocate, 0x42B, 1000ms);
+  }
+  ASSERT_TRUE(a) << "no answer to Allocate";
+  EXPECT_EQ(hex(a->frame), "0A CB 00");
+  EXPECT_GE(a->after, 300ms);
+  EXPECT_LE(a->after, 300ms + patience(200ms));
+
+  const auto explicit_answer = [&](std::vector<std::uint8_t> request) {
+    auto r = master.exchange(0x42C, std::move(request), 0x42B, 300ms + patience(1000ms));
+    if (!r) return std::string("no answer");
+    EXPECT_GE(r->after, 300ms);
+    EXPECT_LE(r->after, 300ms + patience(200ms));
+    return hex(r->frame);
+  };
+  EXPECT_EQ(explicit_answer({kMaster, 0x0E, 0x01, 0x01, 0x06}), "0A 8E 05 00");  // UINT serial
+  EXPECT_EQ(explicit_answer({kMaster, 0x0E, 0x01, 0x01, 0x08}), "0A 94 14 FF");  // no State
+  EXPECT_EQ(explicit_answer({kMaster, 0x10, 0x40, 0x01, 0x04, 0x01}), "0A 94 0C FF");
+  EXPECT_EQ(explicit_answer({kMaster, 0x10, 0x05, 0x02, 0x0E, 0x20, 0x04}), "0A 94 0E FF");
+  // A fragmented request: the first fragment acked at once, the last not.
+  auto ack = master.exchange(0x42C, {0x8A, 0x00, 0x10, 0x05, 0x02, 0x10, 0x21, 0x04}, 0x42B,
+                             patience(1000ms));
+  ASSERT_TRUE(ack);
+  EXPECT_EQ(hex(ack->frame), "8A C0 00");
+  EXPECT_LT(ack->after, 300ms);
+  EXPECT_EQ(explicit_answer({0x8A, 0x81, 0x00, 0x25, 0x64, 0x00, 0x30, 0x03}), "0A 94 0E FF");
+  // EPR 1050 ms kept as 1100 (steps of 100 ms).
+  EXPECT_EQ(explicit_answer({kMaster, 0x10, 0x05, 0x02, 0x09, 0x1A, 0x04}), "0A 90 4C 04");
+
+  auto poll = master.exchange(0x42D, {0x00, 0x00, 0x00, 0x00}, 0x3C5, patience(1000ms));
+  ASSERT_TRUE(poll);
+  EXPECT_EQ(poll->frame.len, 6u);
+  EXPECT_GE(poll->after, 3ms);
+  EXPECT_LE(poll->after, 3ms + patience(100ms));
+  auto idle = master.exchange(0x42D, {}, 0x3C5, patience(1000ms));
+  ASSERT_TRUE(idle);
+  EXPECT_EQ(idle->frame.len, 0u);
+  EXPECT_GE(idle->after, 3ms);
+  EXPECT_TRUE(sim.running()) << "cdn127-sim exited";
 }
 
 // The systemd-networkd examples of deploy/networkd, as an operator installs

@@ -282,19 +282,24 @@ TEST_F(Wire, Group2MessagesCarryTheSlaveMac) {
   for (unsigned m : {kPumpA, kPumpB}) {
     SCOPED_TRACE("MAC " + std::to_string(m));
     // Allocate (G2 message 6 to the slave): [hdr: MAC 0][4B][class 3][instance 1]
-    // [choice: explicit + poll][allocator MAC 0], after the master's own check.
+    // [choice][allocator MAC 0], after the master's own check: the explicit
+    // connection alone first, the poll connection once the configuration is
+    // in place; Release of both at the stop.
     const auto allocs = group2(6, m);
-    ASSERT_GE(allocs.size(), 2u);  // Allocate, and Release at the stop
-    const WireRow& alloc = *allocs.front();
-    EXPECT_EQ(alloc.can_id, 0x406u + (m << 3));
-    ASSERT_EQ(alloc.data.size(), 6u) << hex_string(alloc.data);
-    EXPECT_EQ(alloc.data[0] & 0xBF, kMaster) << "header: no Frag, master MAC";
-    EXPECT_EQ(alloc.data[1], 0x4B);
-    EXPECT_EQ(alloc.data[2], 0x03);
-    EXPECT_EQ(alloc.data[3], 0x01);
-    EXPECT_EQ(alloc.data[4], 0x03);
-    EXPECT_EQ(alloc.data[5], kMaster);
-    EXPECT_GT(alloc.time, master_checked + 0.9);
+    ASSERT_EQ(allocs.size(), 3u);  // Allocate explicit, Allocate poll, Release at the stop
+    for (const auto& [alloc, choice] : {std::pair{allocs[0], 0x01}, std::pair{allocs[1], 0x02}}) {
+      SCOPED_TRACE(hex_string(alloc->data));
+      EXPECT_EQ(alloc->can_id, 0x406u + (m << 3));
+      ASSERT_EQ(alloc->data.size(), 6u);
+      EXPECT_EQ(alloc->data[0] & 0xBF, kMaster) << "header: no Frag, master MAC";
+      EXPECT_EQ(alloc->data[1], 0x4B);
+      EXPECT_EQ(alloc->data[2], 0x03);
+      EXPECT_EQ(alloc->data[3], 0x01);
+      EXPECT_EQ(alloc->data[4], choice);
+      EXPECT_EQ(alloc->data[5], kMaster);
+      EXPECT_GT(alloc->time, master_checked + 0.9);
+    }
+    EXPECT_LT(allocs[0]->time, allocs[1]->time);
     // Release at the end: [hdr][4C][03][01][explicit + poll].
     const WireRow& release = *allocs.back();
     ASSERT_EQ(release.data.size(), 5u) << hex_string(release.data);

@@ -435,10 +435,45 @@ TEST_F(ExplicitClientTest, NegativeAckAbortsTheRequest) {
   EXPECT_TRUE(client.idle());
 }
 
-TEST_F(ExplicitClientTest, UnfragmentedAnswerWhileSendingFragmentsIsUnexpected) {
+// Some devices never acknowledge a request's last fragment: they answer it.
+// The response ends the transaction, and is counted.
+TEST_F(ExplicitClientTest, ResponseWithoutTheAckOfTheLastFragmentEndsTheTransaction) {
   ASSERT_TRUE(client.submit(1, set_twelve(), false, now).ok());
-  answer({0x4A, 0x90});
-  answer({0xCA, 0x00, 0x90, 0x00});  // a response fragment before the request is through
+  answer({0xCA, 0xC0, 0x00});
+  answer({0xCA, 0xC1, 0x00});
+  ASSERT_EQ(sink.last(), "41C: CA 82 09 0A 0B 0C");  // the last fragment, count 2
+  advance(milliseconds(300));
+  answer({0x4A, 0x90});  // 4A: XID 1, MAC 10 | 90 Set response: no ack of count 2 came
+  ASSERT_EQ(listener.results.size(), 1u);
+  EXPECT_FALSE(listener.results[0].error);
+  EXPECT_EQ(listener.results[0].service, 0x10);
+  EXPECT_EQ(client.counters().responses_before_final_ack, 1u);
+  EXPECT_EQ(client.counters().unexpected_frames, 0u);
+  EXPECT_TRUE(client.idle());
+  // Nothing of the ended transfer is sent again.
+  const auto sent = sink.frames.size();
+  advance(seconds(3));
+  client.on_timer(now);
+  EXPECT_EQ(sink.frames.size(), sent);
+}
+
+// A response (here an error reply, in one frame) that comes before the
+// request is through ends it too: the device does not want the rest.
+TEST_F(ExplicitClientTest, ResponseBeforeTheRequestIsThroughEndsTheTransaction) {
+  ASSERT_TRUE(client.submit(1, set_twelve(), false, now).ok());
+  // 4A | 94 error response | 15 too much data | FF no additional code
+  answer({0x4A, 0x94, 0x15, 0xFF});
+  ASSERT_EQ(listener.results.size(), 1u);
+  EXPECT_EQ(listener.results[0].error, Errc::kDeviceError);
+  EXPECT_EQ(client.counters().responses_before_final_ack, 1u);
+  EXPECT_EQ(sink.frames.size(), 1u);  // the middle fragment is not sent
+}
+
+// An answer with another XID is not this request's.
+TEST_F(ExplicitClientTest, AnswerWithAnotherXidWhileSendingFragmentsIsUnexpected) {
+  ASSERT_TRUE(client.submit(1, set_twelve(), false, now).ok());
+  answer({0x0A, 0x90});              // XID 0
+  answer({0x8A, 0x00, 0x90, 0x00});  // a response fragment, XID 0
   EXPECT_EQ(client.counters().unexpected_frames, 2u);
   EXPECT_TRUE(listener.results.empty());
   EXPECT_EQ(sink.frames.size(), 1u);  // and no ack for that fragment

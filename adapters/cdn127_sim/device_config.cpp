@@ -1,0 +1,304 @@
+#include "adapters/cdn127_sim/device_config.hpp"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <span>
+#include <sstream>
+#include <tuple>
+#include <utility>
+
+#include "adapters/sim/sim_rack.hpp"
+#include "adapters/toml/problems.hpp"
+#include "bridge/profiles/cdn127/objects.hpp"
+
+namespace dnbridge::cdn127_sim {
+namespace {
+
+using devicenet::MacId;
+using toml_config::Problem;
+using toml_config::type_name;
+
+constexpr std::string_view kTopKeys[] = {"defaults", "device"};
+// Every key of a [[device]] table; [defaults] takes all but its MAC.
+constexpr std::string_view kDeviceKeys[] = {
+    "mac",
+    "configuration_locked_while_poll_allocated",
+    "poll_paths_fixed",
+    "idle_poll_answered_empty",
+    "no_ack_of_last_request_fragment",
+    "explicit_response_delay_ms",
+    "poll_response_delay_ms",
+    "serial_number_bytes",
+    "identity_state_supported",
+    "epr_resolution_ms",
+};
+constexpr std::span<const std::string_view> kSettingKeys = std::span(kDeviceKeys).subspan(1);
+
+// A delay longer than any master's timeout is still a reading worth trying;
+// a minute bounds typing mistakes.
+constexpr std::int64_t kMaxDelayMs = 60000;
+// The expected packet rate is a UINT of milliseconds.
+constexpr std::int64_t kMaxResolutionMs = 0xFFFF;
+
+constexpr sim::ClassAttribute kIdentityState{profiles::cdn127::class_id::kIdentity, 8};
+
+class Reader {
+ public:
+  void error(const toml::source_region& at, std::string text) {
+    problems_.push_back({at, std::move(text)});
+  }
+  bool ok() const noexcept { return problems_.empty(); }
+
+  // Every problem, "FILE:LINE:COLUMN: text", in the file's order.
+  std::vector<std::string> messages(std::string_view source) {
+    std::stable_sort(problems_.begin(), problems_.end(), [](const Problem& a, const Problem& b) {
+      return std::tie(a.at.begin.line, a.at.begin.column) <
+             std::tie(b.at.begin.line, b.at.begin.column);
+    });
+    std::vector<std::string> out;
+    for (const auto& p : problems_) out.push_back(toml_config::format(source, p));
+    return out;
+  }
+
+  std::optional<bool> boolean(const toml::node& n, std::string_view key) {
+    if (const auto* v = n.as_boolean()) return v->get();
+    error(n.source(), fmt::format("{} must be true or false, not {}", key, type_name(n.type())));
+    return std::nullopt;
+  }
+
+  std::optional<std::int64_t> integer(const toml::node& n, std::string_view key, std::int64_t min,
+                                      std::int64_t max, std::string_view unit = {}) {
+    const auto* v = n.as_integer();
+    if (v == nullptr) {
+      error(n.source(), fmt::format("{} must be an integer, not {}", key, type_name(n.type())));
+      return std::nullopt;
+    }
+    if (v->get() < min || v->get() > max) {
+      error(n.source(),
+            fmt::format("{} = {} is out of range ({}..{}{})", key, v->get(), min, max, unit));
+      return std::nullopt;
+    }
+    return v->get();
+  }
+
+  std::optional<Duration> ms(const toml::node& n, std::string_view key, std::int64_t min,
+                             std::int64_t max) {
+    auto v = integer(n, key, min, max, " ms");
+    if (!v) return std::nullopt;
+    return milliseconds(*v);
+  }
+
+  // The settings keys of `t` (unknown keys are checked by the caller).
+  DeviceSettings settings(const toml::table& t) {
+    DeviceSettings s;
+    auto flag = [&](std::string_view key, std::optional<bool>& out) {
+      if (const toml::node* n = t.get(key)) out = boolean(*n, key);
+    };
+    flag("configuration_locked_while_poll_allocated", s.configuration_locked_while_poll_allocated);
+    flag("poll_paths_fixed", s.poll_paths_fixed);
+    flag("idle_poll_answered_empty", s.idle_poll_answered_empty);
+    flag("no_ack_of_last_request_fragment", s.no_ack_of_last_request_fragment);
+    flag("identity_state_supported", s.identity_state_supported);
+    if (const toml::node* n = t.get("explicit_response_delay_ms")) {
+      s.explicit_response_delay = ms(*n, "explicit_response_delay_ms", 0, kMaxDelayMs);
+    }
+    if (const toml::node* n = t.get("poll_response_delay_ms")) {
+      s.poll_response_delay = ms(*n, "poll_response_delay_ms", 0, kMaxDelayMs);
+    }
+    if (const toml::node* n = t.get("epr_resolution_ms")) {
+      s.epr_resolution = ms(*n, "epr_resolution_ms", 1, kMaxResolutionMs);
+    }
+    if (const toml::node* n = t.get("serial_number_bytes")) {
+      constexpr auto kAny = std::numeric_limits<std::int64_t>::max();
+      if (auto v = integer(*n, "serial_number_bytes", -kAny, kAny)) {
+        if (*v == 2 || *v == 4) {
+          s.serial_number_udint = *v == 4;
+        } else {
+          error(n->source(), fmt::format("serial_number_bytes = {}: 2 (UINT, as the manual's "
+                                         "table types it) or 4 (UDINT, as ODVA's Identity)",
+                                         *v));
+        }
+      }
+    }
+    return s;
+  }
+
+  void unknown_keys(const toml::table& t, std::string_view where,
+                    std::span<const std::string_view> known) {
+    for (auto& p : toml_config::unknown_keys(t, where, known)) {
+      problems_.push_back(std::move(p));
+    }
+  }
+
+ private:
+  std::vector<Problem> problems_;
+};
+
+DeviceConfig read(const toml::table& root, Reader& r) {
+  DeviceConfig config;
+  r.unknown_keys(root, "the device configuration", kTopKeys);
+  if (const toml::node* n = root.get("defaults")) {
+    if (const auto* t = n->as_table()) {
+      r.unknown_keys(*t, "[defaults]", kSettingKeys);
+      config.defaults = r.settings(*t);
+    } else {
+      r.error(n->source(),
+              fmt::format("defaults must be a table ([defaults]), not {}", type_name(n->type())));
+    }
+  }
+  const toml::node* devices = root.get("device");
+  if (devices == nullptr) return config;
+  const auto* list = devices->as_array();
+  if (list == nullptr || !list->is_array_of_tables()) {
+    r.error(devices->source(), fmt::format("device must be an array of tables ([[device]]), not {}",
+                                           type_name(devices->type())));
+    return config;
+  }
+  std::map<unsigned, std::uint32_t> first_line;  // MAC -> line of its [[device]]
+  for (const toml::node& n : *list) {
+    const toml::table& t = *n.as_table();
+    r.unknown_keys(t, "[[device]]", kDeviceKeys);
+    DeviceEntry entry;
+    entry.settings = r.settings(t);
+    const toml::node* mac = t.get("mac");
+    if (mac == nullptr) {
+      r.error(t.source(), "missing required key 'mac' in [[device]]");
+      continue;
+    }
+    auto v = r.integer(*mac, "mac", 0, devicenet::MacId::kMax);
+    if (!v) continue;
+    entry.mac = MacId::from_bits(static_cast<std::uint8_t>(*v));
+    const auto [it, added] = first_line.try_emplace(entry.mac.value(), mac->source().begin.line);
+    if (!added) {
+      r.error(mac->source(),
+              fmt::format("mac = {} is given twice (first on line {})", *v, it->second));
+      continue;
+    }
+    config.devices.push_back(entry);
+  }
+  return config;
+}
+
+}  // namespace
+
+void DeviceSettings::apply_to(sim::SlaveOptions& o) const {
+  if (configuration_locked_while_poll_allocated) {
+    o.configuration_locked_while_poll_allocated = *configuration_locked_while_poll_allocated;
+  }
+  if (poll_paths_fixed) o.poll_paths_fixed = *poll_paths_fixed;
+  if (idle_poll_answered_empty) o.idle_poll_answered_empty = *idle_poll_answered_empty;
+  if (no_ack_of_last_request_fragment) {
+    o.no_ack_of_last_request_fragment = *no_ack_of_last_request_fragment;
+  }
+  if (explicit_response_delay) o.explicit_response_delay = *explicit_response_delay;
+  if (poll_response_delay) o.poll_response_delay = *poll_response_delay;
+  if (serial_number_udint) o.serial_number_udint = *serial_number_udint;
+  if (epr_resolution) o.timer_resolution = *epr_resolution;
+  if (identity_state_supported) {
+    auto& missing = o.unsupported_attributes;
+    missing.erase(std::remove(missing.begin(), missing.end(), kIdentityState), missing.end());
+    if (!*identity_state_supported) missing.push_back(kIdentityState);
+  }
+}
+
+DeviceConfigError::DeviceConfigError(std::vector<std::string> problems)
+    : std::runtime_error(toml_config::join_lines(problems)), problems_(std::move(problems)) {}
+
+DeviceConfig parse_device_config(std::string_view text, std::string_view source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    throw DeviceConfigError(
+        {toml_config::format(source_name, Problem{e.source(), std::string(e.description())})});
+  }
+  Reader r;
+  DeviceConfig config = read(root, r);
+  if (!r.ok()) throw DeviceConfigError(r.messages(source_name));
+  return config;
+}
+
+DeviceConfig load_device_config(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw DeviceConfigError(
+        {fmt::format("{}: is a directory, not a device configuration", path.string())});
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw DeviceConfigError(
+        {fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno))});
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    throw DeviceConfigError(
+        {fmt::format("{}: cannot read: {}", path.string(), std::strerror(errno))});
+  }
+  return parse_device_config(text.str(), path.string());
+}
+
+std::vector<sim::SlaveOptions> device_options(const std::vector<MacId>& macs,
+                                              const DeviceConfig& config, Reading reading) {
+  std::vector<MacId> all;
+  auto add = [&all](MacId mac) {
+    if (std::find(all.begin(), all.end(), mac) == all.end()) all.push_back(mac);
+  };
+  for (MacId m : macs) add(m);
+  for (const auto& d : config.devices) add(d.mac);
+
+  std::vector<sim::SlaveOptions> out;
+  for (MacId mac : all) {
+    sim::SlaveOptions o = sim::default_slave_options(mac);
+    if (reading == Reading::kField) sim::apply_field_reading(o);
+    config.defaults.apply_to(o);
+    for (const auto& d : config.devices) {
+      if (d.mac == mac) d.settings.apply_to(o);
+    }
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+std::string describe_readings(const sim::SlaveOptions& o) {
+  const sim::SlaveOptions lenient;
+  std::vector<std::string> parts;
+  if (o.configuration_locked_while_poll_allocated) {
+    parts.emplace_back("configuration locked while poll allocated");
+  }
+  if (o.poll_paths_fixed) parts.emplace_back("poll paths fixed");
+  if (o.idle_poll_answered_empty) parts.emplace_back("idle poll answered empty");
+  if (o.no_ack_of_last_request_fragment) parts.emplace_back("no ack of last request fragment");
+  auto ms_of = [](Duration d) { return std::chrono::duration_cast<milliseconds>(d).count(); };
+  if (o.explicit_response_delay > Duration::zero()) {
+    parts.push_back(fmt::format("explicit responses {} ms late", ms_of(o.explicit_response_delay)));
+  }
+  if (o.poll_response_delay > Duration::zero()) {
+    parts.push_back(fmt::format("poll responses {} ms late", ms_of(o.poll_response_delay)));
+  }
+  if (o.serial_number_udint) parts.emplace_back("4-byte serial number");
+  if (std::find(o.unsupported_attributes.begin(), o.unsupported_attributes.end(), kIdentityState) !=
+      o.unsupported_attributes.end()) {
+    parts.emplace_back("no Identity State");
+  }
+  if (o.timer_resolution != lenient.timer_resolution) {
+    parts.push_back(fmt::format("EPR in steps of {} ms", ms_of(o.timer_resolution)));
+  }
+  if (parts.empty()) return "lenient";
+  std::string out;
+  for (const auto& p : parts) {
+    if (!out.empty()) out += ", ";
+    out += p;
+  }
+  return out;
+}
+
+}  // namespace dnbridge::cdn127_sim
