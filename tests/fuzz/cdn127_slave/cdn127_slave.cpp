@@ -3,7 +3,8 @@
 // sends are checked and dropped. Properties: no crash or sanitizer report;
 // after on_timer(now) the next deadline is after now; every frame sent is a
 // valid CAN 2.0A frame from this device's MAC; a device in Communication
-// Fault says nothing; its state stays within what the device can hold.
+// Fault answers only the Offline Connection Set (Group 4), which exists to
+// reach it there; its state stays within what the device can hold.
 #include <cstddef>
 #include <cstdint>
 
@@ -17,6 +18,7 @@ namespace {
 using namespace dnbridge;
 using devicenet::Group1Message;
 using devicenet::Group2Message;
+using devicenet::Group4Message;
 using devicenet::MacId;
 using sim::Cdn127Slave;
 
@@ -28,10 +30,19 @@ class CheckingSink final : public can::FrameSink {
     FUZZ_CHECK(frame.len <= can::kMaxDataLength);
     FUZZ_CHECK(now >= last_);
     last_ = now;
-    FUZZ_CHECK(slave_->network_state() != Cdn127Slave::NetworkState::kCommunicationFault);
     FUZZ_CHECK(slave_->network_state() != Cdn127Slave::NetworkState::kOff);
-    // A Group 2 only slave answers on Group 1 message 15 and Group 2
-    // messages 3 and 7, always with its own MAC.
+    // In Communication Fault a device answers only the Offline Connection
+    // Set, which exists to reach it there (Group 4: the communication
+    // faulted and offline ownership responses, which carry no MAC).
+    const bool offline_response =
+        frame.id == devicenet::group4_id(Group4Message::kCommFaultedResponse) ||
+        frame.id == devicenet::group4_id(Group4Message::kOfflineOwnershipResponse);
+    if (slave_->network_state() == Cdn127Slave::NetworkState::kCommunicationFault) {
+      FUZZ_CHECK(offline_response);
+      return;
+    }
+    // Otherwise a Group 2 only slave answers on Group 1 message 15 and Group
+    // 2 messages 3 and 7, always with its own MAC.
     const MacId mac = slave_->mac();
     FUZZ_CHECK(frame.id == devicenet::group1_id(Group1Message::kSlavePollResponse, mac) ||
                frame.id == devicenet::group2_id(mac, Group2Message::kSlaveExplicitResponse) ||
