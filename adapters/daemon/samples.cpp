@@ -1,6 +1,9 @@
 #include "adapters/daemon/samples.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <limits>
 
 #include "adapters/dds/fields.hpp"
 
@@ -121,8 +124,12 @@ void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string
   out.analog_input_count = 0;
   for (std::size_t i = 0; i < 2; ++i) {
     const auto raw = inputs ? v.inputs.analog_inputs_raw[i] : std::optional<std::uint16_t>{};
+    const bool valid = raw && v.inputs.analog_input_in_range[i];
     out.analog_input_raw[i] = raw.value_or(0);
-    out.analog_input_volts[i] = static_cast<float>(cdn127::raw_to_volts(raw.value_or(0)));
+    out.analog_input_volts[i] = valid ? static_cast<float>(cdn127::raw_to_volts(*raw))
+                                : raw ? std::numeric_limits<float>::quiet_NaN()
+                                      : 0.0F;
+    out.analog_input_valid[i] = valid;
     if (raw) out.analog_input_count = static_cast<std::uint8_t>(i + 1);
   }
 
@@ -155,8 +162,12 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   set_string(out.product_name, id.product_name);
   out.device_state_valid = node.device_state().has_value();
   out.device_state = node.device_state().value_or(0);
-  set_string(out.device_state_text,
-             node.device_state() ? device_state_text(*node.device_state()) : std::string_view{});
+  // Identity.State is optional: a device read at start-up (its status
+  // answered) that has none is in a state unknown, not at fault.
+  set_string(out.device_state_text, node.device_state() ? device_state_text(*node.device_state())
+                                    : node.identity().status
+                                        ? std::string_view{"state unknown (no Identity.State)"}
+                                        : std::string_view{});
 
   const auto ms = [](Duration d) {
     return static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(d).count());
@@ -172,6 +183,15 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.last_error_general_status = static_cast<std::uint8_t>(error.general_status);
   out.last_error_additional_status = error.additional_status;
   set_string(out.last_command_refused, v.last_command_refused);
+  std::string invalid;
+  for (std::size_t i = 0; i < v.inputs.analog_inputs_raw.size(); ++i) {
+    const auto& raw = v.inputs.analog_inputs_raw[i];
+    if (!v.has_inputs || !raw || v.inputs.analog_input_in_range[i]) continue;
+    if (!invalid.empty()) invalid += "; ";
+    invalid +=
+        fmt::format("analog input {}: {} counts, above {}", i + 1, *raw, cdn127::kAnalogMaxRaw);
+  }
+  set_string(out.invalid_inputs, invalid);
 
   const auto& c = node.counters();
   const auto& e = node.explicit_counters();
@@ -190,6 +210,7 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.counters.explicit_requests = e.requests;
   out.counters.explicit_timeouts = e.timeouts;
   out.counters.explicit_device_errors = e.device_errors;
+  out.counters.responses_with_invalid_inputs = v.responses_with_invalid_inputs;
   out.counters.commands_accepted = v.commands_accepted;
   out.counters.commands_refused = v.commands_refused;
 }

@@ -236,7 +236,8 @@ std::string pump_line(const dnbridge_PumpState& s, std::string_view time_text) {
     l += " | no inputs yet";
   }
   for (unsigned i = 0; i < s.analog_input_count && i < 2; ++i) {
-    l += fmt::format(" ai{}={:.3f}V", i + 1, s.analog_input_volts[i]);
+    l += s.analog_input_valid[i] ? fmt::format(" ai{}={:.3f}V", i + 1, s.analog_input_volts[i])
+                                 : fmt::format(" ai{}=invalid({})", i + 1, s.analog_input_raw[i]);
   }
   if (s.outputs_idle) {
     l += " | outputs idle";
@@ -255,8 +256,9 @@ std::string pumps_table(std::span<const dnbridge_PumpState* const> pumps) {
     const auto& s = *p;
     const bool in = s.online && s.inputs_valid;
     const auto ai = [&](unsigned i) {
-      return in && i < s.analog_input_count ? fmt::format("{:.3f}V", s.analog_input_volts[i])
-                                            : std::string("-");
+      if (!in || i >= s.analog_input_count) return std::string("-");
+      return s.analog_input_valid[i] ? fmt::format("{:.3f}V", s.analog_input_volts[i])
+                                     : fmt::format("invalid({})", s.analog_input_raw[i]);
     };
     const bool out = s.online && !s.outputs_idle;
     t.add({node_name(view(s.rack), view(s.port), s.mac), std::string(view(s.name)),
@@ -287,7 +289,12 @@ void pump_json(JsonWriter& out, const dnbridge_PumpState& s) {
   out.key("analog_inputs").begin_array();
   for (unsigned i = 0; i < s.analog_input_count && i < 2; ++i) {
     out.begin_object().field("raw", unsigned{s.analog_input_raw[i]});
-    out.key("volts").number(s.analog_input_volts[i], 3);
+    out.field("valid", static_cast<bool>(s.analog_input_valid[i]));
+    if (s.analog_input_valid[i]) {
+      out.key("volts").number(s.analog_input_volts[i], 3);
+    } else {
+      out.key("volts").null();
+    }
     out.end_object();
   }
   out.end_array();
@@ -317,7 +324,8 @@ std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState*
   add("serial number", fmt::format("{} (0x{:08X})", n.serial_number, n.serial_number));
   add("device state", n.device_state_valid
                           ? fmt::format("{} ({})", n.device_state, view(n.device_state_text))
-                          : std::string("not read"));
+                      : view(n.device_state_text).empty() ? std::string("not read")
+                                                          : std::string(view(n.device_state_text)));
   add("poll", fmt::format("every {} ms, {} byte(s) out, {} byte(s) in", n.poll_period_ms,
                           n.consumed_size, n.produced_size));
   add("expected packet rate", fmt::format("{} ms", n.expected_packet_rate_ms));
@@ -328,6 +336,8 @@ std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState*
                                       n.last_error_additional_status));
   add("last refused command",
       view(n.last_command_refused).empty() ? std::string("none") : std::string(view(n.last_command_refused)));
+  add("invalid inputs",
+      view(n.invalid_inputs).empty() ? std::string("none") : std::string(view(n.invalid_inputs)));
   if (pump && !pump->outputs_idle) {
     add("outputs", outputs_text(pump->pump_on, pump->n2_ballast_on, pump->analog_output_raw));
     add("commanded by", std::string(view(pump->commanded_by)));
@@ -354,6 +364,7 @@ std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState*
   counter("explicit timeouts", c.explicit_timeouts);
   counter("explicit device errors", c.explicit_device_errors);
   counter("last fragment unacked", c.explicit_responses_before_final_ack);
+  counter("invalid inputs", c.responses_with_invalid_inputs);
   counter("commands accepted", c.commands_accepted);
   counter("commands refused", c.commands_refused);
   return o;
@@ -396,7 +407,8 @@ void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_Pum
       .field("last_error", view(n.last_error))
       .field("last_error_general_status", unsigned{n.last_error_general_status})
       .field("last_error_additional_status", unsigned{n.last_error_additional_status})
-      .field("last_command_refused", view(n.last_command_refused));
+      .field("last_command_refused", view(n.last_command_refused))
+      .field("invalid_inputs", view(n.invalid_inputs));
   const auto& c = n.counters;
   out.key("counters")
       .begin_object()
@@ -416,6 +428,7 @@ void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_Pum
       .field("explicit_device_errors", std::uint64_t{c.explicit_device_errors})
       .field("explicit_responses_before_final_ack",
              std::uint64_t{c.explicit_responses_before_final_ack})
+      .field("responses_with_invalid_inputs", std::uint64_t{c.responses_with_invalid_inputs})
       .field("commands_accepted", std::uint64_t{c.commands_accepted})
       .field("commands_refused", std::uint64_t{c.commands_refused})
       .end_object();

@@ -309,7 +309,14 @@ std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout, Mutab
   const std::uint8_t bits = pump_.inputs().encode(e2_.configuration.no_nc_mask);
   auto size = profiles::cdn127::encode_poll_response(layout, exception_status_byte(), bits,
                                                      pump_.analog_inputs_raw(), out);
-  return size.ok() ? *size : 0;
+  if (!size.ok()) return 0;
+  for (std::size_t i = 0; i < layout.ain_count && i < failed_analog_.size(); ++i) {
+    if (!failed_analog_[i]) continue;
+    const std::size_t at = layout.ain_offset + 2 * i;
+    out[at] = static_cast<std::uint8_t>(*failed_analog_[i] & 0xFF);
+    out[at + 1] = static_cast<std::uint8_t>(*failed_analog_[i] >> 8);
+  }
+  return *size;
 }
 
 PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {

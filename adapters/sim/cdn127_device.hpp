@@ -6,6 +6,7 @@
 // attributes onto this state.
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "adapters/sim/pump_model.hpp"
@@ -329,6 +330,11 @@ class Cdn127Device {
   std::uint8_t exception_status_byte() noexcept;
   void set_faults(const IdentityFaults& faults) noexcept { faults_ = faults; }
   const IdentityFaults& faults() const noexcept { return faults_; }
+  // A failed converter: the channel's poll response field carries `raw`
+  // whatever it is (above 4095 included) until cleared with nullopt.
+  void fail_analog_input(std::size_t channel, std::optional<std::uint16_t> raw) noexcept {
+    if (channel < failed_analog_.size()) failed_analog_[channel] = raw;
+  }
   // The manufacturer detail bytes of Device Supervisor attributes 13/14.
   std::uint8_t alarm_detail() const noexcept;
   std::uint8_t warning_detail() const noexcept;
@@ -380,6 +386,7 @@ class Cdn127Device {
   bool poll_running_ = false;  // a full poll since the poll connection was established
 
   IdentityFaults faults_;
+  std::array<std::optional<std::uint16_t>, 2> failed_analog_{};
   PendingAction pending_ = PendingAction::kNone;
   std::uint32_t watchdog_timeouts_ = 0;
   TimePoint now_{};

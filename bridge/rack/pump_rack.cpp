@@ -171,7 +171,11 @@ void PumpRack::on_poll_response(MacId mac, Bytes data, TimePoint rx_time) {
     return;
   }
   auto inputs = cdn127::decode_poll_response(slot.format.response, slot.io.no_nc_mask, data);
-  if (!inputs) return;  // the master checked the size; values out of range are dropped
+  if (!inputs) return;  // the master checked the size
+  // A channel out of range is published as invalid; NodeStatus says which,
+  // so it changes when the set of invalid channels does.
+  if (!inputs->all_in_range()) ++v.responses_with_invalid_inputs;
+  if (inputs->analog_input_in_range != v.inputs.analog_input_in_range) ++v.status_changes;
   v.inputs = *inputs;
   v.has_inputs = true;
   v.inputs_time = rx_time;

@@ -55,6 +55,9 @@ struct PumpView {
 
   std::uint64_t commands_accepted = 0;
   std::uint64_t commands_refused = 0;
+  // Poll responses that carried an input out of range (its other inputs were
+  // taken; PollInputs::analog_input_in_range says which channel).
+  std::uint64_t responses_with_invalid_inputs = 0;
   std::string last_command_refused;  // why the last refused command was refused
 
   devicenet::NodeIdentity identity;

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/sample.hpp"
 #include "adapters/dds/topics.hpp"
@@ -27,6 +29,7 @@ Owned<dnbridge_PumpState> pump(unsigned mac) {
   s->interlock_ok = true;
   s->analog_input_count = 1;
   s->analog_input_raw[0] = 1024;
+  s->analog_input_valid[0] = true;
   s->analog_input_volts[0] = 2.5006f;
   s->outputs_idle = false;
   s->pump_on = true;
@@ -147,7 +150,23 @@ TEST(PumpJson, CarriesTheAppliedOutputs) {
   EXPECT_NE(out.str().find(R"("pump_on":true)"), std::string::npos);
   EXPECT_NE(out.str().find(R"("analog_output_raw":2048,"analog_output_volts":5.001)"),
             std::string::npos);
-  EXPECT_NE(out.str().find(R"("analog_inputs":[{"raw":1024,"volts":2.501}])"), std::string::npos);
+  EXPECT_NE(out.str().find(R"("analog_inputs":[{"raw":1024,"valid":true,"volts":2.501}])"),
+            std::string::npos);
+}
+
+// A channel off the 0..4095 scale: its raw value and "invalid", never volts.
+TEST(PumpJson, AnInvalidAnalogInputHasNoVolts) {
+  auto s = pump(3);
+  s->analog_input_raw[0] = 65535;
+  s->analog_input_valid[0] = false;
+  s->analog_input_volts[0] = std::numeric_limits<float>::quiet_NaN();
+  JsonWriter out(false);
+  pump_json(out, *s);
+  EXPECT_NE(out.str().find(R"("analog_inputs":[{"raw":65535,"valid":false,"volts":null}])"),
+            std::string::npos)
+      << out.str();
+  EXPECT_NE(pump_line(*s, "12:00:00.000").find(" ai1=invalid(65535) "), std::string::npos)
+      << pump_line(*s, "12:00:00.000");
 }
 
 TEST(OutputsText, VoltsFromRaw) {

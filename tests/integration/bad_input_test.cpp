@@ -149,5 +149,47 @@ TEST(BadInput, CorruptedPollResponsesAreCountedNotTaken) {
   EXPECT_EQ(rack.pumps().pump(mac(6))->inputs.analog_inputs_raw[0], 1234);
 }
 
+// An analog input off the 0..4095 scale (a failed converter, 4096 and
+// 0xFFFF): that channel is marked and counted; the discrete inputs and the
+// other channel of the same responses keep coming, so an alarm that comes
+// meanwhile is seen.
+TEST(BadInput, AnAnalogInputOffTheScaleFailsThatChannelOnly) {
+  for (const std::uint16_t raw : {std::uint16_t{4096}, std::uint16_t{0xFFFF}}) {
+    SCOPED_TRACE(raw);
+    sim::SimRack rack(rack_config({6}));
+    rack.start();
+    ASSERT_TRUE(rack.world().run_until([&] { return rack.all_online(); }, seconds(20)));
+    sim::Cdn127Device& device = rack.device(mac(6)).device().device();
+    const rack::PumpView& view = *rack.pumps().pump(mac(6));
+    device.pump().set_analog_input(0, 1234);
+    device.fail_analog_input(1, raw);
+    rack.world().run_for(seconds(1));
+    EXPECT_EQ(view.inputs.analog_inputs_raw[1], raw);
+    EXPECT_FALSE(view.inputs.analog_input_in_range[1]);
+    EXPECT_EQ(view.inputs.analog_inputs_raw[0], 1234);
+    EXPECT_TRUE(view.inputs.analog_input_in_range[0]);
+    EXPECT_GE(view.responses_with_invalid_inputs, 9u);  // ten polls a second
+    ASSERT_TRUE(view.inputs.pump.has_value());
+    EXPECT_FALSE(view.inputs.pump->alarm_active);
+
+    // An alarm while the channel is still off the scale: seen at once.
+    device.pump().set_alarm(true, rack.now());
+    const TimePoint raised = rack.now();
+    ASSERT_TRUE(rack.world().run_until(
+        [&] { return view.inputs.pump && view.inputs.pump->alarm_active; }, seconds(1)));
+    EXPECT_LE(rack.now() - raised, milliseconds(110));  // the next poll
+    EXPECT_GT(view.inputs_time, raised);
+    const auto& node = *rack.scanner().node(mac(6));
+    EXPECT_EQ(node.state(), NodeState::kOnline);
+    EXPECT_EQ(node.counters().errors, 0u) << "a full-size response is no poll error";
+
+    // The converter back: the channel is valid again.
+    device.fail_analog_input(1, std::nullopt);
+    rack.world().run_for(milliseconds(200));
+    EXPECT_TRUE(view.inputs.analog_input_in_range[1]);
+    EXPECT_TRUE(view.inputs.all_in_range());
+  }
+}
+
 }  // namespace
 }  // namespace dnbridge::test

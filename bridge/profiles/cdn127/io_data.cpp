@@ -122,10 +122,13 @@ Result<PollInputs> decode_poll_response(const PollResponseLayout& layout, std::u
     if (layout.din_channels >= kPumpInputChannels) in.pump = PumpInputs::decode(bits, no_nc_mask);
   }
   r.skip(layout.pad_size);  // the pad byte, whatever its value
+  // A channel out of range fails that channel only: the discrete inputs and
+  // the other channel of the same response are as good as ever, and dropping
+  // them would freeze interlock and alarm states while the node looks fresh.
   for (std::size_t i = 0; i < layout.ain_count; ++i) {
     const std::uint16_t raw = r.u16le();
-    if (raw > kAnalogMaxRaw) return Errc::kOutOfRange;
     in.analog_inputs_raw[i] = raw;
+    in.analog_input_in_range[i] = raw <= kAnalogMaxRaw;
   }
   if (!r.ok() || !r.at_end()) return Errc::kMalformed;  // unreachable with a well-formed layout
   return in;

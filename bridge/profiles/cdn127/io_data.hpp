@@ -62,12 +62,24 @@ struct PollInputs {
   // inputs' bits would decode as alarms that are not there.
   std::optional<PumpInputs> pump;
   std::array<std::optional<std::uint16_t>, 2> analog_inputs_raw{};  // per channel, when present
+  // Per channel: the value is on the 0..4095 scale. One above has no meaning
+  // (a failed converter, a corrupted frame): kept as received, marked here.
+  std::array<bool, 2> analog_input_in_range{};
+
+  bool all_in_range() const noexcept {
+    for (std::size_t i = 0; i < analog_inputs_raw.size(); ++i) {
+      if (analog_inputs_raw[i] && !analog_input_in_range[i]) return false;
+    }
+    return true;
+  }
 };
 
 // Decodes a poll response of exactly layout.size bytes (kTruncated if shorter,
-// kMalformed if longer). Analog values over 4095 are kOutOfRange. The pad byte's
-// value is ignored. Every codec below refuses a layout whose fields do not add
-// up to its size, or with more channels than the device has, with kOutOfRange.
+// kMalformed if longer). An analog value over 4095 does not fail the response:
+// it is kept and marked out of range (PollInputs::analog_input_in_range), and
+// every other field stands. The pad byte's value is ignored. Every codec below refuses a layout
+// whose fields do not add up to its size, or with more channels than the device has, with
+// kOutOfRange.
 Result<PollInputs> decode_poll_response(const PollResponseLayout& layout, std::uint8_t no_nc_mask,
                                         Bytes payload) noexcept;
 

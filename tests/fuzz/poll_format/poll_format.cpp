@@ -27,7 +27,8 @@ namespace {
 
 bool same(const PollInputs& a, const PollInputs& b) {
   return a.exception_status == b.exception_status && a.input_bits == b.input_bits &&
-         a.pump == b.pump && a.analog_inputs_raw == b.analog_inputs_raw;
+         a.pump == b.pump && a.analog_inputs_raw == b.analog_inputs_raw &&
+         a.analog_input_in_range == b.analog_input_in_range;
 }
 
 void check_response(const PollResponseLayout& layout, std::uint8_t mask, Bytes payload) {
@@ -38,13 +39,21 @@ void check_response(const PollResponseLayout& layout, std::uint8_t mask, Bytes p
   FUZZ_CHECK(in->input_bits.has_value() == (layout.din_size != 0));
   if (in->pump) FUZZ_CHECK(in->input_bits.has_value() && layout.din_channels >= 5);
   std::array<std::uint16_t, 2> analog{};
+  bool in_range = true;
   for (std::size_t i = 0; i < 2; ++i) {
     FUZZ_CHECK(in->analog_inputs_raw[i].has_value() == (i < layout.ain_count));
+    // A value off the 0..4095 scale is kept and marked, never dropped.
     if (in->analog_inputs_raw[i]) {
-      FUZZ_CHECK(*in->analog_inputs_raw[i] <= kAnalogMaxRaw);
+      FUZZ_CHECK(in->analog_input_in_range[i] == (*in->analog_inputs_raw[i] <= kAnalogMaxRaw));
       analog[i] = *in->analog_inputs_raw[i];
+      in_range = in_range && in->analog_input_in_range[i];
+    } else {
+      FUZZ_CHECK(!in->analog_input_in_range[i]);
     }
   }
+  FUZZ_CHECK(in->all_in_range() == in_range);
+  // The encoder (the simulator's) writes only values on the scale.
+  if (!in_range) return;
   const std::uint8_t dsup = layout.has_dsup ? payload[0] : 0;
   const std::uint8_t bits = in->input_bits.value_or(0);
   std::array<std::uint8_t, 16> buf{};

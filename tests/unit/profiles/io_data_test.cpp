@@ -242,12 +242,33 @@ TEST(PollResponse, PumpIsDecodedOnlyWhenTheByteHoldsAllFiveInputs) {
   }
 }
 
-TEST(PollResponse, AnalogOverFullScaleIsOutOfRange) {
+// An analog value off the 0..4095 scale fails its channel only: it is kept
+// and marked, and every other field of the response is decoded.
+TEST(PollResponse, AnalogOverFullScaleIsMarkedAndTheRestDecoded) {
   const PollResponseLayout l = poll_format(preset(ConfigurationPreset::kCdn127))->response;
-  const ByteVec wire = {0x00, 0x1F, 0x00, 0x10, 0x00, 0x00};  // AIN 0 = 4096
-  EXPECT_EQ(decode_poll_response(l, 0, wire).error(), Errc::kOutOfRange);
-  const ByteVec wire2 = {0x00, 0x1F, 0x00, 0x00, 0xFF, 0xFF};  // AIN 1 = 65535
-  EXPECT_EQ(decode_poll_response(l, 0, wire2).error(), Errc::kOutOfRange);
+  // [00 DSUP][1F inputs: all normal][00 AIN1 4096 = 00 10][AIN2 0]
+  const ByteVec wire = {0x00, 0x1F, 0x00, 0x10, 0x00, 0x00};
+  const auto in = decode_poll_response(l, 0, wire);
+  ASSERT_TRUE(in.ok());
+  EXPECT_EQ(in->analog_inputs_raw[0], 4096);
+  EXPECT_FALSE(in->analog_input_in_range[0]);
+  EXPECT_EQ(in->analog_inputs_raw[1], 0);
+  EXPECT_TRUE(in->analog_input_in_range[1]);
+  EXPECT_FALSE(in->all_in_range());
+  ASSERT_TRUE(in->pump.has_value());
+  EXPECT_TRUE(in->pump->interlock_ok);
+  EXPECT_FALSE(in->pump->alarm_active);
+  // [DSUP][00 inputs: pump alarm, interlock open, no N2][AIN1 0][AIN2 65535 = FF FF]
+  const ByteVec wire2 = {0x00, 0x00, 0x00, 0x00, 0xFF, 0xFF};
+  const auto in2 = decode_poll_response(l, 0, wire2);
+  ASSERT_TRUE(in2.ok());
+  EXPECT_EQ(in2->analog_inputs_raw[1], 65535);
+  EXPECT_FALSE(in2->analog_input_in_range[1]);
+  EXPECT_TRUE(in2->analog_input_in_range[0]);
+  EXPECT_TRUE(in2->pump->alarm_active);
+  EXPECT_FALSE(in2->pump->interlock_ok);
+  const ByteVec good = {0x00, 0x1F, 0xFF, 0x0F, 0x00, 0x00};  // AIN1 4095: the top of the scale
+  EXPECT_TRUE(decode_poll_response(l, 0, good)->all_in_range());
   std::array<std::uint8_t, 6> out{};
   EXPECT_EQ(encode_poll_response(l, 0, 0, {4096, 0}, out).error(), Errc::kOutOfRange);
   EXPECT_EQ(encode_poll_response(l, 0, 0, {0, 4096}, out).error(), Errc::kOutOfRange);
@@ -327,8 +348,10 @@ TEST(PollResponse, GarbageOfAnyLengthNeverDecodesWrongly) {
     if (g.size() != 6) {
       EXPECT_FALSE(in.ok());
     } else {
-      const bool in_range = (g[2] | (g[3] << 8)) <= 4095 && (g[4] | (g[5] << 8)) <= 4095;
-      EXPECT_EQ(in.ok(), in_range);
+      // Any six bytes decode; a channel off the scale is marked, not taken as valid.
+      ASSERT_TRUE(in.ok());
+      EXPECT_EQ(in->analog_input_in_range[0], (g[2] | (g[3] << 8)) <= 4095);
+      EXPECT_EQ(in->analog_input_in_range[1], (g[4] | (g[5] << 8)) <= 4095);
     }
   }
 }

@@ -1,0 +1,66 @@
+// What the bridge publishes for a node whose analog input is off the scale:
+// the channel marked invalid in PumpState (raw as received, volts NaN), the
+// other inputs as decoded, and NodeStatus saying which input and counting.
+#include "adapters/daemon/samples.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "adapters/dds/topics.hpp"
+#include "bridge/profiles/cdn127/poll_format.hpp"
+
+namespace dnbridge::daemon {
+namespace {
+
+namespace cdn127 = profiles::cdn127;
+
+class NullSink final : public can::FrameSink {
+ public:
+  void send(const can::CanFrame&, TimePoint) override {}
+};
+
+TEST(Samples, AnAnalogInputOffTheScaleIsInvalidAndNamed) {
+  rack::PumpConfig pump;
+  pump.node.mac = devicenet::MacId::from(6).value();
+  pump.node.name = "pump-6";
+  pump.io = cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
+  rack::PumpRack rack({pump});
+  NullSink sink;
+  devicenet::Scanner scanner(rack::PumpRack::scanner_config({}, {pump}), sink, rack, Logger());
+
+  rack.on_node_state(pump.node.mac, devicenet::NodeState::kVerifying, devicenet::NodeState::kOnline,
+                     "online", TimePoint{} + seconds(1));
+  // [DSUP 00][inputs 1F: all normal][AIN1 1234 = D2 04][AIN2 65535 = FF FF]
+  const std::uint8_t response[] = {0x00, 0x1F, 0xD2, 0x04, 0xFF, 0xFF};
+  rack.on_poll_response(pump.node.mac, Bytes(response), TimePoint{} + seconds(1));
+  const rack::PumpView& view = *rack.pump(pump.node.mac);
+
+  dds::Owned<dnbridge_PumpState> state;
+  fill_pump_state(*state, "r", "A", view);
+  EXPECT_TRUE(state->inputs_valid);
+  EXPECT_TRUE(state->interlock_ok);
+  EXPECT_EQ(state->analog_input_count, 2);
+  EXPECT_TRUE(state->analog_input_valid[0]);
+  EXPECT_NEAR(state->analog_input_volts[0], 1234 * 10.0 / 4095, 1e-3);
+  EXPECT_FALSE(state->analog_input_valid[1]);
+  EXPECT_EQ(state->analog_input_raw[1], 65535);
+  EXPECT_TRUE(std::isnan(state->analog_input_volts[1]));
+
+  dds::Owned<dnbridge_NodeStatus> status;
+  fill_node_status(*status, "r", "A", view, *scanner.node(pump.node.mac));
+  EXPECT_STREQ(status->invalid_inputs, "analog input 2: 65535 counts, above 4095");
+  EXPECT_EQ(status->counters.responses_with_invalid_inputs, 1u);
+
+  // In range again: nothing invalid, the count stays.
+  const std::uint8_t good[] = {0x00, 0x1F, 0xD2, 0x04, 0x00, 0x08};
+  rack.on_poll_response(pump.node.mac, Bytes(good), TimePoint{} + seconds(2));
+  fill_pump_state(*state, "r", "A", view);
+  EXPECT_TRUE(state->analog_input_valid[1]);
+  fill_node_status(*status, "r", "A", view, *scanner.node(pump.node.mac));
+  EXPECT_STREQ(status->invalid_inputs, "");
+  EXPECT_EQ(status->counters.responses_with_invalid_inputs, 1u);
+}
+
+}  // namespace
+}  // namespace dnbridge::daemon
