@@ -184,6 +184,9 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.last_error_additional_status = error.additional_status;
   set_string(out.last_command_refused, v.last_command_refused);
   std::string invalid;
+  if (v.online && v.inputs_withheld_when_idle) {
+    invalid = "no inputs while idle: the device answers idle polls without data";
+  }
   for (std::size_t i = 0; i < v.inputs.analog_inputs_raw.size(); ++i) {
     const auto& raw = v.inputs.analog_inputs_raw[i];
     if (!v.has_inputs || !raw || v.inputs.analog_input_in_range[i]) continue;

@@ -124,6 +124,8 @@ void PortLoop::run() {
   for (;;) {
     heartbeat_.fetch_add(1, std::memory_order_relaxed);
     now = backend_->now();
+    // (A master that starts now checks its MAC anyway: no re-check for it.)
+    const bool master_was_started = master_started_;
     if (!stopping) start_master_when_up(now);
     while (scanner_->next_deadline() <= now) scanner_->on_timer(now);
     if (!drain_inbox(now) && !stopping) {
@@ -135,7 +137,7 @@ void PortLoop::run() {
     // A bus that comes back (bus-off recovered, the interface up again):
     // the master checks its own MAC again before it scans.
     if (const BusState bus = backend_->counters().state; bus != bus_seen_) {
-      if (bus_lost(bus_seen_) && !bus_lost(bus) && master_started_ && !stopping) {
+      if (bus_lost(bus_seen_) && !bus_lost(bus) && master_was_started && !stopping) {
         scanner_->recheck_mac(
             bus_seen_ == BusState::kDown ? "the interface is up again" : "bus-off recovered", now);
       }

@@ -104,7 +104,7 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
       ++counters_.unexpected_frames;
       return;
     }
-    end_request_transfer();
+    end_request_transfer(now);
     handle_response(payload.subspan(1), now);
     return;
   }
@@ -143,7 +143,7 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
     ++counters_.unexpected_frames;
     return;
   }
-  end_request_transfer();
+  end_request_transfer(now);
   const auto outcome = reassembler_.on_fragment(payload);
   // The reassembler says which fragments are acknowledged (an empty ack()
   // means none); acks go back on the explicit connection.
@@ -179,15 +179,19 @@ void ExplicitClient::on_frame(Bytes payload, TimePoint now) noexcept {
   }
 }
 
-// A response that comes before (or without) the acknowledge of the request's
-// last fragment ends the transaction all the same: the device answers only a
-// request it has (some devices never acknowledge the last fragment and send
-// the response instead). Counted, as it departs from the acknowledged
-// fragmentation protocol.
-void ExplicitClient::end_request_transfer() noexcept {
+// A response that comes before the request's transfer is done (without the
+// acknowledge of its last fragment, or before its other fragments went out)
+// ends the transfer: some devices never acknowledge the last fragment and
+// send the response instead, and a device that answers early wants no more.
+// Counted, as it departs from the acknowledged fragmentation protocol. The
+// response timer runs from here: a frame that turns out not to be the answer
+// (another service, a fragment out of order) leaves the request to time out
+// rather than wait for ever.
+void ExplicitClient::end_request_transfer(TimePoint now) noexcept {
   if (!sender_.active()) return;
   sender_.cancel();
   ++counters_.responses_before_final_ack;
+  response_deadline_ = now + current_.timeout;
 }
 
 // The slave resends the last fragment of a response when it misses the ack

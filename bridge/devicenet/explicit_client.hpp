@@ -107,7 +107,7 @@ class ExplicitClient {
   void send_message(TimePoint now) noexcept;
   void send_payload(std::uint32_t can_id, Bytes payload, TimePoint now) noexcept;
   void handle_response(Bytes message, TimePoint now) noexcept;
-  void end_request_transfer() noexcept;
+  void end_request_transfer(TimePoint now) noexcept;
   bool reack_final_fragment(Bytes payload, TimePoint now) noexcept;
   void finish(const ExplicitResult& result, TimePoint now) noexcept;
   void fail(Errc reason, TimePoint now) noexcept;

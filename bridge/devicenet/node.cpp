@@ -79,12 +79,11 @@ Duration Node::next_backoff() {
   jitter_state_ ^= jitter_state_ << 13;
   jitter_state_ ^= jitter_state_ >> 17;
   jitter_state_ ^= jitter_state_ << 5;
-  const auto span = base.count() / 2;
-  if (span <= 0) return base;
-  const auto offset =
-      static_cast<Duration::rep>(
-          jitter_state_ % static_cast<std::uint32_t>(std::min<Duration::rep>(span, 0xFFFFFFFF))) -
-      span / 2;
+  // offset = span x fraction - span / 2, fraction in [0, 1): any base, no
+  // bias, no overflow.
+  const Duration::rep span = base.count() / 2;
+  const double fraction = static_cast<double>(jitter_state_) / 4294967296.0;
+  const auto offset = static_cast<Duration::rep>(static_cast<double>(span) * fraction) - span / 2;
   return base + Duration(offset);
 }
 
@@ -154,6 +153,7 @@ void Node::forget_connections(Errc why, TimePoint now) {
   step_ = Step::kNone;
   connected_ = false;
   poll_allocated_ = false;
+  poll_requested_ = false;
   client_.cancel_all(why, now);
 }
 

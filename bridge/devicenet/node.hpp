@@ -230,6 +230,7 @@ class Node final : private ExplicitClient::Listener {
   Step step_ = Step::kNone;
   bool connected_ = false;       // the master holds the explicit connection
   bool poll_allocated_ = false;  // ... and the poll connection
+  bool poll_requested_ = false;  // Allocate(poll) sent: the device may hold it unanswered
   bool shutting_down_ = false;
   bool started_ = false;
   TimePoint retry_at_ = kNever;

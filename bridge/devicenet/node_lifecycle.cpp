@@ -161,8 +161,11 @@ void Node::get(Step step, const cip::AttributeRef& target, TimePoint now) {
 }
 
 std::uint8_t Node::held_connections() const {
+  // A poll connection asked for but not yet confirmed may be the device's
+  // already: released with the rest (a device without it refuses that
+  // Release with 0x0B, and the explicit connection is released alone).
   return static_cast<std::uint8_t>((connected_ ? allocation::kExplicit : 0) |
-                                   (poll_allocated_ ? allocation::kPoll : 0));
+                                   (poll_allocated_ || poll_requested_ ? allocation::kPoll : 0));
 }
 
 void Node::release(Step step, std::uint8_t choice, TimePoint now) {
@@ -180,6 +183,11 @@ void Node::attempt_allocate(TimePoint now) {
   step_timeouts_ = 0;
   poll_release_tried_ = false;
   setting_retried_ = false;
+  // What an attempt learns is its own: paths and refusals from an earlier one
+  // would otherwise pile up in the reasons.
+  path_refusal_.clear();
+  produced_path_in_force_.clear();
+  consumed_path_in_force_.clear();
   ++counters_.allocate_attempts;
   run(Step::kAllocateExplicit, now);
 }
@@ -189,6 +197,7 @@ void Node::run(Step step, TimePoint now) {
   if (r.phase != NodeState::kAbsent && r.phase != state_) {
     set_state(r.phase, std::string(phase_reason(r.phase)), now);
   }
+  if (step == Step::kAllocatePoll) poll_requested_ = true;
   switch (r.verb) {
     case Verb::kAllocate: {
       const std::array<std::uint8_t, 2> data{r.choice, port_.master_mac.value()};
@@ -293,12 +302,21 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
       on_keepalive_result(r, now);
       return;
     case Step::kReleaseFault:
-      // Whatever the answer, the node is left alone until the re-check.
-      connected_ = poll_allocated_ = false;
-      return;
     case Step::kReleaseShutdown:
-      connected_ = poll_allocated_ = false;
-      set_state(NodeState::kStopped, "released by orderly shutdown", now);
+      // Released both where the device had only the explicit connection:
+      // refused whole (0x0B); the explicit connection alone, then.
+      if (r.error == Errc::kDeviceError &&
+          r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode &&
+          !last_request_data_.empty() && last_request_data_.view()[0] != allocation::kExplicit &&
+          (last_request_data_.view()[0] & allocation::kExplicit) != 0) {
+        release(step, allocation::kExplicit, now);
+        return;
+      }
+      connected_ = poll_allocated_ = poll_requested_ = false;
+      // Whatever the answer, a faulted node is left alone until the re-check.
+      if (step == Step::kReleaseShutdown) {
+        set_state(NodeState::kStopped, "released by orderly shutdown", now);
+      }
       return;
     case Step::kAllocateExplicit:
       // No answer here is an absent node: the handler retries with back-off.
@@ -417,6 +435,7 @@ Node::Step Node::after_allocate_poll(const ExplicitResult& r, TimePoint now) {
     poll_release_tried_ = true;
     return Step::kReleasePollForAllocate;
   }
+  poll_requested_ = false;  // refused: the device did not give it
   if (r.general_status == cip::GeneralStatus::kObjectStateConflict && r.additional_status == 0x01) {
     enter_fault(NodeState::kOwnedByOtherMaster,
                 "Allocate of the poll connection refused: owned by another master (0x0C/0x01)",
@@ -466,11 +485,11 @@ Node::Step Node::after_identity_match(const ExplicitResult& r, TimePoint now) {
 
 // Revision, name and status are information: a device that refuses them is
 // still the expected device.
+// (A refused one is cleared: it may be another device than last time.)
 Node::Step Node::after_revision(const ExplicitResult& r, TimePoint) {
-  if (r.data.size() >= 2) {
-    identity_.major_revision = r.data[0];
-    identity_.minor_revision = r.data[1];
-  }
+  const bool ok = r.ok() && r.data.size() >= 2;
+  identity_.major_revision = ok ? r.data[0] : 0;
+  identity_.minor_revision = ok ? r.data[1] : 0;
   return Step::kSerial;
 }
 
@@ -496,8 +515,8 @@ Node::Step Node::after_serial(const ExplicitResult& r, TimePoint now) {
       return Step::kNone;
     }
   }
+  identity_.serial_number = serial.value_or(0);
   if (serial) {
-    identity_.serial_number = *serial;
     if (first_serial_ && *first_serial_ != *serial) {
       log_.warn("serial number changed from 0x{:08X} to 0x{:08X}: another device at this MAC",
                 *first_serial_, *serial);
@@ -508,6 +527,8 @@ Node::Step Node::after_serial(const ExplicitResult& r, TimePoint now) {
 }
 
 Node::Step Node::after_name(const ExplicitResult& r, TimePoint) {
+  identity_.product_name.clear();
+  if (!r.ok()) return Step::kIdentityStatus;
   if (auto name = cip::decode_short_string(r.data.view()); name) {
     identity_.product_name = std::string(*name);
   }
@@ -584,7 +605,7 @@ Node::Step Node::after_write_setting(const ExplicitResult& r, TimePoint now) {
 
 Node::Step Node::after_release_for_setting(const ExplicitResult&, TimePoint) {
   // "Not allocated" (0x0B) or done: either way no poll connection is left.
-  poll_allocated_ = false;
+  poll_allocated_ = poll_requested_ = false;
   return Step::kWriteSetting;
 }
 

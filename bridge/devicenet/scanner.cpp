@@ -106,6 +106,16 @@ void Scanner::begin_scanning(TimePoint now) {
 }
 
 void Scanner::recheck_mac(std::string_view why, TimePoint now) {
+  if (state_ == PortState::kCheckingMac) {
+    // The check under way may have gone out on a bus that was not there:
+    // it starts again.
+    set_state(PortState::kCheckingMac,
+              fmt::format("{}: checking again that no other node has MAC {}", why,
+                          config_.master_mac.value()),
+              now);
+    sink_.send(mac_check_.start(now), now);
+    return;
+  }
   if (state_ != PortState::kRunning) return;
   // Whatever the nodes had is gone with the bus: they are allocated afresh
   // once the master's MAC is checked again.

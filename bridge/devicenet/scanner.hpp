@@ -49,7 +49,7 @@ class Scanner {
   // The bus came back (bus-off recovered, the interface up again): every node
   // is taken as lost, and the master checks its own MAC again before it
   // scans (a node must not talk on a bus it rejoins before that check).
-  // Only while running.
+  // While running, or during a check (which starts again).
   void recheck_mac(std::string_view why, TimePoint now);
 
   void on_frame(const can::CanFrame& frame, TimePoint rx_time);

@@ -12,6 +12,7 @@ PumpStateGate::Discrete PumpStateGate::discrete(const PumpView& v) {
     d.input_bits = v.inputs.input_bits.value_or(0);
     d.has_exception = v.inputs.exception_status.has_value();
     if (d.has_exception) d.exception_bits = v.inputs.exception_status->encode();
+    d.analog_in_range = v.inputs.analog_input_in_range;
   }
   d.outputs_idle = v.outputs_idle;
   if (!v.outputs_idle) d.outputs = v.outputs_applied;

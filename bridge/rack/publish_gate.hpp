@@ -39,6 +39,7 @@ class PumpStateGate {
     std::uint8_t input_bits = 0;
     std::uint8_t exception_bits = 0;
     bool has_exception = false;
+    std::array<bool, 2> analog_in_range{};  // a channel turning invalid is news at once
     bool outputs_idle = true;
     profiles::cdn127::PumpOutputs outputs;
     friend bool operator==(const Discrete&, const Discrete&) = default;

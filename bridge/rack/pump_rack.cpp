@@ -131,6 +131,7 @@ void PumpRack::on_node_state(MacId mac, NodeState, NodeState to, const std::stri
   v->state_since = at;
   v->online = to == NodeState::kOnline;
   v->has_inputs = false;  // until a poll response since this transition
+  v->inputs_withheld_when_idle = false;
   ++v->changes;
   ++v->status_changes;
 }
@@ -165,11 +166,17 @@ void PumpRack::on_poll_response(MacId mac, Bytes data, TimePoint rx_time) {
   const Slot& slot = slots_[index];
   if (data.empty()) {
     // An idle poll answered with no data: the device applied its idle
-    // outputs; its inputs keep the time of the last response that had them.
+    // outputs, and said nothing of its inputs. What they last were is not
+    // what they are: no inputs are published until a response carries them.
+    if (v.has_inputs || !v.inputs_withheld_when_idle) ++v.status_changes;
+    v.has_inputs = false;
+    v.inputs_withheld_when_idle = true;
     refresh_applied(index);
     ++v.changes;
     return;
   }
+  if (v.inputs_withheld_when_idle) ++v.status_changes;
+  v.inputs_withheld_when_idle = false;
   auto inputs = cdn127::decode_poll_response(slot.format.response, slot.io.no_nc_mask, data);
   if (!inputs) return;  // the master checked the size
   // A channel out of range is published as invalid; NodeStatus says which,

@@ -42,6 +42,9 @@ struct PumpView {
 
   // Inputs from the last poll response (valid once `has_inputs`).
   bool has_inputs = false;
+  // The device answers idle polls without data: while idle its inputs are
+  // not known (has_inputs is false), rather than shown as they last were.
+  bool inputs_withheld_when_idle = false;
   TimePoint inputs_time{};  // CAN receive time of that response
   profiles::cdn127::PollInputs inputs;
 

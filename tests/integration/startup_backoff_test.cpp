@@ -207,6 +207,37 @@ TEST_F(StartupBackoff, RetriesOfTwoSilentNodesDrift) {
   }
 }
 
+// With a long maximum (allocate_retry_max_ms up to an hour), the jitter is
+// still -25..+25 % of it.
+TEST(StartupBackoffLongMaximum, JitterSpansBothSidesOfTheMaximum) {
+  auto config = rack_config({7});
+  config.create_devices = false;
+  config.port.allocate_retry_max = seconds(60);
+  sim::SimRack rack(std::move(config));
+  std::vector<TimePoint> allocates;
+  rack.world().bus().set_tap([&](const sim::WireFrame& f) {
+    if (f.frame.id ==
+        devicenet::group2_id(mac(7), devicenet::Group2Message::kUnconnectedExplicitRequest)) {
+      allocates.push_back(f.end);
+    }
+  });
+  rack.start();
+  rack.world().run_for(seconds(3600));
+  // 250 ms doubling: 60 s is reached at the 9th retry; after it, each
+  // interval is the 2 s response timeout plus 45..75 s.
+  ASSERT_GE(allocates.size(), 40u);
+  Duration shortest = Duration::max(), longest{};
+  for (std::size_t i = 10; i + 1 < allocates.size(); ++i) {
+    const Duration gap = allocates[i + 1] - allocates[i];
+    shortest = std::min(shortest, gap);
+    longest = std::max(longest, gap);
+    EXPECT_GE(gap, seconds(2 + 45) - milliseconds(1));
+    EXPECT_LE(gap, seconds(2 + 75) + milliseconds(1));
+  }
+  EXPECT_LT(shortest, seconds(2 + 52)) << "jitter below the maximum";
+  EXPECT_GT(longest, seconds(2 + 68)) << "jitter above the maximum";
+}
+
 // ---------------------------------------------------------------------------
 // The bus back after bus-off or an interface down: the master's own MAC first.
 

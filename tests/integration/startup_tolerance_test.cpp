@@ -252,6 +252,14 @@ TEST_F(StartupReading, RefusedPathsThatDoNotServeAreAConfigurationFault) {
       << r;
   EXPECT_NE(r.find("poll sizes differ"), std::string::npos) << r;
   EXPECT_EQ(node().counters().polls, 0u);
+  // Re-checked every 10 s, with the same outcome: the reason stays as it is
+  // (no refusal of an earlier attempt added), and it is no news.
+  const std::string first = r;
+  const std::size_t events = events_.of(mac(kMac)).size();
+  rack_->world().run_for(seconds(35));
+  EXPECT_GE(node().counters().allocate_attempts, 4u);
+  EXPECT_EQ(view().reason, first);
+  EXPECT_EQ(events_.of(mac(kMac)).size(), events);
 }
 
 // An idle node whose device answers idle polls empty: 100 idle polls, no
@@ -273,6 +281,18 @@ TEST_F(StartupReading, EmptyAnswersToIdlePollsKeepTheConnection) {
   EXPECT_EQ(view().state, NodeState::kOnline);
   EXPECT_TRUE(view().outputs_idle);
   EXPECT_FALSE(view().has_inputs) << "an empty answer carries no inputs";
+
+  // Commanded, the device answers with data: inputs. Idle again: what they
+  // last were is not published as what they are.
+  cdn127::PumpOutputs out;
+  out.pump_on = true;
+  ASSERT_TRUE(rack_->pumps().command(mac(kMac), out, rack_->now()).ok());
+  ASSERT_TRUE(rack_->world().run_until([&] { return view().has_inputs; }, seconds(1)));
+  EXPECT_FALSE(view().inputs_withheld_when_idle);
+  ASSERT_TRUE(rack_->pumps().release_command(mac(kMac), rack_->now()).ok());
+  ASSERT_TRUE(rack_->world().run_until([&] { return view().outputs_idle; }, seconds(1)));
+  EXPECT_FALSE(view().has_inputs);
+  EXPECT_TRUE(view().inputs_withheld_when_idle);
 }
 
 // The response to a fragmented request without the ack of its last fragment

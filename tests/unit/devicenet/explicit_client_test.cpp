@@ -469,6 +469,21 @@ TEST_F(ExplicitClientTest, ResponseBeforeTheRequestIsThroughEndsTheTransaction) 
   EXPECT_EQ(sink.frames.size(), 1u);  // the middle fragment is not sent
 }
 
+// A frame with this request's XID ends the transfer even if it turns out
+// not to be the answer (here a reply to another service): the request then
+// waits for its response timeout, and times out; it never hangs.
+TEST_F(ExplicitClientTest, AnEarlyFrameThatIsNotTheAnswerLeavesTheRequestToTimeOut) {
+  ASSERT_TRUE(client.submit(1, set_twelve(), false, now).ok());
+  answer({0x4A, 0x8E, 0x00});  // 8E: a Get response, not the Set's
+  EXPECT_TRUE(listener.results.empty());
+  EXPECT_EQ(client.deadline(), now + milliseconds(2000));
+  advance(milliseconds(2000));
+  client.on_timer(now);
+  ASSERT_EQ(listener.results.size(), 1u);
+  EXPECT_EQ(listener.results[0].error, Errc::kTimeout);
+  EXPECT_TRUE(client.idle());
+}
+
 // An answer with another XID is not this request's.
 TEST_F(ExplicitClientTest, AnswerWithAnotherXidWhileSendingFragmentsIsUnexpected) {
   ASSERT_TRUE(client.submit(1, set_twelve(), false, now).ok());

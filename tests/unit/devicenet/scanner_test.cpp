@@ -60,5 +60,38 @@ TEST(Scanner, NodeStartIsReportedWhenItHappensNotAtTheStaggeredFirstAttempt) {
   }
 }
 
+class CountingSink final : public can::FrameSink {
+ public:
+  void send(const can::CanFrame& frame, TimePoint at) override {
+    if (frame.id == 0x407) checks.push_back(at);  // duplicate MAC ID request, MAC 0
+  }
+  std::vector<TimePoint> checks;
+};
+
+// The bus lost and back during the master's MAC check: the check may have
+// gone out on nothing, so it starts again, and scanning waits for it.
+TEST(Scanner, ABusBackDuringTheMacCheckStartsTheCheckAgain) {
+  CountingSink sink;
+  StateTimes observer;
+  Scanner scanner(three_nodes(), sink, observer, Logger());
+  TimePoint now = TimePoint{} + seconds(100);
+  scanner.start(now);
+  ASSERT_EQ(sink.checks.size(), 1u);
+  now += milliseconds(700);
+  scanner.on_timer(now);
+  scanner.recheck_mac("the interface is up again", now);
+  EXPECT_EQ(scanner.state(), PortState::kCheckingMac);
+  ASSERT_EQ(sink.checks.size(), 2u);
+  EXPECT_EQ(sink.checks[1], now);
+  const TimePoint again = now;
+  while (scanner.state() == PortState::kCheckingMac) {
+    now = scanner.next_deadline();
+    scanner.on_timer(now);
+  }
+  EXPECT_EQ(scanner.state(), PortState::kRunning);
+  EXPECT_EQ(now - again, seconds(2)) << "two windows from the new check";
+  EXPECT_EQ(sink.checks.size(), 3u);
+}
+
 }  // namespace
 }  // namespace dnbridge::devicenet

@@ -11,6 +11,7 @@ PumpView online_view() {
   v.has_inputs = true;
   v.inputs.input_bits = 0x1F;
   v.inputs.analog_inputs_raw = {std::uint16_t{1000}, std::uint16_t{2000}};
+  v.inputs.analog_input_in_range = {true, true};
   return v;
 }
 
@@ -45,6 +46,15 @@ TEST(PumpStateGate, DiscreteChangesAreDueAtOnce) {
   EXPECT_TRUE(gate.due(changed, t0 + milliseconds(1)));
   changed = v;
   changed.inputs.exception_status = profiles::cdn127::ExceptionStatus::decode(0x02);
+  EXPECT_TRUE(gate.due(changed, t0 + milliseconds(1)));
+  // A channel going off the scale by a few counts, inside the deadband: its
+  // validity changed, which is news.
+  changed = v;
+  changed.inputs.analog_inputs_raw[0] = std::uint16_t{4096};
+  changed.inputs.analog_input_in_range[0] = false;
+  auto near = v;
+  near.inputs.analog_inputs_raw[0] = std::uint16_t{4094};
+  gate.published(near, t0);
   EXPECT_TRUE(gate.due(changed, t0 + milliseconds(1)));
 }
 
