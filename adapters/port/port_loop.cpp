@@ -134,9 +134,10 @@ void PortLoop::run() {
       log_.info("stopping: idling and releasing every node");
       scanner_->stop(now);
     }
+    const BusState bus = backend_->counters().state;
     // A bus that comes back (bus-off recovered, the interface up again):
     // the master checks its own MAC again before it scans.
-    if (const BusState bus = backend_->counters().state; bus != bus_seen_) {
+    if (bus != bus_seen_) {
       if (bus_lost(bus_seen_) && !bus_lost(bus) && master_was_started && !stopping) {
         scanner_->recheck_mac(
             bus_seen_ == BusState::kDown ? "the interface is up again" : "bus-off recovered", now);
@@ -144,7 +145,7 @@ void PortLoop::run() {
       bus_seen_ = bus;
     }
     // A change of the bus or interface state is published at once.
-    if (const BusState bus = backend_->counters().state; bus != bus_state_) {
+    if (bus != bus_state_) {
       port_dirty_ = true;
       port_event_time_ = now;
     }

@@ -91,6 +91,8 @@ class ExplicitClient {
   void cancel_all(Errc reason, TimePoint now) noexcept;
 
   bool idle() const noexcept { return !outstanding_ && count_ == 0; }
+  // The response timeout a request gets unless it names its own.
+  Duration response_timeout() const noexcept { return config_.response_timeout; }
   std::size_t queued() const noexcept { return count_ + (outstanding_ ? 1 : 0); }
   const ExplicitCounters& counters() const noexcept { return counters_; }
 

@@ -206,9 +206,6 @@ class Node final : private ExplicitClient::Listener {
   void record(NodeError::Kind kind, TimePoint now, std::uint32_t got = 0,
               std::uint32_t expected = 0);
   void record_device_error(const ExplicitResult& result, TimePoint now);
-  Duration explicit_response_timeout() const {
-    return config_.explicit_response_timeout.value_or(port_.explicit_messaging.response_timeout);
-  }
   // Retry delay of the allocation and release paths: doubles up to the
   // port's maximum, with jitter, so that a broken node never floods the bus.
   Duration next_backoff();

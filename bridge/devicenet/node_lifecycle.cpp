@@ -235,7 +235,7 @@ void Node::run(Step step, TimePoint now) {
           // device's 4 x EPR watchdog, so the first poll follows at once. A
           // lost answer is retried after 2 x EPR, while the connection lives.
           value.assign(Bytes(uint_le(to_ms(config_.expected_packet_rate))));
-          timeout = std::min(explicit_response_timeout(), 2 * config_.expected_packet_rate);
+          timeout = std::min(client_.response_timeout(), 2 * config_.expected_packet_rate);
           break;
         default:
           break;
@@ -263,7 +263,9 @@ void Node::advance(Step next, TimePoint now) {
 
 cip::AttributeRef Node::target_of(Step step) const {
   const StepRow& r = row(step);
-  if (r.target == kProfileSetting && r.target.name == kProfileSetting.name) {
+  // The two profile targets share class, instance and attribute 0: their
+  // names tell them apart.
+  if (r.target.name == kProfileSetting.name) {
     const auto& s = config_.profile.settings[setting_index_];
     return {s.class_id, s.instance_id, s.attribute, s.name};
   }
