@@ -33,6 +33,8 @@ dnbridge_NodeLifecycle to_idl(devicenet::NodeState s) {
       return dnbridge_NODE_OWNED_BY_OTHER_MASTER;
     case devicenet::NodeState::kStopped:
       return dnbridge_NODE_STOPPED;
+    case devicenet::NodeState::kDeviceFault:
+      return dnbridge_NODE_DEVICE_FAULT;
   }
   return dnbridge_NODE_ABSENT;
 }
@@ -141,7 +143,56 @@ void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string
   out.analog_output_volts = static_cast<float>(cdn127::raw_to_volts(applied.analog_out_raw));
   set_string(out.commanded_by,
              v.outputs_idle ? std::string_view{} : std::string_view(v.commanded_by));
+  set_string(out.idle_reason, v.idle_reason());
 }
+
+namespace {
+
+dnbridge_SafeAction to_idl(cdn127::DiscreteAction a) {
+  switch (a) {
+    case cdn127::DiscreteAction::kOff:
+      return dnbridge_SAFE_ACTION_OFF;
+    case cdn127::DiscreteAction::kOn:
+      return dnbridge_SAFE_ACTION_ON;
+    case cdn127::DiscreteAction::kHold:
+      return dnbridge_SAFE_ACTION_HOLD;
+  }
+  return dnbridge_SAFE_ACTION_UNKNOWN;
+}
+
+dnbridge_SafeAction to_idl(const cdn127::AnalogAction& a) {
+  switch (a.kind) {
+    case cdn127::AnalogAction::Kind::kHold:
+      return dnbridge_SAFE_ACTION_HOLD;
+    case cdn127::AnalogAction::Kind::kLowLimit:
+      return dnbridge_SAFE_ACTION_OFF;
+    case cdn127::AnalogAction::Kind::kHighLimit:
+      return dnbridge_SAFE_ACTION_ON;
+    case cdn127::AnalogAction::Kind::kValue:
+      return dnbridge_SAFE_ACTION_VALUE;
+  }
+  return dnbridge_SAFE_ACTION_UNKNOWN;
+}
+
+void fill_safe_state(dnbridge_SafeState& out, const rack::PumpView& v) {
+  out.known = v.safe_state.has_value();
+  out.source = v.safe_state_source == cdn127::SafeStateSource::kDevice
+                   ? dnbridge_SAFE_STATE_DEVICE
+                   : dnbridge_SAFE_STATE_CONFIGURED;
+  const auto unknown = dnbridge_SAFE_ACTION_UNKNOWN;
+  const auto& s = v.safe_state;
+  out.pump_on_fault = s ? to_idl(s->pump_fault) : unknown;
+  out.pump_on_idle = s ? to_idl(s->pump_idle) : unknown;
+  out.n2_ballast_on_fault = s ? to_idl(s->n2_ballast_fault) : unknown;
+  out.n2_ballast_on_idle = s ? to_idl(s->n2_ballast_idle) : unknown;
+  out.analog_output_on_fault = s ? to_idl(s->analog_fault) : unknown;
+  out.analog_output_fault_raw = s ? s->analog_fault.raw : 0;
+  out.analog_output_on_idle = s ? to_idl(s->analog_idle) : unknown;
+  out.analog_output_idle_raw = s ? s->analog_idle.raw : 0;
+  set_string(out.text, s ? std::string_view(v.safe_state_text) : std::string_view{"not read yet"});
+}
+
+}  // namespace
 
 void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
                       const rack::PumpView& v, const devicenet::Node& node) {
@@ -195,6 +246,9 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
         fmt::format("analog input {}: {} counts, above {}", i + 1, *raw, cdn127::kAnalogMaxRaw);
   }
   set_string(out.invalid_inputs, invalid);
+  set_string(out.device_faults, v.minor_faults);
+  fill_safe_state(out.safe_state, v);
+  set_string(out.idle_reason, v.idle_reason());
 
   const auto& c = node.counters();
   const auto& e = node.explicit_counters();

@@ -26,6 +26,8 @@ std::string_view to_text(dnbridge_NodeLifecycle state) {
     case dnbridge_NODE_CONFIGURATION_FAULT: return "configuration fault";
     case dnbridge_NODE_OWNED_BY_OTHER_MASTER: return "owned by other master";
     case dnbridge_NODE_STOPPED: return "stopped";
+    case dnbridge_NODE_DEVICE_FAULT:
+      return "device fault";
   }
   return "unknown";
 }
@@ -240,7 +242,8 @@ std::string pump_line(const dnbridge_PumpState& s, std::string_view time_text) {
                                  : fmt::format(" ai{}=invalid({})", i + 1, s.analog_input_raw[i]);
   }
   if (s.outputs_idle) {
-    l += " | outputs idle";
+    l += view(s.idle_reason).empty() ? std::string(" | outputs idle")
+                                     : fmt::format(" | outputs {}", view(s.idle_reason));
   } else {
     l += fmt::format(" | pump={} ballast={} aout={} ({:.3f}V) by \"{}\"", on_off(s.pump_on),
                      on_off(s.n2_ballast_on), s.analog_output_raw, s.analog_output_volts,
@@ -300,6 +303,7 @@ void pump_json(JsonWriter& out, const dnbridge_PumpState& s) {
   out.end_array();
   out.field("exception_status_valid", static_cast<bool>(s.exception_status_valid))
       .field("outputs_idle", static_cast<bool>(s.outputs_idle))
+      .field("idle_reason", view(s.idle_reason))
       .field("pump_on", static_cast<bool>(s.pump_on))
       .field("n2_ballast_on", static_cast<bool>(s.n2_ballast_on))
       .field("analog_output_raw", unsigned{s.analog_output_raw});
@@ -342,8 +346,15 @@ std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState*
     add("outputs", outputs_text(pump->pump_on, pump->n2_ballast_on, pump->analog_output_raw));
     add("commanded by", std::string(view(pump->commanded_by)));
   } else if (pump) {
-    add("outputs", "idle (no commander)");
+    add("outputs", view(pump->idle_reason).empty() ? std::string("idle")
+                                                   : std::string(view(pump->idle_reason)));
   }
+  add("safe state", fmt::format("{} ({})", view(n.safe_state.text),
+                                n.safe_state.source == dnbridge_SAFE_STATE_DEVICE
+                                    ? "the device's own, kept"
+                                    : "from the configuration, read back"));
+  add("device faults",
+      view(n.device_faults).empty() ? std::string("none") : std::string(view(n.device_faults)));
   const auto& c = n.counters;
   o += "counters\n";
   const auto counter = [&o](std::string_view label, std::uint64_t v) {
@@ -369,6 +380,43 @@ std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState*
   counter("commands refused", c.commands_refused);
   return o;
 }
+
+namespace {
+
+std::string_view safe_action_text(dnbridge_SafeAction a) {
+  switch (a) {
+    case dnbridge_SAFE_ACTION_UNKNOWN:
+      return "unknown";
+    case dnbridge_SAFE_ACTION_OFF:
+      return "off";
+    case dnbridge_SAFE_ACTION_ON:
+      return "on";
+    case dnbridge_SAFE_ACTION_HOLD:
+      return "hold";
+    case dnbridge_SAFE_ACTION_VALUE:
+      return "value";
+  }
+  return "unknown";
+}
+
+void safe_state_json(JsonWriter& out, const dnbridge_SafeState& s) {
+  out.key("safe_state")
+      .begin_object()
+      .field("known", static_cast<bool>(s.known))
+      .field("source", s.source == dnbridge_SAFE_STATE_DEVICE ? "device" : "configured")
+      .field("pump_on_fault", safe_action_text(s.pump_on_fault))
+      .field("pump_on_idle", safe_action_text(s.pump_on_idle))
+      .field("n2_ballast_on_fault", safe_action_text(s.n2_ballast_on_fault))
+      .field("n2_ballast_on_idle", safe_action_text(s.n2_ballast_on_idle))
+      .field("analog_output_on_fault", safe_action_text(s.analog_output_on_fault))
+      .field("analog_output_fault_raw", unsigned{s.analog_output_fault_raw})
+      .field("analog_output_on_idle", safe_action_text(s.analog_output_on_idle))
+      .field("analog_output_idle_raw", unsigned{s.analog_output_idle_raw})
+      .field("text", view(s.text))
+      .end_object();
+}
+
+}  // namespace
 
 void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
                bool alive) {
@@ -408,7 +456,10 @@ void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_Pum
       .field("last_error_general_status", unsigned{n.last_error_general_status})
       .field("last_error_additional_status", unsigned{n.last_error_additional_status})
       .field("last_command_refused", view(n.last_command_refused))
-      .field("invalid_inputs", view(n.invalid_inputs));
+      .field("invalid_inputs", view(n.invalid_inputs))
+      .field("device_faults", view(n.device_faults))
+      .field("idle_reason", view(n.idle_reason));
+  safe_state_json(out, n.safe_state);
   const auto& c = n.counters;
   out.key("counters")
       .begin_object()

@@ -89,6 +89,7 @@ NodeClass classify(const NodeRow& r) {
       return NodeClass::kAbsent;
     case dnbridge_NODE_WRONG_DEVICE:
     case dnbridge_NODE_CONFIGURATION_FAULT:
+    case dnbridge_NODE_DEVICE_FAULT:
       return NodeClass::kFaulted;
     case dnbridge_NODE_OWNED_BY_OTHER_MASTER:
       return NodeClass::kOtherMaster;

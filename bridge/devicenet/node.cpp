@@ -225,12 +225,13 @@ void Node::on_timer(TimePoint now) {
   if (now >= keepalive_at_) {
     keepalive_at_ = now + explicit_epr_;
     // Any explicit traffic keeps the explicit connection alive; only an idle
-    // connection needs the keep-alive request.
-    // Identity.State where the device has it (it tells the device's own
-    // state), Identity.Status otherwise.
+    // connection needs the keep-alive request. It reads the device's health:
+    // Identity.Status (fault bits) and Identity.State in turn, Status alone
+    // where the device has no State.
     if (client_.idle()) {
+      keepalive_reads_status_ = !identity_state_supported_ || !keepalive_reads_status_;
       get(Step::kKeepAlive,
-          identity_state_supported_ ? cip::identity::kState : cip::identity::kStatus, now);
+          keepalive_reads_status_ ? cip::identity::kStatus : cip::identity::kState, now);
     }
   }
 }

@@ -78,6 +78,14 @@ class Node final : private ExplicitClient::Listener {
   const NodeError& last_error() const { return last_error_; }
   const NodeIdentity& identity() const { return identity_; }
   std::optional<std::uint8_t> device_state() const { return device_state_; }
+  // The device's minor faults (Identity.Status), in words; empty when none.
+  const std::string& minor_faults() const { return minor_faults_; }
+  // What the device had for each of the profile's settings (index as in
+  // NodeProfile::settings) when it was last read or read back; empty before
+  // that. Complete once the node is online.
+  const std::vector<std::vector<std::uint8_t>>& settings_in_force() const {
+    return settings_in_force_;
+  }
   bool idle() const { return idle_; }
   // Outputs and idle flag of the last poll the device answered.
   Bytes applied_outputs() const { return applied_outputs_.view(); }
@@ -176,6 +184,11 @@ class Node final : private ExplicitClient::Listener {
   Step after_size(const ExplicitResult& r, TimePoint now);
   Step after_epr(const ExplicitResult& r, TimePoint now);
   void on_keepalive_result(const ExplicitResult& r, TimePoint now);
+  // The Identity Status and State read last: a major fault takes the node to
+  // kDeviceFault (false); a minor one is warned of when it appears.
+  bool check_health(TimePoint now);
+  void note_minor_faults();
+  void device_fault(std::string reason, TimePoint now);
 
   void issue(Step step, const RequestMessage& request, bool unconnected, TimePoint now,
              std::optional<Duration> timeout = std::nullopt);
@@ -234,6 +247,7 @@ class Node final : private ExplicitClient::Listener {
   Duration retry_delay_{};
   std::uint32_t jitter_state_ = 0;  // xorshift state, seeded from the MAC
   std::size_t setting_index_ = 0;
+  std::vector<std::vector<std::uint8_t>> settings_in_force_;
   bool setting_retried_ = false;     // a refused Set retried once after releasing the poll
   bool poll_release_tried_ = false;  // the poll Allocate retried once after a Release
   InlineBytes<16> setting_found_;    // what the device had before the Set
@@ -259,6 +273,9 @@ class Node final : private ExplicitClient::Listener {
   std::optional<std::uint32_t> first_serial_;
   // Identity.State answers: the keep-alive reads it; otherwise Identity.Status.
   bool identity_state_supported_ = true;
+  bool keepalive_reads_status_ = false;  // which the last keep-alive read
+  std::string minor_faults_;             // as last warned of
+  unsigned stray_poll_responses_ = 0;    // answers to expect after a device fault's idle poll
   bool epr_warned_ = false;
 
   NodeIdentity identity_;

@@ -15,6 +15,7 @@
 #include <array>
 
 #include "bridge/cip/data_types.hpp"
+#include "bridge/cip/identity_health.hpp"
 #include "bridge/devicenet/node.hpp"
 #include "bridge/devicenet/node_internal.hpp"
 
@@ -542,6 +543,7 @@ Node::Step Node::after_identity_status(const ExplicitResult& r, TimePoint) {
   if (r.ok() && r.data.size() == 2)
     identity_.status = static_cast<std::uint16_t>(*read_uint(r.data.view()));
   if (!r.ok()) log_.info("{} not readable ({})", ident::kStatus.name, status_text(r));
+  note_minor_faults();
   return Step::kIdentityState;
 }
 
@@ -561,7 +563,9 @@ Node::Step Node::after_identity_state(const ExplicitResult& r, TimePoint now) {
     log_.info("{} not supported ({}): state unknown", ident::kState.name, status_text(r));
   }
   observer_.on_node_identity(config_.mac, identity_, now);
+  if (!check_health(now)) return Step::kNone;
   setting_index_ = 0;
+  settings_in_force_.assign(config_.profile.settings.size(), {});
   return first_setting_step();
 }
 
@@ -573,9 +577,24 @@ Node::Step Node::first_setting_step() {
                                                           : Step::kAllocatePoll;
 }
 
-Node::Step Node::after_read_setting(const ExplicitResult& r, TimePoint) {
+Node::Step Node::after_read_setting(const ExplicitResult& r, TimePoint now) {
   const auto& s = config_.profile.settings[setting_index_];
-  if (std::equal(r.data.view().begin(), r.data.view().end(), s.value.begin(), s.value.end())) {
+  const bool equal =
+      std::equal(r.data.view().begin(), r.data.view().end(), s.value.begin(), s.value.end());
+  if (s.keep_device_value) {
+    const auto v = read_uint(r.data.view());
+    if (r.data.size() != s.value.size() || !v || *v > s.device_value_max) {
+      enter_fault(NodeState::kConfigurationFault,
+                  fmt::format("{} reads {}: expected {} byte(s), 0..{} (the device's own value "
+                              "is kept, but this one is not one the profile knows)",
+                              s.name, hex(r.data.view()), s.value.size(), s.device_value_max),
+                  now);
+      return Step::kNone;
+    }
+    log_.info("{} is {}: the device's own, kept", s.name, hex(r.data.view()));
+  }
+  if (equal || s.keep_device_value) {
+    settings_in_force_[setting_index_].assign(r.data.view().begin(), r.data.view().end());
     ++setting_index_;
     return first_setting_step();
   }
@@ -620,6 +639,7 @@ Node::Step Node::after_verify_setting(const ExplicitResult& r, TimePoint now) {
                 now);
     return Step::kNone;
   }
+  settings_in_force_[setting_index_].assign(r.data.view().begin(), r.data.view().end());
   ++setting_index_;
   return first_setting_step();
 }
@@ -784,10 +804,22 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
 
 void Node::on_keepalive_result(const ExplicitResult& r, TimePoint now) {
   if (r.ok() || r.error == Errc::kDeviceError) {
-    if (r.ok() && identity_state_supported_ && r.data.size() == 1 && device_state_ != r.data[0]) {
-      device_state_ = r.data[0];
-      observer_.on_device_state(config_.mac, r.data[0], now);
+    if (r.ok() && !keepalive_reads_status_ && r.data.size() == 1) {
+      identity_.state = r.data[0];
+      if (device_state_ != r.data[0]) {
+        device_state_ = r.data[0];
+        observer_.on_device_state(config_.mac, r.data[0], now);
+      }
     }
+    if (r.ok() && keepalive_reads_status_ && r.data.size() == 2) {
+      const auto status = static_cast<std::uint16_t>(*read_uint(r.data.view()));
+      if (identity_.status != status) {
+        identity_.status = status;
+        note_minor_faults();
+        observer_.on_node_identity(config_.mac, identity_, now);
+      }
+    }
+    if (r.ok() && !check_health(now)) return;
     return;
   }
   // The device drops the explicit connection after 4 x EPR without a
@@ -803,8 +835,40 @@ void Node::on_keepalive_result(const ExplicitResult& r, TimePoint now) {
   keepalive_at_ = now;
 }
 
+void Node::note_minor_faults() {
+  std::string minor = ident::minor_faults(identity_.status.value_or(0));
+  if (minor == minor_faults_) return;
+  if (!minor.empty()) log_.warn("the device reports a {}", minor);
+  if (minor.empty()) log_.info("the device's minor faults cleared");
+  minor_faults_ = std::move(minor);
+}
+
+bool Node::check_health(TimePoint now) {
+  const auto major = ident::major_fault(identity_.status, identity_.state);
+  if (!major) return true;
+  device_fault(fmt::format("the device reports a {}; re-checked every {} ms", *major,
+                           std::chrono::duration_cast<milliseconds>(port_.fault_recheck).count()),
+               now);
+  return false;
+}
+
+void Node::device_fault(std::string reason, TimePoint now) {
+  if (state_ == NodeState::kOnline) {
+    // Outputs to the device's idle state before the connections go: one idle
+    // poll now, whatever the outputs in force (the answers to it, and to a
+    // poll outstanding, arrive once the node has left online).
+    stray_poll_responses_ = poll_outstanding_ ? 2 : 1;
+    const bool idle = idle_;
+    idle_ = true;
+    send_poll(now);
+    idle_ = idle;
+  }
+  enter_fault(NodeState::kDeviceFault, std::move(reason), now);
+}
+
 void Node::go_online(TimePoint now) {
   retry_delay_ = port_.allocate_retry_min;
+  stray_poll_responses_ = 0;
   poll_outstanding_ = false;
   poll_unanswered_ = false;
   consecutive_errors_ = 0;

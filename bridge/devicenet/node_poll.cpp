@@ -68,6 +68,10 @@ void Node::send_poll(TimePoint now) {
 }
 
 void Node::on_poll_response(Bytes payload, TimePoint now) {
+  if (state_ != NodeState::kOnline && stray_poll_responses_ > 0) {
+    --stray_poll_responses_;  // the answer to the idle poll of a device fault
+    return;
+  }
   if (state_ != NodeState::kOnline) {
     // A straggler from before the node went offline, or a device polled by
     // someone else: not ours to take.

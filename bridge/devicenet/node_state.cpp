@@ -24,6 +24,8 @@ std::string_view to_string(NodeState state) noexcept {
       return "owned by another master";
     case NodeState::kStopped:
       return "stopped";
+    case NodeState::kDeviceFault:
+      return "device fault";
   }
   return "?";
 }

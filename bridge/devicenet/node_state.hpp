@@ -19,6 +19,7 @@ enum class NodeState : std::uint8_t {
   kConfigurationFault,  // device refuses the configuration, or its sizes differ
   kOwnedByOtherMaster,  // Allocate refused with 0x0C/0x01
   kStopped,             // released by an orderly shutdown, or the port stopped
+  kDeviceFault,         // the device reports a major fault (Identity): released, not commanded
 };
 
 std::string_view to_string(NodeState state) noexcept;
@@ -28,7 +29,7 @@ std::string_view to_string(NodeState state) noexcept;
 // the outcome changes.
 constexpr bool is_fault(NodeState s) noexcept {
   return s == NodeState::kWrongDevice || s == NodeState::kConfigurationFault ||
-         s == NodeState::kOwnedByOtherMaster;
+         s == NodeState::kOwnedByOtherMaster || s == NodeState::kDeviceFault;
 }
 
 // The last thing that went wrong with a node, kept as values (no text on the

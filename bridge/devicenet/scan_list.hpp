@@ -23,13 +23,19 @@ struct ExpectedIdentity {
 };
 
 // One attribute the master makes equal to a value before it starts the poll
-// connection: read first, written only when it differs.
+// connection: read first, written only when it differs, read back. Or, with
+// `keep_device_value`, only read: the device's own value is kept (and
+// reported, Node::settings_in_force) when it has the size of `value` and, as
+// an unsigned little-endian integer, is at most `device_value_max`; another
+// is a configuration fault.
 struct AttributeSetting {
   std::uint16_t class_id = 0;
   std::uint16_t instance_id = 0;
   std::uint8_t attribute = 0;
   std::vector<std::uint8_t> value;
   std::string name;  // for reasons and logs, e.g. "Configuration.NumAnalogInput"
+  bool keep_device_value = false;
+  std::uint32_t device_value_max = 0;
 };
 
 // Where the device reports the poll connection's sizes: Connection instance 2

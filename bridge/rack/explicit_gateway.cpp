@@ -128,6 +128,7 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
     case NodeState::kWrongDevice:
     case NodeState::kConfigurationFault:
     case NodeState::kOwnedByOtherMaster:
+    case NodeState::kDeviceFault:
       return refuse(call, TransactionStatus::kCouldNotConnect,
                     fmt::format("node {} is not connected ({}): {}", call.mac,
                                 devicenet::to_string(node->state()), node->reason()));

@@ -16,7 +16,7 @@ devicenet::ScannerConfig PumpRack::scanner_config(devicenet::ScannerConfig port,
                                                   const std::vector<PumpConfig>& pumps) {
   port.nodes.clear();
   for (const auto& p : pumps) {
-    auto profile = cdn127::make_node_profile(p.io);
+    auto profile = cdn127::make_node_profile(p.io, p.safe_state);
     if (!profile) {
       throw std::invalid_argument(fmt::format("node {} ({}): invalid I/O configuration: {}",
                                               p.node.mac.value(), p.node.name,
@@ -43,8 +43,9 @@ PumpRack::PumpRack(const std::vector<PumpConfig>& pumps) {
     v.mac = p.node.mac;
     v.name = p.node.name;
     v.reason = "not started";
+    v.safe_state_source = p.safe_state.source;
     views_.push_back(std::move(v));
-    slots_.push_back({p.io, *format, p.no_commander});
+    slots_.push_back({p.io, *format, p.no_commander, p.resume, p.safe_state.source});
   }
 }
 
@@ -56,6 +57,18 @@ PumpView* PumpRack::find(MacId mac) {
 const PumpView* PumpRack::pump(MacId mac) const {
   const int i = index_[mac.value()];
   return i < 0 ? nullptr : &views_[static_cast<std::size_t>(i)];
+}
+
+std::string_view to_string(IdleCause cause) noexcept {
+  switch (cause) {
+    case IdleCause::kNoCommandYet:
+      return "idle: no command yet";
+    case IdleCause::kNoCommander:
+      return "idle: no live commander";
+    case IdleCause::kAfterLoss:
+      return "idle: waiting for a new command after reconnection";
+  }
+  return "idle";
 }
 
 Status PumpRack::refuse(PumpView& view, Status why, std::string text) {
@@ -76,6 +89,12 @@ Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, std::str
                               outputs.analog_out_raw, cdn127::kAnalogMaxRaw));
   }
   const auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
+  if (v->idle_cause == IdleCause::kAfterLoss && !v->outputs_requested && !v->online) {
+    return refuse(*v, Errc::kNotConnected,
+                  fmt::format("from {}: the node was lost and is not back online; only a "
+                              "command written after its return is applied",
+                              issuer));
+  }
   const auto& layout = slot.format.request;
   // An output the configuration leaves out of the poll request cannot be
   // commanded: refuse it rather than drop it silently.
@@ -111,10 +130,31 @@ Status PumpRack::release_command(MacId mac, TimePoint now) {
   if (!v || !scanner_) return Errc::kOutOfRange;
   const auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
   if (slot.no_commander == NoCommanderPolicy::kHoldLastOutputs) return {};
+  if (v->outputs_requested) v->idle_cause = IdleCause::kNoCommander;
   v->outputs_requested.reset();
   v->commanded_by.clear();
   ++v->changes;
   return scanner_->set_idle(mac, true, now);
+}
+
+void PumpRack::on_loss(PumpView& v, const Slot& slot, TimePoint at) {
+  if (slot.resume == ResumePolicy::kLastCommand) return;
+  // The last command was for the device as it was before: after a power
+  // cycle, a cable or a bus-off nobody has seen its state since. Idle polls
+  // until a commander, having seen it back, commands it again.
+  v.idle_cause = IdleCause::kAfterLoss;
+  v.outputs_requested.reset();
+  v.commanded_by.clear();
+  if (scanner_) (void)scanner_->set_idle(v.mac, true, at);
+}
+
+void PumpRack::on_online(PumpView& v) {
+  const devicenet::Node* node = scanner_ ? scanner_->node(v.mac) : nullptr;
+  if (!node) return;
+  const auto& settings = node->config().profile.settings;
+  v.safe_state = cdn127::safe_state_in_force(settings, node->settings_in_force());
+  const Slot& slot = slots_[static_cast<std::size_t>(index_[v.mac.value()])];
+  v.safe_state_text = v.safe_state ? cdn127::describe(*v.safe_state, slot.io) : "not known";
 }
 
 void PumpRack::on_port_state(devicenet::PortState state, const std::string& reason, TimePoint) {
@@ -122,10 +162,15 @@ void PumpRack::on_port_state(devicenet::PortState state, const std::string& reas
   port_reason_ = reason;
 }
 
-void PumpRack::on_node_state(MacId mac, NodeState, NodeState to, const std::string& reason,
+void PumpRack::on_node_state(MacId mac, NodeState from, NodeState to, const std::string& reason,
                              TimePoint at) {
   PumpView* v = find(mac);
   if (!v) return;
+  const Slot& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
+  if (from == NodeState::kOnline && to != NodeState::kOnline && to != NodeState::kStopped) {
+    on_loss(*v, slot, at);
+  }
+  if (to == NodeState::kOnline) on_online(*v);
   v->state = to;
   v->reason = reason;
   v->state_since = at;
@@ -139,6 +184,8 @@ void PumpRack::on_node_state(MacId mac, NodeState, NodeState to, const std::stri
 void PumpRack::on_node_identity(MacId mac, const devicenet::NodeIdentity& identity, TimePoint) {
   if (PumpView* v = find(mac)) {
     v->identity = identity;
+    const devicenet::Node* node = scanner_ ? scanner_->node(mac) : nullptr;
+    v->minor_faults = node ? node->minor_faults() : "";
     ++v->changes;
     ++v->status_changes;
   }

@@ -11,6 +11,7 @@
 
 #include "bridge/devicenet/scanner.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
+#include "bridge/profiles/cdn127/node_profile.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 
 namespace dnbridge::rack {
@@ -23,14 +24,33 @@ enum class NoCommanderPolicy : std::uint8_t {
   kHoldLastOutputs,  // keep polling the last commanded outputs
 };
 
+// What a node's outputs do when it is back after a loss (poll timeout,
+// power cycle, bus-off, interface down, device fault).
+enum class ResumePolicy : std::uint8_t {
+  kFreshCommand,  // idle until a command taken after its return
+  kLastCommand,   // the last command again, at once (unsafe: a pump may start
+                  // on its own after a power cycle)
+};
+
 struct PumpConfig {
   devicenet::NodeConfig node;
   NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
+  ResumePolicy resume = ResumePolicy::kFreshCommand;
+  profiles::cdn127::SafeStateConfig safe_state;
   profiles::cdn127::IoConfiguration io;
   // The identity the device must show; the CDN127's (vendor 59, product type
   // 27, product code 1888) when not given.
   std::optional<devicenet::ExpectedIdentity> identity;
 };
+
+// Why a pump's outputs are idle (the bridge polls idle: the device holds
+// its configured idle state).
+enum class IdleCause : std::uint8_t {
+  kNoCommandYet,  // nothing commanded since the bridge started
+  kNoCommander,   // the last commander went away
+  kAfterLoss,     // back after a loss: a new command is needed (ResumePolicy::kFreshCommand)
+};
+std::string_view to_string(IdleCause cause) noexcept;
 
 struct PumpView {
   devicenet::MacId mac;
@@ -55,6 +75,22 @@ struct PumpView {
   // who asked for them.
   std::optional<profiles::cdn127::PumpOutputs> outputs_requested;
   std::string commanded_by;
+  // Why the outputs are idle, when no command is in force.
+  IdleCause idle_cause = IdleCause::kNoCommandYet;
+  // "idle: ..." when no command is in force; empty otherwise.
+  std::string_view idle_reason() const {
+    return outputs_requested ? std::string_view{} : to_string(idle_cause);
+  }
+
+  // The outputs' fault and idle actions the device had when the node last
+  // came online (read back after the download, or the device's own kept),
+  // and where they came from.
+  std::optional<profiles::cdn127::SafeState> safe_state;
+  profiles::cdn127::SafeStateSource safe_state_source =
+      profiles::cdn127::SafeStateSource::kConfiguration;
+  std::string safe_state_text;  // in words, for the outputs the configuration has
+  // The device's minor faults (Identity.Status), in words; empty when none.
+  std::string minor_faults;
 
   std::uint64_t commands_accepted = 0;
   std::uint64_t commands_refused = 0;
@@ -84,9 +120,11 @@ class PumpRack final : public devicenet::ScannerObserver {
 
   // Validates and forwards new outputs: refused, never clipped, when out of
   // range; refused when the configuration has no room for them (e.g. an
-  // analog value for a configuration without analog output). A refusal is
-  // counted and its reason kept in the pump's view; nothing of the command
-  // is applied. kOutOfRange for a MAC not in the rack.
+  // analog value for a configuration without analog output); refused while
+  // a node lost with ResumePolicy::kFreshCommand is not back online (only a
+  // command taken after its return counts). A refusal is counted and its
+  // reason kept in the pump's view; nothing of the command is applied.
+  // kOutOfRange for a MAC not in the rack.
   Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
                  std::string_view issuer, TimePoint now);
   Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
@@ -117,7 +155,15 @@ class PumpRack final : public devicenet::ScannerObserver {
     profiles::cdn127::IoConfiguration io;
     profiles::cdn127::PollFormat format;
     NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
+    ResumePolicy resume = ResumePolicy::kFreshCommand;
+    profiles::cdn127::SafeStateSource safe_state_source =
+        profiles::cdn127::SafeStateSource::kConfiguration;
   };
+  // The node left online: with kFreshCommand its command is void, and it
+  // comes back idle.
+  void on_loss(PumpView& view, const Slot& slot, TimePoint at);
+  // The node is online: what the device's safe state is.
+  void on_online(PumpView& view);
   Status refuse(PumpView& view, Status why, std::string text);
   PumpView* find(devicenet::MacId mac);
   void refresh_applied(std::size_t index);

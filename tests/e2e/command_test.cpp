@@ -178,9 +178,9 @@ TEST_F(CommandTest, StrongerCommanderWinsWeakerTakesOverThenIdleWhenAllAreGone) 
     }
   }
 
-  // Every commander gone: the bridge polls idle and the CDN127 applies its
-  // configured idle action (digital outputs to their idle value, off; the
-  // analog output's idle state is "hold").
+  // Every commander gone: the bridge polls idle and the CDN127 applies the
+  // idle actions the bridge downloaded at start-up (the default: outputs
+  // off, analog output 0 V, over this simulator's factory "hold").
   weak.reset();
   const auto gone = SteadyClock::now();
   ASSERT_TRUE(pumps_.until([&] {
@@ -192,7 +192,7 @@ TEST_F(CommandTest, StrongerCommanderWinsWeakerTakesOverThenIdleWhenAllAreGone) 
   const PumpOutputs idle = device_outputs(kMac);
   EXPECT_FALSE(idle.pump_on);
   EXPECT_FALSE(idle.n2_ballast_on);
-  EXPECT_EQ(idle.analog_out_raw, 1002);
+  EXPECT_EQ(idle.analog_out_raw, 0);
   EXPECT_TRUE(log_.contains(LogLevel::kInfo, "no live commander left"));
   // Polls continue (idle): the pump stays online.
   EXPECT_TRUE(pumps_.latest(pump_mac(kMac))->online);

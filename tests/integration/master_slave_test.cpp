@@ -1,5 +1,6 @@
 // The master against simulated CDN127s on the in-process bus, on a fake
 // clock: the main proof that the scanner does what a scanner must.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,10 +17,11 @@ namespace dnbridge::test {
 namespace {
 
 namespace cdn127 = profiles::cdn127;
-using devicenet::Group2Message;
 using devicenet::group2_id;
+using devicenet::Group2Message;
 using devicenet::PortState;
 using devicenet::RequestMessage;
+using ::testing::HasSubstr;
 
 class MasterSlave : public ::testing::Test {
  protected:
@@ -173,8 +175,52 @@ TEST_F(MasterSlave, ChangedOutputsGoOutAtOnceNotOnTheNextPeriod) {
   EXPECT_TRUE(device(7).outputs().pump_on);
 }
 
-TEST_F(MasterSlave, PowerCycledNodeComesBackByItself) {
+// A power-cycled node comes back by itself, idle: the command given before
+// the loss was for the device as it was then. A command sent while it is
+// away is refused; one after its return applies.
+TEST_F(MasterSlave, PowerCycledNodeComesBackIdleUntilANewCommand) {
   build(rack_config({5, 6}));
+  rack().start();
+  ASSERT_TRUE(run_until_online());
+  cdn127::PumpOutputs out;
+  out.pump_on = true;
+  ASSERT_TRUE(rack().pumps().command(mac(5), out, now()).ok());
+  ASSERT_TRUE(rack().pumps().command(mac(6), out, now()).ok());
+  rack().world().run_for(seconds(1));
+  ASSERT_TRUE(device(5).outputs().pump_on);
+
+  device(5).power_cycle(now());
+  EXPECT_FALSE(device(5).outputs().pump_on);  // a device powers up with its outputs off
+  rack().world().run_for(milliseconds(50));
+  EXPECT_NE(view(5).state, NodeState::kOnline);
+  // The same command again while the node is away: refused, not kept.
+  EXPECT_FALSE(rack().pumps().command(mac(5), out, now()).ok());
+  EXPECT_THAT(view(5).last_command_refused, HasSubstr("not back online"));
+  ASSERT_TRUE(run_until_online(seconds(20)));
+  rack().world().run_for(seconds(2));
+  // Back online, idle: nothing of the old command is applied.
+  EXPECT_FALSE(device(5).outputs().pump_on);
+  EXPECT_TRUE(view(5).outputs_idle);
+  EXPECT_EQ(view(5).idle_reason(), "idle: waiting for a new command after reconnection");
+  EXPECT_EQ(node(5).counters().reconnects, 1u);
+  // The neighbour, never lost, keeps its command.
+  EXPECT_TRUE(device(6).outputs().pump_on);
+  EXPECT_EQ(node(6).counters().reconnects, 0u);
+
+  // A command after the return: applied.
+  ASSERT_TRUE(rack().pumps().command(mac(5), out, now()).ok());
+  rack().world().run_for(milliseconds(200));
+  EXPECT_TRUE(device(5).outputs().pump_on);
+  EXPECT_FALSE(view(5).outputs_idle);
+  EXPECT_EQ(view(5).idle_reason(), "");
+}
+
+// resume = "last-command": the opt-in to drive the last outputs again after
+// a loss (unsafe; the behaviour before the fresh-command rule).
+TEST_F(MasterSlave, ResumeLastCommandDrivesTheLastOutputsAgainAfterAPowerCycle) {
+  auto config = rack_config({5});
+  config.pumps[0].resume = rack::ResumePolicy::kLastCommand;
+  build(std::move(config));
   rack().start();
   ASSERT_TRUE(run_until_online());
   cdn127::PumpOutputs out;
@@ -183,15 +229,12 @@ TEST_F(MasterSlave, PowerCycledNodeComesBackByItself) {
   rack().world().run_for(seconds(1));
 
   device(5).power_cycle(now());
-  EXPECT_FALSE(device(5).outputs().pump_on);  // a device powers up with its outputs off
+  EXPECT_FALSE(device(5).outputs().pump_on);
   rack().world().run_for(milliseconds(50));
-  EXPECT_NE(view(5).state, NodeState::kOnline);
   ASSERT_TRUE(run_until_online(seconds(20)));
   rack().world().run_for(milliseconds(200));
-  // Back online, and the commanded outputs are applied again.
   EXPECT_TRUE(device(5).outputs().pump_on);
   EXPECT_EQ(node(5).counters().reconnects, 1u);
-  EXPECT_EQ(node(6).counters().reconnects, 0u);
 }
 
 TEST_F(MasterSlave, DisconnectedNodeIsDroppedAfterFourEprAndReturns) {

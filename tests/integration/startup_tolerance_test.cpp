@@ -209,12 +209,20 @@ TEST_F(StartupReading, ConfigurationIsWrittenBeforeThePollConnectionExists) {
     differ += d ? 1 : 0;
   }
   EXPECT_EQ(wire_.configuration_sets, differ);
-  EXPECT_EQ(node().counters().settings_written, differ);
+  // And the analog output's fault and idle states: this simulator's factory
+  // "hold the last value" differs from the configured 0 V.
+  EXPECT_EQ(node().counters().settings_written, differ + 2);
   EXPECT_EQ(device().counters().requests_refused, 0u);
 }
 
 // A device that already matches: the start-up writes nothing.
 TEST_F(StartupReading, ADeviceThatMatchesIsWrittenNothing) {
+  // The safe state this simulator leaves the factory with: outputs off,
+  // the analog output holding its value.
+  pump_adjust_ = [](rack::PumpConfig& p) {
+    p.safe_state.values.analog_fault = {cdn127::AnalogAction::Kind::kHold, 0};
+    p.safe_state.values.analog_idle = {cdn127::AnalogAction::Kind::kHold, 0};
+  };
   build({"matching", [](sim::SlaveOptions& o) {
            o.configuration = cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
            o.poll_paths_fixed = true;

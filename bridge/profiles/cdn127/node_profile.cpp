@@ -31,7 +31,8 @@ std::vector<std::uint8_t> assembly_path(std::uint8_t instance) {
 
 }  // namespace
 
-Result<devicenet::NodeProfile> make_node_profile(const IoConfiguration& config) {
+Result<devicenet::NodeProfile> make_node_profile(const IoConfiguration& config,
+                                                 const SafeStateConfig& safe) {
   auto format = poll_format(config);
   if (!format) return format.error();
 
@@ -55,6 +56,9 @@ Result<devicenet::NodeProfile> make_node_profile(const IoConfiguration& config) 
                                              "Configuration.NumAnalogOutput"));
   p.settings.push_back(configuration_setting(configuration_attr::kNoNcMask, config.no_nc_mask,
                                              "Configuration.NoNcMask"));
+  // The safe state after the configuration, which decides which outputs exist.
+  for (auto& s : safe_state_settings(safe.values, safe.source, config))
+    p.settings.push_back(std::move(s));
   p.produced_path = assembly_path(kDefaultProducedAssembly);
   p.consumed_path = assembly_path(kDefaultConsumedAssembly);
   p.produced_size = format->response.size;

@@ -82,7 +82,8 @@ class NodeStartup : public ::testing::Test {
     n.poll_period = milliseconds(100);
     n.expected_packet_rate = milliseconds(250);
     n.profile = profiles::cdn127::make_node_profile(
-                    profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127))
+                    profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127),
+                    profiles::cdn127::SafeStateConfig{})
                     .value();
     c.nodes.push_back(n);
     scanner_.emplace(c, sink_, states_, Logger());
@@ -187,6 +188,54 @@ TEST_F(NodeStartup, EveryRequestAndAnswerOnTheWire) {
   EXPECT_EQ(sent(), "464: 00 0E 40 01 0A");  // NoNcMask
   answer("463: 00 8E 00");
   EXPECT_EQ(node().counters().settings_written, 2u);
+
+  // 7b. The safe state, off on fault and on idle (the default), before any
+  // poll connection: each output's value first, then its action. DOP
+  // (class 09) instance 1, the pump: fault value (06) off, fault action (05)
+  // "use the value": as wanted.
+  EXPECT_EQ(sent(), "464: 40 0E 09 01 06");
+  answer("463: 40 8E 00");
+  EXPECT_EQ(sent(), "464: 00 0E 09 01 05");
+  answer("463: 00 8E 00");
+  // Idle value (08) off; idle action (07) "no change", an unsafe factory
+  // setting: set to "use the value" and read back.
+  EXPECT_EQ(sent(), "464: 40 0E 09 01 08");
+  answer("463: 40 8E 00");
+  EXPECT_EQ(sent(), "464: 00 0E 09 01 07");
+  answer("463: 00 8E 01");
+  EXPECT_EQ(sent(), "464: 40 10 09 01 07 00");
+  answer("463: 40 90");
+  EXPECT_EQ(sent(), "464: 00 0E 09 01 07");
+  answer("463: 00 8E 00");
+  // DOP instance 2, the N2 ballast: as wanted.
+  EXPECT_EQ(sent(), "464: 40 0E 09 02 06");
+  answer("463: 40 8E 00");
+  EXPECT_EQ(sent(), "464: 00 0E 09 02 05");
+  answer("463: 00 8E 00");
+  EXPECT_EQ(sent(), "464: 40 0E 09 02 08");
+  answer("463: 40 8E 00");
+  EXPECT_EQ(sent(), "464: 00 0E 09 02 07");
+  answer("463: 00 8E 00");
+  // AOP (class 0B) instance 1: fault value (0B) 0, fault state (09) 0
+  // "hold the last value": set to 3, "the fault value".
+  EXPECT_EQ(sent(), "464: 40 0E 0B 01 0B");
+  answer("463: 40 8E 00 00");
+  EXPECT_EQ(sent(), "464: 00 0E 0B 01 09");
+  answer("463: 00 8E 00");
+  EXPECT_EQ(sent(), "464: 40 10 0B 01 09 03");
+  answer("463: 40 90");
+  EXPECT_EQ(sent(), "464: 00 0E 0B 01 09");
+  answer("463: 00 8E 03");
+  // Idle value (0C) 0, idle state (0A) hold: set to 3 likewise.
+  EXPECT_EQ(sent(), "464: 40 0E 0B 01 0C");
+  answer("463: 40 8E 00 00");
+  EXPECT_EQ(sent(), "464: 00 0E 0B 01 0A");
+  answer("463: 00 8E 00");
+  EXPECT_EQ(sent(), "464: 40 10 0B 01 0A 03");
+  answer("463: 40 90");
+  EXPECT_EQ(sent(), "464: 00 0E 0B 01 0A");
+  answer("463: 00 8E 03");
+  EXPECT_EQ(node().counters().settings_written, 5u);
 
   // 8. Allocate the poll connection: [02 choice: poll].
   EXPECT_EQ(sent(), "466: 40 4B 03 01 02 00");
