@@ -234,8 +234,8 @@ constexpr std::array<std::string_view, 15> kPortKeys{"name",
                                                      "explicit_response_timeout_ms",
                                                      "max_consecutive_errors",
                                                      "node"};
-constexpr std::array<std::string_view, 7> kRootKeys{"rack",     "domain", "master_mac", "log_level",
-                                                    "defaults", "port",   "security"};
+constexpr std::array<std::string_view, 8> kRootKeys{
+    "rack", "domain", "master_mac", "log_level", "defaults", "port", "security", "explicit_policy"};
 
 enum class Level { kBuiltIn, kDefaults, kNode };
 
@@ -709,6 +709,32 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
   return port;
 }
 
+// [explicit_policy]: one true/false key per class of guarded request, named
+// by the policy itself.
+rack::ExplicitPolicy read_explicit_policy(const toml::node& n, Reporter& r) {
+  rack::ExplicitPolicy policy;
+  const toml::table* t = n.as_table();
+  if (!t) {
+    r.error(at(n.source()),
+            fmt::format("explicit_policy must be a table ([explicit_policy]), not {}",
+                        type_name(n.type())));
+    return policy;
+  }
+  std::array<std::string_view, rack::kGuardedRequestKinds> keys{};
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    keys[i] = rack::policy_key(static_cast<rack::GuardedRequest>(i));
+  }
+  check_keys(*t, "[explicit_policy]", keys, r);
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (const toml::node* v = t->get(keys[i])) {
+      if (auto allowed = read_bool(*v, keys[i], r)) {
+        policy.allow(static_cast<rack::GuardedRequest>(i), *allowed);
+      }
+    }
+  }
+  return policy;
+}
+
 std::optional<LogLevel> log_level_named(std::string_view name) {
   for (LogLevel l :
        {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn, LogLevel::kError}) {
@@ -750,6 +776,10 @@ DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporte
                         *v));
       }
     }
+  }
+
+  if (const toml::node* n = root.get("explicit_policy")) {
+    config.explicit_policy = read_explicit_policy(*n, r);
   }
 
   if (const toml::node* n = root.get("security")) {
@@ -826,6 +856,25 @@ rack = "sim-rack"
 domain = 0
 master_mac = 0
 log_level = "info"
+
+# Explicit messaging (ExplicitRequest) may always Get; what else it may do
+# to a node is refused (status 8) unless allowed here. Each key, its risk:
+[explicit_policy]
+# Allocate/Release to the DeviceNet object: a Release drops the bridge's
+# connections; outputs go idle or fault until it reconnects.
+allow_allocate_release = false
+# Set, Delete, ... to the Connection object: can stop the I/O or turn the
+# device's lost-master watchdog off.
+allow_connection_changes = false
+# Set of DOP/AOP Value or Assembly data: bypasses PumpCommand's ownership;
+# can switch a pump nobody commands.
+allow_output_writes = false
+# Set of what the bridge configures (Configuration, fault/idle settings)
+# while the node is online: breaks I/O decoding or the safe state.
+allow_managed_attribute_writes = false
+# Reset of the Identity object: the device restarts; the pump is lost until
+# the bridge brings it back.
+allow_identity_reset = false
 
 [defaults]
 poll_period_ms = 100

@@ -20,6 +20,7 @@
 #include "bridge/devicenet/mac_id.hpp"
 #include "bridge/devicenet/scan_list.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
+#include "bridge/rack/explicit_policy.hpp"
 #include "bridge/rack/publish_gate.hpp"
 #include "bridge/rack/pump_rack.hpp"
 
@@ -95,6 +96,10 @@ struct DaemonConfig {
   devicenet::MacId master_mac;  // default master MAC of the ports
   std::vector<PortConfig> ports;
   LogLevel log_level = LogLevel::kInfo;
+  // What remote requesters may do through the explicit gateway of every
+  // port ([explicit_policy]); by default, nothing that takes a node's
+  // connections, outputs or configuration from the bridge.
+  rack::ExplicitPolicy explicit_policy;
   // DDS Security of the bridge's participant ([security]); none: Cyclone's
   // XML configuration decides (CYCLONEDDS_URI), by default no security.
   std::optional<security::Settings> security;

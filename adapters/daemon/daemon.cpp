@@ -23,9 +23,11 @@ Duration offered_deadline(const DaemonConfig& c) {
   return 2 * longest;
 }
 
-port::PortLoopConfig loop_config(const PortConfig& p, std::string_view host_id) {
+port::PortLoopConfig loop_config(const DaemonConfig& rack, const PortConfig& p,
+                                 std::string_view host_id) {
   port::PortLoopConfig c;
   c.port = p.name;
+  c.explicit_policy = rack.explicit_policy;
   c.scanner = to_scanner_config(p, host_id);
   c.pumps = to_pump_configs(p);
   for (const auto& n : p.nodes) c.publish.push_back(n.publish);
@@ -61,6 +63,15 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
                    config_.security ? security::participant_properties(*config_.security)
                                     : dds::Properties{}),
       publisher_(participant_, config_.rack, offered_deadline(config_), Logger(log, "dds")) {
+  // What the explicit gateway lets through beyond Gets is a site decision
+  // worth seeing at every start.
+  for (std::size_t i = 0; i < rack::kGuardedRequestKinds; ++i) {
+    const auto kind = static_cast<rack::GuardedRequest>(i);
+    if (config_.explicit_policy.allows(kind)) {
+      log_.warn("[explicit_policy] {} = true: remote requesters may send {}; risk: {}",
+                rack::policy_key(kind), rack::name_of(kind), rack::risk_of(kind));
+    }
+  }
   std::map<std::string, port::PortLoop*> by_name;
   const std::string host_id = read_host_id();
   for (const auto& p : config_.ports) {
@@ -68,8 +79,8 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
     log_.info("port {}: master MAC {}, duplicate MAC ID identity vendor {} serial 0x{:08X}{}",
               p.name, scanner.master_mac.value(), scanner.vendor_id, scanner.serial_number,
               p.master_serial_number ? "" : " (derived from this host's identifier)");
-    ports_.push_back(
-        std::make_unique<port::PortLoop>(loop_config(p, host_id), backends(p), publisher_, log));
+    ports_.push_back(std::make_unique<port::PortLoop>(loop_config(config_, p, host_id), backends(p),
+                                                      publisher_, log));
     by_name[p.name] = ports_.back().get();
   }
   input_.emplace(participant_, publisher_, config_.rack, std::move(by_name),

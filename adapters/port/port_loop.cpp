@@ -27,7 +27,8 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
   scanner_.emplace(rack::PumpRack::scanner_config(config_.scanner, config_.pumps), backend_->sink(),
                    observer, Logger(log, fmt::format("port {}", config_.port)));
   rack_.attach(*scanner_);
-  gateway_.emplace(*scanner_);
+  gateway_.emplace(*scanner_, rack::ExplicitGateway::Limits{}, config_.explicit_policy,
+                   Logger(log, fmt::format("port {}", config_.port)));
   for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
     const rack::PublishPolicy policy =
         i < config_.publish.size() ? config_.publish[i] : rack::PublishPolicy{};

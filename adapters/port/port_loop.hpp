@@ -29,6 +29,7 @@ struct PortLoopConfig {
   devicenet::ScannerConfig scanner;          // master MAC and timings; nodes from `pumps`
   std::vector<rack::PumpConfig> pumps;       // the scan list
   std::vector<rack::PublishPolicy> publish;  // per pump, same order
+  rack::ExplicitPolicy explicit_policy;      // the rack's [explicit_policy]
   Duration status_period = seconds(1);       // NodeStatus/PortStatus at least this often
   Duration shutdown_timeout = seconds(3);    // for idling and releasing every node
 };

@@ -665,6 +665,11 @@ Reply dispatch(Cdn127Device& device, const devicenet::RequestMessage& req, std::
       return (!class_level && c->allocate != nullptr) ? c->allocate(ctx, req.data, w) : not_supported;
     case cip::Service::kReleaseMasterSlave:
       return (!class_level && c->release != nullptr) ? c->release(ctx, req.data, w) : not_supported;
+    case cip::Service::kGetAttributesAll:
+    case cip::Service::kSetAttributesAll:
+    case cip::Service::kCreate:
+    case cip::Service::kDelete:
+    case cip::Service::kApplyAttributes:
     case cip::Service::kErrorResponse:
       break;
   }

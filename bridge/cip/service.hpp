@@ -7,7 +7,12 @@
 namespace dnbridge::cip {
 
 enum class Service : std::uint8_t {
+  kGetAttributesAll = 0x01,
+  kSetAttributesAll = 0x02,
   kReset = 0x05,
+  kCreate = 0x08,
+  kDelete = 0x09,
+  kApplyAttributes = 0x0D,
   kGetAttributeSingle = 0x0E,
   kSetAttributeSingle = 0x10,
   kErrorResponse = 0x14,  // sent as 0x94

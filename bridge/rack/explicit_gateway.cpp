@@ -56,8 +56,15 @@ ExplicitAnswer refuse(const ExplicitCall& call, TransactionStatus status, std::s
   return a;
 }
 
-ExplicitGateway::ExplicitGateway(devicenet::Scanner& scanner, Limits limits)
-    : scanner_(scanner), limits_(limits) {}
+ExplicitGateway::ExplicitGateway(devicenet::Scanner& scanner, Limits limits, ExplicitPolicy policy,
+                                 Logger log)
+    : scanner_(scanner), limits_(limits), policy_(policy), log_(std::move(log)) {}
+
+std::uint64_t ExplicitGateway::refused_by_policy() const {
+  std::uint64_t total = 0;
+  for (auto n : refused_) total += n;
+  return total;
+}
 
 std::optional<ExplicitAnswer> ExplicitGateway::on_request(const ExplicitCall& call, TimePoint now) {
   const Key key{call.requester, call.txid};
@@ -115,6 +122,15 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
     return refuse(call, TransactionStatus::kNotInScanList,
                   fmt::format("MAC {} is not in the scan list of port {}", call.mac, call.port));
   }
+  devicenet::RequestMessage request;
+  request.service = call.service;
+  request.class_id = call.class_id;
+  request.instance_id = call.instance_id;
+  request.attribute = call.attribute;
+  request.data = Bytes(call.data);
+  // Whatever state the port and the node are in, a request the policy
+  // refuses is refused for what it is.
+  if (auto refusal = apply_policy(call, request, *node, now)) return refusal;
   if (scanner_.state() != devicenet::PortState::kRunning) {
     return refuse(call, TransactionStatus::kPortOffline,
                   fmt::format("port {} is {}", call.port, devicenet::to_string(scanner_.state())));
@@ -145,12 +161,6 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
                   fmt::format("{} transactions already in progress", by_request_id_.size()));
   }
 
-  devicenet::RequestMessage request;
-  request.service = call.service;
-  request.class_id = call.class_id;
-  request.instance_id = call.instance_id;
-  request.attribute = call.attribute;
-  request.data = Bytes(call.data);
   auto id = scanner_.request_explicit(*mac, request, now);
   if (!id) {
     const auto& e = id.error();
@@ -165,10 +175,44 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
     if (e == Errc::kStopped) return refuse(call, TransactionStatus::kPortOffline, "port stopping");
     return refuse(call, TransactionStatus::kCouldNotConnect, e.message());
   }
+  // What the policy lets through of the guarded requests is worth a trace.
+  log_allowed(call, request, *node, now);
   const Key key{call.requester, call.txid};
   transactions_[key] = Transaction{call, false, {}};
   by_request_id_[*id] = key;
   return std::nullopt;
+}
+
+std::optional<ExplicitAnswer> ExplicitGateway::apply_policy(
+    const ExplicitCall& call, const devicenet::RequestMessage& request, const devicenet::Node& node,
+    TimePoint now) {
+  const PolicyNode about{node.config().profile.settings, node.state() == NodeState::kOnline};
+  unsigned suppressed = 0;
+  if (auto refusal = check(policy_, request, about)) {
+    const std::uint64_t count = ++refused_[static_cast<std::size_t>(refusal->kind)];
+    if (refusal_log_limit_.allow(now, suppressed)) {
+      log_.warn(
+          "explicit request from \"{}\" (txid {}) to node {} refused: {} ({} of this "
+          "class refused so far){}",
+          call.requester, call.txid, call.mac, refusal->message, count,
+          suppressed ? fmt::format(" ({} more refusals not logged)", suppressed) : std::string());
+    }
+    return refuse(call, TransactionStatus::kInvalidCommand, std::move(refusal->message));
+  }
+  return std::nullopt;
+}
+
+void ExplicitGateway::log_allowed(const ExplicitCall& call,
+                                  const devicenet::RequestMessage& request,
+                                  const devicenet::Node& node, TimePoint now) {
+  const PolicyNode about{node.config().profile.settings, node.state() == NodeState::kOnline};
+  const auto guarded = classify(request, about);
+  unsigned suppressed = 0;
+  if (guarded.empty() || !allowed_log_limit_.allow(now, suppressed)) return;
+  log_.info("explicit request from \"{}\" (txid {}) to node {} sent: {}, allowed by {}{}",
+            call.requester, call.txid, call.mac, guarded.front().what,
+            policy_key(guarded.front().kind),
+            suppressed ? fmt::format(" ({} more not logged)", suppressed) : std::string());
 }
 
 std::optional<ExplicitAnswer> ExplicitGateway::on_result(std::uint32_t request_id,

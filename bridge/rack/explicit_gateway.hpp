@@ -9,6 +9,12 @@
 //
 // One gateway per port, owned by the port's loop like its Scanner. Sans-IO:
 // requests and scanner results come in, replies go out as return values.
+//
+// Before a request is executed, the rack's ExplicitPolicy decides whether it
+// may be: a refused one gets "invalid command" (8) and a message naming the
+// [explicit_policy] key that would allow it, and is counted and logged with
+// its requester.
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -17,8 +23,10 @@
 #include <utility>
 #include <vector>
 
+#include "bridge/common/log.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/scanner.hpp"
+#include "bridge/rack/explicit_policy.hpp"
 
 namespace dnbridge::rack {
 
@@ -84,7 +92,9 @@ class ExplicitGateway {
   };
 
   explicit ExplicitGateway(devicenet::Scanner& scanner) : ExplicitGateway(scanner, Limits{}) {}
-  ExplicitGateway(devicenet::Scanner& scanner, Limits limits);
+  ExplicitGateway(devicenet::Scanner& scanner, Limits limits)
+      : ExplicitGateway(scanner, limits, ExplicitPolicy{}, Logger()) {}
+  ExplicitGateway(devicenet::Scanner& scanner, Limits limits, ExplicitPolicy policy, Logger log);
 
   // A request for this gateway's port. Returns the reply to send now, if one
   // is due now (executions reply later, from on_result()).
@@ -102,6 +112,12 @@ class ExplicitGateway {
 
   std::size_t in_progress() const { return by_request_id_.size(); }
   std::size_t retained() const { return done_order_.size(); }
+  // Requests the policy refused, in all and of one class.
+  std::uint64_t refused_by_policy() const;
+  std::uint64_t refused_by_policy(GuardedRequest kind) const {
+    return refused_[static_cast<std::size_t>(kind)];
+  }
+  const ExplicitPolicy& policy() const { return policy_; }
 
  private:
   using Key = std::pair<std::string, std::uint32_t>;
@@ -112,10 +128,23 @@ class ExplicitGateway {
   };
 
   std::optional<ExplicitAnswer> execute(const ExplicitCall& call, TimePoint now);
+  // The refusal of a request the policy does not allow; nothing otherwise.
+  std::optional<ExplicitAnswer> apply_policy(const ExplicitCall& call,
+                                             const devicenet::RequestMessage& request,
+                                             const devicenet::Node& node, TimePoint now);
+  void log_allowed(const ExplicitCall& call, const devicenet::RequestMessage& request,
+                   const devicenet::Node& node, TimePoint now);
   void retain(const Key& key);
 
   devicenet::Scanner& scanner_;
   Limits limits_;
+  ExplicitPolicy policy_;
+  Logger log_;
+  // Refusals go to the log with their requester; a requester that keeps
+  // trying must not flood it.
+  RateLimiter refusal_log_limit_;
+  RateLimiter allowed_log_limit_;
+  std::array<std::uint64_t, kGuardedRequestKinds> refused_{};
   std::map<Key, Transaction> transactions_;
   std::map<std::uint32_t, Key> by_request_id_;  // executing
   std::deque<Key> done_order_;                  // completed, oldest first

@@ -882,5 +882,63 @@ TEST(ConfigFile, BusOffRecoveryIsReadAndDefaultsToTheInterface) {
               HasSubstr("t.toml:6:20: bus_off_recovery = \"reboot\" is not a policy"));
 }
 
+// ---------------------------------------------------------------------------
+// [explicit_policy]
+
+TEST(ConfigExplicitPolicy, EverythingIsRefusedUnlessTheFileAllowsIt) {
+  EXPECT_EQ(parse_config(ONE_PORT, "t.toml").explicit_policy, rack::ExplicitPolicy{});
+  EXPECT_EQ(parse_config(ONE_PORT "[explicit_policy]\n", "t.toml").explicit_policy,
+            rack::ExplicitPolicy{});
+  // As shipped, the example and the embedded default write every key out, all false.
+  const DaemonConfig example =
+      load_config_file(DNBRIDGE_SOURCE_DIR "/deploy/config/rack-example.toml");
+  EXPECT_EQ(example.explicit_policy, rack::ExplicitPolicy{});
+  EXPECT_EQ(embedded_default_config().explicit_policy, rack::ExplicitPolicy{});
+  for (std::size_t i = 0; i < rack::kGuardedRequestKinds; ++i) {
+    const auto key = std::string(rack::policy_key(static_cast<rack::GuardedRequest>(i)));
+    EXPECT_THAT(std::string(embedded_default_config_text()), HasSubstr(key + " = false\n"));
+  }
+}
+
+TEST(ConfigExplicitPolicy, EachKeyAllowsItsOwnClass) {
+  for (std::size_t i = 0; i < rack::kGuardedRequestKinds; ++i) {
+    const auto kind = static_cast<rack::GuardedRequest>(i);
+    const std::string key(rack::policy_key(kind));
+    SCOPED_TRACE(key);
+    const DaemonConfig c =
+        parse_config("rack = \"r\"\n[explicit_policy]\n" + key +
+                         " = true\n"
+                         "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n",
+                     "t.toml");
+    rack::ExplicitPolicy expected;
+    expected.allow(kind, true);
+    EXPECT_EQ(c.explicit_policy, expected);
+  }
+  const DaemonConfig some = parse_config(ONE_PORT
+                                         "[explicit_policy]\n"
+                                         "allow_allocate_release = true\n"
+                                         "allow_output_writes = false\n"
+                                         "allow_identity_reset = true\n",
+                                         "t.toml");
+  EXPECT_TRUE(some.explicit_policy.allow_allocate_release);
+  EXPECT_FALSE(some.explicit_policy.allow_connection_changes);
+  EXPECT_FALSE(some.explicit_policy.allow_output_writes);
+  EXPECT_FALSE(some.explicit_policy.allow_managed_attribute_writes);
+  EXPECT_TRUE(some.explicit_policy.allow_identity_reset);
+}
+
+TEST(ConfigExplicitPolicy, MistakesAreErrorsWithTheirPosition) {
+  EXPECT_EQ(problems(ONE_PORT "[explicit_policy]\n"
+                              "allow_output_write = true\n"
+                              "allow_identity_reset = \"yes\"\n"
+                              "allow_everything = true\n"),
+            "t.toml:7:1: unknown key 'allow_output_write' in [explicit_policy] (did you mean "
+            "'allow_output_writes'?)\n"
+            "t.toml:8:24: allow_identity_reset must be true or false, not a string\n"
+            "t.toml:9:1: unknown key 'allow_everything' in [explicit_policy]");
+  EXPECT_EQ(problems("explicit_policy = true\n" ONE_PORT),
+            "t.toml:1:19: explicit_policy must be a table ([explicit_policy]), not a boolean");
+}
+
 }  // namespace
 }  // namespace dnbridge::daemon

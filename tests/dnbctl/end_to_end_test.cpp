@@ -223,6 +223,23 @@ TEST_F(DnbctlEndToEnd, ExplicitMessaging) {
   r = dnbctl({"get", "40", "1", "1", "1"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.out.find("status: 3 (slave not in scan list)"), std::string::npos) << r.out;
+
+  // Refused by the bridge's explicit policy (the embedded default's): the
+  // user sees why and what would allow it.
+  r = dnbctl({"set", "3", "9", "1", "3", "01"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.out.find("status: 8 (invalid command code)\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("message: Set_Attribute_Single (0x10) of Discrete Output Point instance 1 "
+                       "Value is an output write, which the explicit policy refuses. Risk: "),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.err.find("status 8 (invalid command code): Set_Attribute_Single (0x10) of Discrete "
+                       "Output Point instance 1 Value"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("allow_output_writes = true in [explicit_policy] allows it"),
+            std::string::npos)
+      << r.err;
 }
 
 // No bridge needed: these end before (or for lack of) any answer.

@@ -1,8 +1,12 @@
 // The scanner transaction model over the master: every status code that can
-// be provoked against simulated CDN127s, and repeats answered, not re-run.
+// be provoked against simulated CDN127s, repeats answered, not re-run, and
+// the explicit policy: what it refuses, what it lets through.
 #include "bridge/rack/explicit_gateway.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <functional>
 
 #include "bridge/devicenet/identifier.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
@@ -65,7 +69,9 @@ class Gateway : public ::testing::Test {
     config.pumps[2].identity = devicenet::ExpectedIdentity{59, 27, 9999};  // node 3: wrong device
     rack_ = std::make_unique<sim::SimRack>(config);
     rack_->observe(harness_);
-    gateway_ = std::make_unique<ExplicitGateway>(rack_->scanner(), limits_);
+    rack_->observe(events_);
+    gateway_ = std::make_unique<ExplicitGateway>(rack_->scanner(), limits_, policy_,
+                                                 Logger(log_, "port A"));
     harness_.gateway = gateway_.get();
   }
   void start() {
@@ -79,6 +85,9 @@ class Gateway : public ::testing::Test {
   TimePoint now() { return rack_->now(); }
 
   ExplicitGateway::Limits limits_{};
+  rack::ExplicitPolicy policy_{};
+  CountingLogSink log_;
+  EventRecorder events_;
   std::unique_ptr<sim::SimRack> rack_;
   std::unique_ptr<ExplicitGateway> gateway_;
   GatewayHarness harness_;
@@ -249,6 +258,197 @@ TEST_F(Gateway, CompletedTransactionsAreRetainedWithinTheLimit) {
   status.command = 2;
   harness_.request(status, now());
   EXPECT_EQ(harness_.replies.back().status, TransactionStatus::kTxidUnknown);
+}
+
+// One request of each class the explicit policy guards, to node `node`.
+struct GuardedCall {
+  rack::GuardedRequest kind;
+  ExplicitCall call;
+};
+
+std::vector<GuardedCall> guarded_calls(std::uint32_t first_txid, unsigned node) {
+  auto make = [&](std::uint32_t txid, std::uint8_t service, std::uint16_t cls,
+                  std::uint16_t instance, std::optional<std::uint8_t> attribute,
+                  std::vector<std::uint8_t> data) {
+    ExplicitCall c = get_call(first_txid + txid, node, cls, 0);
+    c.service = service;
+    c.instance_id = instance;
+    c.attribute = attribute;
+    c.data = std::move(data);
+    return c;
+  };
+  using rack::GuardedRequest;
+  return {
+      {GuardedRequest::kAllocateRelease, make(0, 0x4C, 0x03, 1, {}, {0x03})},        // Release all
+      {GuardedRequest::kConnectionChange, make(1, 0x10, 0x05, 2, 9, {0x00, 0x00})},  // poll EPR 0
+      {GuardedRequest::kOutputWrite,
+       make(2, 0x10, cdn127::class_id::kDiscreteOutputPoint, 1, 3, {0x01})},  // pump on
+      {GuardedRequest::kManagedAttributeWrite,
+       make(3, 0x10, cdn127::class_id::kConfiguration, 1, 1, {0x81})},  // Mode
+      {GuardedRequest::kIdentityReset, make(4, 0x05, cdn127::class_id::kIdentity, 1, {}, {})},
+  };
+}
+
+// Counts the master's explicit requests to `node` on the bus, Gets (the
+// keep-alive) aside.
+std::function<void(const sim::WireFrame&)> count_changes_to(unsigned node, std::size_t& count) {
+  return [node, &count](const sim::WireFrame& w) {
+    const auto& f = w.frame;
+    if (f.id == devicenet::group2_id(mac(node), devicenet::Group2Message::kMasterExplicitRequest) &&
+        f.len >= 2 && f.data[1] != 0x0E) {
+      ++count;
+    }
+  };
+}
+
+TEST_F(Gateway, EveryGuardedClassIsRefusedByDefault) {
+  start();
+  run();  // past the start-up's own writes
+  std::size_t on_wire = 0;
+  rack_->world().bus().set_tap(count_changes_to(1, on_wire));
+  const auto calls = guarded_calls(100, 1);
+  for (const auto& g : calls) {
+    harness_.request(g.call, now());
+    const auto* r = harness_.reply(g.call.txid);
+    ASSERT_NE(r, nullptr) << rack::policy_key(g.kind);
+    EXPECT_EQ(r->status, TransactionStatus::kInvalidCommand) << r->message;
+    EXPECT_FALSE(r->retained);  // not a transaction: a new txid is not needed to retry
+    EXPECT_NE(r->message.find(std::string(rack::policy_key(g.kind)) + " = true"), std::string::npos)
+        << r->message;
+    EXPECT_EQ(gateway_->refused_by_policy(g.kind), 1u);
+    // Logged with its requester.
+    EXPECT_NE(log_.last_warning.find("\"tester\""), std::string::npos) << log_.last_warning;
+    EXPECT_NE(log_.last_warning.find(fmt::format("txid {}", g.call.txid)), std::string::npos);
+  }
+  EXPECT_EQ(gateway_->refused_by_policy(), calls.size());
+  EXPECT_EQ(log_.warnings, calls.size());
+  EXPECT_EQ(gateway_->in_progress(), 0u);
+  run();
+  EXPECT_EQ(on_wire, 0u);
+  EXPECT_TRUE(rack_->pumps().pump(mac(1))->online);
+  EXPECT_EQ(events_.of(mac(1)).back().to, NodeState::kOnline);
+  EXPECT_EQ(rack_->device(mac(1)).device().counters().restarts, 1u);  // its power-up only
+}
+
+TEST_F(Gateway, RefusalsAreLoggedAtALimitedRate) {
+  start();
+  const auto release = guarded_calls(1, 1).front().call;
+  for (std::uint32_t i = 0; i < 50; ++i) {
+    auto c = release;
+    c.txid = 1000 + i;
+    harness_.request(c, now());
+    EXPECT_EQ(harness_.replies.back().status, TransactionStatus::kInvalidCommand);
+  }
+  EXPECT_EQ(gateway_->refused_by_policy(), 50u);
+  EXPECT_EQ(log_.warnings, 5u);  // RateLimiter's burst per window
+  run(seconds(11));
+  harness_.request(release, now());
+  EXPECT_EQ(log_.warnings, 6u);
+  EXPECT_NE(log_.last_warning.find("45 more refusals not logged"), std::string::npos)
+      << log_.last_warning;
+}
+
+TEST_F(Gateway, EachGuardedClassIsExecutedWhenThePolicyAllowsIt) {
+  for (const auto& g : guarded_calls(100, 1)) {
+    SCOPED_TRACE(rack::policy_key(g.kind));
+    policy_ = rack::ExplicitPolicy{};
+    policy_.allow(g.kind, true);
+    harness_.replies.clear();
+    SetUp();
+    start();
+    std::size_t on_wire = 0;
+    rack_->world().bus().set_tap(count_changes_to(1, on_wire));
+    harness_.request(g.call, now());
+    EXPECT_EQ(harness_.reply(g.call.txid), nullptr);  // executing: its reply comes later
+    EXPECT_EQ(gateway_->in_progress(), 1u);
+    // Sent, and said so with its requester.
+    EXPECT_NE(log_.last_info.find(fmt::format("\"tester\" (txid {})", g.call.txid)),
+              std::string::npos)
+        << log_.last_info;
+    EXPECT_NE(log_.last_info.find(fmt::format("allowed by {}", rack::policy_key(g.kind))),
+              std::string::npos)
+        << log_.last_info;
+    ASSERT_TRUE(rack_->world().run_until([&] { return harness_.reply(g.call.txid) != nullptr; },
+                                         seconds(5)));
+    // Until its reply (after it, a Release or a Reset has the node start up again).
+    EXPECT_EQ(on_wire, 1u);
+    EXPECT_EQ(gateway_->refused_by_policy(), 0u);
+    EXPECT_NE(harness_.reply(g.call.txid)->status, TransactionStatus::kInvalidCommand)
+        << harness_.reply(g.call.txid)->message;
+  }
+}
+
+TEST_F(Gateway, AManagedAttributeMayBeSetWhileTheNodeIsNotOnline) {
+  rack_->start();
+  // Node 1 connected and in its start-up, not online yet.
+  ASSERT_TRUE(rack_->world().run_until(
+      [&] { return rack_->scanner().node(mac(1))->state() == NodeState::kIdentifying; },
+      seconds(10)));
+  const auto mode = guarded_calls(1, 1)[3].call;
+  ASSERT_EQ(mode.class_id, cdn127::class_id::kConfiguration);
+  harness_.request(mode, now());
+  EXPECT_EQ(harness_.reply(mode.txid), nullptr);  // executing
+  EXPECT_EQ(gateway_->in_progress(), 1u);
+  run();
+  ASSERT_NE(harness_.reply(mode.txid), nullptr);
+  EXPECT_NE(harness_.reply(mode.txid)->status, TransactionStatus::kInvalidCommand);
+  EXPECT_EQ(gateway_->refused_by_policy(), 0u);
+  // Once the node is online, the same Set is refused.
+  ASSERT_TRUE(
+      rack_->world().run_until([&] { return rack_->pumps().pump(mac(1))->online; }, seconds(10)));
+  auto again = mode;
+  again.txid = 2;
+  harness_.request(again, now());
+  ASSERT_NE(harness_.reply(2), nullptr);
+  EXPECT_EQ(harness_.reply(2)->status, TransactionStatus::kInvalidCommand);
+}
+
+TEST_F(Gateway, AnAllowedReleaseIsFollowedByTheBridgeReconnecting) {
+  namespace alloc = devicenet::allocation;
+  const std::uint8_t both = alloc::kExplicit | alloc::kPoll;
+  for (const std::uint8_t choice : {both, alloc::kPoll, alloc::kExplicit}) {
+    SCOPED_TRACE(fmt::format("Release choice 0x{:02X}", choice));
+    policy_.allow_allocate_release = true;
+    events_.transitions.clear();
+    harness_.replies.clear();
+    SetUp();
+    start();
+    const auto& device = rack_->device(mac(1)).device().device();
+    ASSERT_EQ(device.allocation_choice(), both);
+    const std::size_t before = events_.of(mac(1)).size();
+    const std::size_t node2_before = events_.of(mac(2)).size();
+
+    auto release = guarded_calls(1, 1).front().call;
+    release.data = {choice};
+    harness_.request(release, now());
+    ASSERT_TRUE(rack_->world().run_until([&] { return harness_.reply(release.txid) != nullptr; },
+                                         seconds(5)));
+    EXPECT_EQ(harness_.reply(release.txid)->status, TransactionStatus::kSuccess)
+        << harness_.reply(release.txid)->message;
+    EXPECT_EQ(harness_.reply(release.txid)->general_status, 0);
+    EXPECT_EQ(device.allocation_choice(), both & ~choice);  // the device dropped them
+
+    // The master notices (no poll response, or no answer to its keep-alive,
+    // for 4 x EPR) and allocates again.
+    const TimePoint released = now();
+    ASSERT_TRUE(rack_->world().run_until(
+        [&] {
+          return events_.of(mac(1)).size() > before + 1 && rack_->pumps().pump(mac(1))->online;
+        },
+        seconds(30)));
+    const auto after = events_.of(mac(1));
+    EXPECT_EQ(after[before].from, NodeState::kOnline);
+    EXPECT_EQ(after[before].to, NodeState::kAbsent);
+    EXPECT_NE(after[before].reason.find("4 x EPR"), std::string::npos) << after[before].reason;
+    EXPECT_EQ(after.back().to, NodeState::kOnline);
+    // 4 x the poll EPR (2 s) or the explicit one (10 s), then the first
+    // allocation retry and the start-up.
+    EXPECT_LT(after.back().at - released, seconds(12));
+    EXPECT_EQ(device.allocation_choice(), both);
+    // Node 2 never noticed.
+    EXPECT_EQ(events_.of(mac(2)).size(), node2_before);
+    EXPECT_TRUE(rack_->pumps().pump(mac(2))->online);
+  }
 }
 
 }  // namespace

@@ -98,10 +98,13 @@ class CountingLogSink final : public LogSink {
     if (level >= LogLevel::kWarn) {
       ++warnings;
       last_warning = std::string(message);
+    } else {
+      last_info = std::string(message);
     }
   }
   std::size_t warnings = 0;
   std::string last_warning;
+  std::string last_info;
 };
 
 }  // namespace dnbridge::test

@@ -224,6 +224,48 @@ TEST(PortLoop, RunsARackOnItsOwnThread) {
   }
 }
 
+TEST(PortLoop, TheExplicitGatewayFollowsTheConfiguredPolicy) {
+  RecordingPublisher publisher;
+  PortLoopConfig config = config_for({5});
+  config.explicit_policy.allow_output_writes = true;
+  PortLoop loop(std::move(config),
+                std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(5)}),
+                publisher, null_log_sink());
+  loop.start();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(5) && publisher.pumps[5].online; }));
+
+  rack::ExplicitCall call;
+  call.requester = "test";
+  call.command = 1;
+  call.port = "A";
+  call.mac = 5;
+  call.instance_id = 1;
+  // Allowed by this rack: a Set of DOP 1's Value reaches the device.
+  call.txid = 1;
+  call.service = 0x10;
+  call.class_id = 0x09;
+  call.attribute = 3;
+  call.data = {0x01};
+  loop.explicit_request(call);
+  // Not allowed: a Reset of the Identity object.
+  call.txid = 2;
+  call.service = 0x05;
+  call.class_id = 0x01;
+  call.attribute.reset();
+  call.data.clear();
+  loop.explicit_request(call);
+  ASSERT_TRUE(publisher.wait_for([&] { return publisher.replies.size() == 2; }));
+  std::map<std::uint32_t, rack::ExplicitAnswer> by_txid;
+  for (const auto& r : publisher.replies) by_txid[r.txid] = r;
+  EXPECT_EQ(by_txid[1].status, rack::TransactionStatus::kSuccess) << by_txid[1].message;
+  EXPECT_EQ(by_txid[2].status, rack::TransactionStatus::kInvalidCommand);
+  EXPECT_NE(by_txid[2].message.find("allow_identity_reset = true"), std::string::npos)
+      << by_txid[2].message;
+  loop.stop();
+  loop.join();
+}
+
 TEST(PortLoop, BadCommandsAreRefusedAndReported) {
   RecordingPublisher publisher;
   PortLoop loop(config_for({4}), std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(4)}),

@@ -1,0 +1,236 @@
+#include "bridge/rack/explicit_policy.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "bridge/cip/objects.hpp"
+#include "bridge/cip/service.hpp"
+#include "bridge/profiles/cdn127/objects.hpp"
+
+namespace dnbridge::rack {
+namespace {
+
+namespace cdn127 = profiles::cdn127;
+using cip::Service;
+using devicenet::AttributeSetting;
+using devicenet::RequestMessage;
+
+bool is(const RequestMessage& r, Service s) { return r.service == static_cast<std::uint8_t>(s); }
+
+std::string service_name(const RequestMessage& r) {
+  const auto name = cip::to_string(static_cast<Service>(r.service));
+  if (name.empty()) return fmt::format("service 0x{:02X}", r.service);
+  return fmt::format("{} (0x{:02X})", name, r.service);
+}
+
+// The attribute a Set_Attribute_Single writes, as the device reads it: the
+// byte after the instance, which is the first data byte when the request
+// gives no attribute of its own.
+std::optional<std::uint8_t> set_attribute(const RequestMessage& r) {
+  if (!is(r, Service::kSetAttributeSingle)) return std::nullopt;
+  if (r.attribute) return r.attribute;
+  if (!r.data.empty()) return static_cast<std::uint8_t>(r.data[0]);
+  return std::nullopt;
+}
+
+// Set_Attributes_All writes every settable attribute of the instance.
+bool writes_attribute(const RequestMessage& r, std::uint8_t attribute) {
+  return is(r, Service::kSetAttributesAll) || set_attribute(r) == attribute;
+}
+
+std::optional<std::string> allocate_release(const RequestMessage& r) {
+  if (r.class_id != devicenet::kDeviceNetClass) return std::nullopt;
+  if (!is(r, Service::kAllocateMasterSlave) && !is(r, Service::kReleaseMasterSlave)) {
+    return std::nullopt;
+  }
+  return fmt::format("{} to the DeviceNet object", service_name(r));
+}
+
+std::optional<std::string> connection_change(const RequestMessage& r) {
+  if (r.class_id != cip::connection::kClass) return std::nullopt;
+  // Delete, Create and Apply_Attributes change connections as much as a Set.
+  if (!is(r, Service::kSetAttributeSingle) && !is(r, Service::kSetAttributesAll) &&
+      !is(r, Service::kCreate) && !is(r, Service::kDelete) && !is(r, Service::kApplyAttributes)) {
+    return std::nullopt;
+  }
+  if (auto a = set_attribute(r)) {
+    return fmt::format("{} of Connection instance {} attribute {}", service_name(r), r.instance_id,
+                       *a);
+  }
+  return fmt::format("{} to Connection instance {}", service_name(r), r.instance_id);
+}
+
+std::optional<std::string> identity_reset(const RequestMessage& r) {
+  if (r.class_id != cip::identity::kClass || !is(r, Service::kReset)) return std::nullopt;
+  return fmt::format("{} of the Identity object", service_name(r));
+}
+
+std::optional<std::string> output_write(const RequestMessage& r) {
+  std::string_view object;
+  std::uint8_t value_attribute = 0;
+  switch (r.class_id) {
+    case cdn127::class_id::kDiscreteOutputPoint:
+      object = "Discrete Output Point";
+      value_attribute = cdn127::dop_attr::kValue;
+      break;
+    case cdn127::class_id::kAnalogOutputPoint:
+      object = "Analog Output Point";
+      value_attribute = cdn127::aop_attr::kValue;
+      break;
+    case cdn127::class_id::kAssembly:
+      object = "Assembly";
+      value_attribute = 3;  // Data
+      break;
+    default:
+      return std::nullopt;
+  }
+  // Instance 0 is the class itself: its attribute 3 is not the value.
+  if (r.instance_id == 0 || !writes_attribute(r, value_attribute)) return std::nullopt;
+  return fmt::format("{} of {} instance {} {}", service_name(r), object, r.instance_id,
+                     r.class_id == cdn127::class_id::kAssembly ? "data" : "Value");
+}
+
+std::optional<std::string> managed_write(const RequestMessage& r, const PolicyNode& node) {
+  if (!node.online) return std::nullopt;
+  const auto in_instance = [&](const AttributeSetting& s) {
+    return s.class_id == r.class_id && s.instance_id == r.instance_id;
+  };
+  if (const auto a = set_attribute(r)) {
+    const auto it = std::find_if(
+        node.managed.begin(), node.managed.end(),
+        [&](const AttributeSetting& s) { return in_instance(s) && s.attribute == *a; });
+    if (it == node.managed.end()) return std::nullopt;
+    return fmt::format("{} of {} while the node is online", service_name(r), it->name);
+  }
+  // Set_Attributes_All and Reset rewrite the instance's attributes (the
+  // CDN127 Configuration object's Reset loads a preset over them).
+  if (!is(r, Service::kSetAttributesAll) && !is(r, Service::kReset)) return std::nullopt;
+  const auto first = std::find_if(node.managed.begin(), node.managed.end(), in_instance);
+  if (first == node.managed.end()) return std::nullopt;
+  const auto count = std::count_if(node.managed.begin(), node.managed.end(), in_instance);
+  return fmt::format("{} of class 0x{:02X} instance {} ({}{}) while the node is online",
+                     service_name(r), r.class_id, r.instance_id, first->name,
+                     count > 1 ? fmt::format(" and {} more", count - 1) : std::string());
+}
+
+}  // namespace
+
+std::string_view policy_key(GuardedRequest kind) noexcept {
+  switch (kind) {
+    case GuardedRequest::kAllocateRelease:
+      return "allow_allocate_release";
+    case GuardedRequest::kConnectionChange:
+      return "allow_connection_changes";
+    case GuardedRequest::kOutputWrite:
+      return "allow_output_writes";
+    case GuardedRequest::kManagedAttributeWrite:
+      return "allow_managed_attribute_writes";
+    case GuardedRequest::kIdentityReset:
+      return "allow_identity_reset";
+  }
+  return "?";
+}
+
+std::string_view name_of(GuardedRequest kind) noexcept {
+  switch (kind) {
+    case GuardedRequest::kAllocateRelease:
+      return "an allocation or release of connections";
+    case GuardedRequest::kConnectionChange:
+      return "a connection change";
+    case GuardedRequest::kOutputWrite:
+      return "an output write";
+    case GuardedRequest::kManagedAttributeWrite:
+      return "a write of an attribute the bridge manages";
+    case GuardedRequest::kIdentityReset:
+      return "a device reset";
+  }
+  return "?";
+}
+
+std::string_view risk_of(GuardedRequest kind) noexcept {
+  switch (kind) {
+    case GuardedRequest::kAllocateRelease:
+      return "the node's connections are the bridge's: a Release drops them and the pump's "
+             "outputs go to their idle or fault values until the bridge has reconnected; an "
+             "Allocate takes connections the bridge does not run";
+    case GuardedRequest::kConnectionChange:
+      return "the bridge's connections run with the paths, sizes, expected packet rates and "
+             "watchdog actions it set: a change can stop the I/O, or keep the device from "
+             "noticing a lost master (an expected packet rate of 0 turns its watchdog off)";
+    case GuardedRequest::kOutputWrite:
+      return "outputs belong to PumpCommand, whose DDS ownership decides who commands a pump: "
+             "a direct write bypasses it, and can switch a pump that nobody commands";
+    case GuardedRequest::kManagedAttributeWrite:
+      return "the bridge decodes the node's I/O and sets its safe state with these values: a "
+             "change under the running connection breaks decoding or the outputs' fault and "
+             "idle behaviour until the node restarts and the bridge writes its own back";
+    case GuardedRequest::kIdentityReset:
+      return "the device restarts: its outputs go to their power-up state and the pump is "
+             "lost until the bridge has brought it online again";
+  }
+  return "?";
+}
+
+bool ExplicitPolicy::allows(GuardedRequest kind) const noexcept {
+  switch (kind) {
+    case GuardedRequest::kAllocateRelease:
+      return allow_allocate_release;
+    case GuardedRequest::kConnectionChange:
+      return allow_connection_changes;
+    case GuardedRequest::kOutputWrite:
+      return allow_output_writes;
+    case GuardedRequest::kManagedAttributeWrite:
+      return allow_managed_attribute_writes;
+    case GuardedRequest::kIdentityReset:
+      return allow_identity_reset;
+  }
+  return false;
+}
+
+void ExplicitPolicy::allow(GuardedRequest kind, bool allowed) noexcept {
+  switch (kind) {
+    case GuardedRequest::kAllocateRelease:
+      allow_allocate_release = allowed;
+      return;
+    case GuardedRequest::kConnectionChange:
+      allow_connection_changes = allowed;
+      return;
+    case GuardedRequest::kOutputWrite:
+      allow_output_writes = allowed;
+      return;
+    case GuardedRequest::kManagedAttributeWrite:
+      allow_managed_attribute_writes = allowed;
+      return;
+    case GuardedRequest::kIdentityReset:
+      allow_identity_reset = allowed;
+      return;
+  }
+}
+
+std::vector<Guarded> classify(const RequestMessage& request, const PolicyNode& node) {
+  std::vector<Guarded> out;
+  const auto add = [&](GuardedRequest kind, std::optional<std::string> what) {
+    if (what) out.push_back({kind, std::move(*what)});
+  };
+  add(GuardedRequest::kAllocateRelease, allocate_release(request));
+  add(GuardedRequest::kConnectionChange, connection_change(request));
+  add(GuardedRequest::kOutputWrite, output_write(request));
+  add(GuardedRequest::kManagedAttributeWrite, managed_write(request, node));
+  add(GuardedRequest::kIdentityReset, identity_reset(request));
+  return out;
+}
+
+std::optional<PolicyRefusal> check(const ExplicitPolicy& policy, const RequestMessage& request,
+                                   const PolicyNode& node) {
+  for (auto& g : classify(request, node)) {
+    if (policy.allows(g.kind)) continue;
+    return PolicyRefusal{
+        g.kind, fmt::format("{} is {}, which the explicit policy refuses. Risk: {}. {} = true in "
+                            "[explicit_policy] allows it",
+                            g.what, name_of(g.kind), risk_of(g.kind), policy_key(g.kind))};
+  }
+  return std::nullopt;
+}
+
+}  // namespace dnbridge::rack
