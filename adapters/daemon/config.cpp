@@ -196,7 +196,7 @@ std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Reporte
 constexpr std::string_view kProfileCdn127 = "cdn127";
 
 // Every key of a node; [defaults] takes all but mac and name.
-constexpr std::array<std::string_view, 15> kNodeKeys{"mac",
+constexpr std::array<std::string_view, 23> kNodeKeys{"mac",
                                                      "name",
                                                      "serial",
                                                      "profile",
@@ -210,7 +210,15 @@ constexpr std::array<std::string_view, 15> kNodeKeys{"mac",
                                                      "analog_deadband_volts",
                                                      "no_commander",
                                                      "explicit_response_timeout_ms",
-                                                     "poll_response_timeout_ms"};
+                                                     "poll_response_timeout_ms",
+                                                     "safe_state",
+                                                     "pump_on_fault",
+                                                     "pump_on_idle",
+                                                     "n2_ballast_on_fault",
+                                                     "n2_ballast_on_idle",
+                                                     "analog_output_on_fault",
+                                                     "analog_output_on_idle",
+                                                     "resume"};
 // [defaults] takes every key of a node but its MAC, name and serial number.
 constexpr KeyList kDefaultsKeys = KeyList(kNodeKeys).subspan(3);
 
@@ -423,6 +431,126 @@ constexpr std::int64_t kMaxResponseTimeoutMs =
     60'000;  // cut to a quarter of each node's poll period
 constexpr double kAnalogFullScaleVolts = 10.0;
 
+// The keys of the outputs' safe state, and where each goes.
+struct SafeStateKey {
+  std::string_view key;
+  cdn127::DiscreteAction cdn127::SafeState::*discrete;
+  cdn127::AnalogAction cdn127::SafeState::*analog;
+};
+constexpr std::array<SafeStateKey, 6> kSafeStateKeys{{
+    {"pump_on_fault", &cdn127::SafeState::pump_fault, nullptr},
+    {"pump_on_idle", &cdn127::SafeState::pump_idle, nullptr},
+    {"n2_ballast_on_fault", &cdn127::SafeState::n2_ballast_fault, nullptr},
+    {"n2_ballast_on_idle", &cdn127::SafeState::n2_ballast_idle, nullptr},
+    {"analog_output_on_fault", nullptr, &cdn127::SafeState::analog_fault},
+    {"analog_output_on_idle", nullptr, &cdn127::SafeState::analog_idle},
+}};
+
+// "off", "on" or "hold".
+std::optional<cdn127::DiscreteAction> read_discrete_action(const toml::node& n,
+                                                           std::string_view key, Reporter& r) {
+  auto v = read_string(n, key, r);
+  if (!v) return std::nullopt;
+  for (auto a : {cdn127::DiscreteAction::kOff, cdn127::DiscreteAction::kOn,
+                 cdn127::DiscreteAction::kHold}) {
+    if (*v == cdn127::to_string(a)) return a;
+  }
+  r.error(at(n.source()),
+          fmt::format("{} = \"{}\" is not an output action: use \"off\", \"on\" or \"hold\"",
+                      key, *v));
+  return std::nullopt;
+}
+
+// A voltage, 0..10, or "hold".
+std::optional<cdn127::AnalogAction> read_analog_action(const toml::node& n, std::string_view key,
+                                                       Reporter& r) {
+  if (n.is_string()) {
+    auto v = read_string(n, key, r);
+    if (v && *v == "hold") return cdn127::AnalogAction{cdn127::AnalogAction::Kind::kHold, 0};
+    if (v) {
+      r.error(at(n.source()),
+              fmt::format("{} = \"{}\" is not an analog output action: use a voltage "
+                          "(0..10, e.g. 0.0) or \"hold\"",
+                          key, *v));
+    }
+    return std::nullopt;
+  }
+  auto volts = read_number(n, key, r);
+  if (!volts) return std::nullopt;
+  auto raw = cdn127::volts_to_raw(*volts);
+  if (!raw) {
+    r.error(at(n.source()), fmt::format("{} = {} V is out of range (0..10 V)", key, *volts));
+    return std::nullopt;
+  }
+  return cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, *raw};
+}
+
+void read_safe_state(const Layers& layers, NodeSettings& s, Reporter& r) {
+  if (Found f = layers.find("safe_state"); f.value) {
+    if (auto v = read_string(*f.value, "safe_state", r)) {
+      if (*v == "configured") {
+        s.safe_state.source = cdn127::SafeStateSource::kConfiguration;
+      } else if (*v == "device") {
+        s.safe_state.source = cdn127::SafeStateSource::kDevice;
+      } else {
+        r.error(at(f.value->source()),
+                fmt::format("safe_state = \"{}\" is not a choice: use \"configured\" (the "
+                            "default: the keys pump_on_fault ... are downloaded) or \"device\"",
+                            *v));
+      }
+    }
+  }
+  const bool keep_device = s.safe_state.source == cdn127::SafeStateSource::kDevice;
+  for (const auto& k : kSafeStateKeys) {
+    const Found f = layers.find(k.key);
+    if (!f.value) continue;
+    // A node that keeps the device's values and gives values of its own
+    // says two things; [defaults] may give values other nodes use.
+    if (keep_device && f.level == Level::kNode) {
+      r.error(at(f.value->source()),
+              fmt::format("{} has no effect with safe_state = \"device\": the device's own "
+                          "fault and idle actions are kept",
+                          k.key));
+      continue;
+    }
+    if (k.discrete) {
+      if (auto v = read_discrete_action(*f.value, k.key, r)) s.safe_state.values.*k.discrete = *v;
+    } else if (auto v = read_analog_action(*f.value, k.key, r)) {
+      s.safe_state.values.*k.analog = *v;
+    }
+  }
+  if (Found f = layers.find("resume"); f.value) {
+    if (auto v = read_string(*f.value, "resume", r)) {
+      if (*v == "new-command") {
+        s.resume = rack::ResumePolicy::kFreshCommand;
+      } else if (*v == "last-command") {
+        s.resume = rack::ResumePolicy::kLastCommand;
+      } else {
+        r.error(at(f.value->source()),
+                fmt::format("resume = \"{}\" is not a policy: use \"new-command\" (the "
+                            "default) or \"last-command\"",
+                            *v));
+      }
+    }
+  }
+  // Opt-ins that give up a guarantee: said in the log at every start.
+  if (layers.node != nullptr && keep_device) {
+    const Found f = layers.find("safe_state");
+    r.warning(at(f.value->source()),
+              fmt::format("node {} keeps the device's own fault and idle actions "
+                          "(safe_state = \"device\"): read and shown, never written",
+                          s.mac.value()));
+  }
+  if (layers.node != nullptr && s.resume == rack::ResumePolicy::kLastCommand) {
+    const Found f = layers.find("resume");
+    r.warning(at(f.value->source()),
+              fmt::format("node {} drives its last outputs again after a loss without a new "
+                          "command (resume = \"last-command\"): a pump may start on its own "
+                          "after a power cycle",
+                          s.mac.value()));
+  }
+}
+
 // Reads every setting a node and [defaults] share into `s`, which holds the
 // built-in values to start with.
 void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
@@ -523,6 +651,7 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
       }
     }
   }
+  read_safe_state(layers, s, r);
 }
 
 // ---------------------------------------------------------------------------
@@ -991,6 +1120,8 @@ rack::PumpConfig to_pump_config(const NodeSettings& node) {
   p.io = node.io;
   p.identity = node.identity;
   p.no_commander = node.no_commander;
+  p.resume = node.resume;
+  p.safe_state = node.safe_state;
   return p;
 }
 

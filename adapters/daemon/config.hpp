@@ -46,6 +46,12 @@ struct NodeSettings {
   bool immediate_poll_on_change = devicenet::NodeConfig{}.immediate_poll_on_change;
   PublishPolicy publish;
   NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
+  // The outputs' fault and idle actions downloaded at start-up (off, 0 V), or
+  // the device's own kept (safe_state = "device").
+  profiles::cdn127::SafeStateConfig safe_state;
+  // After a loss: idle until a new command (the default), or the last
+  // command again (resume = "last-command").
+  rack::ResumePolicy resume = rack::ResumePolicy::kFreshCommand;
   // The serial number the device must have (a swapped module or a misset
   // MAC switch is then a wrong device); without it the first one seen is
   // recorded and a change warned of.

@@ -19,7 +19,8 @@ using devicenet::RequestMessage;
 // The settings of a CDN127 node as the bridge configures it, plus a DOP
 // fault action: the policy must take whatever the profile lists.
 std::vector<devicenet::AttributeSetting> managed_settings() {
-  auto profile = cdn127::make_node_profile(cdn127::preset(cdn127::ConfigurationPreset::kCdn127));
+  auto profile = cdn127::make_node_profile(cdn127::preset(cdn127::ConfigurationPreset::kCdn127),
+                                           cdn127::SafeStateConfig{});
   EXPECT_TRUE(profile.ok());
   auto settings = profile->settings;
   devicenet::AttributeSetting fault_action;
