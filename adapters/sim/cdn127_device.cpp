@@ -27,6 +27,8 @@ E2Memory initial_e2(const SlaveOptions& o) noexcept {
   e2.configuration = o.configuration;
   e2.mac = o.stored_mac <= MacId::kMax ? o.stored_mac : MacId::kMax;
   e2.baud = o.stored_baud <= 2 ? o.stored_baud : 0;
+  e2.dop = o.factory_output_actions.dop;
+  e2.aop = o.factory_output_actions.aop;
   return e2;
 }
 

@@ -79,6 +79,41 @@ struct ClassAttribute {
   friend bool operator==(const ClassAttribute&, const ClassAttribute&) = default;
 };
 
+// DOP attributes 5..8. The manual's encoding: action 0 = use the value, 1 = hold.
+struct DopSettings {
+  bool fault_hold = false;
+  bool fault_value = false;
+  bool idle_hold = false;
+  bool idle_value = false;
+  friend bool operator==(const DopSettings&, const DopSettings&) = default;
+};
+
+// AOP attributes 9..12: state 0 hold, 1 low (0 V), 2 high (4095), 3 the value.
+struct AopSettings {
+  std::uint8_t fault_state = 0;
+  std::uint8_t idle_state = 0;
+  std::uint16_t fault_value = 0;
+  std::uint16_t idle_value = 0;
+  friend bool operator==(const AopSettings&, const AopSettings&) = default;
+};
+
+// What every output does on a fault and on idle: DOP instances 1 (Pump On)
+// and 2 (N2 Ballast On) attributes 5..8, AOP attributes 9..12.
+struct OutputActions {
+  std::array<DopSettings, 2> dop{};
+  AopSettings aop{};
+  friend bool operator==(const OutputActions&, const OutputActions&) = default;
+};
+
+// A device that leaves every output as it is when its master goes idle or
+// away: DOP fault and idle actions 1 (no change), AOP fault and idle states 0
+// (hold the last value). A pump that was on stays on.
+inline constexpr OutputActions kUnsafeFactoryOutputActions{
+    .dop = {DopSettings{.fault_hold = true, .idle_hold = true},
+            DopSettings{.fault_hold = true, .idle_hold = true}},
+    .aop = AopSettings{.fault_state = 0, .idle_state = 0},
+};
+
 struct SlaveOptions {
   // Front-panel rotary switches, read at power-up only (manual, "Switches"):
   // MAC 0..63 valid, 64..99 the program position (MAC set in software); baud
@@ -110,6 +145,13 @@ struct SlaveOptions {
   // Configuration object values in E2 before the first power-up.
   profiles::cdn127::IoConfiguration configuration =
       profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127);
+  // The outputs' fault and idle actions in E2 before the first power-up, and
+  // what Identity Reset type 1 restores. The manual gives no factory values.
+  // By default each DOP goes to its value, Off, on a fault and on idle
+  // (action 0, value 0) and the AOP holds its last value (state 0): every
+  // attribute 0. kUnsafeFactoryOutputActions is the device a master must
+  // not trust as it comes: it keeps the pump on.
+  OutputActions factory_output_actions{};
 
   PumpModel::Config pump{};
   Duration duplicate_mac_window = seconds(1);
@@ -168,23 +210,11 @@ struct SlaveOptions {
 // responses 300 ms and poll responses 3 ms late, the 2-byte (UINT) serial
 // number, no Identity State attribute (0x01/8), expected packet rates in
 // steps of 100 ms. What `cdn127-sim --reading field` runs.
+// The factory output actions are left as they are: they are not a reading of
+// the manual but values in E2, and a device in the field holds whatever the
+// last configuration tool wrote there, safe or not. Choose them on their own
+// (factory_output_actions) to try either with any reading.
 void apply_field_reading(SlaveOptions& options);
-
-// DOP attributes 5..8. The manual's encoding: action 0 = use the value, 1 = hold.
-struct DopSettings {
-  bool fault_hold = false;
-  bool fault_value = false;
-  bool idle_hold = false;
-  bool idle_value = false;
-};
-
-// AOP attributes 9..12: state 0 hold, 1 low (0 V), 2 high (4095), 3 the value.
-struct AopSettings {
-  std::uint8_t fault_state = 0;
-  std::uint8_t idle_state = 0;
-  std::uint16_t fault_value = 0;
-  std::uint16_t idle_value = 0;
-};
 
 // What the CDN127 keeps in E2 across power cycles. The manual says so for the
 // Configuration object (NOTE 1) and the software MAC/baud ("defaults to the

@@ -957,6 +957,114 @@ TEST_F(Cdn127SlaveTest, GroupsAndMessagesNotSupportedAreIgnored) {
 }
 
 // ---------------------------------------------------------------------------
+// Factory output actions (SlaveOptions::factory_output_actions)
+
+constexpr std::uint8_t kDopInstances[] = {1, 2};  // Pump On, N2 Ballast On
+
+SlaveOptions unsafe_options() {
+  SlaveOptions o = default_options();
+  o.factory_output_actions = kUnsafeFactoryOutputActions;
+  return o;
+}
+
+// The simulator's factory values: every attribute 0, each DOP to Off on a
+// fault and on idle, the AOP holding.
+TEST_F(Cdn127SlaveTest, DefaultFactoryOutputActionsTurnTheDopsOff) {
+  boot();
+  allocate();
+  for (std::uint8_t instance : kDopInstances) {
+    for (std::uint8_t attribute = 5; attribute <= 8; ++attribute) {
+      EXPECT_EQ(get(0x09, instance, attribute), (ByteVec{0x8E, 0x00})) << int{attribute};
+    }
+  }
+  EXPECT_EQ(get(0x0B, 0x01, 0x09), (ByteVec{0x8E, 0x00}));
+  EXPECT_EQ(get(0x0B, 0x01, 0x0A), (ByteVec{0x8E, 0x00}));
+}
+
+TEST_F(Cdn127SlaveTest, UnsafeFactoryOutputActionsAreWhatTheDeviceAnswers) {
+  create(unsafe_options());
+  boot();
+  allocate();
+  for (std::uint8_t instance : kDopInstances) {
+    EXPECT_EQ(get(0x09, instance, 0x05), (ByteVec{0x8E, 0x01}));  // fault action: no change
+    EXPECT_EQ(get(0x09, instance, 0x06), (ByteVec{0x8E, 0x00}));
+    EXPECT_EQ(get(0x09, instance, 0x07), (ByteVec{0x8E, 0x01}));  // idle action: no change
+    EXPECT_EQ(get(0x09, instance, 0x08), (ByteVec{0x8E, 0x00}));
+  }
+  EXPECT_EQ(get(0x0B, 0x01, 0x09), (ByteVec{0x8E, 0x00}));  // fault state: hold
+  EXPECT_EQ(get(0x0B, 0x01, 0x0A), (ByteVec{0x8E, 0x00}));  // idle state: hold
+}
+
+// The unsafe device going idle keeps the pump on, until a master writes an
+// idle action of its own over the explicit connection.
+TEST_F(Cdn127SlaveTest, UnsafeDeviceKeepsThePumpOnWhenIdleUntilToldOtherwise) {
+  create(unsafe_options());
+  boot();
+  establish_poll();
+  poll({0x05, 0x00, 0x34, 0x02});  // pump on, ballast on, 0x234
+  ASSERT_TRUE(slave_->outputs().pump_on);
+
+  EXPECT_EQ(poll({}).size(), 6u);
+  EXPECT_EQ(slave_->counters().polls_idle, 1u);
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0x0234);
+
+  // DOP 1 Idle Action 0 (use the value), Idle Value 0 (Off).
+  EXPECT_EQ(set(0x09, 0x01, 0x07, {0x00}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x09, 0x01, 0x08, {0x00}), (ByteVec{0x90}));
+  poll({0x05, 0x00, 0x34, 0x02});
+  ASSERT_TRUE(slave_->outputs().pump_on);
+  poll({});
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);  // DOP 2 still holds
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0x0234);
+  EXPECT_TRUE(slave_->pump().last_change_was_idle());
+}
+
+// A poll connection timing out (the fault condition): the unsafe device holds
+// every output; once told to use its fault values, it takes them.
+TEST_F(Cdn127SlaveTest, UnsafeDeviceHoldsOnPollTimeoutUntilGivenFaultValues) {
+  create(unsafe_options());
+  boot();
+  establish_poll(100);
+  poll({0x05, 0x00, 0x34, 0x02});
+  advance(milliseconds(400));
+  ASSERT_EQ(slave_->poll_state(), ConnectionState::kTimedOut);
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0x0234);
+  EXPECT_TRUE(slave_->pump().last_change_was_fault());
+
+  // DOP 1 Fault Action 0 with Fault Value 0; AOP Fault State 3 with Fault Value 500.
+  EXPECT_EQ(set(0x09, 0x01, 0x05, {0x00}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x09, 0x01, 0x06, {0x00}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x0B, 0x01, 0x09, {0x03}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x0B, 0x01, 0x0B, {0xF4, 0x01}), (ByteVec{0x90}));
+  EXPECT_EQ(request({0x05, 0x05, 0x02}), (ByteVec{0x85}));  // Connection Reset
+  poll({0x05, 0x00, 0x34, 0x02});
+  advance(milliseconds(400));
+  ASSERT_EQ(slave_->poll_state(), ConnectionState::kTimedOut);
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);  // DOP 2 still holds
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 500);
+}
+
+// Identity Reset type 1 brings back the factory values, unsafe ones included.
+TEST_F(Cdn127SlaveTest, FactoryResetRestoresTheUnsafeOutputActions) {
+  create(unsafe_options());
+  boot();
+  allocate();
+  EXPECT_EQ(set(0x09, 0x01, 0x07, {0x00}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x0B, 0x01, 0x0A, {0x01}), (ByteVec{0x90}));
+  exchange(kRequestId, {kMaster, 0x05, 0x01, 0x01, 0x01});
+  advance(milliseconds(2001));
+  allocate();
+  EXPECT_EQ(get(0x09, 0x01, 0x07), (ByteVec{0x8E, 0x01}));
+  EXPECT_EQ(get(0x0B, 0x01, 0x0A), (ByteVec{0x8E, 0x00}));
+}
+
+// ---------------------------------------------------------------------------
 // Resets and power cycles
 
 TEST_F(Cdn127SlaveTest, PowerCycleKeepsE2AndDropsEverythingElse) {
@@ -982,6 +1090,61 @@ TEST_F(Cdn127SlaveTest, PowerCycleKeepsE2AndDropsEverythingElse) {
   EXPECT_EQ(get(0x40, 0x01, 0x01), (ByteVec{0x8E, 0x81}));
   EXPECT_EQ(get(0x0B, 0x01, 0x0B), (ByteVec{0x8E, 0x00, 0x02}));
   EXPECT_EQ(get(0x05, 0x02, 0x09), (ByteVec{0x8E, 0x00, 0x00}));
+}
+
+// The fault and idle actions a master writes are E2: a power cycle keeps
+// them and they act after it, while the outputs start off.
+TEST_F(Cdn127SlaveTest, PowerCycleKeepsTheOutputActionsWrittenAndStartsWithOutputsOff) {
+  create(unsafe_options());
+  boot();
+  allocate();
+  for (std::uint8_t instance : kDopInstances) {
+    EXPECT_EQ(set(0x09, instance, 0x05, {0x00}), (ByteVec{0x90}));  // fault: the value,
+    EXPECT_EQ(set(0x09, instance, 0x07, {0x00}), (ByteVec{0x90}));  // idle: the value,
+    EXPECT_EQ(set(0x09, instance, 0x08, {0x00}), (ByteVec{0x90}));  // Off
+  }
+  EXPECT_EQ(set(0x0B, 0x01, 0x09, {0x03}), (ByteVec{0x90}));        // fault: the value,
+  EXPECT_EQ(set(0x0B, 0x01, 0x0B, {0xC8, 0x00}), (ByteVec{0x90}));  // 200
+  EXPECT_EQ(set(0x0B, 0x01, 0x0A, {0x01}), (ByteVec{0x90}));        // idle: low
+  EXPECT_EQ(set(0x05, 0x02, 0x09, {0x64, 0x00}), (ByteVec{0x90, 0x64, 0x00}));
+  poll({0x05, 0x00, 0x34, 0x02});
+  ASSERT_TRUE(slave_->outputs().pump_on);
+
+  slave_->power_cycle(now_);
+  auto out = sink_.take();
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].id, kDupMacId);
+  EXPECT_EQ(slave_->network_state(), Cdn127Slave::NetworkState::kDuplicateMacCheck);
+  EXPECT_EQ(slave_->owner(), 255);
+  EXPECT_EQ(slave_->poll_state(), ConnectionState::kNonExistent);
+  EXPECT_EQ(slave_->outputs(), profiles::cdn127::PumpOutputs{});
+  EXPECT_EQ(slave_->pump().last_cause(), OutputCause::kPowerUp);
+  // Silent to a master until the check is over.
+  EXPECT_TRUE(exchange(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x03, kMaster}).empty());
+  advance(milliseconds(2001));
+  ASSERT_EQ(slave_->network_state(), Cdn127Slave::NetworkState::kOnline);
+
+  allocate();
+  for (std::uint8_t instance : kDopInstances) {
+    EXPECT_EQ(get(0x09, instance, 0x05), (ByteVec{0x8E, 0x00}));
+    EXPECT_EQ(get(0x09, instance, 0x07), (ByteVec{0x8E, 0x00}));
+    EXPECT_EQ(get(0x09, instance, 0x08), (ByteVec{0x8E, 0x00}));
+  }
+  EXPECT_EQ(get(0x0B, 0x01, 0x09), (ByteVec{0x8E, 0x03}));
+  EXPECT_EQ(get(0x0B, 0x01, 0x0B), (ByteVec{0x8E, 0xC8, 0x00}));
+  EXPECT_EQ(get(0x0B, 0x01, 0x0A), (ByteVec{0x8E, 0x01}));
+  // And they act: idle, then a timeout.
+  EXPECT_EQ(set(0x05, 0x02, 0x09, {0x64, 0x00}), (ByteVec{0x90, 0x64, 0x00}));
+  poll({0x05, 0x00, 0x34, 0x02});
+  poll({});
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_FALSE(slave_->outputs().n2_ballast_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0);
+  poll({0x05, 0x00, 0x34, 0x02});
+  advance(milliseconds(400));
+  ASSERT_EQ(slave_->poll_state(), ConnectionState::kTimedOut);
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 200);
 }
 
 TEST_F(Cdn127SlaveTest, IdentityResetRestartsAfterAnswering) {
