@@ -241,12 +241,25 @@ struct Connection {
 };
 
 // Identity attribute 5 bits 8..11 (ODVA numbering; the manual lists 8/9 twice).
+// A recoverable fault lasts as long as its cause, which is outside the device
+// (a short on a DOP, the +24 Vdc gone): it stays until cleared, power cycles
+// included. An unrecoverable one lasts until the next power cycle, "the only
+// exit from a Major Unrecoverable fault condition" (manual, Identity
+// attribute 8); the manual names no exit for the minor one, which is taken to
+// be the same. An Identity Reset is no power cycle: it clears neither.
 struct IdentityFaults {
   bool minor_recoverable = false;    // DOP short circuit
   bool minor_unrecoverable = false;
   bool major_recoverable = false;    // loss of +24 Vdc
   bool major_unrecoverable = false;  // checksum, A/D
+
+  bool major() const noexcept { return major_recoverable || major_unrecoverable; }
+  friend bool operator==(const IdentityFaults&, const IdentityFaults&) = default;
 };
+
+// What starts the device up: power applied, which ends unrecoverable faults,
+// or a restart with power on (Identity Reset, a new MAC), which does not.
+enum class PowerUpCause : std::uint8_t { kPowerOn, kRestart };
 
 // Work to do once the response to the current request has been sent.
 enum class PendingAction : std::uint8_t {
@@ -262,6 +275,8 @@ enum class PollOutcome : std::uint8_t {
   kIdle,            // shorter than the consumed size: idle actions, response built
                     // (empty with SlaveOptions::idle_poll_answered_empty)
   kInvalid,         // full size but an analog value over 4095: outputs kept, response built
+  kMajorFault,      // a major fault stands: outputs kept in their fault state, response
+                    // built (empty for an idle poll with idle_poll_answered_empty)
 };
 
 struct PollResult {
@@ -277,8 +292,11 @@ class Cdn127Device {
  public:
   explicit Cdn127Device(const SlaveOptions& options) noexcept;
 
-  // Power-up: volatile state cleared, switches read, outputs off.
-  void power_up(TimePoint now) noexcept;
+  // Power-up: volatile state cleared, switches read, outputs off; with
+  // power applied, the unrecoverable faults end too (IdentityFaults). E2
+  // persists. Under a recoverable major fault still standing the outputs
+  // stay off until it clears: fault actions act on the change to a fault.
+  void power_up(TimePoint now, PowerUpCause cause) noexcept;
   // Identity Reset type 1: E2 back to the out-of-box values.
   void restore_factory_defaults() noexcept;
 
@@ -341,9 +359,12 @@ class Cdn127Device {
   Reply set_consumed_assembly(std::uint8_t assembly, Bytes data, TimePoint now) noexcept;
 
   // --- outputs ---
-  void set_outputs(const profiles::cdn127::PumpOutputs& outputs, OutputCause cause,
-                   TimePoint now) noexcept;
+  // Outputs set over the network (DOP State): refused with 0x10 (device
+  // state conflict) while a major fault stands.
+  Reply set_outputs(const profiles::cdn127::PumpOutputs& outputs, OutputCause cause,
+                    TimePoint now) noexcept;
   void apply_fault_actions(TimePoint now) noexcept;
+  // Nothing while a major fault stands: the outputs keep their fault state.
   void apply_idle_actions(TimePoint now) noexcept;
 
   // --- Configuration object ---
@@ -358,8 +379,16 @@ class Cdn127Device {
   std::uint8_t identity_state() const noexcept;
   std::uint8_t supervisor_device_status() const noexcept;
   std::uint8_t exception_status_byte() noexcept;
-  void set_faults(const IdentityFaults& faults) noexcept { faults_ = faults; }
+  // The device's faults as they are now. A major fault where there was none
+  // applies the fault actions (DOP attribute 5, AOP attribute 9) and then
+  // holds the outputs there until every major fault has cleared: polls are
+  // answered but not applied, DOP State and consumed assembly Sets refused.
+  // The manual's Identity section says nothing of the outputs; its AOP Fault
+  // State applies on fault conditions that "include software conditions
+  // (connection timeout)", so not only those. Minor faults change no output.
+  void set_faults(const IdentityFaults& faults, TimePoint now) noexcept;
   const IdentityFaults& faults() const noexcept { return faults_; }
+  bool major_fault() const noexcept { return faults_.major(); }
   // A failed converter: the channel's poll response field carries `raw`
   // whatever it is (above 4095 included) until cleared with nullopt.
   void fail_analog_input(std::size_t channel, std::optional<std::uint16_t> raw) noexcept {

@@ -1065,6 +1065,109 @@ TEST_F(Cdn127SlaveTest, FactoryResetRestoresTheUnsafeOutputActions) {
 }
 
 // ---------------------------------------------------------------------------
+// Identity faults (Cdn127Device::set_faults, cdn127-sim's `fault` command)
+
+TEST_F(Cdn127SlaveTest, IdentityFaultsShowInStatusAndState) {
+  boot();
+  allocate();
+  auto& device = slave_->device();
+  struct Case {
+    IdentityFaults faults;
+    ByteVec status;  // attribute 5, owned (bit 0) included
+    std::uint8_t state;
+    std::uint8_t supervisor;  // Device Supervisor attribute 11
+  };
+  const Case cases[] = {
+      {{.minor_recoverable = true}, {0x01, 0x01}, 3, 2},
+      {{.minor_unrecoverable = true}, {0x01, 0x02}, 3, 2},
+      {{.major_recoverable = true}, {0x01, 0x04}, 4, 5},    // Abort
+      {{.major_unrecoverable = true}, {0x01, 0x08}, 5, 6},  // Critical Fault
+      {{.major_recoverable = true, .major_unrecoverable = true}, {0x01, 0x0C}, 5, 6},
+  };
+  for (const Case& c : cases) {
+    device.set_faults(c.faults, now_);
+    ByteVec status{0x8E};
+    status.insert(status.end(), c.status.begin(), c.status.end());
+    EXPECT_EQ(get(0x01, 0x01, 0x05), status) << hex(status);
+    EXPECT_EQ(get(0x01, 0x01, 0x08), (ByteVec{0x8E, c.state})) << hex(status);
+    EXPECT_EQ(get(0x32, 0x01, 0x0B), (ByteVec{0x8E, c.supervisor})) << hex(status);
+    device.set_faults({}, now_);
+    EXPECT_EQ(get(0x01, 0x01, 0x05), (ByteVec{0x8E, 0x01, 0x00}));
+    EXPECT_EQ(get(0x01, 0x01, 0x08), (ByteVec{0x8E, 0x03}));  // operating again
+    EXPECT_EQ(get(0x32, 0x01, 0x0B), (ByteVec{0x8E, 0x02}));
+  }
+  // The short circuit of the minor recoverable fault is a DOP's Status too.
+  device.set_faults({.minor_recoverable = true}, now_);
+  EXPECT_EQ(get(0x09, 0x01, 0x04), (ByteVec{0x8E, 0x01}));
+}
+
+// A major fault applies the fault actions and holds the outputs there: polls
+// are answered (the master still reads the inputs) but not applied, and
+// output Sets are refused, until it clears.
+TEST_F(Cdn127SlaveTest, MajorFaultAppliesTheFaultActionsAndHoldsTheOutputs) {
+  boot();
+  allocate();
+  EXPECT_EQ(set(0x0B, 0x01, 0x09, {0x01}), (ByteVec{0x90}));  // AOP fault state: low
+  EXPECT_EQ(set(0x05, 0x02, 0x09, {0x64, 0x00}), (ByteVec{0x90, 0x64, 0x00}));
+  poll({0x05, 0x00, 0x34, 0x02});
+  ASSERT_TRUE(slave_->outputs().pump_on);
+
+  slave_->device().set_faults({.major_recoverable = true}, now_);
+  EXPECT_FALSE(slave_->outputs().pump_on);  // fault value Off
+  EXPECT_FALSE(slave_->outputs().n2_ballast_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0);
+  EXPECT_TRUE(slave_->pump().last_change_was_fault());
+
+  EXPECT_EQ(poll({0x05, 0x00, 0x34, 0x02}).size(), 6u);
+  EXPECT_EQ(poll({}).size(), 6u);
+  EXPECT_EQ(slave_->counters().polls_major_fault, 2u);
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->pump().last_change_was_fault());
+  EXPECT_EQ(set(0x09, 0x01, 0x03, {0x01}), error(0x10));  // device state conflict
+  EXPECT_EQ(set(0x04, 0x05, 0x03, {0x01}), error(0x10));  // consumed assembly 5
+  EXPECT_FALSE(slave_->outputs().pump_on);
+
+  // A second major fault on top applies nothing new; clearing one leaves the
+  // other in force.
+  slave_->device().set_faults({.major_recoverable = true, .major_unrecoverable = true}, now_);
+  slave_->device().set_faults({.major_unrecoverable = true}, now_);
+  poll({0x05, 0x00, 0x34, 0x02});
+  EXPECT_FALSE(slave_->outputs().pump_on);
+
+  slave_->device().set_faults({}, now_);
+  EXPECT_FALSE(slave_->outputs().pump_on);  // nothing is switched back on by itself
+  poll({0x05, 0x00, 0x34, 0x02});
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0x0234);
+  EXPECT_EQ(slave_->counters().polls_major_fault, 3u);
+}
+
+// With the unsafe factory actions a major fault leaves the pump on: what
+// the device was told to do on a fault.
+TEST_F(Cdn127SlaveTest, MajorFaultOnAnUnsafeDeviceHoldsThePumpOn) {
+  create(unsafe_options());
+  boot();
+  establish_poll();
+  poll({0x01, 0x00, 0x00, 0x00});
+  slave_->device().set_faults({.major_recoverable = true}, now_);
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  poll({});  // idle actions held off too
+  EXPECT_TRUE(slave_->outputs().pump_on);
+}
+
+// Minor faults change no output.
+TEST_F(Cdn127SlaveTest, MinorFaultsLeaveTheOutputsToTheMaster) {
+  boot();
+  establish_poll();
+  poll({0x01, 0x00, 0x00, 0x00});
+  slave_->device().set_faults({.minor_recoverable = true, .minor_unrecoverable = true}, now_);
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  poll({0x00, 0x00, 0x00, 0x00});
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_EQ(slave_->counters().polls_major_fault, 0u);
+}
+
+// ---------------------------------------------------------------------------
 // Resets and power cycles
 
 TEST_F(Cdn127SlaveTest, PowerCycleKeepsE2AndDropsEverythingElse) {
@@ -1145,6 +1248,31 @@ TEST_F(Cdn127SlaveTest, PowerCycleKeepsTheOutputActionsWrittenAndStartsWithOutpu
   ASSERT_EQ(slave_->poll_state(), ConnectionState::kTimedOut);
   EXPECT_FALSE(slave_->outputs().pump_on);
   EXPECT_EQ(slave_->outputs().analog_out_raw, 200);
+}
+
+// A power cycle is the exit from an unrecoverable fault (manual, Identity
+// attribute 8); a recoverable one stands, its cause being outside the
+// device. An Identity Reset is no power cycle.
+TEST_F(Cdn127SlaveTest, PowerCycleEndsUnrecoverableFaultsOnly) {
+  boot();
+  const IdentityFaults all{.minor_recoverable = true,
+                           .minor_unrecoverable = true,
+                           .major_recoverable = true,
+                           .major_unrecoverable = true};
+  slave_->device().set_faults(all, now_);
+  allocate();
+  exchange(kRequestId, {kMaster, 0x05, 0x01, 0x01});  // Identity Reset
+  advance(milliseconds(2001));
+  EXPECT_EQ(slave_->device().faults(), all);
+
+  slave_->power_cycle(now_);
+  advance(milliseconds(2001));
+  EXPECT_EQ(slave_->device().faults(),
+            (IdentityFaults{.minor_recoverable = true, .major_recoverable = true}));
+  EXPECT_EQ(slave_->outputs(), profiles::cdn127::PumpOutputs{});
+  allocate();
+  EXPECT_EQ(get(0x01, 0x01, 0x05), (ByteVec{0x8E, 0x01, 0x05}));
+  EXPECT_EQ(get(0x01, 0x01, 0x08), (ByteVec{0x8E, 0x04}));
 }
 
 TEST_F(Cdn127SlaveTest, IdentityResetRestartsAfterAnswering) {
