@@ -92,6 +92,32 @@ ParseResult parse_control(std::string_view line) {
   if (verb == "power-cycle") return with_target(Verb::kPowerCycle, false);
   if (verb == "power-off") return with_target(Verb::kPowerOff, false);
   if (verb == "power-on") return with_target(Verb::kPowerOn, false);
+  if (verb == "fault") {
+    if (w.size() != 4) return std::string("usage: fault MAC|all FAULT on|off");
+    c.verb = Verb::kFault;
+    auto t = target(w[1], true);
+    if (auto* e = std::get_if<std::string>(&t)) return *e;
+    c.mac = std::get<std::optional<std::uint8_t>>(t);
+    const std::string_view fault = w[2];
+    if (fault == "minor-recoverable") {
+      c.fault = Fault::kMinorRecoverable;
+    } else if (fault == "minor-unrecoverable") {
+      c.fault = Fault::kMinorUnrecoverable;
+    } else if (fault == "major-recoverable") {
+      c.fault = Fault::kMajorRecoverable;
+    } else if (fault == "major-unrecoverable") {
+      c.fault = Fault::kMajorUnrecoverable;
+    } else {
+      return fmt::format(
+          "unknown fault \"{}\": minor-recoverable, minor-unrecoverable, major-recoverable, "
+          "major-unrecoverable",
+          fault);
+    }
+    // Only on and off: "ok" or "fail" would read backwards for a fault.
+    if (w[3] != "on" && w[3] != "off") return fmt::format("\"{}\" is not on or off", w[3]);
+    c.on = w[3] == "on";
+    return c;
+  }
   if (verb != "set") return fmt::format("unknown command \"{}\" (help lists them)", verb);
 
   if (w.size() != 4) return std::string("usage: set MAC INPUT VALUE");
@@ -132,10 +158,17 @@ std::string_view control_help() noexcept {
   set MAC n2-flow on|off      N2 purge flow present (on = ok)
   set MAC interlock on|off    interlock satisfied (on = ok)
   set MAC ain1|ain2 VALUE     analog input: volts ("2.5V", 0..10) or counts (0..4095)
-  power-cycle MAC|all         power off and on: volatile state lost, duplicate MAC check
+  fault MAC|all FAULT on|off  Identity fault on or off; FAULT: minor-recoverable (DOP
+                              short), minor-unrecoverable, major-recoverable (+24 V lost;
+                              State 4), major-unrecoverable (checksum, A/D; State 5).
+                              A major fault applies the outputs' fault actions and holds
+                              them there (polls answered, not applied) until cleared
+  power-cycle MAC|all         power off and on: volatile state lost, duplicate MAC check;
+                              E2 settings kept; unrecoverable faults end, recoverable stay
   power-off MAC|all           the device goes silent until power-on
-  power-on MAC|all
-  status [MAC]                network state, owner, outputs and inputs of each device
+  power-on MAC|all            (after power-off: a power cycle, as above)
+  status [MAC]                network state, owner, outputs, inputs, Identity state and
+                              faults of each device
   help
   quit                        (end of input quits too, unless --control is given)
 Pump running follows the Pump On output the master sets, after the pump's spin-up

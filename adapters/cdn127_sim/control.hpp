@@ -9,11 +9,19 @@
 //   set MAC interlock on|off      interlock satisfied (on = ok)
 //   set MAC ain1|ain2 VALUE       analog input: volts with a V ("2.5V",
 //                                 0..10) or raw counts (0..4095)
+//   fault MAC|all FAULT on|off    an Identity fault (attribute 5 bits 8..11):
+//                                 minor-recoverable, minor-unrecoverable,
+//                                 major-recoverable (State 4) or
+//                                 major-unrecoverable (State 5); a major
+//                                 one applies the fault actions and holds
+//                                 the outputs there until cleared
 //   power-cycle MAC|all           off and on again: volatile state lost,
-//                                 duplicate MAC check, waits for a master
+//                                 duplicate MAC check, waits for a master;
+//                                 E2 kept; unrecoverable faults end
 //   power-off MAC|all             silent and deaf until power-on
-//   power-on MAC|all
-//   status [MAC]                  one line per device
+//   power-on MAC|all              after power-off: a power cycle, as above
+//   status [MAC]                  one line per device (Identity state and
+//                                 faults at its end)
 //   help
 //   quit                          ends cdn127-sim (so does end of input)
 //
@@ -28,14 +36,31 @@
 
 namespace dnbridge::cdn127_sim {
 
-enum class Verb : std::uint8_t { kSet, kPowerCycle, kPowerOff, kPowerOn, kStatus, kHelp, kQuit };
+enum class Verb : std::uint8_t {
+  kSet,
+  kFault,
+  kPowerCycle,
+  kPowerOff,
+  kPowerOn,
+  kStatus,
+  kHelp,
+  kQuit
+};
 enum class Input : std::uint8_t { kAlarm, kWarning, kN2Flow, kInterlock, kAnalog1, kAnalog2 };
+// The Identity faults (sim::IdentityFaults).
+enum class Fault : std::uint8_t {
+  kMinorRecoverable,
+  kMinorUnrecoverable,
+  kMajorRecoverable,
+  kMajorUnrecoverable
+};
 
 struct ControlCommand {
   Verb verb = Verb::kHelp;
   std::optional<std::uint8_t> mac;  // none: every device
   Input input = Input::kAlarm;      // kSet
-  bool on = false;                  // kSet of a digital input
+  bool on = false;                  // kSet of a digital input; kFault: set or cleared
+  Fault fault = Fault::kMinorRecoverable;  // kFault
   std::uint16_t raw = 0;            // kSet of an analog input, 12-bit counts
 };
 

@@ -39,6 +39,7 @@ constexpr std::string_view kDeviceKeys[] = {
     "serial_number_bytes",
     "identity_state_supported",
     "epr_resolution_ms",
+    "unsafe_factory_output_actions",
 };
 constexpr std::span<const std::string_view> kSettingKeys = std::span(kDeviceKeys).subspan(1);
 
@@ -107,6 +108,7 @@ class Reader {
     flag("idle_poll_answered_empty", s.idle_poll_answered_empty);
     flag("no_ack_of_last_request_fragment", s.no_ack_of_last_request_fragment);
     flag("identity_state_supported", s.identity_state_supported);
+    flag("unsafe_factory_output_actions", s.unsafe_factory_output_actions);
     if (const toml::node* n = t.get("explicit_response_delay_ms")) {
       s.explicit_response_delay = ms(*n, "explicit_response_delay_ms", 0, kMaxDelayMs);
     }
@@ -202,6 +204,11 @@ void DeviceSettings::apply_to(sim::SlaveOptions& o) const {
   if (poll_response_delay) o.poll_response_delay = *poll_response_delay;
   if (serial_number_udint) o.serial_number_udint = *serial_number_udint;
   if (epr_resolution) o.timer_resolution = *epr_resolution;
+  // false: the simulator's factory values, not whatever a layer below set.
+  if (unsafe_factory_output_actions) {
+    o.factory_output_actions =
+        *unsafe_factory_output_actions ? sim::kUnsafeFactoryOutputActions : sim::OutputActions{};
+  }
   if (identity_state_supported) {
     auto& missing = o.unsupported_attributes;
     missing.erase(std::remove(missing.begin(), missing.end(), kIdentityState), missing.end());
@@ -291,6 +298,11 @@ std::string describe_readings(const sim::SlaveOptions& o) {
   }
   if (o.timer_resolution != lenient.timer_resolution) {
     parts.push_back(fmt::format("EPR in steps of {} ms", ms_of(o.timer_resolution)));
+  }
+  if (o.factory_output_actions == sim::kUnsafeFactoryOutputActions) {
+    parts.emplace_back("unsafe factory output actions (every output holds on fault and idle)");
+  } else if (o.factory_output_actions != lenient.factory_output_actions) {
+    parts.emplace_back("own factory output actions");
   }
   if (parts.empty()) return "lenient";
   std::string out;

@@ -1,7 +1,8 @@
 #pragma once
 // cdn127-sim's device configuration (--device-config FILE, TOML): for each
 // simulated device, the readings of the CDN127 manual it takes, as field
-// devices differ (sim::SlaveOptions documents each).
+// devices differ, and the output fault/idle actions it leaves the factory
+// with (sim::SlaveOptions documents each).
 //
 //   [defaults]                  # every device, those given only with --mac too
 //   explicit_response_delay_ms = 300
@@ -21,6 +22,7 @@
 //   serial_number_bytes = 2|4
 //   identity_state_supported = true|false
 //   epr_resolution_ms = 1..65535
+//   unsafe_factory_output_actions = true|false
 // deploy/config/cdn127-sim-example.toml is an annotated example.
 //
 // A device's options: sim::default_slave_options(mac), then the --reading
@@ -54,6 +56,9 @@ struct DeviceSettings {
   std::optional<bool> serial_number_udint;       // serial_number_bytes = 4
   std::optional<bool> identity_state_supported;  // false: Identity attribute 8 answers 0x14
   std::optional<Duration> epr_resolution;        // SlaveOptions::timer_resolution
+  // SlaveOptions::factory_output_actions: true sim::kUnsafeFactoryOutputActions,
+  // false the simulator's default.
+  std::optional<bool> unsafe_factory_output_actions;
 
   void apply_to(sim::SlaveOptions& options) const;
 };
@@ -93,8 +98,9 @@ DeviceConfig load_device_config(const std::filesystem::path& path);
 std::vector<sim::SlaveOptions> device_options(const std::vector<devicenet::MacId>& macs,
                                               const DeviceConfig& config, Reading reading);
 
-// The readings a device takes, for the log: "lenient" when it takes none,
-// else a comma-separated list ("configuration locked while poll allocated,
+// The readings a device takes, and its factory output actions when they
+// are not the default, for the log: "lenient" when it has none of them, else
+// a comma-separated list ("configuration locked while poll allocated,
 // explicit responses 300 ms late, ...").
 std::string describe_readings(const sim::SlaveOptions& options);
 

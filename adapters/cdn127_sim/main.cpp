@@ -67,7 +67,12 @@ int main(int argc, char** argv) {
       "  identity_state_supported = false # Identity attribute 8 answers 0x14\n"
       "  epr_resolution_ms = 100          # expected packet rates rounded up to this\n"
       "--reading field is all of these as shown. A device's options: --reading, then\n"
-      "[defaults], then its [[device]] (deploy/config/cdn127-sim-example.toml).\n\n" +
+      "[defaults], then its [[device]] (deploy/config/cdn127-sim-example.toml).\n"
+      "Not a reading, so not in --reading field, a key of the same tables:\n"
+      "  unsafe_factory_output_actions = true  # E2 as it leaves the factory (and after\n"
+      "      # Identity Reset type 1): DOP fault/idle actions 1 (no change), AOP fault/idle\n"
+      "      # states 0 (hold): the pump stays on when the master goes idle or away. false\n"
+      "      # (default): each DOP goes Off (action 0, value 0), the AOP holds (state 0).\n\n" +
       std::string(cdn127_sim::control_help())};
   std::string interface;
   std::vector<unsigned> macs;

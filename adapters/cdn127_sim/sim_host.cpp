@@ -37,6 +37,35 @@ bool interface_gone(const std::error_code& e) {
 
 const char* on_off(bool b) { return b ? "on" : "off"; }
 
+// "none", or the faults that stand: "major-recoverable,minor-recoverable".
+std::string fault_list(const sim::IdentityFaults& f) {
+  std::string out;
+  auto add = [&out](bool on, const char* name) {
+    if (!on) return;
+    if (!out.empty()) out += ',';
+    out += name;
+  };
+  add(f.major_unrecoverable, "major-unrecoverable");
+  add(f.major_recoverable, "major-recoverable");
+  add(f.minor_unrecoverable, "minor-unrecoverable");
+  add(f.minor_recoverable, "minor-recoverable");
+  return out.empty() ? "none" : out;
+}
+
+bool& fault_flag(sim::IdentityFaults& f, Fault which) {
+  switch (which) {
+    case Fault::kMinorRecoverable:
+      return f.minor_recoverable;
+    case Fault::kMinorUnrecoverable:
+      return f.minor_unrecoverable;
+    case Fault::kMajorRecoverable:
+      return f.major_recoverable;
+    case Fault::kMajorUnrecoverable:
+      break;
+  }
+  return f.major_unrecoverable;
+}
+
 }  // namespace
 
 // --- one device ------------------------------------------------------------
@@ -233,14 +262,16 @@ std::string SimHost::status_line(SocketDevice& d, TimePoint now) {
   const auto& ain = s.pump().analog_inputs_raw();
   return fmt::format(
       "mac {} power {} network {} owner {} poll {} | outputs pump-on {} n2-ballast {} aout {} | "
-      "running {} alarm {} warning {} n2-flow {} interlock {} ain1 {} ain2 {}",
+      "running {} alarm {} warning {} n2-flow {} interlock {} ain1 {} ain2 {} | "
+      "identity state {} status 0x{:04X} faults {}",
       d.mac().value(), on_off(d.powered()), sim::to_string(s.network_state()),
       s.owner() == 255 ? std::string("none") : std::to_string(s.owner()),
       s.poll_state() == sim::ConnectionState::kEstablished ? "established" : "not-established",
       on_off(out.pump_on), on_off(out.n2_ballast_on), out.analog_out_raw,
       on_off(s.pump().running()), on_off(s.pump().alarm_active()),
       on_off(s.pump().warning_active()), on_off(s.pump().n2_flow_ok()),
-      on_off(s.pump().interlock_ok()), ain[0], ain[1]);
+      on_off(s.pump().interlock_ok()), ain[0], ain[1], s.device().identity_state(),
+      s.device().identity_status(), fault_list(s.device().faults()));
 }
 
 std::string SimHost::execute(const ControlCommand& c, TimePoint now) {
@@ -280,6 +311,15 @@ std::string SimHost::execute(const ControlCommand& c, TimePoint now) {
       for (auto* d : targets) {
         if (!d->powered()) d->power_on(now);
         log_.info("device {} powered on", d->mac().value());
+      }
+      return "ok";
+    case Verb::kFault:
+      for (auto* d : targets) {
+        auto& device = d->slave().device();
+        sim::IdentityFaults f = device.faults();
+        fault_flag(f, c.fault) = c.on;
+        device.set_faults(f, now);
+        log_.info("device {} faults: {}", d->mac().value(), fault_list(f));
       }
       return "ok";
     case Verb::kSet:

@@ -27,6 +27,8 @@ E2Memory initial_e2(const SlaveOptions& o) noexcept {
   e2.configuration = o.configuration;
   e2.mac = o.stored_mac <= MacId::kMax ? o.stored_mac : MacId::kMax;
   e2.baud = o.stored_baud <= 2 ? o.stored_baud : 0;
+  e2.dop = o.factory_output_actions.dop;
+  e2.aop = o.factory_output_actions.aop;
   return e2;
 }
 
@@ -71,8 +73,12 @@ Cdn127Device::Cdn127Device(const SlaveOptions& options) noexcept
       mac_switch_at_power_up_(options.mac_switch),
       baud_switch_at_power_up_(options.baud_switch) {}
 
-void Cdn127Device::power_up(TimePoint now) noexcept {
+void Cdn127Device::power_up(TimePoint now, PowerUpCause cause) noexcept {
   now_ = now;
+  if (cause == PowerUpCause::kPowerOn) {
+    faults_.major_unrecoverable = false;
+    faults_.minor_unrecoverable = false;
+  }
   // The switches are only read during power-up; a valid switch also becomes
   // the software setting ("defaults to the last hardware setting").
   mac_switch_at_power_up_ = mac_switch_;
@@ -347,6 +353,12 @@ PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {
       result.outcome = PollOutcome::kInvalid;
     }
   }
+  // A major fault holds the outputs in their fault state (set_faults); the
+  // master still gets the inputs.
+  if (major_fault()) {
+    result.outcome = PollOutcome::kMajorFault;
+    poll_running_ = false;
+  }
   auto apply = [&] {
     if (result.outcome == PollOutcome::kIdle) {
       apply_idle_actions(now);
@@ -361,8 +373,7 @@ PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {
   // updated during poll processing, so the response sees the new outputs.
   const bool no_poll_update = (e2_.configuration.mode & profiles::cdn127::mode::kNoPollUpdate) != 0;
   // A device that answers the idle condition with no data.
-  const bool answer_empty =
-      result.outcome == PollOutcome::kIdle && options_.idle_poll_answered_empty;
+  const bool answer_empty = idle && options_.idle_poll_answered_empty;
   if (!no_poll_update) apply();
   if (!answer_empty) {
     result.response.resize(build_produced(*response_layout, result.response.storage()));
@@ -394,6 +405,7 @@ Reply Cdn127Device::set_consumed_assembly(std::uint8_t assembly, Bytes data, Tim
   if (poll_.state == ConnectionState::kEstablished && poll_.consumed_assembly == assembly) {
     return reply_error(GeneralStatus::kObjectStateConflict);
   }
+  if (major_fault()) return reply_error(GeneralStatus::kDeviceStateConflict);
   if (layout->size == 0) return kReplyOk;
   auto decoded = profiles::cdn127::decode_poll_request(*layout, data);
   if (!decoded.ok()) return reply_error(GeneralStatus::kInvalidAttributeValue);
@@ -413,9 +425,12 @@ void Cdn127Device::apply_decoded_outputs(const PollRequestLayout& layout, const 
   pump_.set_outputs(next, cause, now);
 }
 
-void Cdn127Device::set_outputs(const PumpOutputs& outputs, OutputCause cause, TimePoint now) noexcept {
+Reply Cdn127Device::set_outputs(const PumpOutputs& outputs, OutputCause cause,
+                                TimePoint now) noexcept {
   now_ = now;
+  if (major_fault()) return reply_error(GeneralStatus::kDeviceStateConflict);
   pump_.set_outputs(outputs, cause, now);
+  return kReplyOk;
 }
 
 void Cdn127Device::apply_fault_actions(TimePoint now) noexcept {
@@ -428,6 +443,7 @@ void Cdn127Device::apply_fault_actions(TimePoint now) noexcept {
 }
 
 void Cdn127Device::apply_idle_actions(TimePoint now) noexcept {
+  if (major_fault()) return;
   PumpOutputs next = pump_.outputs();
   const auto& dop = e2_.dop;
   if (!dop[0].idle_hold) next.pump_on = dop[0].idle_value;
@@ -467,8 +483,22 @@ std::uint8_t Cdn127Device::identity_state() const noexcept {
   return 3;  // Operating
 }
 
+void Cdn127Device::set_faults(const IdentityFaults& faults, TimePoint now) noexcept {
+  now_ = now;
+  const bool was_major = major_fault();
+  faults_ = faults;
+  if (!was_major && major_fault()) {
+    apply_fault_actions(now);
+    poll_running_ = false;
+  }
+}
+
+// The manual lists the values without saying when each is taken; ODVA's
+// S-Device Supervisor stops in Abort on a recoverable fault and in Critical
+// Fault on an unrecoverable one.
 std::uint8_t Cdn127Device::supervisor_device_status() const noexcept {
   if (faults_.major_unrecoverable) return 6;  // Critical Fault
+  if (faults_.major_recoverable) return 5;    // Abort
   if (poll_.state == ConnectionState::kEstablished && poll_running_) return 4;  // Executing
   return 2;  // Idle
 }

@@ -79,6 +79,41 @@ struct ClassAttribute {
   friend bool operator==(const ClassAttribute&, const ClassAttribute&) = default;
 };
 
+// DOP attributes 5..8. The manual's encoding: action 0 = use the value, 1 = hold.
+struct DopSettings {
+  bool fault_hold = false;
+  bool fault_value = false;
+  bool idle_hold = false;
+  bool idle_value = false;
+  friend bool operator==(const DopSettings&, const DopSettings&) = default;
+};
+
+// AOP attributes 9..12: state 0 hold, 1 low (0 V), 2 high (4095), 3 the value.
+struct AopSettings {
+  std::uint8_t fault_state = 0;
+  std::uint8_t idle_state = 0;
+  std::uint16_t fault_value = 0;
+  std::uint16_t idle_value = 0;
+  friend bool operator==(const AopSettings&, const AopSettings&) = default;
+};
+
+// What every output does on a fault and on idle: DOP instances 1 (Pump On)
+// and 2 (N2 Ballast On) attributes 5..8, AOP attributes 9..12.
+struct OutputActions {
+  std::array<DopSettings, 2> dop{};
+  AopSettings aop{};
+  friend bool operator==(const OutputActions&, const OutputActions&) = default;
+};
+
+// A device that leaves every output as it is when its master goes idle or
+// away: DOP fault and idle actions 1 (no change), AOP fault and idle states 0
+// (hold the last value). A pump that was on stays on.
+inline constexpr OutputActions kUnsafeFactoryOutputActions{
+    .dop = {DopSettings{.fault_hold = true, .idle_hold = true},
+            DopSettings{.fault_hold = true, .idle_hold = true}},
+    .aop = AopSettings{.fault_state = 0, .idle_state = 0},
+};
+
 struct SlaveOptions {
   // Front-panel rotary switches, read at power-up only (manual, "Switches"):
   // MAC 0..63 valid, 64..99 the program position (MAC set in software); baud
@@ -110,6 +145,13 @@ struct SlaveOptions {
   // Configuration object values in E2 before the first power-up.
   profiles::cdn127::IoConfiguration configuration =
       profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127);
+  // The outputs' fault and idle actions in E2 before the first power-up, and
+  // what Identity Reset type 1 restores. The manual gives no factory values.
+  // By default each DOP goes to its value, Off, on a fault and on idle
+  // (action 0, value 0) and the AOP holds its last value (state 0): every
+  // attribute 0. kUnsafeFactoryOutputActions is the device a master must
+  // not trust as it comes: it keeps the pump on.
+  OutputActions factory_output_actions{};
 
   PumpModel::Config pump{};
   Duration duplicate_mac_window = seconds(1);
@@ -168,23 +210,11 @@ struct SlaveOptions {
 // responses 300 ms and poll responses 3 ms late, the 2-byte (UINT) serial
 // number, no Identity State attribute (0x01/8), expected packet rates in
 // steps of 100 ms. What `cdn127-sim --reading field` runs.
+// The factory output actions are left as they are: they are not a reading of
+// the manual but values in E2, and a device in the field holds whatever the
+// last configuration tool wrote there, safe or not. Choose them on their own
+// (factory_output_actions) to try either with any reading.
 void apply_field_reading(SlaveOptions& options);
-
-// DOP attributes 5..8. The manual's encoding: action 0 = use the value, 1 = hold.
-struct DopSettings {
-  bool fault_hold = false;
-  bool fault_value = false;
-  bool idle_hold = false;
-  bool idle_value = false;
-};
-
-// AOP attributes 9..12: state 0 hold, 1 low (0 V), 2 high (4095), 3 the value.
-struct AopSettings {
-  std::uint8_t fault_state = 0;
-  std::uint8_t idle_state = 0;
-  std::uint16_t fault_value = 0;
-  std::uint16_t idle_value = 0;
-};
 
 // What the CDN127 keeps in E2 across power cycles. The manual says so for the
 // Configuration object (NOTE 1) and the software MAC/baud ("defaults to the
@@ -211,12 +241,25 @@ struct Connection {
 };
 
 // Identity attribute 5 bits 8..11 (ODVA numbering; the manual lists 8/9 twice).
+// A recoverable fault lasts as long as its cause, which is outside the device
+// (a short on a DOP, the +24 Vdc gone): it stays until cleared, power cycles
+// included. An unrecoverable one lasts until the next power cycle, "the only
+// exit from a Major Unrecoverable fault condition" (manual, Identity
+// attribute 8); the manual names no exit for the minor one, which is taken to
+// be the same. An Identity Reset is no power cycle: it clears neither.
 struct IdentityFaults {
   bool minor_recoverable = false;    // DOP short circuit
   bool minor_unrecoverable = false;
   bool major_recoverable = false;    // loss of +24 Vdc
   bool major_unrecoverable = false;  // checksum, A/D
+
+  bool major() const noexcept { return major_recoverable || major_unrecoverable; }
+  friend bool operator==(const IdentityFaults&, const IdentityFaults&) = default;
 };
+
+// What starts the device up: power applied, which ends unrecoverable faults,
+// or a restart with power on (Identity Reset, a new MAC), which does not.
+enum class PowerUpCause : std::uint8_t { kPowerOn, kRestart };
 
 // Work to do once the response to the current request has been sent.
 enum class PendingAction : std::uint8_t {
@@ -232,6 +275,8 @@ enum class PollOutcome : std::uint8_t {
   kIdle,            // shorter than the consumed size: idle actions, response built
                     // (empty with SlaveOptions::idle_poll_answered_empty)
   kInvalid,         // full size but an analog value over 4095: outputs kept, response built
+  kMajorFault,      // a major fault stands: outputs kept in their fault state, response
+                    // built (empty for an idle poll with idle_poll_answered_empty)
 };
 
 struct PollResult {
@@ -247,8 +292,11 @@ class Cdn127Device {
  public:
   explicit Cdn127Device(const SlaveOptions& options) noexcept;
 
-  // Power-up: volatile state cleared, switches read, outputs off.
-  void power_up(TimePoint now) noexcept;
+  // Power-up: volatile state cleared, switches read, outputs off; with
+  // power applied, the unrecoverable faults end too (IdentityFaults). E2
+  // persists. Under a recoverable major fault still standing the outputs
+  // stay off until it clears: fault actions act on the change to a fault.
+  void power_up(TimePoint now, PowerUpCause cause) noexcept;
   // Identity Reset type 1: E2 back to the out-of-box values.
   void restore_factory_defaults() noexcept;
 
@@ -311,9 +359,12 @@ class Cdn127Device {
   Reply set_consumed_assembly(std::uint8_t assembly, Bytes data, TimePoint now) noexcept;
 
   // --- outputs ---
-  void set_outputs(const profiles::cdn127::PumpOutputs& outputs, OutputCause cause,
-                   TimePoint now) noexcept;
+  // Outputs set over the network (DOP State): refused with 0x10 (device
+  // state conflict) while a major fault stands.
+  Reply set_outputs(const profiles::cdn127::PumpOutputs& outputs, OutputCause cause,
+                    TimePoint now) noexcept;
   void apply_fault_actions(TimePoint now) noexcept;
+  // Nothing while a major fault stands: the outputs keep their fault state.
   void apply_idle_actions(TimePoint now) noexcept;
 
   // --- Configuration object ---
@@ -328,8 +379,16 @@ class Cdn127Device {
   std::uint8_t identity_state() const noexcept;
   std::uint8_t supervisor_device_status() const noexcept;
   std::uint8_t exception_status_byte() noexcept;
-  void set_faults(const IdentityFaults& faults) noexcept { faults_ = faults; }
+  // The device's faults as they are now. A major fault where there was none
+  // applies the fault actions (DOP attribute 5, AOP attribute 9) and then
+  // holds the outputs there until every major fault has cleared: polls are
+  // answered but not applied, DOP State and consumed assembly Sets refused.
+  // The manual's Identity section says nothing of the outputs; its AOP Fault
+  // State applies on fault conditions that "include software conditions
+  // (connection timeout)", so not only those. Minor faults change no output.
+  void set_faults(const IdentityFaults& faults, TimePoint now) noexcept;
   const IdentityFaults& faults() const noexcept { return faults_; }
+  bool major_fault() const noexcept { return faults_.major(); }
   // A failed converter: the channel's poll response field carries `raw`
   // whatever it is (above 4095 included) until cleared with nullopt.
   void fail_analog_input(std::size_t channel, std::optional<std::uint16_t> raw) noexcept {

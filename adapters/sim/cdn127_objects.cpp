@@ -411,8 +411,7 @@ const AttributeDef kDopAttributes[] = {
        if (!r.ok()) return r;
        PumpOutputs o = c.device.pump().outputs();
        (c.instance == 1 ? o.pump_on : o.n2_ballast_on) = on;
-       c.device.set_outputs(o, OutputCause::kExplicit, c.now);
-       return kReplyOk;
+       return c.device.set_outputs(o, OutputCause::kExplicit, c.now);
      }},
     {4, Access::kGet,  // a short circuit is the Identity's minor recoverable fault
      [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.faults().minor_recoverable ? 1 : 0); },

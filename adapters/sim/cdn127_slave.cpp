@@ -63,9 +63,11 @@ Cdn127Slave::Cdn127Slave(can::FrameSink& sink, SlaveOptions options, Logger log)
       dup_check_(MacId::from_bits(options.stored_mac), duplicate_mac_config(options)),
       sender_(sender_config(options)) {}
 
-void Cdn127Slave::power_on(TimePoint now) noexcept {
+void Cdn127Slave::power_on(TimePoint now) noexcept { start_up(now, PowerUpCause::kPowerOn); }
+
+void Cdn127Slave::start_up(TimePoint now, PowerUpCause cause) noexcept {
   ++counters_.restarts;
-  device_.power_up(now);
+  device_.power_up(now, cause);
   reassembler_.reset();
   sender_.cancel();
   drop_delayed();
@@ -94,7 +96,7 @@ void Cdn127Slave::enter_communication_fault() noexcept {
   log_.debug("duplicate MAC {} detected: communication fault", device_.mac().value());
 }
 
-void Cdn127Slave::restart(TimePoint now) noexcept { power_on(now); }
+void Cdn127Slave::restart(TimePoint now) noexcept { start_up(now, PowerUpCause::kRestart); }
 
 void Cdn127Slave::drop_delayed() noexcept {
   delayed_responses_.clear();
@@ -455,6 +457,9 @@ void Cdn127Slave::on_poll(const can::CanFrame& frame, TimePoint now) noexcept {
       break;
     case PollOutcome::kInvalid:
       ++counters_.polls_invalid;
+      break;
+    case PollOutcome::kMajorFault:
+      ++counters_.polls_major_fault;
       break;
   }
   const Duration delay = device_.options().poll_response_delay;

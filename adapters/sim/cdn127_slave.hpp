@@ -72,6 +72,7 @@ struct SlaveCounters {
   std::uint32_t polls_idle = 0;
   std::uint32_t polls_oversize = 0;        // longer than the consumed size: ignored
   std::uint32_t polls_invalid = 0;
+  std::uint32_t polls_major_fault = 0;     // answered, outputs not applied: a major fault stands
   std::uint32_t polls_ignored = 0;         // no established poll connection
   std::uint32_t fragment_transfers_failed = 0;
   std::uint32_t restarts = 0;              // power-ups, Identity Reset, MAC change
@@ -98,6 +99,8 @@ class Cdn127Slave {
 
   // First power-up (and power_cycle() for later ones): volatile state reset,
   // switches read, outputs off, the duplicate MAC check started. E2 persists.
+  // Unrecoverable Identity faults end, recoverable ones stay (IdentityFaults);
+  // a restart (Identity Reset, a new MAC) keeps both.
   void power_on(TimePoint now) noexcept;
   void power_cycle(TimePoint now) noexcept { power_on(now); }
 
@@ -151,6 +154,7 @@ class Cdn127Slave {
   void after_response(PendingAction action, TimePoint now) noexcept;
   void drop_delayed() noexcept;
   void restart(TimePoint now) noexcept;
+  void start_up(TimePoint now, PowerUpCause cause) noexcept;
   void enter_communication_fault() noexcept;
   std::uint32_t response_id() const noexcept;
 

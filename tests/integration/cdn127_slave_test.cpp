@@ -957,6 +957,217 @@ TEST_F(Cdn127SlaveTest, GroupsAndMessagesNotSupportedAreIgnored) {
 }
 
 // ---------------------------------------------------------------------------
+// Factory output actions (SlaveOptions::factory_output_actions)
+
+constexpr std::uint8_t kDopInstances[] = {1, 2};  // Pump On, N2 Ballast On
+
+SlaveOptions unsafe_options() {
+  SlaveOptions o = default_options();
+  o.factory_output_actions = kUnsafeFactoryOutputActions;
+  return o;
+}
+
+// The simulator's factory values: every attribute 0, each DOP to Off on a
+// fault and on idle, the AOP holding.
+TEST_F(Cdn127SlaveTest, DefaultFactoryOutputActionsTurnTheDopsOff) {
+  boot();
+  allocate();
+  for (std::uint8_t instance : kDopInstances) {
+    for (std::uint8_t attribute = 5; attribute <= 8; ++attribute) {
+      EXPECT_EQ(get(0x09, instance, attribute), (ByteVec{0x8E, 0x00})) << int{attribute};
+    }
+  }
+  EXPECT_EQ(get(0x0B, 0x01, 0x09), (ByteVec{0x8E, 0x00}));
+  EXPECT_EQ(get(0x0B, 0x01, 0x0A), (ByteVec{0x8E, 0x00}));
+}
+
+TEST_F(Cdn127SlaveTest, UnsafeFactoryOutputActionsAreWhatTheDeviceAnswers) {
+  create(unsafe_options());
+  boot();
+  allocate();
+  for (std::uint8_t instance : kDopInstances) {
+    EXPECT_EQ(get(0x09, instance, 0x05), (ByteVec{0x8E, 0x01}));  // fault action: no change
+    EXPECT_EQ(get(0x09, instance, 0x06), (ByteVec{0x8E, 0x00}));
+    EXPECT_EQ(get(0x09, instance, 0x07), (ByteVec{0x8E, 0x01}));  // idle action: no change
+    EXPECT_EQ(get(0x09, instance, 0x08), (ByteVec{0x8E, 0x00}));
+  }
+  EXPECT_EQ(get(0x0B, 0x01, 0x09), (ByteVec{0x8E, 0x00}));  // fault state: hold
+  EXPECT_EQ(get(0x0B, 0x01, 0x0A), (ByteVec{0x8E, 0x00}));  // idle state: hold
+}
+
+// The unsafe device going idle keeps the pump on, until a master writes an
+// idle action of its own over the explicit connection.
+TEST_F(Cdn127SlaveTest, UnsafeDeviceKeepsThePumpOnWhenIdleUntilToldOtherwise) {
+  create(unsafe_options());
+  boot();
+  establish_poll();
+  poll({0x05, 0x00, 0x34, 0x02});  // pump on, ballast on, 0x234
+  ASSERT_TRUE(slave_->outputs().pump_on);
+
+  EXPECT_EQ(poll({}).size(), 6u);
+  EXPECT_EQ(slave_->counters().polls_idle, 1u);
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0x0234);
+
+  // DOP 1 Idle Action 0 (use the value), Idle Value 0 (Off).
+  EXPECT_EQ(set(0x09, 0x01, 0x07, {0x00}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x09, 0x01, 0x08, {0x00}), (ByteVec{0x90}));
+  poll({0x05, 0x00, 0x34, 0x02});
+  ASSERT_TRUE(slave_->outputs().pump_on);
+  poll({});
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);  // DOP 2 still holds
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0x0234);
+  EXPECT_TRUE(slave_->pump().last_change_was_idle());
+}
+
+// A poll connection timing out (the fault condition): the unsafe device holds
+// every output; once told to use its fault values, it takes them.
+TEST_F(Cdn127SlaveTest, UnsafeDeviceHoldsOnPollTimeoutUntilGivenFaultValues) {
+  create(unsafe_options());
+  boot();
+  establish_poll(100);
+  poll({0x05, 0x00, 0x34, 0x02});
+  advance(milliseconds(400));
+  ASSERT_EQ(slave_->poll_state(), ConnectionState::kTimedOut);
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0x0234);
+  EXPECT_TRUE(slave_->pump().last_change_was_fault());
+
+  // DOP 1 Fault Action 0 with Fault Value 0; AOP Fault State 3 with Fault Value 500.
+  EXPECT_EQ(set(0x09, 0x01, 0x05, {0x00}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x09, 0x01, 0x06, {0x00}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x0B, 0x01, 0x09, {0x03}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x0B, 0x01, 0x0B, {0xF4, 0x01}), (ByteVec{0x90}));
+  EXPECT_EQ(request({0x05, 0x05, 0x02}), (ByteVec{0x85}));  // Connection Reset
+  poll({0x05, 0x00, 0x34, 0x02});
+  advance(milliseconds(400));
+  ASSERT_EQ(slave_->poll_state(), ConnectionState::kTimedOut);
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);  // DOP 2 still holds
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 500);
+}
+
+// Identity Reset type 1 brings back the factory values, unsafe ones included.
+TEST_F(Cdn127SlaveTest, FactoryResetRestoresTheUnsafeOutputActions) {
+  create(unsafe_options());
+  boot();
+  allocate();
+  EXPECT_EQ(set(0x09, 0x01, 0x07, {0x00}), (ByteVec{0x90}));
+  EXPECT_EQ(set(0x0B, 0x01, 0x0A, {0x01}), (ByteVec{0x90}));
+  exchange(kRequestId, {kMaster, 0x05, 0x01, 0x01, 0x01});
+  advance(milliseconds(2001));
+  allocate();
+  EXPECT_EQ(get(0x09, 0x01, 0x07), (ByteVec{0x8E, 0x01}));
+  EXPECT_EQ(get(0x0B, 0x01, 0x0A), (ByteVec{0x8E, 0x00}));
+}
+
+// ---------------------------------------------------------------------------
+// Identity faults (Cdn127Device::set_faults, cdn127-sim's `fault` command)
+
+TEST_F(Cdn127SlaveTest, IdentityFaultsShowInStatusAndState) {
+  boot();
+  allocate();
+  auto& device = slave_->device();
+  struct Case {
+    IdentityFaults faults;
+    ByteVec status;  // attribute 5, owned (bit 0) included
+    std::uint8_t state;
+    std::uint8_t supervisor;  // Device Supervisor attribute 11
+  };
+  const Case cases[] = {
+      {{.minor_recoverable = true}, {0x01, 0x01}, 3, 2},
+      {{.minor_unrecoverable = true}, {0x01, 0x02}, 3, 2},
+      {{.major_recoverable = true}, {0x01, 0x04}, 4, 5},    // Abort
+      {{.major_unrecoverable = true}, {0x01, 0x08}, 5, 6},  // Critical Fault
+      {{.major_recoverable = true, .major_unrecoverable = true}, {0x01, 0x0C}, 5, 6},
+  };
+  for (const Case& c : cases) {
+    device.set_faults(c.faults, now_);
+    ByteVec status{0x8E};
+    status.insert(status.end(), c.status.begin(), c.status.end());
+    EXPECT_EQ(get(0x01, 0x01, 0x05), status) << hex(status);
+    EXPECT_EQ(get(0x01, 0x01, 0x08), (ByteVec{0x8E, c.state})) << hex(status);
+    EXPECT_EQ(get(0x32, 0x01, 0x0B), (ByteVec{0x8E, c.supervisor})) << hex(status);
+    device.set_faults({}, now_);
+    EXPECT_EQ(get(0x01, 0x01, 0x05), (ByteVec{0x8E, 0x01, 0x00}));
+    EXPECT_EQ(get(0x01, 0x01, 0x08), (ByteVec{0x8E, 0x03}));  // operating again
+    EXPECT_EQ(get(0x32, 0x01, 0x0B), (ByteVec{0x8E, 0x02}));
+  }
+  // The short circuit of the minor recoverable fault is a DOP's Status too.
+  device.set_faults({.minor_recoverable = true}, now_);
+  EXPECT_EQ(get(0x09, 0x01, 0x04), (ByteVec{0x8E, 0x01}));
+}
+
+// A major fault applies the fault actions and holds the outputs there: polls
+// are answered (the master still reads the inputs) but not applied, and
+// output Sets are refused, until it clears.
+TEST_F(Cdn127SlaveTest, MajorFaultAppliesTheFaultActionsAndHoldsTheOutputs) {
+  boot();
+  allocate();
+  EXPECT_EQ(set(0x0B, 0x01, 0x09, {0x01}), (ByteVec{0x90}));  // AOP fault state: low
+  EXPECT_EQ(set(0x05, 0x02, 0x09, {0x64, 0x00}), (ByteVec{0x90, 0x64, 0x00}));
+  poll({0x05, 0x00, 0x34, 0x02});
+  ASSERT_TRUE(slave_->outputs().pump_on);
+
+  slave_->device().set_faults({.major_recoverable = true}, now_);
+  EXPECT_FALSE(slave_->outputs().pump_on);  // fault value Off
+  EXPECT_FALSE(slave_->outputs().n2_ballast_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0);
+  EXPECT_TRUE(slave_->pump().last_change_was_fault());
+
+  EXPECT_EQ(poll({0x05, 0x00, 0x34, 0x02}).size(), 6u);
+  EXPECT_EQ(poll({}).size(), 6u);
+  EXPECT_EQ(slave_->counters().polls_major_fault, 2u);
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_TRUE(slave_->pump().last_change_was_fault());
+  EXPECT_EQ(set(0x09, 0x01, 0x03, {0x01}), error(0x10));  // device state conflict
+  EXPECT_EQ(set(0x04, 0x05, 0x03, {0x01}), error(0x10));  // consumed assembly 5
+  EXPECT_FALSE(slave_->outputs().pump_on);
+
+  // A second major fault on top applies nothing new; clearing one leaves the
+  // other in force.
+  slave_->device().set_faults({.major_recoverable = true, .major_unrecoverable = true}, now_);
+  slave_->device().set_faults({.major_unrecoverable = true}, now_);
+  poll({0x05, 0x00, 0x34, 0x02});
+  EXPECT_FALSE(slave_->outputs().pump_on);
+
+  slave_->device().set_faults({}, now_);
+  EXPECT_FALSE(slave_->outputs().pump_on);  // nothing is switched back on by itself
+  poll({0x05, 0x00, 0x34, 0x02});
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0x0234);
+  EXPECT_EQ(slave_->counters().polls_major_fault, 3u);
+}
+
+// With the unsafe factory actions a major fault leaves the pump on: what
+// the device was told to do on a fault.
+TEST_F(Cdn127SlaveTest, MajorFaultOnAnUnsafeDeviceHoldsThePumpOn) {
+  create(unsafe_options());
+  boot();
+  establish_poll();
+  poll({0x01, 0x00, 0x00, 0x00});
+  slave_->device().set_faults({.major_recoverable = true}, now_);
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  poll({});  // idle actions held off too
+  EXPECT_TRUE(slave_->outputs().pump_on);
+}
+
+// Minor faults change no output.
+TEST_F(Cdn127SlaveTest, MinorFaultsLeaveTheOutputsToTheMaster) {
+  boot();
+  establish_poll();
+  poll({0x01, 0x00, 0x00, 0x00});
+  slave_->device().set_faults({.minor_recoverable = true, .minor_unrecoverable = true}, now_);
+  EXPECT_TRUE(slave_->outputs().pump_on);
+  poll({0x00, 0x00, 0x00, 0x00});
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_EQ(slave_->counters().polls_major_fault, 0u);
+}
+
+// ---------------------------------------------------------------------------
 // Resets and power cycles
 
 TEST_F(Cdn127SlaveTest, PowerCycleKeepsE2AndDropsEverythingElse) {
@@ -982,6 +1193,86 @@ TEST_F(Cdn127SlaveTest, PowerCycleKeepsE2AndDropsEverythingElse) {
   EXPECT_EQ(get(0x40, 0x01, 0x01), (ByteVec{0x8E, 0x81}));
   EXPECT_EQ(get(0x0B, 0x01, 0x0B), (ByteVec{0x8E, 0x00, 0x02}));
   EXPECT_EQ(get(0x05, 0x02, 0x09), (ByteVec{0x8E, 0x00, 0x00}));
+}
+
+// The fault and idle actions a master writes are E2: a power cycle keeps
+// them and they act after it, while the outputs start off.
+TEST_F(Cdn127SlaveTest, PowerCycleKeepsTheOutputActionsWrittenAndStartsWithOutputsOff) {
+  create(unsafe_options());
+  boot();
+  allocate();
+  for (std::uint8_t instance : kDopInstances) {
+    EXPECT_EQ(set(0x09, instance, 0x05, {0x00}), (ByteVec{0x90}));  // fault: the value,
+    EXPECT_EQ(set(0x09, instance, 0x07, {0x00}), (ByteVec{0x90}));  // idle: the value,
+    EXPECT_EQ(set(0x09, instance, 0x08, {0x00}), (ByteVec{0x90}));  // Off
+  }
+  EXPECT_EQ(set(0x0B, 0x01, 0x09, {0x03}), (ByteVec{0x90}));        // fault: the value,
+  EXPECT_EQ(set(0x0B, 0x01, 0x0B, {0xC8, 0x00}), (ByteVec{0x90}));  // 200
+  EXPECT_EQ(set(0x0B, 0x01, 0x0A, {0x01}), (ByteVec{0x90}));        // idle: low
+  EXPECT_EQ(set(0x05, 0x02, 0x09, {0x64, 0x00}), (ByteVec{0x90, 0x64, 0x00}));
+  poll({0x05, 0x00, 0x34, 0x02});
+  ASSERT_TRUE(slave_->outputs().pump_on);
+
+  slave_->power_cycle(now_);
+  auto out = sink_.take();
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].id, kDupMacId);
+  EXPECT_EQ(slave_->network_state(), Cdn127Slave::NetworkState::kDuplicateMacCheck);
+  EXPECT_EQ(slave_->owner(), 255);
+  EXPECT_EQ(slave_->poll_state(), ConnectionState::kNonExistent);
+  EXPECT_EQ(slave_->outputs(), profiles::cdn127::PumpOutputs{});
+  EXPECT_EQ(slave_->pump().last_cause(), OutputCause::kPowerUp);
+  // Silent to a master until the check is over.
+  EXPECT_TRUE(exchange(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x03, kMaster}).empty());
+  advance(milliseconds(2001));
+  ASSERT_EQ(slave_->network_state(), Cdn127Slave::NetworkState::kOnline);
+
+  allocate();
+  for (std::uint8_t instance : kDopInstances) {
+    EXPECT_EQ(get(0x09, instance, 0x05), (ByteVec{0x8E, 0x00}));
+    EXPECT_EQ(get(0x09, instance, 0x07), (ByteVec{0x8E, 0x00}));
+    EXPECT_EQ(get(0x09, instance, 0x08), (ByteVec{0x8E, 0x00}));
+  }
+  EXPECT_EQ(get(0x0B, 0x01, 0x09), (ByteVec{0x8E, 0x03}));
+  EXPECT_EQ(get(0x0B, 0x01, 0x0B), (ByteVec{0x8E, 0xC8, 0x00}));
+  EXPECT_EQ(get(0x0B, 0x01, 0x0A), (ByteVec{0x8E, 0x01}));
+  // And they act: idle, then a timeout.
+  EXPECT_EQ(set(0x05, 0x02, 0x09, {0x64, 0x00}), (ByteVec{0x90, 0x64, 0x00}));
+  poll({0x05, 0x00, 0x34, 0x02});
+  poll({});
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_FALSE(slave_->outputs().n2_ballast_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 0);
+  poll({0x05, 0x00, 0x34, 0x02});
+  advance(milliseconds(400));
+  ASSERT_EQ(slave_->poll_state(), ConnectionState::kTimedOut);
+  EXPECT_FALSE(slave_->outputs().pump_on);
+  EXPECT_EQ(slave_->outputs().analog_out_raw, 200);
+}
+
+// A power cycle is the exit from an unrecoverable fault (manual, Identity
+// attribute 8); a recoverable one stands, its cause being outside the
+// device. An Identity Reset is no power cycle.
+TEST_F(Cdn127SlaveTest, PowerCycleEndsUnrecoverableFaultsOnly) {
+  boot();
+  const IdentityFaults all{.minor_recoverable = true,
+                           .minor_unrecoverable = true,
+                           .major_recoverable = true,
+                           .major_unrecoverable = true};
+  slave_->device().set_faults(all, now_);
+  allocate();
+  exchange(kRequestId, {kMaster, 0x05, 0x01, 0x01});  // Identity Reset
+  advance(milliseconds(2001));
+  EXPECT_EQ(slave_->device().faults(), all);
+
+  slave_->power_cycle(now_);
+  advance(milliseconds(2001));
+  EXPECT_EQ(slave_->device().faults(),
+            (IdentityFaults{.minor_recoverable = true, .major_recoverable = true}));
+  EXPECT_EQ(slave_->outputs(), profiles::cdn127::PumpOutputs{});
+  allocate();
+  EXPECT_EQ(get(0x01, 0x01, 0x05), (ByteVec{0x8E, 0x01, 0x05}));
+  EXPECT_EQ(get(0x01, 0x01, 0x08), (ByteVec{0x8E, 0x04}));
 }
 
 TEST_F(Cdn127SlaveTest, IdentityResetRestartsAfterAnswering) {

@@ -59,6 +59,20 @@ TEST(Control, PowerAndStatus) {
   EXPECT_EQ(ok("help").verb, Verb::kHelp);
 }
 
+TEST(Control, IdentityFaults) {
+  auto c = ok("fault 5 major-recoverable on");
+  EXPECT_EQ(c.verb, Verb::kFault);
+  EXPECT_EQ(c.mac, 5);
+  EXPECT_EQ(c.fault, Fault::kMajorRecoverable);
+  EXPECT_TRUE(c.on);
+  c = ok("fault all major-unrecoverable off");
+  EXPECT_FALSE(c.mac.has_value());
+  EXPECT_EQ(c.fault, Fault::kMajorUnrecoverable);
+  EXPECT_FALSE(c.on);
+  EXPECT_EQ(ok("fault 0 minor-recoverable on").fault, Fault::kMinorRecoverable);
+  EXPECT_EQ(ok("fault 63 minor-unrecoverable on").fault, Fault::kMinorUnrecoverable);
+}
+
 TEST(Control, BlankAndCommentLinesAreNothing) {
   EXPECT_TRUE(std::holds_alternative<std::monostate>(parse_control("")));
   EXPECT_TRUE(std::holds_alternative<std::monostate>(parse_control("   \t")));
@@ -78,6 +92,13 @@ TEST(Control, ErrorsSayWhatIsWrong) {
   EXPECT_EQ(error("power-cycle"), "usage: power-cycle MAC|all");
   EXPECT_EQ(error("reboot 5"), "unknown command \"reboot\" (help lists them)");
   EXPECT_EQ(error("power-on 5 6"), "usage: power-on MAC|all");
+  EXPECT_EQ(error("fault 5 major-recoverable"), "usage: fault MAC|all FAULT on|off");
+  EXPECT_EQ(error("fault 64 major-recoverable on"), "\"64\" is not a MAC ID (0..63 or all)");
+  EXPECT_EQ(error("fault 5 major on"),
+            "unknown fault \"major\": minor-recoverable, minor-unrecoverable, "
+            "major-recoverable, major-unrecoverable");
+  // "ok" would read backwards for a fault: only on and off.
+  EXPECT_EQ(error("fault 5 minor-recoverable ok"), "\"ok\" is not on or off");
 }
 
 }  // namespace

@@ -47,6 +47,7 @@ poll_response_delay_ms = 3
 serial_number_bytes = 4
 identity_state_supported = false
 epr_resolution_ms = 100
+unsafe_factory_output_actions = true
 )",
                                              "sim.toml");
   ASSERT_EQ(c.devices.size(), 1u);
@@ -65,10 +66,12 @@ epr_resolution_ms = 100
   EXPECT_TRUE(o.serial_number_udint);
   EXPECT_FALSE(has_identity_state(o));
   EXPECT_EQ(o.timer_resolution, milliseconds(100));
+  EXPECT_EQ(o.factory_output_actions, sim::kUnsafeFactoryOutputActions);
   EXPECT_EQ(describe_readings(o),
             "configuration locked while poll allocated, poll paths fixed, idle poll answered "
             "empty, no ack of last request fragment, explicit responses 300 ms late, poll "
-            "responses 3 ms late, 4-byte serial number, no Identity State, EPR in steps of 100 ms");
+            "responses 3 ms late, 4-byte serial number, no Identity State, EPR in steps of 100 "
+            "ms, unsafe factory output actions (every output holds on fault and idle)");
 }
 
 TEST(DeviceConfig, WithoutAFileEveryDeviceIsLenient) {
@@ -85,6 +88,7 @@ TEST(DeviceConfig, WithoutAFileEveryDeviceIsLenient) {
     EXPECT_FALSE(o.serial_number_udint);
     EXPECT_TRUE(has_identity_state(o));
     EXPECT_EQ(o.timer_resolution, lenient.timer_resolution);
+    EXPECT_EQ(o.factory_output_actions, sim::OutputActions{});
     EXPECT_EQ(describe_readings(o), "lenient");
   }
 }
@@ -140,12 +144,43 @@ TEST(DeviceConfig, FieldReadingIsTheStrictestDevice) {
   EXPECT_FALSE(o.serial_number_udint);
   EXPECT_FALSE(has_identity_state(o));
   EXPECT_EQ(o.timer_resolution, milliseconds(100));
+  // Values in E2, not a reading: the field reading leaves them alone.
+  EXPECT_EQ(o.factory_output_actions, sim::OutputActions{});
+}
+
+// [defaults] gives every device the unsafe actions; a [[device]] false takes
+// them back to the simulator's own.
+TEST(DeviceConfig, UnsafeFactoryOutputActionsLayer) {
+  const DeviceConfig c = parse_device_config(R"(
+[defaults]
+unsafe_factory_output_actions = true
+
+[[device]]
+mac = 8
+unsafe_factory_output_actions = false
+)",
+                                             "sim.toml");
+  const auto all = device_options({mac(1)}, c, Reading::kField);
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_EQ(all[0].factory_output_actions, sim::kUnsafeFactoryOutputActions);
+  EXPECT_EQ(all[1].factory_output_actions, sim::OutputActions{});
+  const auto lenient = device_options({mac(1)}, DeviceConfig{}, Reading::kLenient);
+  ASSERT_EQ(lenient.size(), 1u);
+  EXPECT_EQ(describe_readings(lenient[0]), "lenient");
+  EXPECT_EQ(problems("[defaults]\nunsafe_factory_output_actions = 1\n"),
+            (std::vector<std::string>{
+                "sim.toml:2:33: unsafe_factory_output_actions must be true or false, not an "
+                "integer"}));
 }
 
 TEST(DeviceConfig, TheShippedExampleLoads) {
   const DeviceConfig c =
       load_device_config(DNBRIDGE_SOURCE_DIR "/deploy/config/cdn127-sim-example.toml");
   EXPECT_FALSE(c.devices.empty());
+  const auto all = device_options({}, c, Reading::kLenient);
+  EXPECT_TRUE(std::any_of(all.begin(), all.end(), [](const sim::SlaveOptions& o) {
+    return o.factory_output_actions == sim::kUnsafeFactoryOutputActions;
+  }));
 }
 
 TEST(DeviceConfig, EmptyFileIsNoChange) {
