@@ -18,19 +18,13 @@ using devicenet::RequestMessage;
 
 // The settings of a CDN127 node as the bridge configures it, plus a DOP
 // fault action: the policy must take whatever the profile lists.
+// The CDN127 profile's settings: the Configuration object and the outputs'
+// safe state (DOP 1 FaultAction among them).
 std::vector<devicenet::AttributeSetting> managed_settings() {
   auto profile = cdn127::make_node_profile(cdn127::preset(cdn127::ConfigurationPreset::kCdn127),
                                            cdn127::SafeStateConfig{});
   EXPECT_TRUE(profile.ok());
-  auto settings = profile->settings;
-  devicenet::AttributeSetting fault_action;
-  fault_action.class_id = cdn127::class_id::kDiscreteOutputPoint;
-  fault_action.instance_id = 1;
-  fault_action.attribute = cdn127::dop_attr::kFaultAction;
-  fault_action.value = {0};
-  fault_action.name = "DOP 1.FaultAction";
-  settings.push_back(fault_action);
-  return settings;
+  return profile->settings;
 }
 
 struct Fixture {
@@ -172,7 +166,7 @@ const std::vector<Case>& guarded_cases() {
        5,
        {0x01},
        GuardedRequest::kManagedAttributeWrite,
-       "of DOP 1.FaultAction"},
+       "of DOP 1 (pump).FaultAction"},
       {"ResetConfiguration",
        0x05,
        0x40,
