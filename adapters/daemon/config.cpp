@@ -1009,6 +1009,19 @@ allow_identity_reset = false
 poll_period_ms = 100
 expected_packet_rate_ms = 500
 io = "cdn127"
+# Each output's safe state, downloaded into every node and read back before
+# it is polled: on a fault (the bridge's polls stop for 4 x the expected
+# packet rate) and when idle (no command). "off", "on" or "hold"; the analog
+# output a voltage or "hold".
+pump_on_fault = "off"
+pump_on_idle = "off"
+n2_ballast_on_fault = "off"
+n2_ballast_on_idle = "off"
+analog_output_on_fault = 0.0
+analog_output_on_idle = 0.0
+# After a loss (power cycle, cable, bus-off) a node is idle until a new
+# command arrives.
+resume = "new-command"
 
 [[port]]
 name = "A"

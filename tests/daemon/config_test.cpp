@@ -942,3 +942,135 @@ TEST(ConfigExplicitPolicy, MistakesAreErrorsWithTheirPosition) {
 
 }  // namespace
 }  // namespace dnbridge::daemon
+
+// ---------------------------------------------------------------------------
+// The outputs' safe state and the resume policy.
+
+namespace dnbridge::daemon {
+namespace {
+
+TEST(ConfigSafeState, DefaultIsEveryOutputOffOnFaultAndIdleDownloaded) {
+  const DaemonConfig c = parse_config(ONE_PORT
+                                      "[[port.node]]\n"
+                                      "mac = 1\n"
+                                      "name = \"p\"\n",
+                                      "t.toml");
+  const NodeSettings& n = c.ports.at(0).nodes.at(0);
+  EXPECT_EQ(n.safe_state.source, cdn127::SafeStateSource::kConfiguration);
+  EXPECT_EQ(n.safe_state.values, cdn127::SafeState{});
+  EXPECT_EQ(n.safe_state.values.pump_fault, cdn127::DiscreteAction::kOff);
+  EXPECT_EQ(n.safe_state.values.analog_idle,
+            (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, 0}));
+  EXPECT_EQ(n.resume, rack::ResumePolicy::kFreshCommand);
+  EXPECT_TRUE(c.warnings.empty());
+  // And the rack's scan list asks for them: DOP 1 and 2, AOP 1.
+  const rack::PumpConfig p = to_pump_config(n);
+  EXPECT_EQ(p.safe_state.values, n.safe_state.values);
+  auto profile = cdn127::make_node_profile(p.io, p.safe_state);
+  ASSERT_TRUE(profile.ok());
+  unsigned dop = 0, aop = 0;
+  for (const auto& s : profile->settings) {
+    dop += s.class_id == cdn127::class_id::kDiscreteOutputPoint ? 1 : 0;
+    aop += s.class_id == cdn127::class_id::kAnalogOutputPoint ? 1 : 0;
+    EXPECT_FALSE(s.keep_device_value) << s.name;
+  }
+  EXPECT_EQ(dop, 8u);  // 2 instances x (fault, idle) x (value, action)
+  EXPECT_EQ(aop, 4u);
+}
+
+TEST(ConfigSafeState, WordsAndVoltsFromDefaultsAndNodes) {
+  const DaemonConfig c = parse_config("rack = \"r\"\n"
+                                      "[defaults]\n"
+                                      "pump_on_idle = \"hold\"\n"
+                                      "analog_output_on_fault = 2.5\n"
+                                      "[[port]]\n"
+                                      "name = \"A\"\n"
+                                      "interface = \"simulated\"\n"
+                                      "bitrate = 500000\n"
+                                      "[[port.node]]\n"
+                                      "mac = 1\n"
+                                      "name = \"p\"\n"
+                                      "pump_on_fault = \"off\"\n"
+                                      "n2_ballast_on_fault = \"on\"\n"
+                                      "n2_ballast_on_idle = \"hold\"\n"
+                                      "analog_output_on_idle = \"hold\"\n"
+                                      "[[port.node]]\n"
+                                      "mac = 2\n"
+                                      "name = \"q\"\n"
+                                      "pump_on_idle = \"off\"\n"
+                                      "analog_output_on_fault = 10\n",
+                                      "t.toml");
+  const auto& p = c.ports.at(0).nodes.at(0).safe_state.values;
+  EXPECT_EQ(p.pump_fault, cdn127::DiscreteAction::kOff);
+  EXPECT_EQ(p.pump_idle, cdn127::DiscreteAction::kHold);  // from [defaults]
+  EXPECT_EQ(p.n2_ballast_fault, cdn127::DiscreteAction::kOn);
+  EXPECT_EQ(p.n2_ballast_idle, cdn127::DiscreteAction::kHold);
+  EXPECT_EQ(p.analog_fault, (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, 1024}));
+  EXPECT_EQ(p.analog_idle, (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kHold, 0}));
+  const auto& q = c.ports.at(0).nodes.at(1).safe_state.values;
+  EXPECT_EQ(q.pump_idle, cdn127::DiscreteAction::kOff);  // its own over [defaults]
+  EXPECT_EQ(q.analog_fault, (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, 4095}));
+  EXPECT_EQ(q.analog_idle, (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, 0}));
+}
+
+TEST(ConfigSafeState, OptInsAreReadAndWarnedOf) {
+  const DaemonConfig c = parse_config(ONE_PORT
+                                      "[[port.node]]\n"
+                                      "mac = 1\n"
+                                      "name = \"p\"\n"
+                                      "safe_state = \"device\"\n"
+                                      "resume = \"last-command\"\n",
+                                      "t.toml");
+  const NodeSettings& n = c.ports.at(0).nodes.at(0);
+  EXPECT_EQ(n.safe_state.source, cdn127::SafeStateSource::kDevice);
+  EXPECT_EQ(n.resume, rack::ResumePolicy::kLastCommand);
+  EXPECT_THAT(c.warnings,
+              ElementsAre("t.toml:9:14: node 1 keeps the device's own fault and idle actions "
+                          "(safe_state = \"device\"): read and shown, never written",
+                          "t.toml:10:10: node 1 drives its last outputs again after a loss "
+                          "without a new command (resume = \"last-command\"): a pump may start on "
+                          "its own after a power cycle"));
+  // The device's values are read, none written.
+  const rack::PumpConfig p = to_pump_config(n);
+  EXPECT_EQ(p.resume, rack::ResumePolicy::kLastCommand);
+  auto profile = cdn127::make_node_profile(p.io, p.safe_state);
+  ASSERT_TRUE(profile.ok());
+  unsigned kept = 0;
+  for (const auto& s : profile->settings) kept += s.keep_device_value ? 1 : 0;
+  EXPECT_EQ(kept, 12u);
+}
+
+TEST(ConfigSafeState, MistakesAreErrorsWithTheirPosition) {
+  EXPECT_EQ(problems(ONE_PORT
+                     "[[port.node]]\n"
+                     "mac = 1\n"
+                     "name = \"p\"\n"
+                     "pump_on_fault = \"stop\"\n"
+                     "pump_on_idle = true\n"
+                     "analog_output_on_fault = 10.5\n"
+                     "analog_output_on_idle = \"zero\"\n"
+                     "safe_state = \"factory\"\n"
+                     "resume = \"always\"\n"),
+            "t.toml:9:17: pump_on_fault = \"stop\" is not an output action: use \"off\", \"on\" "
+            "or \"hold\"\n"
+            "t.toml:10:16: pump_on_idle must be a string, not a boolean\n"
+            "t.toml:11:26: analog_output_on_fault = 10.5 V is out of range (0..10 V)\n"
+            "t.toml:12:25: analog_output_on_idle = \"zero\" is not an analog output action: use "
+            "a voltage (0..10, e.g. 0.0) or \"hold\"\n"
+            "t.toml:13:14: safe_state = \"factory\" is not a choice: use \"configured\" (the "
+            "default: the keys pump_on_fault ... are downloaded) or \"device\"\n"
+            "t.toml:14:10: resume = \"always\" is not a policy: use \"new-command\" (the default) "
+            "or \"last-command\"");
+  // Values of a node that keeps the device's own: contradictory.
+  EXPECT_EQ(problems(ONE_PORT
+                     "[[port.node]]\n"
+                     "mac = 1\n"
+                     "name = \"p\"\n"
+                     "safe_state = \"device\"\n"
+                     "pump_on_idle = \"off\"\n"),
+            "t.toml:10:16: pump_on_idle has no effect with safe_state = \"device\": the device's "
+            "own fault and idle actions are kept");
+}
+
+}  // namespace
+}  // namespace dnbridge::daemon
