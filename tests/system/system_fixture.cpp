@@ -157,7 +157,11 @@ void Supervisor::update() {
       p.online = s->online;
       p.pump_running = s->pump_running;
       p.alarm_active = s->alarm_active;
+      p.outputs_idle = s->outputs_idle;
+      p.idle_reason = std::string(dds::view(s->idle_reason));
       p.pump_on = s->pump_on;
+      p.n2_ballast_on = s->n2_ballast_on;
+      p.analog_output_raw = s->analog_output_raw;
       p.analog_in1 = s->analog_input_count > 0 ? s->analog_input_volts[0] : 0.0F;
       p.commanded_by = std::string(dds::view(s->commanded_by));
       p.source_time = s.info().source_timestamp();
@@ -188,12 +192,15 @@ bool Supervisor::wait_until(const std::function<bool()>& done, std::chrono::seco
   }
 }
 
-bool Supervisor::command(const std::string& port, unsigned mac, bool pump_on) {
+bool Supervisor::command(const std::string& port, unsigned mac, bool pump_on, bool n2_ballast_on,
+                         std::uint16_t analog_output_raw) {
   dds::Owned<dnbridge_PumpCommand> c;
   dds::set_string(c->rack, rack_);
   dds::set_string(c->port, port);
   c->mac = static_cast<std::uint8_t>(mac);
   c->pump_on = pump_on;
+  c->n2_ballast_on = n2_ballast_on;
+  c->analog_output_raw = analog_output_raw;
   dds::set_string(c->issuer, "system-test");
   return command_writer_.write(*c).ok();
 }
@@ -218,9 +225,12 @@ std::string Supervisor::describe() const {
                      p.nodes_online, p.nodes_configured, p.reason);
   }
   for (const auto& [k, p] : pumps_) {
-    s += fmt::format("pump {}/{}: online {}, running {}, alarm {}, pump_on {}, ain1 {:.3f}\n",
-                     k.port, k.mac, p.online, p.pump_running, p.alarm_active, p.pump_on,
-                     p.analog_in1);
+    s += fmt::format(
+        "pump {}/{}: online {}, running {}, alarm {}, pump_on {}, n2_ballast_on {}, aout {}, "
+        "ain1 {:.3f}, {}\n",
+        k.port, k.mac, p.online, p.pump_running, p.alarm_active, p.pump_on, p.n2_ballast_on,
+        p.analog_output_raw, p.analog_in1,
+        p.outputs_idle ? fmt::format("\"{}\"", p.idle_reason) : "commanded by " + p.commanded_by);
   }
   return s;
 }
@@ -259,9 +269,9 @@ std::string rack_config(const std::string& rack, const std::vector<PortSpec>& po
   // Short expected packet rates and allocation retries: lost nodes are
   // noticed and found again within seconds.
   std::string s = fmt::format(
-      "rack = \"{}\"\ndomain = 0\nlog_level = \"info\"\n[defaults]\npoll_period_ms = 50\n"
-      "expected_packet_rate_ms = 250\n",
-      rack);
+      "rack = \"{}\"\ndomain = 0\nlog_level = \"info\"\n[defaults]\npoll_period_ms = {}\n"
+      "expected_packet_rate_ms = {}\n",
+      rack, kPollPeriod.count(), kExpectedPacketRate.count());
   for (const auto& p : ports) {
     s += fmt::format(
         "[[port]]\nname = \"{}\"\ninterface = \"{}\"\nbitrate = 500000\n"
@@ -269,6 +279,9 @@ std::string rack_config(const std::string& rack, const std::vector<PortSpec>& po
         p.name, p.interface);
     for (auto m : p.macs) {
       s += fmt::format("  [[port.node]]\n  mac = {}\n  name = \"pump-{}\"\n", m, m);
+      if (auto it = p.node_settings.find(m); it != p.node_settings.end()) {
+        s += it->second + "\n";
+      }
     }
   }
   return s;

@@ -83,7 +83,11 @@ struct PumpSeen {
   bool online = false;
   bool pump_running = false;
   bool alarm_active = false;
-  bool pump_on = false;  // output
+  bool outputs_idle = false;
+  std::string idle_reason;
+  bool pump_on = false;  // outputs
+  bool n2_ballast_on = false;
+  std::uint16_t analog_output_raw = 0;
   float analog_in1 = 0;
   std::string commanded_by;
   dds::Timestamp source_time{};
@@ -110,7 +114,8 @@ class Supervisor {
   // the product must meet.
   bool wait_until(const std::function<bool()>& done, std::chrono::seconds timeout);
 
-  bool command(const std::string& port, unsigned mac, bool pump_on);
+  bool command(const std::string& port, unsigned mac, bool pump_on, bool n2_ballast_on = false,
+               std::uint16_t analog_output_raw = 0);
 
   const std::map<PumpKey, PumpSeen>& pumps() const { return pumps_; }
   const std::map<std::string, PortSeen>& ports() const { return ports_; }
@@ -148,11 +153,19 @@ fs::path work_dir();
 // Runs a shell command; its exit status.
 int shell(const std::string& command);
 
-// A rack configuration: `ports` is {port name, interface, node MACs}.
+// The poll period and expected packet rate of every node of rack_config():
+// short, so that lost nodes are noticed and found again within seconds. A
+// device whose poll stops applies its fault actions 4 x EPR after the last.
+inline constexpr std::chrono::milliseconds kPollPeriod{50};
+inline constexpr std::chrono::milliseconds kExpectedPacketRate{250};
+
+// A rack configuration: `ports` is {port name, interface, node MACs}, and
+// TOML lines of a node's own by MAC (`safe_state = "device"`, say).
 struct PortSpec {
   std::string name;
   std::string interface;
   std::vector<unsigned> macs;
+  std::map<unsigned, std::string> node_settings = {};
 };
 std::string rack_config(const std::string& rack, const std::vector<PortSpec>& ports);
 

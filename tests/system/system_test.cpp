@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/wait.h>
 
 #include <cmath>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include <thread>
 #include <utility>
 
+#include "adapters/dnbctl/commander.hpp"
 #include "system_fixture.hpp"
 
 namespace dnbridge::system_test {
@@ -47,6 +49,15 @@ std::size_t count_lines(const fs::path& file, const std::string& containing) {
   for (std::string l; std::getline(in, l);) n += l.find(containing) != std::string::npos;
   return n;
 }
+
+// One device's outputs and poll connection, as cdn127-sim's `status` shows them.
+struct SimDevice {
+  bool poll_established = false;
+  bool pump_on = false;
+  bool n2_ballast_on = false;
+  unsigned aout = 0;
+};
+using SimStatus = std::map<unsigned, SimDevice>;
 
 class SystemTest : public ::testing::Test {
  protected:
@@ -92,6 +103,80 @@ class SystemTest : public ::testing::Test {
     children_.push_back(
         std::make_unique<Child>(argv, dir_ / fmt::format("cdn127-sim-{}.log", interface)));
     return *children_.back();
+  }
+
+  // dnbctl commanding a pump on, and holding it on until killed.
+  Child& start_commander(const std::string& port, unsigned mac) {
+    const double timeout = static_cast<double>(patience(10000ms).count()) / 1000.0;
+    children_.push_back(std::make_unique<Child>(
+        std::vector<std::string>{DNBCTL_BIN, "--rack", rack_, "--port", port, "--timeout",
+                                 fmt::format("{:g}", timeout), "pump", std::to_string(mac), "on",
+                                 "--issuer", fmt::format("commander {}", mac), "--hold-for",
+                                 "3600"},
+        dir_ / fmt::format("dnbctl-{}.log", mac)));
+    return *children_.back();
+  }
+
+  // cdn127-sim's answer to `status`, read from its log, for `devices`
+  // devices; empty if no whole answer came within the test's patience.
+  SimStatus sim_status(Child& sim, std::size_t devices) {
+    static const std::regex line(
+        R"(^ok mac (\d+) .* poll (\S+) \| outputs pump-on (on|off) n2-ballast (on|off) aout (\d+) )");
+    const auto from = static_cast<std::streamoff>(fs::file_size(sim.log()));
+    sim.send("status");
+    const auto until = std::chrono::steady_clock::now() + patience(2000ms);
+    for (;;) {
+      SimStatus status;
+      std::ifstream in(sim.log());
+      in.seekg(from);
+      std::smatch m;
+      for (std::string l; std::getline(in, l);) {
+        if (!std::regex_search(l, m, line)) continue;
+        status[static_cast<unsigned>(std::stoul(m[1]))] =
+            SimDevice{m[2] == "established", m[3] == "on", m[4] == "on",
+                      static_cast<unsigned>(std::stoul(m[5]))};
+      }
+      if (status.size() == devices) return status;
+      if (std::chrono::steady_clock::now() >= until) return {};
+      std::this_thread::sleep_for(2ms);
+    }
+  }
+
+  // Reads cdn127-sim's status until `done` holds for it or `timeout` (scaled
+  // by patience) has passed; whether it held.
+  bool wait_sim(Child& sim, std::size_t devices, const std::function<bool(const SimStatus&)>& done,
+                std::chrono::milliseconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + patience(timeout);
+    for (;;) {
+      const SimStatus s = sim_status(sim, devices);
+      if (!s.empty() && done(s)) return true;
+      if (std::chrono::steady_clock::now() >= until) return false;
+      std::this_thread::sleep_for(20ms);
+    }
+  }
+
+  // For each of `macs`, how long after `since` cdn127-sim's status first
+  // showed `reached` for its device, with that status; reads it every 10 ms
+  // until each has or `timeout` (scaled by patience) has passed.
+  std::map<unsigned, std::pair<std::chrono::milliseconds, SimDevice>> time_until(
+      Child& sim, std::size_t devices, const std::vector<unsigned>& macs,
+      const std::function<bool(const SimDevice&)>& reached,
+      std::chrono::steady_clock::time_point since, std::chrono::milliseconds timeout) {
+    std::map<unsigned, std::pair<std::chrono::milliseconds, SimDevice>> out;
+    const auto until = std::chrono::steady_clock::now() + patience(timeout);
+    while (out.size() < macs.size() && std::chrono::steady_clock::now() < until) {
+      const SimStatus s = sim_status(sim, devices);
+      const auto after = std::chrono::duration_cast<std::chrono::milliseconds>(
+          std::chrono::steady_clock::now() - since);
+      for (unsigned mac : macs) {
+        auto it = s.find(mac);
+        if (!out.contains(mac) && it != s.end() && reached(it->second)) {
+          out[mac] = {after, it->second};
+        }
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    return out;
   }
 
   Supervisor& supervisor() {
@@ -352,6 +437,130 @@ TEST_F(SystemTest, PowerCycledDeviceComesBack) {
   EXPECT_TRUE(supervisor().online("A", 6));
   sim.send("power-on 5");
   ASSERT_TRUE(wait_online("A", {5, 6})) << "node 5 did not come back after power-on";
+}
+
+// CDN127s whose factory fault and idle actions hold every output (a pump
+// that is on stays on when its master goes idle or away) are made safe by
+// the safe state the bridge downloads before polling them (the default:
+// outputs off on fault and on idle, analog output 0 V). When the commander
+// dies, the pumps stop within its liveliness lease plus one poll (idle); when
+// the bridge dies (SIGKILL: no idle poll, no Release), within 4 x EPR (the
+// devices' fault action). Node 7 keeps the device's own actions
+// (safe_state = "device"): the control that shows the factory state unsafe
+// over the wire, and that this test sees a pump left on.
+TEST_F(SystemTest, UnsafeFactoryDevicesAreMadeSafeByTheBridge) {
+  const std::vector<unsigned> all{5, 6, 7};
+  const std::vector<unsigned> configured{5, 6};
+  constexpr unsigned kControl = 7;
+  // What the test adds to the bounds for its own observation: DDS and the
+  // status round trip inside the virtual machine; scaled by patience.
+  constexpr auto kObservation = 250ms;
+  const fs::path devices = dir_ / "devices.toml";
+  std::ofstream(devices) << "[defaults]\nunsafe_factory_output_actions = true\n";
+  Child& sim = start_sim("vcan0", all, {"--device-config", devices.string()});
+  Child& bridge = start_bridge({{"A", "vcan0", all, {{kControl, "safe_state = \"device\""}}}});
+  ASSERT_TRUE(wait_online("A", all));
+
+  // A commander of each pump: dnbctl, pump on, holding.
+  std::vector<Child*> commanders;
+  for (unsigned mac : all) commanders.push_back(&start_commander("A", mac));
+  const auto all_on = [&](const SimStatus& s) {
+    return std::all_of(all.begin(), all.end(), [&](unsigned m) { return s.at(m).pump_on; });
+  };
+  ASSERT_TRUE(wait_sim(sim, all.size(), all_on, 20s)) << "the pumps did not come on";
+  ASSERT_TRUE(supervisor().wait_until(
+      [&] {
+        return std::all_of(all.begin(), all.end(), [&](unsigned m) {
+          return pump("A", m).pump_on && !pump("A", m).outputs_idle &&
+                 pump("A", m).commanded_by == fmt::format("commander {}", m);
+        });
+      },
+      10s));
+
+  // The commanders die: once their lease is over, the bridge polls idle.
+  using std::chrono::milliseconds;
+  const auto lease = std::chrono::duration_cast<milliseconds>(dnbctl::Commander::kLease);
+  const milliseconds idle_bound = lease + kPollPeriod + patience(kObservation);
+  const auto left = std::chrono::steady_clock::now();
+  for (Child* c : commanders) c->signal(SIGKILL);
+  const auto stopped = time_until(
+      sim, all.size(), configured, [](const SimDevice& d) { return !d.pump_on; }, left,
+      idle_bound + 5s);
+  for (unsigned mac : configured) {
+    ASSERT_TRUE(stopped.contains(mac)) << "pump " << mac << " still on after the commander left";
+    const auto& [after, d] = stopped.at(mac);
+    std::printf(
+        "pump %u off %lld ms after its commander was killed (lease %lld ms + poll %lld ms)\n", mac,
+        static_cast<long long>(after.count()), static_cast<long long>(lease.count()),
+        static_cast<long long>(kPollPeriod.count()));
+    EXPECT_LE(after.count(), idle_bound.count()) << "pump " << mac;
+    EXPECT_TRUE(d.poll_established) << "pump " << mac << ": its poll connection ended";
+  }
+  ASSERT_TRUE(supervisor().wait_until(
+      [&] {
+        return std::all_of(all.begin(), all.end(), [&](unsigned m) {
+          return pump("A", m).online && pump("A", m).outputs_idle;
+        });
+      },
+      5s));
+  for (unsigned mac : all) {
+    EXPECT_EQ(pump("A", mac).idle_reason, "idle: no live commander") << "pump " << mac;
+    EXPECT_EQ(pump("A", mac).commanded_by, "") << "pump " << mac;
+  }
+  // The control has answered idle polls (its PumpState says so): its own
+  // idle action left the pump on.
+  {
+    const SimStatus s = sim_status(sim, all.size());
+    ASSERT_FALSE(s.empty()) << "no status from cdn127-sim";
+    EXPECT_TRUE(s.at(kControl).pump_on && s.at(kControl).poll_established)
+        << "the control's factory idle action did not hold the pump on";
+  }
+
+  // A new commander: pump and N2 ballast on, analog output 5 V.
+  constexpr std::uint16_t kHalfScale = 2048;
+  for (unsigned mac : all) ASSERT_TRUE(supervisor().command("A", mac, true, true, kHalfScale));
+  ASSERT_TRUE(wait_sim(
+      sim, all.size(),
+      [&](const SimStatus& s) {
+        return std::all_of(all.begin(), all.end(), [&](unsigned m) {
+          const SimDevice& d = s.at(m);
+          return d.pump_on && d.n2_ballast_on && d.aout == kHalfScale;
+        });
+      },
+      10s))
+      << "the new commands were not applied";
+
+  // The bridge dies: every device's poll connection times out 4 x EPR after
+  // the last poll, and its fault action applies.
+  const auto killed = std::chrono::steady_clock::now();
+  bridge.signal(SIGKILL);
+  const milliseconds fault_bound = 4 * kExpectedPacketRate + patience(kObservation);
+  const auto timed_out = time_until(
+      sim, all.size(), all, [](const SimDevice& d) { return !d.poll_established; }, killed,
+      fault_bound + 5s);
+  for (unsigned mac : all) {
+    ASSERT_TRUE(timed_out.contains(mac)) << "device " << mac << " still polled after SIGKILL";
+    const auto& [after, d] = timed_out.at(mac);
+    std::printf(
+        "device %u: poll timed out %lld ms after SIGKILL to the bridge (4 x EPR = %lld "
+        "ms): pump %s, N2 ballast %s, analog output %u\n",
+        mac, static_cast<long long>(after.count()),
+        static_cast<long long>((4 * kExpectedPacketRate).count()), d.pump_on ? "on" : "off",
+        d.n2_ballast_on ? "on" : "off", d.aout);
+    EXPECT_LE(after.count(), fault_bound.count()) << "device " << mac;
+    // Not sooner than its watchdog can: an orderly stop would have been.
+    EXPECT_GE(after.count(), (2 * kExpectedPacketRate).count()) << "device " << mac;
+  }
+  for (unsigned mac : configured) {
+    const SimDevice& d = timed_out.at(mac).second;
+    EXPECT_TRUE(!d.pump_on && !d.n2_ballast_on && d.aout == 0)
+        << "device " << mac << " did not apply the configured fault action";
+  }
+  const SimDevice& control = timed_out.at(kControl).second;
+  EXPECT_TRUE(control.pump_on && control.n2_ballast_on && control.aout == kHalfScale)
+      << "the control's factory fault action did not hold its outputs";
+  const int status = bridge.stop();
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "dnbridge status " << status;
 }
 
 // The test as the master, on a raw CAN socket: a request out, the first
