@@ -1,5 +1,7 @@
 #include "adapters/daemon/dds_publisher.hpp"
 
+#include <algorithm>
+
 #include "adapters/daemon/samples.hpp"
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/sample.hpp"
@@ -138,10 +140,15 @@ void DdsPublisher::port_stopped(const std::string& port) {
 namespace dnbridge::daemon {
 
 void DdsPublisher::flush(Duration timeout) {
-  (void)pump_writer_.wait_for_acks(timeout);
-  (void)node_writer_.wait_for_acks(timeout);
-  (void)port_writer_.wait_for_acks(timeout);
-  (void)reply_writer_.wait_for_acks(timeout);
+  // One deadline for the four: a reader that died without leaving stays
+  // matched until its lease ends, and each wait would otherwise take all of
+  // `timeout` for it.
+  const TimePoint deadline = port::steady_now() + timeout;
+  auto left = [&] { return std::max(Duration::zero(), deadline - port::steady_now()); };
+  (void)pump_writer_.wait_for_acks(left());
+  (void)node_writer_.wait_for_acks(left());
+  (void)port_writer_.wait_for_acks(left());
+  (void)reply_writer_.wait_for_acks(left());
 }
 
 }  // namespace dnbridge::daemon
