@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
   daemon::StderrLogSink log(config.log_level);
   if (!level_name.empty()) log.set_level(*parse_level(level_name));
   Logger main_log(log, "dnbridge");
-  for (const auto& w : config.warnings) main_log.warn("{}: {}", config.source, w);
+  for (const auto& w : config.warnings) main_log.warn("{}", w);  // each warning starts with FILE:LINE:COLUMN
   if (identity) {
     main_log.info("{}", security_text(*identity));
   }

@@ -427,10 +427,31 @@ TEST_F(SystemTest, PowerCycledDeviceComesBack) {
   Child& sim = start_sim("vcan0", {5, 6});
   start_bridge({{"A", "vcan0", {5, 6}}});
   ASSERT_TRUE(wait_online("A", {5, 6}));
+  ASSERT_TRUE(supervisor().command("A", 6, true));
+  ASSERT_TRUE(wait_sim(sim, 2, [](const SimStatus& s) { return s.at(6).pump_on; }, 10s))
+      << "pump 6 did not come on";
 
   sim.send("power-cycle 6");
   ASSERT_TRUE(wait_offline("A", 6)) << "the master did not notice the power cycle";
   ASSERT_TRUE(wait_online("A", {5, 6})) << "node 6 did not come back after its power cycle";
+  // Back idle: the command from before the power cycle is not applied again.
+  ASSERT_TRUE(supervisor().wait_until(
+      [&] {
+        return pump("A", 6).online && pump("A", 6).outputs_idle &&
+               pump("A", 6).idle_reason == "idle: waiting for a new command after reconnection";
+      },
+      10s))
+      << "node 6: " << pump("A", 6).idle_reason;
+  {
+    const SimStatus s = sim_status(sim, 2);
+    ASSERT_FALSE(s.empty()) << "no status from cdn127-sim";
+    EXPECT_FALSE(s.at(6).pump_on) << "pump 6 came back on by itself";
+    EXPECT_TRUE(s.at(6).poll_established);
+  }
+  // A command written after the return: applied.
+  ASSERT_TRUE(supervisor().command("A", 6, true));
+  ASSERT_TRUE(wait_sim(sim, 2, [](const SimStatus& s) { return s.at(6).pump_on; }, 10s))
+      << "pump 6 did not come on after a new command";
 
   sim.send("power-off 5");
   ASSERT_TRUE(wait_offline("A", 5));
