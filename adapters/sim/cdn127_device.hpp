@@ -164,6 +164,12 @@ struct SlaveOptions {
   // leaves a master the Configuration object's Number Produced/Consumed;
   // {{0x01, 8}} one without the Identity's State.
   std::vector<ClassAttribute> unsupported_attributes;
+  // Attributes this device's firmware has Get only although the manual lists
+  // them Get/Set: Get answers as usual, Set answers 0x0E (attribute not
+  // settable). {{0x0B, 9}} is a firmware whose analog output's Fault State
+  // cannot be changed over the network, which a master downloading the safe
+  // state must report rather than go on with the device's own.
+  std::vector<ClassAttribute> read_only_attributes;
 
   // --- Readings of the manual that field devices took. Each off (zero) by
   // default: the reading this simulator takes otherwise.

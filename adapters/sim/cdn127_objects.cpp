@@ -619,6 +619,16 @@ const AttributeDef* firmware_attribute(const Cdn127Device& device, const ClassDe
   return find_attribute(c, attribute);
 }
 
+// An attribute the manual lists Get/Set that this firmware has Get only
+// (SlaveOptions::read_only_attributes).
+bool firmware_read_only(const Cdn127Device& device, const ClassDef& c,
+                        std::uint8_t attribute) noexcept {
+  for (const ClassAttribute& fixed : device.options().read_only_attributes) {
+    if (fixed == ClassAttribute{c.id, attribute}) return true;
+  }
+  return false;
+}
+
 Reply dispatch(Cdn127Device& device, const devicenet::RequestMessage& req, std::uint8_t requester,
                TimePoint now, ByteWriter& w) noexcept {
   const ClassDef* c = find_class(req.class_id);
@@ -651,7 +661,8 @@ Reply dispatch(Cdn127Device& device, const devicenet::RequestMessage& req, std::
       if (!req.attribute) return reply_error(GeneralStatus::kNotEnoughData);
       const AttributeDef* a = firmware_attribute(device, *c, *req.attribute);
       if (a == nullptr) return reply_error(GeneralStatus::kAttributeNotSupported);
-      if (a->access != Access::kGetSet || a->set == nullptr) {
+      if (a->access != Access::kGetSet || a->set == nullptr ||
+          firmware_read_only(device, *c, *req.attribute)) {
         return reply_error(GeneralStatus::kAttributeNotSettable);
       }
       return a->set(ctx, req.data, w);

@@ -201,6 +201,9 @@ class Node final : private ExplicitClient::Listener {
   void release(Step step, std::uint8_t choice, TimePoint now);
   // The setting in hand (setting_index_), or the poll connection after the last.
   Step first_setting_step();
+  // What a refused Get of the setting in hand was for, for the reason:
+  // "; the configuration needs 03"; empty for other steps.
+  std::string setting_expectation(Step step) const;
   // The path a step reads or writes, and the one the profile needs.
   bool path_step_produced(Step step) const;
   Bytes wanted_path(bool produced) const;

@@ -357,8 +357,8 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
   switch (rule.on_refusal) {
     case OnRefusal::kFault:
       enter_fault(NodeState::kConfigurationFault,
-                  fmt::format("device refused {} {}: {}", verb_name(last_request_.service),
-                              target.name, status_text(r)),
+                  fmt::format("device refused {} {}: {}{}", verb_name(last_request_.service),
+                              target.name, status_text(r), setting_expectation(step)),
                   now);
       return;
     case OnRefusal::kWrongDevice:
@@ -570,6 +570,16 @@ Node::Step Node::after_identity_state(const ExplicitResult& r, TimePoint now) {
 }
 
 // --- configuration ---------------------------------------------------------------
+
+std::string Node::setting_expectation(Step step) const {
+  if (step != Step::kReadSetting && step != Step::kVerifySetting) return {};
+  const auto& s = config_.profile.settings[setting_index_];
+  if (s.keep_device_value) {
+    return fmt::format("; the device's own value is kept: expected {} byte(s), 0..{}",
+                       s.value.size(), s.device_value_max);
+  }
+  return fmt::format("; the configuration needs {}", hex(Bytes(s.value)));
+}
 
 Node::Step Node::first_setting_step() {
   setting_retried_ = false;

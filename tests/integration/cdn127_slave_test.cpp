@@ -483,6 +483,21 @@ TEST_F(Cdn127SlaveTest, FirmwareWithoutConnectionSizesRefusesThemWithAttributeNo
   EXPECT_EQ(get(0x40, 0x01, 17), (ByteVec{0x8E, 0x04}));        // DOUT PAD AOUT
 }
 
+// A firmware that has an attribute Get only although the manual lists it
+// Get/Set: its Get answers, its Set is refused with 0x0E and changes nothing.
+TEST_F(Cdn127SlaveTest, FirmwareWithAReadOnlyAttributeAnswersItsGetAndRefusesItsSet) {
+  SlaveOptions o = default_options();
+  o.read_only_attributes = {{0x0B, 9}};
+  create(o);
+  boot();
+  allocate();
+  EXPECT_EQ(get(0x0B, 0x01, 9), (ByteVec{0x8E, 0x00}));  // AOP Fault State: hold
+  EXPECT_EQ(set(0x0B, 0x01, 9, {0x03}), error(0x0E));
+  EXPECT_EQ(slave_->device().e2().aop.fault_state, 0);
+  EXPECT_EQ(set(0x0B, 0x01, 10, {0x03}), (ByteVec{0x90}));  // the others as before
+  EXPECT_EQ(slave_->device().e2().aop.idle_state, 3);
+}
+
 TEST_F(Cdn127SlaveTest, PollConnectionDoesNotExistBeforeAllocation) {
   boot();
   allocate(0x01);
