@@ -5,10 +5,14 @@
 namespace dnbridge::cip::identity {
 namespace {
 
+// The values that say so (Status with a major fault bit, State 4 or 5): the
+// two are read at different times, and the other may be older.
 std::string read_values(std::optional<std::uint16_t> status, std::optional<std::uint8_t> state) {
   std::string s;
-  if (status) s = fmt::format("Identity.Status 0x{:04X}", *status);
-  if (state) s += fmt::format("{}Identity.State {}", s.empty() ? "" : ", ", *state);
+  if (status && (*status & (kMajorRecoverableFault | kMajorUnrecoverableFault)) != 0)
+    s = fmt::format("Identity.Status 0x{:04X}", *status);
+  if (state == kStateMajorRecoverableFault || state == kStateMajorUnrecoverableFault)
+    s += fmt::format("{}Identity.State {}", s.empty() ? "" : ", ", *state);
   return s;
 }
 

@@ -864,6 +864,7 @@ bool Node::check_health(TimePoint now) {
 
 void Node::device_fault(std::string reason, TimePoint now) {
   if (state_ == NodeState::kOnline) {
+    ++counters_.reconnects;
     // Outputs to the device's idle state before the connections go: one idle
     // poll now, whatever the outputs in force (the answers to it, and to a
     // poll outstanding, arrive once the node has left online).

@@ -167,7 +167,10 @@ void PumpRack::on_node_state(MacId mac, NodeState from, NodeState to, const std:
   PumpView* v = find(mac);
   if (!v) return;
   const Slot& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
-  if (from == NodeState::kOnline && to != NodeState::kOnline && to != NodeState::kStopped) {
+  // A device fault voids a command even before the node was first online:
+  // the fault may clear long after the command was given.
+  if ((from == NodeState::kOnline && to != NodeState::kOnline && to != NodeState::kStopped) ||
+      to == NodeState::kDeviceFault) {
     on_loss(*v, slot, at);
   }
   if (to == NodeState::kOnline) on_online(*v);

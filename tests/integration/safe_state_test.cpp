@@ -357,6 +357,7 @@ TEST_F(IdentityFault, AMajorFaultWhileOnlineIdlesAndReleasesTheNodeUntilANewComm
   EXPECT_LE(faulted - fault_at, 2 * explicit_epr);
   EXPECT_THAT(view().reason, HasSubstr("major recoverable fault"));
   EXPECT_THAT(view().reason, HasSubstr("re-checked every 3000 ms"));
+  EXPECT_EQ(node().counters().reconnects, 1u);
   // One idle poll as the node leaves online, then no poll at all.
   world().run_for(milliseconds(50));
   ASSERT_GE(wire_.polls_after(faulted), 1u);
@@ -417,14 +418,22 @@ TEST_F(IdentityFault, AMajorFaultAtStartUpIsNeverOnlineNorPolledUntilCleared) {
   for (const auto& t : events_.of(mac(kMac))) EXPECT_NE(t.to, NodeState::kOnline) << t.reason;
   EXPECT_TRUE(wire_.polls.empty());
   EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kNonExistent);
+  // A command while the device is faulted is refused: the fault may clear
+  // long after it was given.
+  EXPECT_FALSE(command(all_on()).ok());
+  EXPECT_THAT(view().last_command_refused, HasSubstr("not back online"));
 
-  // Cleared: online by the next re-check and a start-up.
+  // Cleared: online by the next re-check and a start-up, idle.
   device().set_faults({}, now());
   const TimePoint cleared = now();
   ASSERT_TRUE(run_until_state(NodeState::kOnline, kFaultRecheck + kStartUp)) << view().reason;
   EXPECT_LE(view().state_since - cleared, kFaultRecheck + kStartUp);
-  EXPECT_EQ(view().idle_reason(), "idle: no command yet");
+  EXPECT_EQ(view().idle_reason(), "idle: waiting for a new command after reconnection");
+  world().run_for(seconds(1));
   EXPECT_FALSE(outputs().pump_on);
+  EXPECT_TRUE(command(all_on()).ok());
+  world().run_for(milliseconds(200));
+  EXPECT_TRUE(outputs().pump_on);
 }
 
 // ---------------------------------------------------------------------------
