@@ -998,12 +998,18 @@ allow_connection_changes = false
 # Set of DOP/AOP Value or Assembly data: bypasses PumpCommand's ownership;
 # can switch a pump nobody commands.
 allow_output_writes = false
-# Set of what the bridge configures (Configuration, fault/idle settings)
-# while the node is online: breaks I/O decoding or the safe state.
+# Set of what the bridge configures (Configuration, fault/idle settings):
+# breaks I/O decoding or the safe state, unseen until the node restarts.
 allow_managed_attribute_writes = false
 # Reset of the Identity object: the device restarts; the pump is lost until
 # the bridge brings it back.
 allow_identity_reset = false
+# Set of the DeviceNet object (MAC ID, bit rate): the node may come back at
+# another scan-list entry's address, or not at all.
+allow_network_settings = false
+# Any other service (Multiple_Service_Packet, Start/Stop, Save/Restore,
+# vendor services): its effect is unknown to the bridge.
+allow_other_services = false
 
 [defaults]
 poll_period_ms = 100

@@ -224,11 +224,13 @@ void Node::on_timer(TimePoint now) {
   }
   if (now >= keepalive_at_) {
     keepalive_at_ = now + explicit_epr_;
-    // Any explicit traffic keeps the explicit connection alive; only an idle
-    // connection needs the keep-alive request. It reads the device's health:
-    // Identity.Status (fault bits) and Identity.State in turn, Status alone
-    // where the device has no State.
-    if (client_.idle()) {
+    // The keep-alive reads the device's health: Identity.Status (fault bits)
+    // and Identity.State in turn, Status alone where the device has no
+    // State. Every period, busy or not: other requests keep the connection
+    // alive, but only this one tells a major fault. It has its own place in
+    // the client's queue (request_explicit leaves it); one still unanswered
+    // is not doubled.
+    if (step_ != Step::kKeepAlive) {
       keepalive_reads_status_ = !identity_state_supported_ || !keepalive_reads_status_;
       get(Step::kKeepAlive,
           keepalive_reads_status_ ? cip::identity::kStatus : cip::identity::kState, now);

@@ -186,7 +186,7 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
 std::optional<ExplicitAnswer> ExplicitGateway::apply_policy(
     const ExplicitCall& call, const devicenet::RequestMessage& request, const devicenet::Node& node,
     TimePoint now) {
-  const PolicyNode about{node.config().profile.settings, node.state() == NodeState::kOnline};
+  const PolicyNode about{node.config().profile.settings};
   unsigned suppressed = 0;
   if (auto refusal = check(policy_, request, about)) {
     const std::uint64_t count = ++refused_[static_cast<std::size_t>(refusal->kind)];
@@ -205,7 +205,7 @@ std::optional<ExplicitAnswer> ExplicitGateway::apply_policy(
 void ExplicitGateway::log_allowed(const ExplicitCall& call,
                                   const devicenet::RequestMessage& request,
                                   const devicenet::Node& node, TimePoint now) {
-  const PolicyNode about{node.config().profile.settings, node.state() == NodeState::kOnline};
+  const PolicyNode about{node.config().profile.settings};
   const auto guarded = classify(request, about);
   unsigned suppressed = 0;
   if (guarded.empty() || !allowed_log_limit_.allow(now, suppressed)) return;

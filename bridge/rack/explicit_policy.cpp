@@ -49,9 +49,12 @@ std::optional<std::string> allocate_release(const RequestMessage& r) {
 
 std::optional<std::string> connection_change(const RequestMessage& r) {
   if (r.class_id != cip::connection::kClass) return std::nullopt;
-  // Delete, Create and Apply_Attributes change connections as much as a Set.
+  // Delete, Create, Apply_Attributes and Reset change connections as much as
+  // a Set (a Reset restarts the connection's watchdog, the CDN127 manual's
+  // Connection object lists it).
   if (!is(r, Service::kSetAttributeSingle) && !is(r, Service::kSetAttributesAll) &&
-      !is(r, Service::kCreate) && !is(r, Service::kDelete) && !is(r, Service::kApplyAttributes)) {
+      !is(r, Service::kCreate) && !is(r, Service::kDelete) && !is(r, Service::kApplyAttributes) &&
+      !is(r, Service::kReset)) {
     return std::nullopt;
   }
   if (auto a = set_attribute(r)) {
@@ -59,6 +62,30 @@ std::optional<std::string> connection_change(const RequestMessage& r) {
                        *a);
   }
   return fmt::format("{} to Connection instance {}", service_name(r), r.instance_id);
+}
+
+std::optional<std::string> network_setting(const RequestMessage& r) {
+  if (r.class_id != devicenet::kDeviceNetClass) return std::nullopt;
+  if (!is(r, Service::kSetAttributeSingle) && !is(r, Service::kSetAttributesAll))
+    return std::nullopt;
+  if (auto a = set_attribute(r)) {
+    return fmt::format("{} of DeviceNet object attribute {}", service_name(r), *a);
+  }
+  return fmt::format("{} to the DeviceNet object", service_name(r));
+}
+
+// The services the classes above judge, and the Gets; anything else (a
+// Multiple_Service_Packet carrying requests of its own, Start/Stop,
+// Save/Restore, a vendor's service) is not let through unknown.
+std::optional<std::string> other_service(const RequestMessage& r) {
+  for (Service known :
+       {Service::kGetAttributeSingle, Service::kGetAttributesAll, Service::kSetAttributeSingle,
+        Service::kSetAttributesAll, Service::kReset, Service::kCreate, Service::kDelete,
+        Service::kApplyAttributes, Service::kAllocateMasterSlave, Service::kReleaseMasterSlave}) {
+    if (is(r, known)) return std::nullopt;
+  }
+  return fmt::format("{} to class 0x{:02X} instance {}", service_name(r), r.class_id,
+                     r.instance_id);
 }
 
 std::optional<std::string> identity_reset(const RequestMessage& r) {
@@ -92,7 +119,6 @@ std::optional<std::string> output_write(const RequestMessage& r) {
 }
 
 std::optional<std::string> managed_write(const RequestMessage& r, const PolicyNode& node) {
-  if (!node.online) return std::nullopt;
   const auto in_instance = [&](const AttributeSetting& s) {
     return s.class_id == r.class_id && s.instance_id == r.instance_id;
   };
@@ -101,7 +127,7 @@ std::optional<std::string> managed_write(const RequestMessage& r, const PolicyNo
         node.managed.begin(), node.managed.end(),
         [&](const AttributeSetting& s) { return in_instance(s) && s.attribute == *a; });
     if (it == node.managed.end()) return std::nullopt;
-    return fmt::format("{} of {} while the node is online", service_name(r), it->name);
+    return fmt::format("{} of {}", service_name(r), it->name);
   }
   // Set_Attributes_All and Reset rewrite the instance's attributes (the
   // CDN127 Configuration object's Reset loads a preset over them).
@@ -109,8 +135,8 @@ std::optional<std::string> managed_write(const RequestMessage& r, const PolicyNo
   const auto first = std::find_if(node.managed.begin(), node.managed.end(), in_instance);
   if (first == node.managed.end()) return std::nullopt;
   const auto count = std::count_if(node.managed.begin(), node.managed.end(), in_instance);
-  return fmt::format("{} of class 0x{:02X} instance {} ({}{}) while the node is online",
-                     service_name(r), r.class_id, r.instance_id, first->name,
+  return fmt::format("{} of class 0x{:02X} instance {} ({}{})", service_name(r), r.class_id,
+                     r.instance_id, first->name,
                      count > 1 ? fmt::format(" and {} more", count - 1) : std::string());
 }
 
@@ -128,6 +154,10 @@ std::string_view policy_key(GuardedRequest kind) noexcept {
       return "allow_managed_attribute_writes";
     case GuardedRequest::kIdentityReset:
       return "allow_identity_reset";
+    case GuardedRequest::kNetworkSettings:
+      return "allow_network_settings";
+    case GuardedRequest::kOtherService:
+      return "allow_other_services";
   }
   return "?";
 }
@@ -144,6 +174,10 @@ std::string_view name_of(GuardedRequest kind) noexcept {
       return "a write of an attribute the bridge manages";
     case GuardedRequest::kIdentityReset:
       return "a device reset";
+    case GuardedRequest::kNetworkSettings:
+      return "a change of the node's network settings";
+    case GuardedRequest::kOtherService:
+      return "a service the policy does not know";
   }
   return "?";
 }
@@ -162,12 +196,20 @@ std::string_view risk_of(GuardedRequest kind) noexcept {
       return "outputs belong to PumpCommand, whose DDS ownership decides who commands a pump: "
              "a direct write bypasses it, and can switch a pump that nobody commands";
     case GuardedRequest::kManagedAttributeWrite:
-      return "the bridge decodes the node's I/O and sets its safe state with these values: a "
-             "change under the running connection breaks decoding or the outputs' fault and "
-             "idle behaviour until the node restarts and the bridge writes its own back";
+      return "the bridge decodes the node's I/O and sets its safe state with these values, "
+             "read back during start-up: a change afterwards breaks decoding or the outputs' "
+             "fault and idle behaviour, unseen, until the node restarts and the bridge writes "
+             "its own back";
     case GuardedRequest::kIdentityReset:
       return "the device restarts: its outputs go to their power-up state and the pump is "
              "lost until the bridge has brought it online again";
+    case GuardedRequest::kNetworkSettings:
+      return "a new MAC ID or bit rate takes the node off this port at its next restart, or "
+             "puts it at another scan-list entry's address, where the bridge would command "
+             "the wrong pump unless that entry pins a serial number";
+    case GuardedRequest::kOtherService:
+      return "its effect is unknown to the bridge: it may carry requests of its own "
+             "(Multiple_Service_Packet) or change the device in ways no other key covers";
   }
   return "?";
 }
@@ -184,6 +226,10 @@ bool ExplicitPolicy::allows(GuardedRequest kind) const noexcept {
       return allow_managed_attribute_writes;
     case GuardedRequest::kIdentityReset:
       return allow_identity_reset;
+    case GuardedRequest::kNetworkSettings:
+      return allow_network_settings;
+    case GuardedRequest::kOtherService:
+      return allow_other_services;
   }
   return false;
 }
@@ -205,6 +251,12 @@ void ExplicitPolicy::allow(GuardedRequest kind, bool allowed) noexcept {
     case GuardedRequest::kIdentityReset:
       allow_identity_reset = allowed;
       return;
+    case GuardedRequest::kNetworkSettings:
+      allow_network_settings = allowed;
+      return;
+    case GuardedRequest::kOtherService:
+      allow_other_services = allowed;
+      return;
   }
 }
 
@@ -218,6 +270,8 @@ std::vector<Guarded> classify(const RequestMessage& request, const PolicyNode& n
   add(GuardedRequest::kOutputWrite, output_write(request));
   add(GuardedRequest::kManagedAttributeWrite, managed_write(request, node));
   add(GuardedRequest::kIdentityReset, identity_reset(request));
+  add(GuardedRequest::kNetworkSettings, network_setting(request));
+  add(GuardedRequest::kOtherService, other_service(request));
   return out;
 }
 

@@ -27,10 +27,12 @@ enum class GuardedRequest : std::uint8_t {
   kAllocateRelease,        // Allocate/Release (0x4B/0x4C) to the DeviceNet object
   kConnectionChange,       // Set, Create, Delete, Apply_Attributes to the Connection object
   kOutputWrite,            // Set of a DOP/AOP Value or of Assembly data
-  kManagedAttributeWrite,  // Set of an attribute the bridge configures, node online
+  kManagedAttributeWrite,  // Set of an attribute the bridge configures
   kIdentityReset,          // Reset to the Identity object
+  kNetworkSettings,        // Set of the DeviceNet object (MAC ID, bit rate, ...)
+  kOtherService,           // a service the policy does not know (not Get, Set, Reset, ...)
 };
-inline constexpr std::size_t kGuardedRequestKinds = 5;
+inline constexpr std::size_t kGuardedRequestKinds = 7;
 
 // Its [explicit_policy] key ("allow_identity_reset"), its name ("a device
 // reset") and what it risks, for refusals and logs.
@@ -45,6 +47,8 @@ struct ExplicitPolicy {
   bool allow_output_writes = false;
   bool allow_managed_attribute_writes = false;
   bool allow_identity_reset = false;
+  bool allow_network_settings = false;
+  bool allow_other_services = false;
 
   bool allows(GuardedRequest kind) const noexcept;
   void allow(GuardedRequest kind, bool allowed) noexcept;
@@ -63,7 +67,6 @@ struct PolicyNode {
   // The attributes the bridge makes equal to its configuration at start-up
   // (the node profile's settings).
   std::span<const devicenet::AttributeSetting> managed;
-  bool online = false;
 };
 
 // A class of guarded request that `request` belongs to, with a description
@@ -76,8 +79,10 @@ struct Guarded {
 // Every class `request` belongs to, in the order of GuardedRequest (a
 // Set_Attributes_All of an output point can write its Value and its
 // fault/idle attributes at once). Empty for what is allowed whatever the
-// policy: every Get, and a Set of a managed attribute while the node is not
-// online (commissioning a node in configuration fault).
+// policy: every Get, and Sets and Resets of what the bridge neither runs nor
+// configures. Managed attributes are guarded in every state the gateway
+// reaches a node in: a write during its start-up would land after the
+// bridge's own read-back.
 std::vector<Guarded> classify(const devicenet::RequestMessage& request, const PolicyNode& node);
 
 // nullopt when `policy` lets `request` through.

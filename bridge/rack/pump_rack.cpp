@@ -89,11 +89,17 @@ Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, std::str
                               outputs.analog_out_raw, cdn127::kAnalogMaxRaw));
   }
   const auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
-  if (v->idle_cause == IdleCause::kAfterLoss && !v->outputs_requested && !v->online) {
+  // Only an online node is commanded: a command kept for a node that is
+  // away would start its pump whenever it comes (back), perhaps hours later.
+  if (!v->online) {
     return refuse(*v, Errc::kNotConnected,
-                  fmt::format("from {}: the node was lost and is not back online; only a "
-                              "command written after its return is applied",
-                              issuer));
+                  v->idle_cause == IdleCause::kAfterLoss
+                      ? fmt::format("from {}: the node was lost and is not back online; only a "
+                                    "command written after its return is applied",
+                                    issuer)
+                      : fmt::format("from {}: the node is not online ({}); a command applies "
+                                    "only to an online node",
+                                    issuer, devicenet::to_string(v->state)));
   }
   const auto& layout = slot.format.request;
   // An output the configuration leaves out of the poll request cannot be
@@ -137,8 +143,10 @@ Status PumpRack::release_command(MacId mac, TimePoint now) {
   return scanner_->set_idle(mac, true, now);
 }
 
-void PumpRack::on_loss(PumpView& v, const Slot& slot, TimePoint at) {
-  if (slot.resume == ResumePolicy::kLastCommand) return;
+void PumpRack::on_loss(PumpView& v, const Slot& slot, NodeState to, TimePoint at) {
+  // A device fault voids the command whatever the policy: the fault (a loss
+  // of the outputs' supply) may clear long after.
+  if (slot.resume == ResumePolicy::kLastCommand && to != NodeState::kDeviceFault) return;
   // The last command was for the device as it was before: after a power
   // cycle, a cable or a bus-off nobody has seen its state since. Idle polls
   // until a commander, having seen it back, commands it again.
@@ -171,7 +179,7 @@ void PumpRack::on_node_state(MacId mac, NodeState from, NodeState to, const std:
   // the fault may clear long after the command was given.
   if ((from == NodeState::kOnline && to != NodeState::kOnline && to != NodeState::kStopped) ||
       to == NodeState::kDeviceFault) {
-    on_loss(*v, slot, at);
+    on_loss(*v, slot, to, at);
   }
   if (to == NodeState::kOnline) on_online(*v);
   v->state = to;

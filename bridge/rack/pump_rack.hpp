@@ -121,8 +121,8 @@ class PumpRack final : public devicenet::ScannerObserver {
   // Validates and forwards new outputs: refused, never clipped, when out of
   // range; refused when the configuration has no room for them (e.g. an
   // analog value for a configuration without analog output); refused while
-  // a node lost with ResumePolicy::kFreshCommand is not back online (only a
-  // command taken after its return counts). A refusal is counted and its
+  // the node is not online (after a loss, only a command taken after its
+  // return counts). A refusal is counted and its
   // reason kept in the pump's view; nothing of the command is applied.
   // kOutOfRange for a MAC not in the rack.
   Status command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
@@ -159,9 +159,9 @@ class PumpRack final : public devicenet::ScannerObserver {
     profiles::cdn127::SafeStateSource safe_state_source =
         profiles::cdn127::SafeStateSource::kConfiguration;
   };
-  // The node left online: with kFreshCommand its command is void, and it
-  // comes back idle.
-  void on_loss(PumpView& view, const Slot& slot, TimePoint at);
+  // The node left online, or has a device fault: with kFreshCommand (and
+  // for a device fault always) its command is void, and it comes back idle.
+  void on_loss(PumpView& view, const Slot& slot, devicenet::NodeState to, TimePoint at);
   // The node is online: what the device's safe state is.
   void on_online(PumpView& view);
   Status refuse(PumpView& view, Status why, std::string text);

@@ -183,12 +183,15 @@ TEST_F(DnbctlRacks, ShowsEachRacksNodesByClassWithTheReason) {
   Client supervisor(test_domain(), "racks test supervisor");
   Commander commander(supervisor, 10);
   ASSERT_TRUE(commander.wait_matched(supervisor, deadline_after(kReady)));
-  ASSERT_TRUE(commander.write({"rack-north", "A", 1}, Outputs{true, false, 0}, "racks test"));
-
   const auto state = [&](const char* rack, unsigned m) {
     const auto* n = supervisor.node({rack, "A", static_cast<std::uint8_t>(m)});
     return n ? n->data->state : dnbridge_NODE_STOPPED;
   };
+  // A command applies only to an online node: written once it is.
+  ASSERT_TRUE(supervisor.wait_until(
+      deadline_after(kReady), [&] { return state("rack-north", 1) == dnbridge_NODE_ONLINE; }));
+  ASSERT_TRUE(commander.write({"rack-north", "A", 1}, Outputs{true, false, 0}, "racks test"));
+
   const auto outputs_idle = [&](const char* rack, unsigned m) {
     const auto* p = supervisor.pump({rack, "A", static_cast<std::uint8_t>(m)});
     return !p || p->data->outputs_idle;

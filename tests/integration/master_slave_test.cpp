@@ -216,7 +216,7 @@ TEST_F(MasterSlave, PowerCycledNodeComesBackIdleUntilANewCommand) {
 }
 
 // resume = "last-command": the opt-in to drive the last outputs again after
-// a loss (unsafe; the behaviour before the fresh-command rule).
+// a loss (unsafe: a pump may start on its own after a power cycle).
 TEST_F(MasterSlave, ResumeLastCommandDrivesTheLastOutputsAgainAfterAPowerCycle) {
   auto config = rack_config({5});
   config.pumps[0].resume = rack::ResumePolicy::kLastCommand;

@@ -481,3 +481,38 @@ INSTANTIATE_TEST_SUITE_P(Outages, BusLoss,
 
 }  // namespace
 }  // namespace dnbridge::test
+
+namespace dnbridge::test {
+namespace {
+
+// A command given before the node is online is refused, not kept: a pump
+// must never start when its device comes, perhaps hours later.
+TEST_F(IdentityFault, ACommandBeforeTheNodeIsFirstOnlineIsRefused) {
+  build();
+  EXPECT_NE(view().state, NodeState::kOnline);
+  EXPECT_FALSE(command(all_on()).ok());
+  EXPECT_THAT(view().last_command_refused, HasSubstr("not online"));
+  ASSERT_TRUE(run_until_state(NodeState::kOnline, seconds(10))) << view().reason;
+  world().run_for(seconds(1));
+  EXPECT_FALSE(outputs().pump_on);
+  EXPECT_EQ(view().idle_reason(), "idle: no command yet");
+  EXPECT_EQ(node().counters().polls, node().counters().idle_polls);
+  command_all_on();
+}
+
+// resume = "last-command" does not reach across a device fault: the fault
+// may clear long after the command was given.
+TEST_F(IdentityFault, ADeviceFaultVoidsTheCommandEvenWithResumeLastCommand) {
+  build([](sim::SimRackConfig& c) { c.pumps[0].resume = rack::ResumePolicy::kLastCommand; });
+  ASSERT_TRUE(run_until_state(NodeState::kOnline, seconds(10))) << view().reason;
+  command_all_on();
+  device().set_faults({.major_recoverable = true}, now());
+  ASSERT_TRUE(run_until_state(NodeState::kDeviceFault, 2 * node().explicit_epr())) << view().reason;
+  device().set_faults({}, now());
+  note_loss();
+  ASSERT_TRUE(run_until_state(NodeState::kOnline, kFaultRecheck + kStartUp)) << view().reason;
+  expect_idle_until_a_new_command();
+}
+
+}  // namespace
+}  // namespace dnbridge::test

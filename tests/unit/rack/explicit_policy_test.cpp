@@ -31,7 +31,7 @@ struct Fixture {
   std::vector<devicenet::AttributeSetting> settings = managed_settings();
   std::deque<std::vector<std::uint8_t>> data;  // what the requests' spans point into
 
-  PolicyNode node(bool online) const { return {settings, online}; }
+  PolicyNode node() const { return {settings}; }
   RequestMessage request(std::uint8_t service, std::uint16_t cls, std::uint16_t instance,
                          std::optional<std::uint8_t> attribute, std::vector<std::uint8_t> d = {}) {
     data.push_back(std::move(d));
@@ -158,7 +158,7 @@ const std::vector<Case>& guarded_cases() {
        1,
        {0x81},
        GuardedRequest::kManagedAttributeWrite,
-       "Set_Attribute_Single (0x10) of Configuration.Mode while the node is online"},
+       "Set_Attribute_Single (0x10) of Configuration.Mode"},
       {"SetDopFaultAction",
        0x10,
        0x09,
@@ -174,8 +174,7 @@ const std::vector<Case>& guarded_cases() {
        {},
        {0x01},
        GuardedRequest::kManagedAttributeWrite,
-       "Reset (0x05) of class 0x40 instance 1 (Configuration.Mode and 5 more) while the node is "
-       "online"},
+       "Reset (0x05) of class 0x40 instance 1 (Configuration.Mode and 5 more)"},
       {"ResetIdentity",
        0x05,
        0x01,
@@ -192,6 +191,46 @@ const std::vector<Case>& guarded_cases() {
        {0x01},
        GuardedRequest::kIdentityReset,
        "Reset (0x05) of the Identity object"},
+      {"ResetPollConnection",
+       0x05,
+       0x05,
+       2,
+       {},
+       {},
+       GuardedRequest::kConnectionChange,
+       "Reset (0x05) to Connection instance 2"},
+      {"SetMacId",
+       0x10,
+       0x03,
+       1,
+       1,
+       {0x05},
+       GuardedRequest::kNetworkSettings,
+       "Set_Attribute_Single (0x10) of DeviceNet object attribute 1"},
+      {"SetBitRate",
+       0x10,
+       0x03,
+       1,
+       2,
+       {0x02},
+       GuardedRequest::kNetworkSettings,
+       "Set_Attribute_Single (0x10) of DeviceNet object attribute 2"},
+      {"MultipleServicePacket",
+       0x0A,
+       0x02,
+       1,
+       {},
+       {0x01, 0x00, 0x04, 0x00, 0x10, 0x09, 0x01, 0x03},
+       GuardedRequest::kOtherService,
+       "to class 0x02 instance 1"},
+      {"VendorService",
+       0x32,
+       0x40,
+       1,
+       {},
+       {},
+       GuardedRequest::kOtherService,
+       "service 0x32 to class 0x40 instance 1"},
   };
   return cases;
 }
@@ -203,7 +242,7 @@ TEST_P(GuardedClass, RefusedByDefaultWithItsClassReasonAndKey) {
   Fixture f;
   const auto r =
       check(ExplicitPolicy{}, f.request(c.service, c.class_id, c.instance_id, c.attribute, c.data),
-            f.node(true));
+            f.node());
   ASSERT_TRUE(r.has_value());
   EXPECT_EQ(r->kind, c.kind);
   EXPECT_NE(r->message.find(c.what), std::string::npos) << r->message;
@@ -218,8 +257,8 @@ TEST_P(GuardedClass, AllowedByItsOwnKeyAndByNoOther) {
   const Case& c = GetParam();
   Fixture f;
   const auto request = f.request(c.service, c.class_id, c.instance_id, c.attribute, c.data);
-  EXPECT_FALSE(check(allowing(c.kind), request, f.node(true)).has_value());
-  const auto others = check(allowing_all_but(c.kind), request, f.node(true));
+  EXPECT_FALSE(check(allowing(c.kind), request, f.node()).has_value());
+  const auto others = check(allowing_all_but(c.kind), request, f.node());
   ASSERT_TRUE(others.has_value());
   EXPECT_EQ(others->kind, c.kind);
 }
@@ -232,47 +271,34 @@ TEST(ExplicitPolicy, GetsAreAlwaysAllowed) {
   const std::vector<std::pair<std::uint16_t, std::uint8_t>> targets{
       {0x01, 7}, {0x03, 5}, {0x04, 3}, {0x05, 9}, {0x09, 3}, {0x0B, 3}, {0x40, 1}};
   for (const auto& [cls, attr] : targets) {
-    for (bool online : {true, false}) {
-      EXPECT_TRUE(classify(f.request(0x0E, cls, 1, attr), f.node(online)).empty()) << cls;
-      EXPECT_TRUE(classify(f.request(0x01, cls, 1, {}), f.node(online)).empty()) << cls;
-      EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x0E, cls, 1, attr), f.node(online)));
-    }
+    EXPECT_TRUE(classify(f.request(0x0E, cls, 1, attr), f.node()).empty()) << cls;
+    EXPECT_TRUE(classify(f.request(0x01, cls, 1, {}), f.node()).empty()) << cls;
+    EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x0E, cls, 1, attr), f.node()));
   }
-}
-
-TEST(ExplicitPolicy, ManagedAttributeSetAllowedWhileTheNodeIsNotOnline) {
-  Fixture f;
-  const auto set_mode = f.request(0x10, 0x40, 1, 1, {0x81});
-  EXPECT_TRUE(check(ExplicitPolicy{}, set_mode, f.node(true)).has_value());
-  EXPECT_FALSE(check(ExplicitPolicy{}, set_mode, f.node(false)).has_value());
-  const auto reset = f.request(0x05, 0x40, 1, {}, {0x01});
-  EXPECT_FALSE(check(ExplicitPolicy{}, reset, f.node(false)).has_value());
-  // Outputs stay PumpCommand's whatever the node's state.
-  EXPECT_TRUE(check(ExplicitPolicy{}, f.request(0x10, 0x09, 1, 3, {1}), f.node(false)));
 }
 
 TEST(ExplicitPolicy, ManagedMeansListedInTheProfile) {
   Fixture f;
   // Configuration attribute 16 (NumberProduced) is not one the bridge sets.
-  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x40, 1, 16, {4}), f.node(true)));
+  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x40, 1, 16, {4}), f.node()));
   // Another instance of a managed attribute's class.
-  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x40, 2, 1, {0x81}), f.node(true)));
+  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x40, 2, 1, {0x81}), f.node()));
   f.settings.clear();
-  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x40, 1, 1, {0x81}), f.node(true)));
-  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x09, 1, 5, {1}), f.node(true)));
+  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x40, 1, 1, {0x81}), f.node()));
+  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x09, 1, 5, {1}), f.node()));
 }
 
 TEST(ExplicitPolicy, TheAttributeIsReadAsTheDeviceReadsIt) {
   Fixture f;
   // No attribute given: the first data byte is the attribute on the wire.
-  const auto dop = check(ExplicitPolicy{}, f.request(0x10, 0x09, 1, {}, {3, 1}), f.node(true));
+  const auto dop = check(ExplicitPolicy{}, f.request(0x10, 0x09, 1, {}, {3, 1}), f.node());
   ASSERT_TRUE(dop.has_value());
   EXPECT_EQ(dop->kind, GuardedRequest::kOutputWrite);
-  const auto mode = check(ExplicitPolicy{}, f.request(0x10, 0x40, 1, {}, {1, 0x81}), f.node(true));
+  const auto mode = check(ExplicitPolicy{}, f.request(0x10, 0x40, 1, {}, {1, 0x81}), f.node());
   ASSERT_TRUE(mode.has_value());
   EXPECT_EQ(mode->kind, GuardedRequest::kManagedAttributeWrite);
   // A Set with no attribute at all writes nothing: the device refuses it.
-  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x09, 1, {}), f.node(true)));
+  EXPECT_FALSE(check(ExplicitPolicy{}, f.request(0x10, 0x09, 1, {}), f.node()));
 }
 
 TEST(ExplicitPolicy, OtherRequestsAreNotGuarded) {
@@ -280,11 +306,11 @@ TEST(ExplicitPolicy, OtherRequestsAreNotGuarded) {
   for (const auto& r : {f.request(0x10, 0x01, 1, 7, {1, 'x'}),       // Identity name
                         f.request(0x10, 0x09, 0, 3, {1}),            // DOP class attribute
                         f.request(0x10, 0x09, 1, 4, {1}),            // DOP status
-                        f.request(0x10, 0x03, 1, 1, {5}),            // DeviceNet MAC ID
-                        f.request(0x05, 0x05, 2, {}),                // Connection Reset
+                        f.request(0x10, 0x32, 1, 15, {1}),           // Supervisor alarm enable
+                        f.request(0x05, 0x08, 1, {}),                // DIP Reset
                         f.request(0x4C, 0x40, 1, {}, {0x03}),        // Release elsewhere
                         f.request(0x4B, 0x01, 1, {}, {0x03, 0})}) {  // Allocate elsewhere
-    EXPECT_TRUE(classify(r, f.node(true)).empty()) << int{r.service} << " " << r.class_id;
+    EXPECT_TRUE(classify(r, f.node()).empty()) << int{r.service} << " " << r.class_id;
   }
 }
 
@@ -292,16 +318,14 @@ TEST(ExplicitPolicy, ARequestOfTwoClassesNeedsBoth) {
   Fixture f;
   // Set_Attributes_All of DOP 1 writes its Value and its managed fault action.
   const auto all = f.request(0x02, 0x09, 1, {}, {1, 0, 0, 0, 0, 0});
-  ASSERT_EQ(classify(all, f.node(true)).size(), 2u);
+  ASSERT_EQ(classify(all, f.node()).size(), 2u);
   ExplicitPolicy outputs;
   outputs.allow_output_writes = true;
-  const auto r = check(outputs, all, f.node(true));
+  const auto r = check(outputs, all, f.node());
   ASSERT_TRUE(r.has_value());
   EXPECT_EQ(r->kind, GuardedRequest::kManagedAttributeWrite);
   outputs.allow_managed_attribute_writes = true;
-  EXPECT_FALSE(check(outputs, all, f.node(true)));
-  // Not online, the output write alone is left.
-  EXPECT_EQ(classify(all, f.node(false)).size(), 1u);
+  EXPECT_FALSE(check(outputs, all, f.node()));
 }
 
 TEST(ExplicitPolicy, EveryClassHasItsOwnKey) {
