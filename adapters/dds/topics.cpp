@@ -61,6 +61,11 @@ Qos command_writer_qos(int32_t strength, Duration lease) {
 
 Qos command_reader_qos() {
   Qos qos = command_common();
+  // Commands in the order they arrive, whatever their source timestamps:
+  // ordered by those, one commander whose clock runs ahead would have every
+  // later sample dropped, its own unregistration included, and hold its
+  // pumps long after it left. (Any writer's order is compatible with this.)
+  qos.destination_order_by_source_timestamp(false);
   // An infinite requested lease accepts every writer's lease; the writer's
   // own lease still decides when the reader sees it lose liveliness.
   qos.liveliness(Liveliness::kAutomatic, kInfinite);

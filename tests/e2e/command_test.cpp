@@ -19,7 +19,10 @@ class Commander {
         topic_(participant_),
         writer_(participant_, topic_, dds::command_writer_qos(strength, seconds(1))) {}
 
-  bool write(unsigned mac, bool pump_on, bool n2_ballast_on, std::uint16_t analog) {
+  // With the source timestamp `ahead` of this host's clock (a commander
+  // whose clock is wrong).
+  bool write(unsigned mac, bool pump_on, bool n2_ballast_on, std::uint16_t analog,
+             Duration ahead = Duration::zero()) {
     dds::Owned<dnbridge_PumpCommand> c;
     dds::set_string(c->rack, kRack);
     dds::set_string(c->port, kPort);
@@ -28,6 +31,7 @@ class Commander {
     c->n2_ballast_on = n2_ballast_on;
     c->analog_output_raw = analog;
     dds::set_string(c->issuer, issuer_);
+    if (ahead != Duration::zero()) return writer_.write(*c, dds::dds_now() + ahead).ok();
     return writer_.write(*c).ok();
   }
   // Until the bridge has matched this commander.
@@ -224,6 +228,48 @@ TEST_F(CommandTest, CommanderThatWritesAndExitsAtOnceLeavesThePumpIdle) {
   for (unsigned mac = 4; mac <= 7; ++mac) {
     EXPECT_FALSE(device_outputs(mac).pump_on) << mac;
   }
+}
+
+// A commander whose clock runs an hour ahead commands a pump and leaves: its
+// timestamps do not outrank the bridge's order of arrival, so a weaker
+// commander's next command is applied at once, and with no commander left
+// the pump goes idle within the command lease.
+TEST_F(CommandTest, ACommanderStampingAnHourAheadDoesNotOutliveItsDeparture) {
+  ASSERT_NO_FATAL_FAILURE(start_online());
+  constexpr unsigned kMac = 7;
+  auto weak = std::make_unique<Commander>("weak", 1);
+  ASSERT_TRUE(weak->matched());
+  ASSERT_TRUE(weak->write(kMac, false, false, 0));
+  ASSERT_TRUE(pumps_.until([&] { return echoes(kMac, false, false, 0, "weak"); }));
+
+  {
+    Commander ahead("an hour ahead", 50);
+    ASSERT_TRUE(ahead.matched());
+    ASSERT_TRUE(ahead.write(kMac, true, false, 0, seconds(3600)));
+    ASSERT_TRUE(pumps_.until([&] { return echoes(kMac, true, false, 0, "an hour ahead"); }));
+    ASSERT_TRUE(ahead.acked());
+  }  // deleted: it unregisters, stamped with its own (now older) time
+  // The weaker commander's next command takes the pump.
+  const auto left = SteadyClock::now();
+  ASSERT_TRUE(weak->write(kMac, false, true, 0));
+  ASSERT_TRUE(pumps_.until([&] { return echoes(kMac, false, true, 0, "weak"); }))
+      << "the weaker commander's command was dropped";
+  report("commander an hour ahead gone -> weaker commander in control", ms_since(left));
+
+  // Again with no other commander: idle within the lease.
+  {
+    Commander ahead("an hour ahead", 50);
+    ASSERT_TRUE(ahead.matched());
+    ASSERT_TRUE(ahead.write(kMac, true, false, 0, seconds(3600)));
+    ASSERT_TRUE(pumps_.until([&] { return echoes(kMac, true, false, 0, "an hour ahead"); }));
+    ASSERT_TRUE(ahead.acked());
+    weak.reset();
+  }
+  ASSERT_TRUE(pumps_.until([&] {
+    const auto* s = pumps_.latest(pump_mac(kMac));
+    return s && s->outputs_idle && dds::view(s->commanded_by).empty();
+  })) << "the pump stayed commanded by a departed writer";
+  EXPECT_FALSE(device_outputs(kMac).pump_on);
 }
 
 }  // namespace
