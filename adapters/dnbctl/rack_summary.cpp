@@ -103,8 +103,14 @@ std::string class_reason(const NodeRow& r) {
   const auto& n = *r.node;
   const std::string reason(view(n.reason));
   switch (classify(r)) {
-    case NodeClass::kIdle:
-      return "no commander: idle polls, the device applies its own idle outputs";
+    case NodeClass::kIdle: {
+      // PumpState says why ("idle: no command yet", ...); an older bridge
+      // does not.
+      std::string_view why = r.pump ? view(r.pump->idle_reason) : std::string_view{};
+      if (why.starts_with("idle: ")) why.remove_prefix(6);
+      return fmt::format("{}: idle polls, the device holds its configured idle state",
+                         why.empty() ? "no commander" : why);
+    }
     case NodeClass::kAbsent: {
       std::string s = reason;
       s += fmt::format(" ({} Allocate attempt{}", n.counters.allocate_attempts,

@@ -95,7 +95,7 @@ TEST(RackSummary, ReasonsSayWhatToLookAt) {
   EXPECT_EQ(class_reason(s.node("r", 1, dnbridge_NODE_ONLINE, "polled every 100 ms", false)),
             "polled every 100 ms; commanded by supervisor-1");
   EXPECT_EQ(class_reason(s.node("r", 1, dnbridge_NODE_ONLINE, "polled every 100 ms")),
-            "no commander: idle polls, the device applies its own idle outputs");
+            "no commander: idle polls, the device holds its configured idle state");
   EXPECT_EQ(class_reason(s.node("r", 3, dnbridge_NODE_CONFIGURATION_FAULT, "poll sizes differ")),
             "poll sizes differ");
   EXPECT_EQ(class_reason(s.node("r", 1, dnbridge_NODE_ONLINE, "polled", true, false)),

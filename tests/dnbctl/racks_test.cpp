@@ -230,11 +230,11 @@ TEST_F(DnbctlRacks, ShowsEachRacksNodesByClassWithTheReason) {
            "rack-north live 1/1 running 3 1 2 0 0 0 0 0 0 "
            "rack-south live 1/1 running 4 0 1 0 1 1 1 0 0 ",
            "RACK PORT MAC NAME CLASS STATE REASON "
-           "rack-north A 2 pump-2 idle online no commander: idle polls, the device applies its "
-           "own idle outputs "
-           "rack-north A 3 pump-3 idle online no commander: ",
-           "rack-south A 1 pump-1 idle online no commander: idle polls, the device applies its "
-           "own idle outputs "
+           "rack-north A 2 pump-2 idle online no command yet: idle polls, the device holds its "
+           "configured idle state "
+           "rack-north A 3 pump-3 idle online no command yet: ",
+           "rack-south A 1 pump-1 idle online no command yet: idle polls, the device holds its "
+           "configured idle state "
            "rack-south A 2 pump-2 absent absent waiting for the first Allocate (",
            " Allocate attempts; last error: explicit request timed out) "
            "rack-south A 3 pump-3 faulted wrong device expected vendor 59 product type 27 "
