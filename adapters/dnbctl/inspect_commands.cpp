@@ -132,7 +132,8 @@ CLI::App* add_racks(CLI::App& app) {
       "racks",
       "Find every bridge on the domain and summarize each rack: its bridge (live, no status yet, "
       "gone), ports running, and how many nodes are online, idle (no command in force), starting, "
-      "absent, faulted (wrong device, configuration fault), owned by another master, stopped or "
+      "absent, faulted (wrong device, configuration fault, device fault), owned by another master, "
+      "stopped or "
       "unknown (no longer published); then the ports that need attention and every node that is "
       "not online, with the reason. A bridge is found by its participant (\"dnbridge <rack>\") "
       "even before it publishes anything. --json gives every node with its class.");
