@@ -45,7 +45,7 @@ PumpRack::PumpRack(const std::vector<PumpConfig>& pumps) {
     v.reason = "not started";
     v.safe_state_source = p.safe_state.source;
     views_.push_back(std::move(v));
-    slots_.push_back({p.io, *format, p.no_commander, p.resume, p.safe_state.source});
+    slots_.push_back({p.io, *format, p.no_commander, p.resume});
   }
 }
 

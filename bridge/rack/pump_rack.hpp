@@ -156,8 +156,6 @@ class PumpRack final : public devicenet::ScannerObserver {
     profiles::cdn127::PollFormat format;
     NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
     ResumePolicy resume = ResumePolicy::kFreshCommand;
-    profiles::cdn127::SafeStateSource safe_state_source =
-        profiles::cdn127::SafeStateSource::kConfiguration;
   };
   // The node left online, or has a device fault: with kFreshCommand (and
   // for a device fault always) its command is void, and it comes back idle.
