@@ -139,9 +139,9 @@ void DdsInput::on_request(const dnbridge_ExplicitRequest& r) {
   rack::ExplicitCall call = call_of(r);
   port::PortLoop* loop = port_of(call.port);
   if (!loop) {
-    publisher_.explicit_reply(rack::refuse(call, rack::TransactionStatus::kInvalidPort,
-                                           fmt::format("rack {} has no port \"{}\"", rack_,
-                                                       call.port)));
+    publisher_.explicit_reply(
+        {}, rack::refuse(call, rack::TransactionStatus::kInvalidPort,
+                         fmt::format("rack {} has no port \"{}\"", rack_, call.port)));
     return;
   }
   loop->explicit_request(std::move(call));

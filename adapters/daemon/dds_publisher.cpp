@@ -1,6 +1,7 @@
 #include "adapters/daemon/dds_publisher.hpp"
 
 #include <algorithm>
+#include <memory>
 
 #include "adapters/daemon/samples.hpp"
 #include "adapters/dds/fields.hpp"
@@ -33,43 +34,71 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
       pump_writer_(participant, pump_topic_, dds::state_writer_qos(state_deadline)),
       node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
       port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
-      reply_writer_(participant, reply_topic_, dds::reply_writer_qos()) {}
+      reply_writer_(participant, reply_topic_, dds::reply_writer_qos()),
+      // State samples are keyed (one waits per instance): the capacity only
+      // bounds the unregistrations of a port that stops.
+      state_out_("dds state out", 64),
+      reply_out_("dds reply out", kReplyBacklog) {}
 
-void DdsPublisher::check(Status s, const char* what) {
-  if (s) return;
+bool DdsPublisher::check(Status s, const char* what) {
+  if (s) return true;
+  std::lock_guard lock(log_mutex_);
   unsigned suppressed = 0;
   if (error_limit_.allow(port::steady_now(), suppressed)) {
     log_.error("writing {} failed: {}{}", what, s.error().message(),
                suppressed ? fmt::format(" ({} more suppressed)", suppressed) : std::string());
   }
+  return false;
 }
+
+namespace {
+
+// What an outbox keeps of a sample: a std::function must be copyable.
+template <class T>
+using Shared = std::shared_ptr<dds::Owned<T>>;
+
+std::string instance_key(char topic, const std::string& port, std::uint8_t mac = 0) {
+  return fmt::format("{}{}/{}", topic, mac, port);
+}
+
+}  // namespace
 
 void DdsPublisher::pump_state(const std::string& port, const rack::PumpView& pump,
                               TimePoint source_time) {
-  dds::Owned<dnbridge_PumpState> sample;
-  fill_pump_state(*sample, rack_, port, pump);
-  check(pump_writer_.write(*sample, clock_.to_wall(source_time)), "PumpState");
+  auto sample = std::make_shared<dds::Owned<dnbridge_PumpState>>();
+  fill_pump_state(**sample, rack_, port, pump);
+  const auto at = clock_.to_wall(source_time);
+  state_out_.post(instance_key('P', port, pump.mac.value()),
+                  [this, sample, at] { check(pump_writer_.write(**sample, at), "PumpState"); });
   std::lock_guard lock(mutex_);
   written_[port].insert(pump.mac.value());
 }
 
 void DdsPublisher::node_status(const std::string& port, const rack::PumpView& pump,
                                const devicenet::Node& node, TimePoint source_time) {
-  dds::Owned<dnbridge_NodeStatus> sample;
-  fill_node_status(*sample, rack_, port, pump, node);
-  check(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
+  auto sample = std::make_shared<dds::Owned<dnbridge_NodeStatus>>();
+  fill_node_status(**sample, rack_, port, pump, node);
+  const auto at = clock_.to_wall(source_time);
+  state_out_.post(instance_key('N', port, pump.mac.value()),
+                  [this, sample, at] { check(node_writer_.write(**sample, at), "NodeStatus"); });
 }
 
 void DdsPublisher::port_status(const port::PortStatusView& status, TimePoint source_time) {
-  dds::Owned<dnbridge_PortStatus> sample;
-  fill_port_status(*sample, rack_, status);
-  check(port_writer_.write(*sample, clock_.to_wall(source_time)), "PortStatus");
+  auto sample = std::make_shared<dds::Owned<dnbridge_PortStatus>>();
+  fill_port_status(**sample, rack_, status);
+  (*sample)->replies_undelivered = replies_undelivered(status.port);
+  const auto at = clock_.to_wall(source_time);
+  state_out_.post(instance_key('S', status.port),
+                  [this, sample, at] { check(port_writer_.write(**sample, at), "PortStatus"); });
 }
 
-void DdsPublisher::explicit_reply(const rack::ExplicitAnswer& answer) {
-  dds::Owned<dnbridge_ExplicitReply> sample;
-  fill_explicit_reply(*sample, answer);
-  check(reply_writer_.write(*sample), "ExplicitReply");
+void DdsPublisher::explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) {
+  auto sample = std::make_shared<dds::Owned<dnbridge_ExplicitReply>>();
+  fill_explicit_reply(**sample, answer);
+  const bool queued = reply_out_.post([this, sample, port] {
+    if (!check(reply_writer_.write(**sample), "ExplicitReply")) undelivered(port);
+  });
+  if (!queued) undelivered(port);
   // Completed transactions stay registered until their gateway forgets them
   // (forget_reply); any other reply is kept for a while, then let go.
   constexpr std::size_t kPassingReplies = 256;
@@ -91,6 +120,17 @@ void DdsPublisher::explicit_reply(const rack::ExplicitAnswer& answer) {
   for (const auto& [requester, txid] : expired) unregister_reply(requester, txid);
 }
 
+void DdsPublisher::undelivered(const std::string& port) {
+  std::lock_guard lock(mutex_);
+  ++undelivered_[port];
+}
+
+std::uint64_t DdsPublisher::replies_undelivered(const std::string& port) const {
+  std::lock_guard lock(mutex_);
+  auto it = undelivered_.find(port);
+  return it == undelivered_.end() ? 0 : it->second;
+}
+
 void DdsPublisher::forget_reply(const std::string& requester, std::uint32_t txid) {
   {
     std::lock_guard lock(mutex_);
@@ -101,38 +141,44 @@ void DdsPublisher::forget_reply(const std::string& requester, std::uint32_t txid
 
 void DdsPublisher::unregister_reply(const std::string& requester, std::uint32_t txid) {
   // Readers keep an instance while any writer has it registered: replies the
-  // bridge no longer keeps are unregistered, or readers fill up.
-  dds::Owned<dnbridge_ExplicitReply> key;
-  dds::set_string(key->requester, requester);
-  key->txid = txid;
-  check(reply_writer_.unregister_instance(*key), "ExplicitReply unregistration");
+  // bridge no longer keeps are unregistered, or readers fill up. Never
+  // refused for the backlog: as many as replies were, and after them.
+  auto key = std::make_shared<dds::Owned<dnbridge_ExplicitReply>>();
+  dds::set_string((*key)->requester, requester);
+  (*key)->txid = txid;
+  reply_out_.post_always([this, key] {
+    check(reply_writer_.unregister_instance(**key), "ExplicitReply unregistration");
+  });
 }
 
 void DdsPublisher::port_stopped(const std::string& port) {
   // Unregister, never dispose: the last samples (online false, stopped) stay
-  // what late readers see until the bridge is back.
+  // what late readers see until the bridge is back. After the port's last
+  // samples, which wait in the same outbox.
   std::set<std::uint8_t> macs;
   {
     std::lock_guard lock(mutex_);
     macs = written_[port];
   }
-  const auto now = dds::dds_now();
-  for (std::uint8_t mac : macs) {
-    dds::Owned<dnbridge_PumpState> pump_key;
-    dds::set_string(pump_key->rack, rack_);
-    dds::set_string(pump_key->port, port);
-    pump_key->mac = mac;
-    check(pump_writer_.unregister_instance(*pump_key, now), "PumpState unregistration");
-    dds::Owned<dnbridge_NodeStatus> node_key;
-    dds::set_string(node_key->rack, rack_);
-    dds::set_string(node_key->port, port);
-    node_key->mac = mac;
-    check(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
-  }
-  dds::Owned<dnbridge_PortStatus> port_key;
-  dds::set_string(port_key->rack, rack_);
-  dds::set_string(port_key->port, port);
-  check(port_writer_.unregister_instance(*port_key, now), "PortStatus unregistration");
+  state_out_.post_always([this, port, macs] {
+    const auto now = dds::dds_now();
+    for (std::uint8_t mac : macs) {
+      dds::Owned<dnbridge_PumpState> pump_key;
+      dds::set_string(pump_key->rack, rack_);
+      dds::set_string(pump_key->port, port);
+      pump_key->mac = mac;
+      check(pump_writer_.unregister_instance(*pump_key, now), "PumpState unregistration");
+      dds::Owned<dnbridge_NodeStatus> node_key;
+      dds::set_string(node_key->rack, rack_);
+      dds::set_string(node_key->port, port);
+      node_key->mac = mac;
+      check(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
+    }
+    dds::Owned<dnbridge_PortStatus> port_key;
+    dds::set_string(port_key->rack, rack_);
+    dds::set_string(port_key->port, port);
+    check(port_writer_.unregister_instance(*port_key, now), "PortStatus unregistration");
+  });
 }
 
 }  // namespace dnbridge::daemon
@@ -145,6 +191,8 @@ void DdsPublisher::flush(Duration timeout) {
   // `timeout` for it.
   const TimePoint deadline = port::steady_now() + timeout;
   auto left = [&] { return std::max(Duration::zero(), deadline - port::steady_now()); };
+  (void)state_out_.drain(left());
+  (void)reply_out_.drain(left());
   (void)pump_writer_.wait_for_acks(left());
   (void)node_writer_.wait_for_acks(left());
   (void)port_writer_.wait_for_acks(left());

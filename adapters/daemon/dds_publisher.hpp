@@ -1,14 +1,18 @@
 #pragma once
 // The DDS face of the ports: writes PumpState, NodeStatus, PortStatus and
-// ExplicitReply samples. Called from every port's thread (Cyclone's writers
-// are thread-safe); each sample carries the monotonic event time mapped to
-// the wall clock as its source timestamp.
+// ExplicitReply samples. Called from every port's thread, it fills the
+// sample there and hands it to an outbox (adapters/daemon/outbox.hpp): state
+// samples to one thread, replies to another, so that a reader that does not
+// acknowledge can delay neither a poll nor the state topics. Each sample
+// carries the monotonic event time mapped to the wall clock as its source
+// timestamp.
 #include <deque>
 #include <map>
 #include <mutex>
 #include <set>
 #include <string>
 
+#include "adapters/daemon/outbox.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/time.hpp"
 #include "adapters/dds/topic.hpp"
@@ -41,19 +45,26 @@ class DdsPublisher final : public port::PortPublisher {
   void node_status(const std::string& port, const rack::PumpView& pump, const devicenet::Node& node,
                    TimePoint source_time) override;
   void port_status(const port::PortStatusView& status, TimePoint source_time) override;
-  void explicit_reply(const rack::ExplicitAnswer& answer) override;
+  void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) override;
   void forget_reply(const std::string& requester, std::uint32_t txid) override;
   void port_stopped(const std::string& port) override;
 
-  // Waits (at most `timeout`) until every reader has acknowledged what was
-  // written: the last samples of a shutdown reach their readers.
+  // Waits (at most `timeout`) until what was handed over is written and every
+  // reader has acknowledged it: the last samples of a shutdown reach their
+  // readers.
   void flush(Duration timeout);
+
+  // Replies not written (the outbox full, or the write failed) for `port`.
+  std::uint64_t replies_undelivered(const std::string& port) const;
+  // Replies handed over at most this many at a time; more are undelivered.
+  static constexpr std::size_t kReplyBacklog = 1024;
 
   const dds::Topic<dnbridge_PumpCommand>& command_topic() const { return command_topic_; }
   const dds::Topic<dnbridge_ExplicitRequest>& request_topic() const { return request_topic_; }
 
  private:
-  void check(Status s, const char* what);
+  // Logs a failed write (rate-limited); true when it succeeded.
+  bool check(Status s, const char* what);
 
   std::string rack_;
   Logger log_;
@@ -70,14 +81,20 @@ class DdsPublisher final : public port::PortPublisher {
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;
 
   void unregister_reply(const std::string& requester, std::uint32_t txid);
+  void undelivered(const std::string& port);
 
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::map<std::string, std::set<std::uint8_t>> written_;  // per port, the MACs written
   // Replies the gateways do not retain (refusals, status answers, resets),
   // oldest first: unregistered beyond a bound, or readers would fill up.
   std::deque<std::pair<std::string, std::uint32_t>> passing_replies_;
   std::set<std::pair<std::string, std::uint32_t>> retained_replies_;
+  std::map<std::string, std::uint64_t> undelivered_;  // per port
+  std::mutex log_mutex_;
   RateLimiter error_limit_;
+  // Last: their threads end, after writing what waits, before the writers go.
+  Outbox state_out_;
+  Outbox reply_out_;
 };
 
 }  // namespace dnbridge::daemon

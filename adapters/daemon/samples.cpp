@@ -289,6 +289,10 @@ void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,
   out.scan_cycle_ms = static_cast<float>(s.scan_cycle_ms);
   out.nodes_online = s.nodes_online;
   out.nodes_configured = s.nodes_configured;
+  out.explicit_outstanding = s.explicit_outstanding;
+  out.explicit_retained = s.explicit_retained;
+  out.explicit_refused_for_limits = s.explicit_refused_for_limits;
+  out.loop_longest_pass_ms = static_cast<float>(s.loop_longest_pass_ms);
 }
 
 void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer& a) {

@@ -28,12 +28,13 @@ Qos command_common() {
   return qos;
 }
 
-Qos explicit_common(Durability durability) {
+// A reply that cannot be written at once (a reader somewhere does not
+// acknowledge) is given up soon; the requester repeats and gets it again.
+constexpr Duration kReplyMaxBlocking = milliseconds(10);
+
+Qos explicit_reader(Durability durability) {
   Qos qos;
-  qos.reliable(kMaxBlocking)
-      .durability(durability)
-      .keep_all()
-      .resource_limits(kExplicitMaxSamples, kExplicitMaxInstances, kExplicitMaxSamplesPerInstance);
+  qos.reliable(kMaxBlocking).durability(durability).keep_last(kExplicitHistoryDepth);
   return qos;
 }
 
@@ -72,20 +73,26 @@ Qos command_reader_qos() {
   return qos;
 }
 
-Qos request_writer_qos() { return explicit_common(Durability::kVolatile); }
-Qos request_reader_qos() { return explicit_common(Durability::kVolatile); }
+Qos request_writer_qos() {
+  Qos qos;
+  qos.reliable(kMaxBlocking)
+      .durability(Durability::kVolatile)
+      .keep_all()
+      .resource_limits(kRequestWriterMaxSamples, kRequestWriterMaxSamples, kExplicitHistoryDepth);
+  return qos;
+}
+
+Qos request_reader_qos() { return explicit_reader(Durability::kVolatile); }
 
 Qos reply_writer_qos() {
-  Qos qos = explicit_common(Durability::kTransientLocal);
-  qos.durability_service_keep_last(1);
-  qos.resource_limits(kReplyMaxSamples, kReplyMaxInstances, kExplicitMaxSamplesPerInstance);
+  Qos qos;
+  qos.reliable(kReplyMaxBlocking)
+      .durability(Durability::kTransientLocal)
+      .keep_last(kExplicitHistoryDepth)
+      .durability_service_keep_last(1);
   return qos;
 }
 
-Qos reply_reader_qos() {
-  Qos qos = explicit_common(Durability::kTransientLocal);
-  qos.resource_limits(kReplyMaxSamples, kReplyMaxInstances, kExplicitMaxSamplesPerInstance);
-  return qos;
-}
+Qos reply_reader_qos() { return explicit_reader(Durability::kTransientLocal); }
 
 }  // namespace dnbridge::dds

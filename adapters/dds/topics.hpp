@@ -69,33 +69,34 @@ Qos command_writer_qos(int32_t strength, Duration lease);
 Qos command_reader_qos();
 
 // --- ExplicitRequest / ExplicitReply -------------------------------------------
-// Reliable and keep-all (no request or reply is overwritten while waiting),
-// bounded: a port runs one explicit transaction per node at a time and a rack
-// has a few ports of at most 64 nodes, so 256 outstanding requests is far
-// above what a bridge can execute, while keeping memory bounded. A
-// transaction is one instance; 4 samples per instance leave room for a
-// repeated request or the IN_PROGRESS and final replies of a GET_STATUS.
-// Past a limit a write blocks for at most the reliability max_blocking_time
-// and then fails with DDS_RETCODE_TIMEOUT: pushed back, never dropped.
+// Reliable. A transaction is one instance; keep-last 4 per instance leaves
+// room for a repeated request, or the IN_PROGRESS and final replies of a
+// GET_STATUS.
+//
+// Readers never refuse a sample: no resource limits. With Cyclone DDS 0.10 a
+// reader that rejects a reliable sample (a full keep-all history, a limit on
+// instances) makes the thread that delivers it retry until the reader takes
+// something, and that thread delivers every reader of the participant: one
+// client that filled the bridge's request reader would stop the bridge from
+// taking anyone's commands. The bridge takes every request at once and
+// answers the excess itself, with OUT_OF_BUFFERS (its per-requester and
+// per-port limits), so the number of requests it holds stays bounded where
+// it can say so.
+//
 // A reader keeps an instance for as long as a writer has it registered, even
 // with no sample left, so each side unregisters a transaction's instance
 // once done with it (the requester after its reply, the bridge when it
 // forgets the transaction); readers skip the invalid samples that follow.
-inline constexpr int32_t kExplicitMaxSamples = 256;
-inline constexpr int32_t kExplicitMaxInstances = 256;
-inline constexpr int32_t kExplicitMaxSamplesPerInstance = 4;
-// Every reply reader receives the replies of every requester, and a bridge
-// keeps the replies of the transactions it remembers registered (256 per
-// port, plus the last 256 refusals and status answers): reply readers take
-// far more instances than request readers, so that a bridge's writer is
-// never pushed back by a reader that is full of other requesters' replies.
-inline constexpr int32_t kReplyMaxInstances = 8192;
-inline constexpr int32_t kReplyMaxSamples = 8192;
+inline constexpr int32_t kExplicitHistoryDepth = 4;
 
 // Requests are volatile: a bridge that starts must never execute requests
 // written before it existed (a stale Set_Attribute would be replayed). A
 // requester that wrote before the bridge matched gets no reply and repeats
 // the request (same key: the same reply, not a second execution).
+// The writer's history is keep-all, bounded: a requester that writes faster
+// than the bridge acknowledges waits up to the max_blocking_time and then
+// gets DDS_RETCODE_TIMEOUT, in its own process.
+inline constexpr int32_t kRequestWriterMaxSamples = 256;
 Qos request_writer_qos();
 Qos request_reader_qos();
 
@@ -104,7 +105,10 @@ Qos request_reader_qos();
 // independent), and a volatile reply would then be lost. The writer keeps the
 // last reply of each transaction (durability service keep-last 1) for such a
 // late reader; the bridge unregisters a transaction's instance when it
-// forgets the transaction, which releases it from that cache.
+// forgets the transaction (explicit_retention), which releases it from that
+// cache and from every reader. The bridge writes replies from a thread of its
+// own with a short max_blocking_time: a reply reader that does not
+// acknowledge costs lost replies (counted on PortStatus), never a poll.
 Qos reply_writer_qos();
 Qos reply_reader_qos();
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 
 #include "adapters/port/thread_name.hpp"
 
@@ -71,7 +72,25 @@ void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs,
   push(Command{mac, outputs, std::move(issuer)});
 }
 void PortLoop::release_command(MacId mac) { push(Release{mac}); }
-void PortLoop::explicit_request(rack::ExplicitCall call) { push(std::move(call)); }
+void PortLoop::explicit_request(rack::ExplicitCall call) {
+  bool queued = false;
+  {
+    std::lock_guard lock(inbox_mutex_);
+    if (calls_.size() < kMaxQueuedCalls) {
+      calls_.push_back(call);
+      queued = true;
+    }
+  }
+  if (queued) {
+    backend_->wake();
+    return;
+  }
+  calls_refused_.fetch_add(1, std::memory_order_relaxed);
+  publisher_.explicit_reply(config_.port,
+                            rack::refuse(call, rack::TransactionStatus::kOutOfBuffers,
+                                         fmt::format("{} requests already wait for port {}",
+                                                     kMaxQueuedCalls, config_.port)));
+}
 void PortLoop::post(std::function<void(CanBackend&)> fn) { push(std::move(fn)); }
 
 void PortLoop::push(Item item) {
@@ -84,9 +103,11 @@ void PortLoop::push(Item item) {
 
 bool PortLoop::drain_inbox(TimePoint now) {
   std::vector<Item> items;
+  std::vector<rack::ExplicitCall> calls;
   {
     std::lock_guard lock(inbox_mutex_);
     items.swap(inbox_);
+    calls.swap(calls_);
   }
   bool keep_running = true;
   for (auto& item : items) {
@@ -103,16 +124,21 @@ bool PortLoop::drain_inbox(TimePoint now) {
       if (rack_.release_command(r->mac, now)) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
-    } else if (auto* call = std::get_if<rack::ExplicitCall>(&item)) {
-      if (auto answer = gateway_->on_request(*call, now)) publisher_.explicit_reply(*answer);
-      forget_replies();
     } else if (auto* fn = std::get_if<std::function<void(CanBackend&)>>(&item)) {
       (*fn)(*backend_);
     } else {
       keep_running = false;
     }
   }
+  for (const auto& call : calls) on_call(call, now);
+  gateway_->expire(now);
+  forget_replies();
   return keep_running;
+}
+
+void PortLoop::on_call(const rack::ExplicitCall& call, TimePoint now) {
+  if (auto answer = gateway_->on_request(call, now))
+    publisher_.explicit_reply(config_.port, *answer);
 }
 
 void PortLoop::run() {
@@ -123,6 +149,7 @@ void PortLoop::run() {
   bool stopping = false;
   TimePoint stop_deadline = kNever;
   for (;;) {
+    const auto pass_start = std::chrono::steady_clock::now();
     heartbeat_.fetch_add(1, std::memory_order_relaxed);
     now = backend_->now();
     // (A master that starts now checks its MAC anyway: no re-check for it.)
@@ -153,11 +180,14 @@ void PortLoop::run() {
     publish(now, false);
     if (stopping && (scanner_->stopped() || now >= stop_deadline)) break;
 
-    TimePoint wake = std::min(
-        {scanner_->next_deadline(), stop_deadline, port_status_time_ + config_.status_period});
+    TimePoint wake = std::min({scanner_->next_deadline(), stop_deadline,
+                               port_status_time_ + config_.status_period, gateway_->next_expiry()});
     for (const auto& p : published_) {
       wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
     }
+    longest_pass_ = std::max<Duration>(
+        longest_pass_,
+        std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now() - pass_start));
     FrameReceiver& receiver = *this;
     backend_->wait(wake, receiver);
   }
@@ -244,6 +274,16 @@ void PortLoop::publish_port(TimePoint now) {
   s.frames_per_second = metrics_.frames_per_second;
   s.bus_load_percent = metrics_.bus_load_percent;
   s.scan_cycle_ms = metrics_.scan_cycle_ms;
+  {
+    std::lock_guard lock(inbox_mutex_);
+    s.explicit_outstanding = static_cast<std::uint32_t>(calls_.size());
+  }
+  s.explicit_outstanding += static_cast<std::uint32_t>(gateway_->in_progress());
+  s.explicit_retained = static_cast<std::uint32_t>(gateway_->retained());
+  s.explicit_refused_for_limits =
+      gateway_->refused_for_limits() + calls_refused_.load(std::memory_order_relaxed);
+  s.loop_longest_pass_ms = std::chrono::duration<double, std::milli>(longest_pass_).count();
+  longest_pass_ = Duration::zero();
   nodes_online_.store(s.nodes_online, std::memory_order_relaxed);
   publisher_.port_status(s, std::max(now, port_event_time_));
   port_status_time_ = now;
@@ -306,7 +346,8 @@ void PortLoop::on_device_state(MacId m, std::uint8_t s, TimePoint at) {
 }
 void PortLoop::on_explicit_result(std::uint32_t id, MacId, const devicenet::ExplicitResult& r,
                                   TimePoint at) {
-  if (auto answer = gateway_->on_result(id, r, at)) publisher_.explicit_reply(*answer);
+  if (auto answer = gateway_->on_result(id, r, at))
+    publisher_.explicit_reply(config_.port, *answer);
   forget_replies();
 }
 

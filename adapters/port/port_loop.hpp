@@ -53,7 +53,10 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
                std::string issuer);
   void release_command(devicenet::MacId mac);
+  // Past kMaxQueuedCalls requests waiting for the loop, answered at once
+  // with "out of buffers" (on the caller's thread, through the publisher).
   void explicit_request(rack::ExplicitCall call);
+  static constexpr std::size_t kMaxQueuedCalls = 256;
   // Runs `fn` on the port's thread with its backend (tests and tools only).
   void post(std::function<void(CanBackend&)> fn);
 
@@ -86,15 +89,17 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     devicenet::MacId mac;
   };
   struct Stop {};
-  using Item =
-      std::variant<Command, Release, rack::ExplicitCall, Stop, std::function<void(CanBackend&)>>;
+  using Item = std::variant<Command, Release, Stop, std::function<void(CanBackend&)>>;
 
   void run();
   // Starts the master once the interface is up: its duplicate MAC ID check
   // must reach the bus to mean anything.
   void start_master_when_up(TimePoint now);
   void push(Item item);
-  bool drain_inbox(TimePoint now);  // false once a Stop was seen
+  // Commands first, then explicit requests: a pump command never waits
+  // behind explicit traffic. False once a Stop was seen.
+  bool drain_inbox(TimePoint now);
+  void on_call(const rack::ExplicitCall& call, TimePoint now);
   void publish(TimePoint now, bool force);
   void publish_port(TimePoint now);
   void update_metrics(const BusCounters& bus, TimePoint now);
@@ -146,8 +151,14 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     double scan_cycle_ms = 0;
   } metrics_;
 
+  // The longest pass of the loop (woken to waiting again) since the last
+  // PortStatus, on the steady clock whatever clock the backend runs on.
+  Duration longest_pass_{};
+
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
+  std::vector<rack::ExplicitCall> calls_;
+  std::atomic<std::uint64_t> calls_refused_{0};  // kMaxQueuedCalls reached
   std::thread thread_;
   std::atomic<bool> running_{false};
   std::atomic<bool> started_up_{false};

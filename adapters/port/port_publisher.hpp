@@ -25,6 +25,10 @@ struct PortStatusView {
   double scan_cycle_ms = 0;  // mean interval between two polls of an online node
   std::uint16_t nodes_online = 0;
   std::uint16_t nodes_configured = 0;
+  std::uint32_t explicit_outstanding = 0;  // queued for the loop or executing
+  std::uint32_t explicit_retained = 0;
+  std::uint64_t explicit_refused_for_limits = 0;
+  double loop_longest_pass_ms = 0;  // since the previous PortStatus
 };
 
 class PortPublisher {
@@ -38,7 +42,8 @@ class PortPublisher {
   virtual void node_status(const std::string& port, const rack::PumpView& pump,
                            const devicenet::Node& node, TimePoint source_time) = 0;
   virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;
-  virtual void explicit_reply(const rack::ExplicitAnswer& answer) = 0;
+  // `port`: the port whose gateway answers; empty for a request no port took.
+  virtual void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) = 0;
   // The transaction is forgotten: a repeat would now execute again.
   virtual void forget_reply(const std::string& requester, std::uint32_t txid) = 0;
   // The port has stopped: its instances are unregistered (never disposed).

@@ -157,8 +157,14 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
                               devicenet::kMaxExplicitMessage - 8));
   }
   if (by_request_id_.size() >= limits_.in_progress) {
-    return refuse(call, TransactionStatus::kOutOfBuffers,
-                  fmt::format("{} transactions already in progress", by_request_id_.size()));
+    return refuse_for_limits(call, fmt::format("{} transactions already in progress on port {}",
+                                               by_request_id_.size(), call.port));
+  }
+  if (auto it = executing_by_requester_.find(call.requester);
+      it != executing_by_requester_.end() && it->second >= limits_.per_requester) {
+    return refuse_for_limits(
+        call, fmt::format("{} transactions of \"{}\" already in progress on port {} (at most {})",
+                          it->second, call.requester, call.port, limits_.per_requester));
   }
 
   auto id = scanner_.request_explicit(*mac, request, now);
@@ -178,9 +184,16 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
   // What the policy lets through of the guarded requests is worth a trace.
   log_allowed(call, request, *node, now);
   const Key key{call.requester, call.txid};
-  transactions_[key] = Transaction{call, false, {}};
+  transactions_[key] = Transaction{call, false, {}, {}};
   by_request_id_[*id] = key;
+  ++executing_by_requester_[call.requester];
   return std::nullopt;
+}
+
+std::optional<ExplicitAnswer> ExplicitGateway::refuse_for_limits(const ExplicitCall& call,
+                                                                 std::string message) {
+  ++refused_for_limits_;
+  return refuse(call, TransactionStatus::kOutOfBuffers, std::move(message));
 }
 
 std::optional<ExplicitAnswer> ExplicitGateway::apply_policy(
@@ -217,11 +230,14 @@ void ExplicitGateway::log_allowed(const ExplicitCall& call,
 
 std::optional<ExplicitAnswer> ExplicitGateway::on_result(std::uint32_t request_id,
                                                          const devicenet::ExplicitResult& result,
-                                                         TimePoint) {
+                                                         TimePoint now) {
   auto it = by_request_id_.find(request_id);
   if (it == by_request_id_.end()) return std::nullopt;
   const Key key = it->second;
   by_request_id_.erase(it);
+  if (auto n = executing_by_requester_.find(key.first); n != executing_by_requester_.end()) {
+    if (--n->second == 0) executing_by_requester_.erase(n);
+  }
   Transaction& t = transactions_.at(key);
 
   ExplicitAnswer a = refuse(t.call, TransactionStatus::kSuccess, {});
@@ -258,17 +274,32 @@ std::optional<ExplicitAnswer> ExplicitGateway::on_result(std::uint32_t request_i
   a.retained = true;
   t.done = true;
   t.answer = a;
+  t.done_at = now;
   retain(key);
   return a;
 }
 
 void ExplicitGateway::retain(const Key& key) {
   done_order_.push_back(key);
-  while (done_order_.size() > limits_.retained) {
-    transactions_.erase(done_order_.front());
-    forgotten_.push_back(done_order_.front());
-    done_order_.pop_front();
+  while (done_order_.size() > limits_.retained) forget_oldest();
+}
+
+void ExplicitGateway::expire(TimePoint now) {
+  while (!done_order_.empty() &&
+         now >= transactions_.at(done_order_.front()).done_at + limits_.retention) {
+    forget_oldest();
   }
+}
+
+TimePoint ExplicitGateway::next_expiry() const {
+  if (done_order_.empty()) return kNever;
+  return transactions_.at(done_order_.front()).done_at + limits_.retention;
+}
+
+void ExplicitGateway::forget_oldest() {
+  transactions_.erase(done_order_.front());
+  forgotten_.push_back(done_order_.front());
+  done_order_.pop_front();
 }
 
 }  // namespace dnbridge::rack

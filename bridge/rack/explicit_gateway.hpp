@@ -86,9 +86,13 @@ ExplicitAnswer refuse(const ExplicitCall& call, TransactionStatus status, std::s
 
 class ExplicitGateway {
  public:
+  // Past a limit a request is answered at once with "out of buffers" (9):
+  // one requester can neither take every slot nor make the others wait.
   struct Limits {
-    std::size_t in_progress = 32;  // transactions executing at once (then "out of buffers")
-    std::size_t retained = 256;    // completed transactions kept to answer repeats
+    std::size_t in_progress = 32;      // transactions executing at once, all requesters
+    std::size_t per_requester = 8;     // of those, of one requester
+    std::size_t retained = 256;        // completed transactions kept to answer repeats
+    Duration retention = seconds(60);  // and for at most this long
   };
 
   explicit ExplicitGateway(devicenet::Scanner& scanner) : ExplicitGateway(scanner, Limits{}) {}
@@ -104,8 +108,14 @@ class ExplicitGateway {
   std::optional<ExplicitAnswer> on_result(std::uint32_t request_id,
                                           const devicenet::ExplicitResult& result, TimePoint now);
 
+  // Forgets the completed transactions kept longer than the retention: a
+  // repeat of one of them is then executed again.
+  void expire(TimePoint now);
+  // The earliest time expire() has something to do; kNever when nothing.
+  TimePoint next_expiry() const;
+
   // Transactions forgotten since the last call (evicted from the retained
-  // replies, or reset by their requester): their reply instances can go.
+  // replies, expired, or reset by their requester): their reply instances can go.
   std::vector<std::pair<std::string, std::uint32_t>> take_forgotten() {
     return std::exchange(forgotten_, {});
   }
@@ -117,6 +127,8 @@ class ExplicitGateway {
   std::uint64_t refused_by_policy(GuardedRequest kind) const {
     return refused_[static_cast<std::size_t>(kind)];
   }
+  // Requests answered "out of buffers" because a limit was reached.
+  std::uint64_t refused_for_limits() const { return refused_for_limits_; }
   const ExplicitPolicy& policy() const { return policy_; }
 
  private:
@@ -125,6 +137,7 @@ class ExplicitGateway {
     ExplicitCall call;
     bool done = false;
     ExplicitAnswer answer;  // when done
+    TimePoint done_at{};    // when done
   };
 
   std::optional<ExplicitAnswer> execute(const ExplicitCall& call, TimePoint now);
@@ -135,6 +148,8 @@ class ExplicitGateway {
   void log_allowed(const ExplicitCall& call, const devicenet::RequestMessage& request,
                    const devicenet::Node& node, TimePoint now);
   void retain(const Key& key);
+  void forget_oldest();  // of the completed transactions
+  std::optional<ExplicitAnswer> refuse_for_limits(const ExplicitCall& call, std::string message);
 
   devicenet::Scanner& scanner_;
   Limits limits_;
@@ -147,6 +162,8 @@ class ExplicitGateway {
   std::array<std::uint64_t, kGuardedRequestKinds> refused_{};
   std::map<Key, Transaction> transactions_;
   std::map<std::uint32_t, Key> by_request_id_;  // executing
+  std::map<std::string, std::size_t> executing_by_requester_;
+  std::uint64_t refused_for_limits_ = 0;
   std::deque<Key> done_order_;                  // completed, oldest first
   std::vector<Key> forgotten_;
 };

@@ -57,31 +57,40 @@ TEST_F(DdsTest, RepeatedRequestsOfOneTransactionAreAllKept) {
   EXPECT_EQ(taken->size(), 3U);
 }
 
-TEST_F(DdsTest, FullRequestHistoryPushesBackOnTheRequester) {
-  // Keep-all with resource limits: past kExplicitMaxSamplesPerInstance
-  // untaken samples of one transaction, a write blocks for the reliability
-  // max_blocking_time and then fails; nothing is dropped silently.
+TEST_F(DdsTest, RequestReaderNeverRefusesASample) {
+  // Untaken repeats of one transaction and hundreds of transactions left
+  // registered: the bridge's reader keeps the newest kExplicitHistoryDepth of
+  // each and refuses nothing, so no write waits (a refused reliable sample
+  // would block the writer here, and across processes the delivery thread
+  // every reader of the participant shares).
   Topic<dnbridge_ExplicitRequest> topic(participant_);
   Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
   Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
   const auto r = request(rack_, 1);
-  for (int32_t i = 0; i < kExplicitMaxSamplesPerInstance; ++i) ASSERT_TRUE(client.write(*r).ok());
-  const Status full = client.write(*r);
-  ASSERT_FALSE(full.ok());
-  EXPECT_EQ(full.error(), make_error_code(DDS_RETCODE_TIMEOUT));
-  EXPECT_EQ(bridge.take()->size(), static_cast<std::size_t>(kExplicitMaxSamplesPerInstance));
+  for (int32_t i = 0; i < 2 * kExplicitHistoryDepth; ++i) ASSERT_TRUE(client.write(*r).ok()) << i;
+  EXPECT_EQ(bridge.take()->size(), static_cast<std::size_t>(kExplicitHistoryDepth));
+  constexpr std::uint32_t kRegistered = 600;
+  std::size_t taken = 0;
+  for (std::uint32_t txid = 2; txid < 2 + kRegistered; ++txid) {
+    ASSERT_TRUE(client.write(*request(rack_, txid)).ok()) << txid;
+    if (txid % 100 == 0) taken += bridge.take()->size();
+  }
+  for (auto more = bridge.take(); more.ok() && !more->empty(); more = bridge.take()) {
+    taken += more->size();
+  }
+  EXPECT_EQ(taken, kRegistered);
 }
 
 TEST_F(DdsTest, UnregisteredTransactionsFreeTheirInstances) {
   // A reader keeps an instance while a writer has it registered, even with
   // no sample left: a requester unregisters each finished transaction, or
-  // after kExplicitMaxInstances of them its writes would block.
+  // its instances add up in every reader.
   Topic<dnbridge_ExplicitRequest> topic(participant_);
   Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
   Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
   ReadCondition not_read(bridge, DDS_NOT_READ_SAMPLE_STATE);
   int executed = 0;
-  for (std::uint32_t txid = 1; txid <= 2 * kExplicitMaxInstances; ++txid) {
+  for (std::uint32_t txid = 1; txid <= 512; ++txid) {
     const auto r = request(rack_, txid);
     ASSERT_TRUE(client.write(*r).ok()) << txid;
     ASSERT_TRUE(client.unregister_instance(*r).ok());
@@ -90,7 +99,7 @@ TEST_F(DdsTest, UnregisteredTransactionsFreeTheirInstances) {
     ASSERT_TRUE(taken.ok());
     for (const auto& sample : *taken) executed += sample.valid_data() ? 1 : 0;
   }
-  EXPECT_EQ(executed, 2 * kExplicitMaxInstances);
+  EXPECT_EQ(executed, 512);
 }
 
 TEST_F(DdsTest, ReplyReachesARequesterDiscoveredAfterIt) {

@@ -261,8 +261,8 @@ TEST_F(ExplicitTest, InProgressBusyAndOutOfBuffersUnderLoad) {
   Request status = get(100, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kVendor);
   status.command = dnbridge_COMMAND_GET_STATUS;
   ASSERT_NO_FATAL_FAILURE(send(status));
-  // Nodes 2..7, five each (within their queues): more than the 32
-  // transactions a port runs at once.
+  // Nodes 2..7, five each (within their queues): more than one requester's
+  // share of the transactions a port runs at once.
   for (std::uint32_t mac = 2; mac <= 7; ++mac) {
     for (std::uint32_t i = 0; i < 5; ++i) {
       ASSERT_NO_FATAL_FAILURE(send(get(200 + 10 * mac + i, mac, cdn127::class_id::kIdentity,
@@ -292,7 +292,8 @@ TEST_F(ExplicitTest, InProgressBusyAndOutOfBuffersUnderLoad) {
   EXPECT_TRUE(std::all_of(busy_from, node1.end(), [](auto s) { return s == kConnectionBusy; }));
   const auto in_progress_of_node1 = static_cast<unsigned>(busy_from - node1.begin());
 
-  // The rest: accepted up to 32 in progress, then out of buffers.
+  // The rest: accepted while this requester has fewer than 8 in progress
+  // (its share of the port's 32), then out of buffers.
   unsigned accepted = in_progress_of_node1;
   unsigned out_of_buffers = 0;
   for (std::uint32_t mac = 2; mac <= 7; ++mac) {
@@ -308,8 +309,8 @@ TEST_F(ExplicitTest, InProgressBusyAndOutOfBuffersUnderLoad) {
       }
     }
   }
-  EXPECT_EQ(accepted, 32u);
-  EXPECT_EQ(out_of_buffers, in_progress_of_node1 + 30 - 32);
+  EXPECT_EQ(accepted, 8u);
+  EXPECT_EQ(out_of_buffers, in_progress_of_node1 + 30 - 8);
 }
 
 }  // namespace

@@ -224,6 +224,58 @@ TEST_F(Gateway, BusyConnectionAndFullTableAreRefused) {
   EXPECT_EQ(gateway_->in_progress(), 0u);
 }
 
+TEST_F(Gateway, OneRequesterCannotTakeEverySlot) {
+  limits_.per_requester = 3;
+  SetUp();
+  start();
+  // "greedy" fills its share over two nodes; the next is refused at once.
+  for (std::uint32_t txid = 1; txid <= 4; ++txid) {
+    harness_.request(get_call(txid, 1 + txid % 2, cdn127::class_id::kIdentity, 1), now());
+  }
+  ASSERT_EQ(harness_.replies.size(), 1u);
+  const auto* refused = harness_.reply(4);
+  ASSERT_NE(refused, nullptr);
+  EXPECT_EQ(refused->status, TransactionStatus::kOutOfBuffers);
+  EXPECT_NE(refused->message.find("3 transactions of \"tester\""), std::string::npos)
+      << refused->message;
+  EXPECT_EQ(gateway_->refused_for_limits(), 1u);
+  // Another requester is served meanwhile.
+  auto other = get_call(1, 2, cdn127::class_id::kIdentity, 1);
+  other.requester = "patient";
+  harness_.request(other, now());
+  EXPECT_EQ(gateway_->in_progress(), 4u);
+  run();
+  EXPECT_EQ(gateway_->in_progress(), 0u);
+  // Its share is back once its transactions completed.
+  harness_.request(get_call(5, 1, cdn127::class_id::kIdentity, 1), now());
+  EXPECT_EQ(gateway_->in_progress(), 1u);
+  EXPECT_EQ(gateway_->refused_for_limits(), 1u);
+}
+
+TEST_F(Gateway, CompletedTransactionsAreForgottenAfterTheRetention) {
+  limits_.retention = seconds(20);
+  SetUp();
+  start();
+  auto call = get_call(1, 1, cdn127::class_id::kIdentity, 1);
+  harness_.request(call, now());
+  run();
+  ASSERT_EQ(gateway_->retained(), 1u);
+  const TimePoint done = gateway_->next_expiry() - seconds(20);
+  EXPECT_LE(done, now());
+  gateway_->expire(done + seconds(19));
+  EXPECT_EQ(gateway_->retained(), 1u);
+  EXPECT_TRUE(gateway_->take_forgotten().empty());
+  gateway_->expire(done + seconds(20));
+  EXPECT_EQ(gateway_->retained(), 0u);
+  EXPECT_EQ(gateway_->next_expiry(), kNever);
+  const auto forgotten = gateway_->take_forgotten();
+  ASSERT_EQ(forgotten.size(), 1u);
+  EXPECT_EQ(forgotten[0], std::make_pair(std::string("tester"), std::uint32_t{1}));
+  // A repeat now is a new execution.
+  harness_.request(call, now());
+  EXPECT_EQ(gateway_->in_progress(), 1u);
+}
+
 TEST_F(Gateway, ResetAllForgetsTheRequestersTransactions) {
   start();
   auto call = get_call(1, 1, cdn127::class_id::kIdentity, 1);

@@ -47,7 +47,7 @@ class RecordingPublisher final : public PortPublisher {
     ++port_samples;
     changed_.notify_all();
   }
-  void explicit_reply(const rack::ExplicitAnswer& a) override {
+  void explicit_reply(const std::string&, const rack::ExplicitAnswer& a) override {
     std::lock_guard lock(mutex_);
     replies.push_back(a);
     changed_.notify_all();
