@@ -14,24 +14,32 @@ namespace {
 
 enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3 };
 
+// A command stamped further ahead of this host's clock is reported.
+constexpr Duration kClockSkewReported = seconds(1);
+
 // Samples taken at a time.
 constexpr std::size_t kBatch = 32;
 
-// Takes every sample the reader holds, a buffer at a time (taking resets
-// DATA_AVAILABLE while samples may remain, so a full buffer is followed by
-// another take), and hands each to `fn`.
+// Requests taken before the commands are looked at again.
+constexpr std::size_t kRequestBatches = 4;
+
+// Takes what the reader holds, a buffer at a time, at most `batches` buffers
+// (unlimited: 0), and hands each sample to `fn`. True when samples may
+// remain: taking resets DATA_AVAILABLE while samples may remain, so a full
+// buffer is followed by another take, here or on the next call.
 template <class T, class Fn>
-void take_all(const dds::Reader<T>& reader, dds::TakeBuffer<T>& buffer, Logger& log,
-              const char* what, Fn fn) {
-  for (;;) {
+bool take_some(const dds::Reader<T>& reader, dds::TakeBuffer<T>& buffer, Logger& log,
+               const char* what, std::size_t batches, Fn fn) {
+  for (std::size_t n = 0; batches == 0 || n < batches; ++n) {
     auto taken = reader.take(buffer);
     if (!taken) {
       log.error("taking {} failed: {}", what, taken.error().message());
-      return;
+      return false;
     }
     for (std::size_t i = 0; i < *taken; ++i) fn(buffer.data(i), buffer.info(i));
-    if (*taken < buffer.capacity()) return;
+    if (*taken < buffer.capacity()) return false;
   }
+  return true;
 }
 
 }  // namespace
@@ -82,25 +90,31 @@ port::PortLoop* DdsInput::port_of(std::string_view name) {
 }
 
 void DdsInput::run() {
+  // Commands first, and again between batches of requests: a pump command
+  // never waits behind a flood of explicit requests.
+  bool requests_left = false;
   for (;;) {
-    auto triggered = waitset_.wait(seconds(1));
+    auto triggered = waitset_.wait(requests_left ? Duration::zero() : seconds(1));
     if (!triggered) {
       log_.error("waiting for DDS input failed: {}", triggered.error().message());
       continue;
     }
+    bool commands = false;
+    bool requests = requests_left;
     for (auto token : *triggered) {
       if (token == kStop) return;
-      if (token == kCommands) take_commands();
-      if (token == kRequests) take_requests();
+      commands = commands || token == kCommands;
+      requests = requests || token == kRequests;
     }
+    if (commands) take_commands();
+    requests_left = requests && take_requests();
   }
 }
 
 void DdsInput::take_commands() {
-  take_all(commands_, command_buffer_, log_, "pump commands",
-           [this](const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
-             on_command(c, info);
-           });
+  take_some(
+      commands_, command_buffer_, log_, "pump commands", 0,
+      [this](const dnbridge_PumpCommand& c, const dds::SampleInfo& info) { on_command(c, info); });
 }
 
 void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
@@ -124,14 +138,35 @@ void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& 
     loop->release_command(*mac);
     return;
   }
-  if (info.valid_data()) loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
+  if (!info.valid_data()) return;
+  note_clock_skew(c, info);
+  loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
 }
 
-void DdsInput::take_requests() {
-  take_all(requests_, request_buffer_, log_, "explicit requests",
-           [this](const dnbridge_ExplicitRequest& r, const dds::SampleInfo& info) {
-             if (info.valid_data()) on_request(r);
-           });
+void DdsInput::note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
+  // Commands are applied in the order they arrive, whatever their stamps
+  // (dds::command_reader_qos): a commander's clock cannot hold a pump. A
+  // stamp far ahead still says that a commander's clock is wrong, and other
+  // readers of its samples (ordered by source timestamp) will be misled.
+  const auto ahead = info.source_timestamp() - dds::dds_now();
+  if (ahead <= kClockSkewReported) return;
+  ++commands_stamped_ahead_;
+  unsigned suppressed = 0;
+  if (skew_limit_.allow(port::steady_now(), suppressed)) {
+    log_.warn(
+        "command from \"{}\" for port \"{}\" MAC {} is stamped {:.1f} s ahead of this host's "
+        "clock ({} such commands so far): applied in the order received; check the commander's "
+        "clock synchronisation",
+        dds::view(c.issuer), dds::view(c.port), c.mac, std::chrono::duration<double>(ahead).count(),
+        commands_stamped_ahead_);
+  }
+}
+
+bool DdsInput::take_requests() {
+  return take_some(requests_, request_buffer_, log_, "explicit requests", kRequestBatches,
+                   [this](const dnbridge_ExplicitRequest& r, const dds::SampleInfo& info) {
+                     if (info.valid_data()) on_request(r);
+                   });
 }
 
 void DdsInput::on_request(const dnbridge_ExplicitRequest& r) {

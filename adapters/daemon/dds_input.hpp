@@ -29,9 +29,10 @@ class DdsInput {
  private:
   void run();
   void take_commands();
-  void take_requests();
+  bool take_requests();  // true when requests may remain
   void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
   void on_request(const dnbridge_ExplicitRequest& r);
+  void note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
   port::PortLoop* port_of(std::string_view name);
 
   std::string rack_;
@@ -46,6 +47,8 @@ class DdsInput {
   dds::WaitSet waitset_;
   std::thread thread_;
   RateLimiter warn_limit_;
+  RateLimiter skew_limit_;
+  std::uint64_t commands_stamped_ahead_ = 0;
 };
 
 }  // namespace dnbridge::daemon

@@ -249,6 +249,10 @@ TEST_F(CommandTest, ACommanderStampingAnHourAheadDoesNotOutliveItsDeparture) {
     ASSERT_TRUE(pumps_.until([&] { return echoes(kMac, true, false, 0, "an hour ahead"); }));
     ASSERT_TRUE(ahead.acked());
   }  // deleted: it unregisters, stamped with its own (now older) time
+  // The wrong clock is reported, with the commander's name.
+  EXPECT_TRUE(log_.contains(LogLevel::kWarn,
+                            "command from \"an hour ahead\" for port \"A\" MAC 7 is stamped 3"))
+      << "no warning about the commander's clock";
   // The weaker commander's next command takes the pump.
   const auto left = SteadyClock::now();
   ASSERT_TRUE(weak->write(kMac, false, true, 0));
