@@ -163,15 +163,43 @@ void DdsInput::note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleI
 }
 
 bool DdsInput::take_requests() {
-  return take_some(requests_, request_buffer_, log_, "explicit requests", kRequestBatches,
-                   [this](const dnbridge_ExplicitRequest& r, const dds::SampleInfo& info) {
-                     if (info.valid_data()) on_request(r);
-                   });
+  // Serialized as well: a requester name is checked whole (see on_request).
+  for (std::size_t n = 0; n < kRequestBatches; ++n) {
+    auto taken = requests_.take(request_buffer_, request_cdr_);
+    if (!taken) {
+      log_.error("taking explicit requests failed: {}", taken.error().message());
+      return false;
+    }
+    for (std::size_t i = 0; i < *taken; ++i) {
+      if (request_buffer_.info(i).valid_data())
+        on_request(request_buffer_.data(i), request_cdr_[i]);
+    }
+    if (*taken < request_buffer_.capacity()) return false;
+  }
+  return true;
 }
 
-void DdsInput::on_request(const dnbridge_ExplicitRequest& r) {
+void DdsInput::on_request(const dnbridge_ExplicitRequest& r,
+                          std::span<const unsigned char> serialized) {
   if (dds::view(r.rack) != rack_) return;
   rack::ExplicitCall call = call_of(r);
+  if (dds::leading_string_has_nul(serialized)) {
+    // The name reads as its part before the NUL: two such requesters would
+    // take each other's transactions. Not executed; the reply goes to the
+    // part before the NUL (a C string cannot say more).
+    ++requests_refused_for_names_;
+    unsigned suppressed = 0;
+    if (warn_limit_.allow(port::steady_now(), suppressed)) {
+      log_.warn(
+          "explicit request (txid {}) refused: its requester name \"{}\" goes on past a NUL "
+          "character ({} such requests so far)",
+          call.txid, call.requester, requests_refused_for_names_);
+    }
+    publisher_.explicit_reply(
+        {}, rack::refuse(call, rack::TransactionStatus::kInvalidCommand,
+                         "the requester name holds a NUL character: use a name without one"));
+    return;
+  }
   port::PortLoop* loop = port_of(call.port);
   if (!loop) {
     publisher_.explicit_reply(

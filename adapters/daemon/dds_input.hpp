@@ -4,8 +4,10 @@
 // its port's loop through the loop's inbox; no DDS callback touches master
 // state. Requests for other racks are left to their bridges.
 #include <map>
+#include <span>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "adapters/daemon/dds_publisher.hpp"
 #include "adapters/dds/reader.hpp"
@@ -31,7 +33,7 @@ class DdsInput {
   void take_commands();
   bool take_requests();  // true when requests may remain
   void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
-  void on_request(const dnbridge_ExplicitRequest& r);
+  void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
   void note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
   port::PortLoop* port_of(std::string_view name);
 
@@ -43,12 +45,14 @@ class DdsInput {
   dds::Reader<dnbridge_ExplicitRequest> requests_;
   dds::TakeBuffer<dnbridge_PumpCommand> command_buffer_;
   dds::TakeBuffer<dnbridge_ExplicitRequest> request_buffer_;
+  std::vector<std::vector<unsigned char>> request_cdr_;
   dds::GuardCondition stop_;
   dds::WaitSet waitset_;
   std::thread thread_;
   RateLimiter warn_limit_;
   RateLimiter skew_limit_;
   std::uint64_t commands_stamped_ahead_ = 0;
+  std::uint64_t requests_refused_for_names_ = 0;
 };
 
 }  // namespace dnbridge::daemon

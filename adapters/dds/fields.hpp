@@ -53,4 +53,24 @@ inline std::span<const std::uint8_t> view(const dds_sequence_octet& seq) noexcep
   return {seq._buffer, seq._length};
 }
 
+// Whether the first member of a serialized sample (CDR from its 4-byte
+// encapsulation header on), a string, holds a NUL before its end. The
+// generated struct's copy of such a string ends at that NUL, so two
+// different values would read the same. False for anything that does not
+// parse as such.
+inline bool leading_string_has_nul(std::span<const unsigned char> cdr) noexcept {
+  constexpr std::size_t kHeader = 4;
+  if (cdr.size() < kHeader + 4) return false;
+  // Encapsulation identifiers: the low bit of the second byte says little endian.
+  const bool little = (cdr[1] & 1) != 0;
+  std::uint32_t length = 0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const std::uint32_t byte = cdr[kHeader + (little ? 3 - i : i)];
+    length = (length << 8) | byte;
+  }
+  // The length counts the terminating NUL.
+  if (length < 2 || length > cdr.size() - kHeader - 4) return false;
+  return std::memchr(cdr.data() + kHeader + 4, 0, length - 1) != nullptr;
+}
+
 }  // namespace dnbridge::dds

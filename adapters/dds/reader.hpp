@@ -4,6 +4,7 @@
 // Sample<T> (or TakeBuffer<T>) frees, so no loan is ever outstanding.
 // Creation throws Error; every operation after that returns a Status or Result.
 #include <dds/dds.h>
+#include <dds/ddsi/ddsi_serdata.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -84,6 +85,32 @@ class Reader : public Entity {
     into.count_ = 0;
     const dds_return_t n = dds_take(handle(), into.buffers_.data(), into.infos_.data(), cap, cap);
     if (n < 0) return make_error_code(n);
+    into.count_ = static_cast<std::size_t>(n);
+    return into.count_;
+  }
+  // As take(into), and the serialized form of each sample (CDR, from its
+  // 4-byte encapsulation header on) into `serialized`: what the typed sample
+  // cannot show, such as a string with a NUL inside (the struct's copy ends
+  // at that NUL). Not for a hot path: it allocates.
+  Result<std::size_t> take(TakeBuffer<T>& into,
+                           std::vector<std::vector<unsigned char>>& serialized) const {
+    const auto cap = static_cast<uint32_t>(into.capacity());
+    into.count_ = 0;
+    std::vector<ddsi_serdata*> raw(cap, nullptr);
+    const dds_return_t n =
+        dds_takecdr(handle(), raw.data(), cap, into.infos_.data(), DDS_ANY_STATE);
+    if (n < 0) return make_error_code(n);
+    serialized.resize(static_cast<std::size_t>(n));
+    for (std::size_t i = 0; i < serialized.size(); ++i) {
+      auto& sample = into.samples_[i];
+      sample.clear();
+      // Key members only, for a sample without valid data.
+      (void)ddsi_serdata_to_sample(raw[i], sample.get(), nullptr, nullptr);
+      auto& bytes = serialized[i];
+      bytes.resize(ddsi_serdata_size(raw[i]));
+      ddsi_serdata_to_ser(raw[i], 0, bytes.size(), bytes.data());
+      ddsi_serdata_unref(raw[i]);
+    }
     into.count_ = static_cast<std::size_t>(n);
     return into.count_;
   }

@@ -7,8 +7,10 @@
 // response is over 512 bytes (devicenet::kMaxExplicitMessage), and no
 // attribute of the CDN127, real or simulated, comes near that (the longest,
 // Device Supervisor Exception Detail, is a few tens of bytes).
+#include <algorithm>
 #include <atomic>
 #include <memory>
+#include <vector>
 
 #include "bridge/devicenet/identifier.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
@@ -92,6 +94,52 @@ TEST_F(ExplicitTest, GetsIdentityAndFragmentedDeviceSupervisorStringsThroughDds)
   EXPECT_EQ(missing->status, kSuccess);
   EXPECT_EQ(missing->general_status, 0x14);  // attribute not supported
   EXPECT_TRUE(missing->data.empty());
+}
+
+TEST_F(ExplicitTest, ARequesterNameWithANulInsideIsRefused) {
+  ASSERT_NO_FATAL_FAILURE(start_online());
+  // What a client in another language can send: this requester's name, a
+  // NUL, and more. Read as a C string it is this requester's name; executed,
+  // two such clients would take each other's transactions. Made here from
+  // the serialized form of a request named with an X where the NUL goes.
+  dds::Reader<dnbridge_ExplicitRequest> tap(supervisor_, request_topic_, dds::request_reader_qos());
+  dds::ReadCondition fresh(tap, DDS_NOT_READ_SAMPLE_STATE);
+  dds::Owned<dnbridge_ExplicitRequest> r;
+  dds::set_string(r->requester, requester_ + "Xtwin");
+  r->txid = 77;
+  r->command = dnbridge_COMMAND_EXECUTE;
+  dds::set_string(r->rack, kRack);
+  dds::set_string(r->port, kPort);
+  r->mac = 1;
+  r->service = 0x0E;
+  r->class_id = 1;
+  r->instance_id = 1;
+  r->has_attribute = true;
+  r->attribute_id = 1;
+  ASSERT_TRUE(requests_.write(*r).ok());
+  ASSERT_TRUE(dds::testing::wait_for(supervisor_, fresh));
+  ddsi_serdata* raw = nullptr;
+  dds_sample_info_t info{};
+  ASSERT_EQ(dds_takecdr(tap.handle(), &raw, 1, &info, DDS_ANY_STATE), 1);
+  std::vector<unsigned char> bytes(ddsi_serdata_size(raw));
+  ddsi_serdata_to_ser(raw, 0, bytes.size(), bytes.data());
+  const auto x =
+      std::search(bytes.begin(), bytes.end(), std::begin("Xtwin"), std::end("Xtwin") - 1);
+  ASSERT_NE(x, bytes.end());
+  *x = 0;
+  ddsrt_iovec_t iov{};
+  iov.iov_base = bytes.data();
+  iov.iov_len = static_cast<ddsrt_iov_len_t>(bytes.size());
+  ddsi_serdata* with_nul = ddsi_serdata_from_ser_iov(raw->type, SDK_DATA, 1, &iov, bytes.size());
+  ddsi_serdata_unref(raw);
+  ASSERT_NE(with_nul, nullptr);
+  ASSERT_EQ(dds_writecdr(requests_.handle(), with_nul), DDS_RETCODE_OK);
+
+  const auto refused = reply(77);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, dnbridge_STATUS_INVALID_COMMAND) << refused->message;
+  EXPECT_NE(refused->message.find("NUL"), std::string::npos) << refused->message;
+  EXPECT_TRUE(log_.contains(LogLevel::kWarn, "goes on past a NUL character"));
 }
 
 TEST_F(ExplicitTest, RepeatedRequestGetsTheSameReplyAndIsNotExecutedTwice) {
