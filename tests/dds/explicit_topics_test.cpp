@@ -100,22 +100,11 @@ TEST_F(DdsTest, ARequesterNameWithANulInsideIsSeenWhole) {
   EXPECT_FALSE(leading_string_has_nul(serialized[0]));
 
   // The same bytes with the X made a NUL, written as they are.
-  std::vector<unsigned char> bytes = serialized[0];
-  const auto x = std::find(bytes.begin(), bytes.end(), 'X');
-  ASSERT_NE(x, bytes.end());
-  *x = 0;
-  ddsi_serdata* raw = nullptr;
-  dds_sample_info_t info{};
-  ASSERT_TRUE(client.write(*request("type", 2)).ok());
+  ASSERT_TRUE(client.write(*request("abXx", 2)).ok());
   ASSERT_TRUE(wait_for(participant_, fresh));
-  ASSERT_EQ(dds_takecdr(bridge.handle(), &raw, 1, &info, DDS_ANY_STATE), 1);
-  ddsrt_iovec_t iov{};
-  iov.iov_base = bytes.data();
-  iov.iov_len = static_cast<ddsrt_iov_len_t>(bytes.size());
-  ddsi_serdata* with_nul = ddsi_serdata_from_ser_iov(raw->type, SDK_DATA, 1, &iov, bytes.size());
-  ddsi_serdata_unref(raw);
-  ASSERT_NE(with_nul, nullptr);
-  ASSERT_EQ(dds_writecdr(client.handle(), with_nul), DDS_RETCODE_OK);
+  Serialized with_nul = take_serialized(bridge);
+  ASSERT_TRUE(put_nul(with_nul, "Xx"));
+  ASSERT_EQ(write_serialized(client, std::move(with_nul)), DDS_RETCODE_OK);
   ASSERT_TRUE(wait_for(participant_, fresh));
   ASSERT_EQ(*bridge.take(buffer, serialized), 1u);
   EXPECT_EQ(view(buffer.data(0).requester), "ab");

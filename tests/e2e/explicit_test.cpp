@@ -118,22 +118,9 @@ TEST_F(ExplicitTest, ARequesterNameWithANulInsideIsRefused) {
   r->attribute_id = 1;
   ASSERT_TRUE(requests_.write(*r).ok());
   ASSERT_TRUE(dds::testing::wait_for(supervisor_, fresh));
-  ddsi_serdata* raw = nullptr;
-  dds_sample_info_t info{};
-  ASSERT_EQ(dds_takecdr(tap.handle(), &raw, 1, &info, DDS_ANY_STATE), 1);
-  std::vector<unsigned char> bytes(ddsi_serdata_size(raw));
-  ddsi_serdata_to_ser(raw, 0, bytes.size(), bytes.data());
-  const auto x =
-      std::search(bytes.begin(), bytes.end(), std::begin("Xtwin"), std::end("Xtwin") - 1);
-  ASSERT_NE(x, bytes.end());
-  *x = 0;
-  ddsrt_iovec_t iov{};
-  iov.iov_base = bytes.data();
-  iov.iov_len = static_cast<ddsrt_iov_len_t>(bytes.size());
-  ddsi_serdata* with_nul = ddsi_serdata_from_ser_iov(raw->type, SDK_DATA, 1, &iov, bytes.size());
-  ddsi_serdata_unref(raw);
-  ASSERT_NE(with_nul, nullptr);
-  ASSERT_EQ(dds_writecdr(requests_.handle(), with_nul), DDS_RETCODE_OK);
+  dds::testing::Serialized with_nul = dds::testing::take_serialized(tap);
+  ASSERT_TRUE(dds::testing::put_nul(with_nul, "Xtwin"));
+  ASSERT_EQ(dds::testing::write_serialized(requests_, std::move(with_nul)), DDS_RETCODE_OK);
 
   const auto refused = reply(77);
   ASSERT_TRUE(refused);
