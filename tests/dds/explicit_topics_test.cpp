@@ -111,6 +111,26 @@ TEST_F(DdsTest, ARequesterNameWithANulInsideIsSeenWhole) {
   EXPECT_TRUE(leading_string_has_nul(serialized[0]));
 }
 
+TEST(LeadingString, ANulIsFoundOnlyInsideAStringThatParses) {
+  using Bytes = std::vector<unsigned char>;
+  const auto has_nul = [](const Bytes& b) { return leading_string_has_nul(b); };
+  // Little endian (encapsulation 00 01), "ab\0x" and its terminating NUL.
+  EXPECT_TRUE(has_nul(Bytes{0, 1, 0, 0, 5, 0, 0, 0, 'a', 'b', 0, 'x', 0}));
+  EXPECT_FALSE(has_nul(Bytes{0, 1, 0, 0, 5, 0, 0, 0, 'a', 'b', 'y', 'x', 0}));
+  // Big endian (00 00).
+  EXPECT_TRUE(has_nul(Bytes{0, 0, 0, 0, 0, 0, 0, 3, 0, 'b', 0}));
+  EXPECT_FALSE(has_nul(Bytes{0, 0, 0, 0, 0, 0, 0, 3, 'a', 'b', 0}));
+  // A NUL at the start counts; the terminating one alone does not.
+  EXPECT_TRUE(has_nul(Bytes{0, 1, 0, 0, 2, 0, 0, 0, 0, 0}));
+  EXPECT_FALSE(has_nul(Bytes{0, 1, 0, 0, 1, 0, 0, 0, 0}));
+  // What does not parse: too short, a length past the end, a huge length.
+  EXPECT_FALSE(has_nul(Bytes{}));
+  EXPECT_FALSE(has_nul(Bytes{0, 1, 0, 0, 5, 0, 0}));
+  EXPECT_FALSE(has_nul(Bytes{0, 1, 0, 0, 9, 0, 0, 0, 'a', 0, 'b', 0}));
+  EXPECT_FALSE(has_nul(Bytes{0, 1, 0, 0, 0xFF, 0xFF, 0xFF, 0xFF, 0, 0}));
+  EXPECT_FALSE(has_nul(Bytes{0, 1, 0, 0, 0, 0, 0, 0}));
+}
+
 TEST_F(DdsTest, UnregisteredTransactionsFreeTheirInstances) {
   // A reader keeps an instance while a writer has it registered, even with
   // no sample left: a requester unregisters each finished transaction, or
