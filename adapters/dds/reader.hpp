@@ -91,7 +91,9 @@ class Reader : public Entity {
   // As take(into), and the serialized form of each sample (CDR, from its
   // 4-byte encapsulation header on) into `serialized`: what the typed sample
   // cannot show, such as a string with a NUL inside (the struct's copy ends
-  // at that NUL). Not for a hot path: it allocates.
+  // at that NUL). A sample without valid data (an instance state change)
+  // comes with neither its key members nor bytes: for a reader that only
+  // acts on data. Not for a hot path: it allocates.
   Result<std::size_t> take(TakeBuffer<T>& into,
                            std::vector<std::vector<unsigned char>>& serialized) const {
     const auto cap = static_cast<uint32_t>(into.capacity());
@@ -104,11 +106,17 @@ class Reader : public Entity {
     for (std::size_t i = 0; i < serialized.size(); ++i) {
       auto& sample = into.samples_[i];
       sample.clear();
-      // Key members only, for a sample without valid data.
-      (void)ddsi_serdata_to_sample(raw[i], sample.get(), nullptr, nullptr);
       auto& bytes = serialized[i];
-      bytes.resize(ddsi_serdata_size(raw[i]));
-      ddsi_serdata_to_ser(raw[i], 0, bytes.size(), bytes.data());
+      if (into.infos_[i].valid_data) {
+        (void)ddsi_serdata_to_sample(raw[i], sample.get(), nullptr, nullptr);
+        bytes.resize(ddsi_serdata_size(raw[i]));
+        ddsi_serdata_to_ser(raw[i], 0, bytes.size(), bytes.data());
+      } else {
+        // An instance state change. Cyclone 0.10 hands it over as a bare
+        // key without its type, which cannot be deserialised here, and the
+        // instance may be gone already: neither key nor bytes.
+        bytes.clear();
+      }
       ddsi_serdata_unref(raw[i]);
     }
     into.count_ = static_cast<std::size_t>(n);

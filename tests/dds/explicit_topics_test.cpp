@@ -109,6 +109,15 @@ TEST_F(DdsTest, ARequesterNameWithANulInsideIsSeenWhole) {
   ASSERT_EQ(*bridge.take(buffer, serialized), 1u);
   EXPECT_EQ(view(buffer.data(0).requester), "ab");
   EXPECT_TRUE(leading_string_has_nul(serialized[0]));
+
+  // A transaction the requester unregisters (as every requester does after
+  // its reply): a sample without data, taken without bytes.
+  ASSERT_TRUE(client.unregister_instance(*request("abXx", 1)).ok());
+  ASSERT_TRUE(wait_for(participant_, fresh));
+  ASSERT_EQ(*bridge.take(buffer, serialized), 1u);
+  EXPECT_FALSE(buffer.info(0).valid_data());
+  EXPECT_NE(buffer.info(0).instance_state(), InstanceState::kAlive);
+  EXPECT_TRUE(serialized[0].empty());
 }
 
 TEST(LeadingString, ANulIsFoundOnlyInsideAStringThatParses) {
