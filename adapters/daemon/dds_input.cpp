@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "adapters/daemon/samples.hpp"
@@ -16,6 +17,10 @@ enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3 };
 
 // A command stamped further ahead of this host's clock is reported.
 constexpr Duration kClockSkewReported = seconds(1);
+
+// Commands are not taken again sooner than this after a take: under a flood
+// each pump's newest command is applied once per hold-off, at most 1 ms late.
+constexpr Duration kCommandHoldoff = milliseconds(1);
 
 // Samples taken at a time.
 constexpr std::size_t kBatch = 32;
@@ -91,22 +96,44 @@ port::PortLoop* DdsInput::port_of(std::string_view name) {
 
 void DdsInput::run() {
   // Commands first, and again between batches of requests: a pump command
-  // never waits behind a flood of explicit requests.
+  // never waits behind a flood of explicit requests. Commands are taken at
+  // most once per kCommandHoldoff: one that comes alone is taken at once, a
+  // flood in batches (one wake of this thread and of each port loop per
+  // batch, not per command).
   bool requests_left = false;
+  bool commands_waiting = false;
+  TimePoint next_command_take{};
   for (;;) {
-    auto triggered = waitset_.wait(requests_left ? Duration::zero() : seconds(1));
+    Duration timeout = requests_left ? Duration::zero() : seconds(1);
+    if (commands_waiting) {
+      timeout =
+          std::min(timeout, std::max(Duration::zero(), next_command_take - port::steady_now()));
+    }
+    auto triggered = waitset_.wait(timeout);
     if (!triggered) {
       log_.error("waiting for DDS input failed: {}", triggered.error().message());
       continue;
     }
-    bool commands = false;
     bool requests = requests_left;
     for (auto token : *triggered) {
       if (token == kStop) return;
-      commands = commands || token == kCommands;
+      commands_waiting = commands_waiting || token == kCommands;
       requests = requests || token == kRequests;
     }
-    if (commands) take_commands();
+    if (commands_waiting) {
+      const TimePoint now = port::steady_now();
+      if (now >= next_command_take) {
+        (void)commands_.set_status_mask(DDS_DATA_AVAILABLE_STATUS);
+        take_commands();
+        commands_waiting = false;
+        next_command_take = now + kCommandHoldoff;
+      } else {
+        // Held off: the samples stay in the reader (keep-last 1 per pump:
+        // the newest of each pump is taken at the end), and until then
+        // more of them do not wake this thread.
+        (void)commands_.set_status_mask(0);
+      }
+    }
     requests_left = requests && take_requests();
   }
 }

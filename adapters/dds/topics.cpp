@@ -88,7 +88,8 @@ Qos reply_writer_qos() {
   Qos qos;
   qos.reliable(kReplyMaxBlocking)
       .durability(Durability::kTransientLocal)
-      .keep_last(kExplicitHistoryDepth)
+      .keep_all()
+      .resource_limits(kReplyWriterMaxSamples, kReplyWriterMaxSamples, kExplicitHistoryDepth)
       .durability_service_keep_last(1);
   return qos;
 }
