@@ -4,32 +4,17 @@
 // order. Its configuration is the embedded default on this process's domain;
 // CYCLONEDDS_URI (loopback, this process's discovery tag) is inherited.
 #include <filesystem>
-#include <fstream>
 #include <map>
 
 #include "bridge_fixture.hpp"
+#include "bridge_process.hpp"
 #include "child_process.hpp"
 
 namespace dnbridge::e2e {
 namespace {
 
-// `dnbridge --simulate`'s configuration, on `domain`, logging warnings only.
-std::filesystem::path write_config(dds_domainid_t domain) {
-  std::string text(daemon::embedded_default_config_text());
-  const auto replace = [&](std::string_view from, const std::string& to) {
-    const auto at = text.find(from);
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-  };
-  replace("domain = 0", "domain = " + std::to_string(domain));
-  replace("log_level = \"info\"", "log_level = \"warn\"");
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("dnbridge-e2e-" + std::to_string(getpid()) + ".toml");
-  std::ofstream(path) << text;
-  return path;
-}
-
 TEST_F(BridgeTest, DnbridgeProcessServesTheSupervisorAndStopsInOrderOnSigterm) {
-  const auto config = write_config(test_domain());
+  const auto config = write_simulated_rack_config(test_domain());
   const auto spawned = SteadyClock::now();
   ChildProcess bridge({DNBRIDGE_BINARY, "--config", config.string()});
   ASSERT_TRUE(bridge.running());
