@@ -89,7 +89,8 @@ Qos reply_writer_qos() {
   qos.reliable(kReplyMaxBlocking)
       .durability(Durability::kTransientLocal)
       .keep_all()
-      .resource_limits(kReplyWriterMaxSamples, kReplyWriterMaxSamples, kExplicitHistoryDepth)
+      // Instances unlimited: the bridge bounds how many it keeps registered.
+      .resource_limits(kReplyWriterMaxSamples, -1, kExplicitHistoryDepth)
       .durability_service_keep_last(1);
   return qos;
 }

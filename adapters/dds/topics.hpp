@@ -106,14 +106,15 @@ Qos request_reader_qos();
 // last reply of each transaction (durability service keep-last 1) for such a
 // late reader; the bridge unregisters a transaction's instance when it
 // forgets the transaction (explicit_retention), which releases it from that
-// cache and from every reader. The writer's history is keep-all, bounded:
-// when readers do not acknowledge, a write waits a short max_blocking_time
-// and fails. (Measured with Cyclone 0.10.2: a keep-last reply writer kept
-// about 1.4 KB per transaction answered and unregistered, keep-all about
-// 0.4 KB; see the operations guide.) The bridge writes replies from a thread
-// of its own: a reply reader that does not acknowledge costs lost replies
-// (counted on PortStatus), never a poll.
-inline constexpr int32_t kReplyWriterMaxSamples = 8192;
+// cache and from every reader. The writer's history is keep-all, at most
+// kReplyWriterMaxSamples samples: when readers do not acknowledge, a write
+// waits a short max_blocking_time and fails, and what the writer holds stays
+// bounded (Cyclone 0.10.2 keeps each sample in a buffer of about 4 KB until
+// every reader acknowledged it; a keep-last writer, unbounded across
+// instances, held 170 MB under a burst). The bridge writes replies from a
+// thread of its own: a reply reader that does not acknowledge costs lost
+// replies (counted on PortStatus), never a poll.
+inline constexpr int32_t kReplyWriterMaxSamples = 4096;
 Qos reply_writer_qos();
 Qos reply_reader_qos();
 

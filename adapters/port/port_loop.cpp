@@ -185,9 +185,7 @@ void PortLoop::run() {
     for (const auto& p : published_) {
       wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
     }
-    longest_pass_ = std::max<Duration>(
-        longest_pass_,
-        std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now() - pass_start));
+    note_busy(pass_start);
     FrameReceiver& receiver = *this;
     backend_->wait(wake, receiver);
   }
@@ -315,7 +313,14 @@ void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
 }
 
 void PortLoop::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
+  const auto start = std::chrono::steady_clock::now();
   scanner_->on_frame(frame, rx_time);
+  note_busy(start);
+}
+
+void PortLoop::note_busy(std::chrono::steady_clock::time_point since) {
+  longest_pass_ = std::max<Duration>(longest_pass_, std::chrono::duration_cast<Duration>(
+                                                        std::chrono::steady_clock::now() - since));
 }
 
 void PortLoop::on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) {

@@ -5,6 +5,7 @@
 // (the DDS input) talk to it through its inbox, which wakes it. State is
 // published from here.
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -151,8 +152,10 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     double scan_cycle_ms = 0;
   } metrics_;
 
-  // The longest pass of the loop (woken to waiting again) since the last
-  // PortStatus, on the steady clock whatever clock the backend runs on.
+  // The longest the loop was busy at once since the last PortStatus: a pass
+  // (woken to waiting again) or the handling of one received frame, on the
+  // steady clock whatever clock the backend runs on.
+  void note_busy(std::chrono::steady_clock::time_point since);
   Duration longest_pass_{};
 
   std::mutex inbox_mutex_;
