@@ -69,11 +69,11 @@
 #include <thread>
 #include <vector>
 
-#include "adapters/dds/loopback.hpp"
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
 #include "adapters/dds/fields.hpp"
+#include "adapters/dds/loopback.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/reader.hpp"
 #include "adapters/dds/sample.hpp"
@@ -85,6 +85,7 @@
 #include "bridge/devicenet/identifier.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
+#include "figures.hpp"
 
 namespace dnbridge::bench {
 namespace {
@@ -94,13 +95,6 @@ using devicenet::MacId;
 // ---------------------------------------------------------------------------
 // Clocks
 
-std::int64_t clock_ns(clockid_t clock) {
-  timespec ts{};
-  clock_gettime(clock, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-std::int64_t monotonic_ns() { return clock_ns(CLOCK_MONOTONIC); }
-std::int64_t realtime_ns() { return clock_ns(CLOCK_REALTIME); }
 std::int64_t process_cpu_ns() { return clock_ns(CLOCK_PROCESS_CPUTIME_ID); }
 std::int64_t steady_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -169,40 +163,6 @@ std::map<pid_t, ThreadSample> snapshot_threads() {
 }
 
 pid_t this_thread_id() { return static_cast<pid_t>(gettid()); }
-
-std::string load_average() {
-  std::ifstream f("/proc/loadavg");
-  std::string a, b, c;
-  f >> a >> b >> c;
-  return a + " " + b + " " + c;
-}
-
-// ---------------------------------------------------------------------------
-// Statistics (microseconds)
-
-struct Summary {
-  std::size_t count = 0;
-  double p50 = 0, p99 = 0, max = 0, min = 0;
-};
-
-// Nearest-rank percentile of sorted values.
-double percentile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return 0;
-  const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(sorted.size())));
-  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
-}
-
-Summary summarize(std::vector<double> us) {
-  Summary s;
-  s.count = us.size();
-  if (us.empty()) return s;
-  std::sort(us.begin(), us.end());
-  s.p50 = percentile(us, 0.50);
-  s.p99 = percentile(us, 0.99);
-  s.min = us.front();
-  s.max = us.back();
-  return s;
-}
 
 // ---------------------------------------------------------------------------
 // Child processes

@@ -71,6 +71,7 @@
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
+#include "figures.hpp"
 
 namespace dnbridge::bench {
 namespace {
@@ -92,53 +93,12 @@ constexpr std::uint16_t kIdentityClass = 1;
 // ---------------------------------------------------------------------------
 // Clocks
 
-std::int64_t clock_ns(clockid_t clock) {
-  timespec ts{};
-  clock_gettime(clock, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-std::int64_t monotonic_ns() { return clock_ns(CLOCK_MONOTONIC); }
-std::int64_t realtime_ns() { return clock_ns(CLOCK_REALTIME); }
-
 void sleep_until_monotonic(std::int64_t t) {
   timespec ts{};
   ts.tv_sec = static_cast<time_t>(t / 1'000'000'000);
   ts.tv_nsec = static_cast<long>(t % 1'000'000'000);
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
   }
-}
-
-std::string load_average() {
-  std::ifstream f("/proc/loadavg");
-  std::string a, b, c;
-  f >> a >> b >> c;
-  return a + " " + b + " " + c;
-}
-
-// ---------------------------------------------------------------------------
-// Statistics
-
-struct Summary {
-  std::size_t count = 0;
-  double p50 = 0, p99 = 0, max = 0;
-};
-
-// Nearest-rank percentile of sorted values.
-double percentile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return 0;
-  const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(sorted.size())));
-  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
-}
-
-Summary summarize(std::vector<double> v) {
-  Summary s;
-  s.count = v.size();
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  s.p50 = percentile(v, 0.50);
-  s.p99 = percentile(v, 0.99);
-  s.max = v.back();
-  return s;
 }
 
 // A duration given in microseconds, in the unit that reads best.

@@ -60,9 +60,12 @@
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
+#include "vendor_request.hpp"
 
 namespace dnbridge::careless {
 namespace {
+
+using e2e::get_vendor;
 
 constexpr const char* kRack = "sim-rack";
 constexpr const char* kPort = "A";
@@ -125,25 +128,6 @@ dds::Owned<dnbridge_PumpCommand> command(unsigned mac, bool on, bool n2, std::ui
   c->analog_output_raw = analog;
   dds::set_string(c->issuer, issuer);
   return c;
-}
-
-// Get_Attribute_Single of the Identity vendor (class 1, instance 1,
-// attribute 1) of node `mac`.
-dds::Owned<dnbridge_ExplicitRequest> get_vendor(const std::string& requester, std::uint32_t txid,
-                                                unsigned mac) {
-  dds::Owned<dnbridge_ExplicitRequest> r;
-  dds::set_string(r->requester, requester);
-  r->txid = txid;
-  r->command = dnbridge_COMMAND_EXECUTE;
-  dds::set_string(r->rack, kRack);
-  dds::set_string(r->port, kPort);
-  r->mac = static_cast<std::uint8_t>(mac);
-  r->service = 0x0E;
-  r->class_id = 1;
-  r->instance_id = 1;
-  r->has_attribute = true;
-  r->attribute_id = 1;
-  return r;
 }
 
 unsigned node_of(std::uint32_t n) { return 1 + n % kPumps; }

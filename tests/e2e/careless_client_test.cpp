@@ -20,6 +20,7 @@
 #include "bridge_fixture.hpp"
 #include "bridge_process.hpp"
 #include "child_process.hpp"
+#include "vendor_request.hpp"
 
 namespace dnbridge::e2e {
 namespace {
@@ -129,22 +130,9 @@ class CarelessClientTest : public ::testing::Test {
     return c;
   }
 
-  // Get_Attribute_Single class 1 (Identity) instance 1 attribute 1 (vendor)
-  // of node `mac` (one not in the scan list is refused at once).
+  // The vendor of node `mac` (one not in the scan list is refused at once).
   dds::Owned<dnbridge_ExplicitRequest> get_vendor(std::uint32_t txid, unsigned mac) const {
-    dds::Owned<dnbridge_ExplicitRequest> r;
-    dds::set_string(r->requester, requester_);
-    r->txid = txid;
-    r->command = dnbridge_COMMAND_EXECUTE;
-    dds::set_string(r->rack, kRack);
-    dds::set_string(r->port, kPort);
-    r->mac = static_cast<std::uint8_t>(mac);
-    r->service = 0x0E;
-    r->class_id = 1;
-    r->instance_id = 1;
-    r->has_attribute = true;
-    r->attribute_id = 1;
-    return r;
+    return e2e::get_vendor(requester_, txid, mac);
   }
 
   // The replies `replies` took for (`requester`, txid) with txid in [first, last].
