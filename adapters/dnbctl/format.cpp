@@ -161,7 +161,12 @@ void port_json_members(JsonWriter& out, const dnbridge_PortStatus& p) {
   out.key("bus_load_percent").number(p.bus_load_percent, 1);
   out.key("scan_cycle_ms").number(p.scan_cycle_ms, 1);
   out.field("nodes_online", unsigned{p.nodes_online})
-      .field("nodes_configured", unsigned{p.nodes_configured});
+      .field("nodes_configured", unsigned{p.nodes_configured})
+      .field("explicit_outstanding", unsigned{p.explicit_outstanding})
+      .field("explicit_retained", unsigned{p.explicit_retained})
+      .field("explicit_refused_for_limits", std::uint64_t{p.explicit_refused_for_limits})
+      .field("replies_undelivered", std::uint64_t{p.replies_undelivered});
+  out.key("loop_longest_pass_ms").number(p.loop_longest_pass_ms, 1);
 }
 
 namespace {

@@ -109,6 +109,24 @@ TEST(Json, CompactAndPrettyWithEscapes) {
   EXPECT_EQ(pretty.str(), "{\n  \"a\": [\n    1,\n    2\n  ]\n}");
 }
 
+TEST(Format, PortJsonCarriesTheExplicitCountsAndTheLoopsBusyTime) {
+  auto p = port();
+  p->explicit_outstanding = 3;
+  p->explicit_retained = 256;
+  p->explicit_refused_for_limits = 12;
+  p->replies_undelivered = 1;
+  p->loop_longest_pass_ms = 0.44f;
+  JsonWriter out(false);
+  out.begin_object();
+  port_json_members(out, *p);
+  out.end_object();
+  EXPECT_NE(out.str().find(R"("explicit_outstanding":3,"explicit_retained":256,)"
+                           R"("explicit_refused_for_limits":12,"replies_undelivered":1,)"
+                           R"("loop_longest_pass_ms":0.4})"),
+            std::string::npos)
+      << out.str();
+}
+
 TEST(Json, Latin1BytesAreEscapedAsCodePoints) {
   // Device strings are ISO 8859-1: 0xB5 is U+00B5, never raw invalid UTF-8.
   EXPECT_EQ(json_quote("\xB5s"), "\"\\u00b5s\"");
