@@ -166,7 +166,7 @@ void port_json_members(JsonWriter& out, const dnbridge_PortStatus& p) {
       .field("explicit_retained", unsigned{p.explicit_retained})
       .field("explicit_refused_for_limits", std::uint64_t{p.explicit_refused_for_limits})
       .field("replies_undelivered", std::uint64_t{p.replies_undelivered});
-  out.key("loop_longest_pass_ms").number(p.loop_longest_pass_ms, 1);
+  out.key("loop_longest_pass_ms").number(p.loop_longest_pass_ms, 2);
 }
 
 namespace {

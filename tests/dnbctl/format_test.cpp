@@ -122,7 +122,7 @@ TEST(Format, PortJsonCarriesTheExplicitCountsAndTheLoopsBusyTime) {
   out.end_object();
   EXPECT_NE(out.str().find(R"("explicit_outstanding":3,"explicit_retained":256,)"
                            R"("explicit_refused_for_limits":12,"replies_undelivered":1,)"
-                           R"("loop_longest_pass_ms":0.4})"),
+                           R"("loop_longest_pass_ms":0.44})"),
             std::string::npos)
       << out.str();
 }
