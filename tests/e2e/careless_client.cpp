@@ -60,15 +60,14 @@
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
-#include "vendor_request.hpp"
+#include "client_samples.hpp"
 
 namespace dnbridge::careless {
 namespace {
 
 using e2e::get_vendor;
+using e2e::pump_command;
 
-constexpr const char* kRack = "sim-rack";
-constexpr const char* kPort = "A";
 constexpr unsigned kPumps = 8;
 constexpr Duration kMatchTimeout = seconds(10);
 constexpr Duration kAckTimeout = seconds(5);
@@ -117,19 +116,6 @@ void await_writer(const dds::Participant& participant, const dds::Reader<T>& rea
       [&] { return reader.matched_publications().value_or(0); }, what);
 }
 
-dds::Owned<dnbridge_PumpCommand> command(unsigned mac, bool on, bool n2, std::uint16_t analog,
-                                         const std::string& issuer) {
-  dds::Owned<dnbridge_PumpCommand> c;
-  dds::set_string(c->rack, kRack);
-  dds::set_string(c->port, kPort);
-  c->mac = static_cast<std::uint8_t>(mac);
-  c->pump_on = on;
-  c->n2_ballast_on = n2;
-  c->analog_output_raw = analog;
-  dds::set_string(c->issuer, issuer);
-  return c;
-}
-
 unsigned node_of(std::uint32_t n) { return 1 + n % kPumps; }
 
 int ahead(dds_domainid_t domain, unsigned mac, std::int32_t strength, Duration lease,
@@ -139,7 +125,7 @@ int ahead(dds_domainid_t domain, unsigned mac, std::int32_t strength, Duration l
   auto writer = std::make_unique<dds::Writer<dnbridge_PumpCommand>>(
       participant, topic, dds::command_writer_qos(strength, lease));
   await_reader(participant, *writer, "the PumpCommand writer");
-  if (!writer->write(*command(mac, true, true, 4000, issuer), dds::dds_now() + ahead_by)) {
+  if (!writer->write(*pump_command(mac, true, true, 4000, issuer), dds::dds_now() + ahead_by)) {
     fail("writing the command");
   }
   if (!writer->wait_for_acks(kAckTimeout)) fail("the command was not acknowledged");
@@ -244,8 +230,8 @@ int three_writers(dds_domainid_t domain, std::int32_t strength, Duration lease,
   dds::Topic<dnbridge_PumpCommand> topic(participant);
   std::vector<std::unique_ptr<dds::Writer<dnbridge_PumpCommand>>> writers;
   const auto write = [&](unsigned n) {
-    return writers[n - 1]->write(*command(n, true, false, static_cast<std::uint16_t>(100 * n),
-                                          "writer-" + std::to_string(n)));
+    return writers[n - 1]->write(*pump_command(n, true, false, static_cast<std::uint16_t>(100 * n),
+                                               "writer-" + std::to_string(n)));
   };
   for (unsigned n = 1; n <= 3; ++n) {
     writers.push_back(std::make_unique<dds::Writer<dnbridge_PumpCommand>>(

@@ -20,7 +20,7 @@
 #include "bridge_fixture.hpp"
 #include "bridge_process.hpp"
 #include "child_process.hpp"
-#include "vendor_request.hpp"
+#include "client_samples.hpp"
 
 namespace dnbridge::e2e {
 namespace {
@@ -117,19 +117,6 @@ class CarelessClientTest : public ::testing::Test {
     }
   }
 
-  static dds::Owned<dnbridge_PumpCommand> command(unsigned mac, bool pump_on, bool n2,
-                                                  std::uint16_t analog, std::string_view issuer) {
-    dds::Owned<dnbridge_PumpCommand> c;
-    dds::set_string(c->rack, kRack);
-    dds::set_string(c->port, kPort);
-    c->mac = static_cast<std::uint8_t>(mac);
-    c->pump_on = pump_on;
-    c->n2_ballast_on = n2;
-    c->analog_output_raw = analog;
-    dds::set_string(c->issuer, issuer);
-    return c;
-  }
-
   // The vendor of node `mac` (one not in the scan list is refused at once).
   dds::Owned<dnbridge_ExplicitRequest> get_vendor(std::uint32_t txid, unsigned mac) const {
     return e2e::get_vendor(requester_, txid, mac);
@@ -208,7 +195,7 @@ TEST_F(CarelessClientTest, CommanderWithItsClockAnHourAheadLosesThePumpWhenItsPr
   dds::Writer<dnbridge_PumpCommand> weak(supervisor_, command_topic_,
                                          dds::command_writer_qos(1, seconds(1)));
   ASSERT_TRUE(writer_matched(weak));
-  const auto off = command(kMac, false, true, 123, weak_issuer);
+  const auto off = pump_command(kMac, false, true, 123, weak_issuer);
   ASSERT_TRUE(weak.write(*off));
   ASSERT_TRUE(pumps_.until([&] { return echoes(kMac, false, true, 123, weak_issuer); }));
 
@@ -271,7 +258,7 @@ TEST_F(CarelessClientTest, RequesterThatNeverUnregistersDelaysNeitherCommandsNor
                             << " of the careless client's " << kCareless << " requests answered";
 
   const auto sent = SteadyClock::now();
-  ASSERT_TRUE(commander.write(*command(5, true, false, 2500, "e2e")));
+  ASSERT_TRUE(commander.write(*pump_command(5, true, false, 2500, "e2e")));
   const bool applied =
       pumps_.until([&] { return echoes(5, true, false, 2500, "e2e"); }, seconds(1));
   EXPECT_TRUE(applied) << "the command was not applied within 1 s";
