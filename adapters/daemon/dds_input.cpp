@@ -28,21 +28,22 @@ constexpr std::size_t kBatch = 32;
 // Requests taken before the commands are looked at again.
 constexpr std::size_t kRequestBatches = 4;
 
-// Takes what the reader holds, a buffer at a time, at most `batches` buffers
-// (unlimited: 0), and hands each sample to `fn`. True when samples may
-// remain: taking resets DATA_AVAILABLE while samples may remain, so a full
-// buffer is followed by another take, here or on the next call.
-template <class T, class Fn>
-bool take_some(const dds::Reader<T>& reader, dds::TakeBuffer<T>& buffer, Logger& log,
-               const char* what, std::size_t batches, Fn fn) {
+// Takes, a buffer at a time, at most `batches` buffers (unlimited: 0): `take`
+// fills the buffer and returns how many samples it holds, `fn` handles the
+// i-th. True when samples may remain: taking resets DATA_AVAILABLE while
+// samples may remain, so a full buffer is followed by another take, here or
+// on the next call.
+template <class Take, class Fn>
+bool take_batches(Take take, std::size_t capacity, std::size_t batches, Logger& log,
+                  const char* what, Fn fn) {
   for (std::size_t n = 0; batches == 0 || n < batches; ++n) {
-    auto taken = reader.take(buffer);
+    auto taken = take();
     if (!taken) {
       log.error("taking {} failed: {}", what, taken.error().message());
       return false;
     }
-    for (std::size_t i = 0; i < *taken; ++i) fn(buffer.data(i), buffer.info(i));
-    if (*taken < buffer.capacity()) return false;
+    for (std::size_t i = 0; i < *taken; ++i) fn(i);
+    if (*taken < capacity) return false;
   }
   return true;
 }
@@ -139,9 +140,10 @@ void DdsInput::run() {
 }
 
 void DdsInput::take_commands() {
-  take_some(
-      commands_, command_buffer_, log_, "pump commands", 0,
-      [this](const dnbridge_PumpCommand& c, const dds::SampleInfo& info) { on_command(c, info); });
+  take_batches(
+      [this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0, log_,
+      "pump commands",
+      [this](std::size_t i) { on_command(command_buffer_.data(i), command_buffer_.info(i)); });
 }
 
 void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
@@ -191,19 +193,12 @@ void DdsInput::note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleI
 
 bool DdsInput::take_requests() {
   // Serialized as well: a requester name is checked whole (see on_request).
-  for (std::size_t n = 0; n < kRequestBatches; ++n) {
-    auto taken = requests_.take(request_buffer_, request_cdr_);
-    if (!taken) {
-      log_.error("taking explicit requests failed: {}", taken.error().message());
-      return false;
-    }
-    for (std::size_t i = 0; i < *taken; ++i) {
-      if (request_buffer_.info(i).valid_data())
-        on_request(request_buffer_.data(i), request_cdr_[i]);
-    }
-    if (*taken < request_buffer_.capacity()) return false;
-  }
-  return true;
+  return take_batches([this] { return requests_.take(request_buffer_, request_cdr_); },
+                      request_buffer_.capacity(), kRequestBatches, log_, "explicit requests",
+                      [this](std::size_t i) {
+                        if (request_buffer_.info(i).valid_data())
+                          on_request(request_buffer_.data(i), request_cdr_[i]);
+                      });
 }
 
 void DdsInput::on_request(const dnbridge_ExplicitRequest& r,

@@ -53,10 +53,6 @@ bool DdsPublisher::check(Status s, const char* what) {
 
 namespace {
 
-// What an outbox keeps of a sample: a std::function must be copyable.
-template <class T>
-using Shared = std::shared_ptr<dds::Owned<T>>;
-
 std::string instance_key(char topic, const std::string& port, std::uint8_t mac = 0) {
   return fmt::format("{}{}/{}", topic, mac, port);
 }

@@ -10,7 +10,6 @@
 // one sample per instance, and a thread that fell behind writes the newest
 // only. Jobs posted without a key are bounded in number: past the capacity
 // they are refused (the caller counts them), never queued without end.
-#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -51,7 +50,6 @@ class Outbox {
     std::uint64_t replaced = 0;  // keyed jobs replaced before they ran
     std::uint64_t refused = 0;   // unkeyed jobs refused for the capacity
     std::size_t waiting = 0;
-    Duration longest_job{};  // the longest a job took (a write that waited)
   };
   Counters counters() const;
 

@@ -130,15 +130,13 @@ bool PortLoop::drain_inbox(TimePoint now) {
       keep_running = false;
     }
   }
-  for (const auto& call : calls) on_call(call, now);
+  for (const auto& call : calls) {
+    if (auto answer = gateway_->on_request(call, now))
+      publisher_.explicit_reply(config_.port, *answer);
+  }
   gateway_->expire(now);
   forget_replies();
   return keep_running;
-}
-
-void PortLoop::on_call(const rack::ExplicitCall& call, TimePoint now) {
-  if (auto answer = gateway_->on_request(call, now))
-    publisher_.explicit_reply(config_.port, *answer);
 }
 
 void PortLoop::run() {

@@ -100,7 +100,6 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // Commands first, then explicit requests: a pump command never waits
   // behind explicit traffic. False once a Stop was seen.
   bool drain_inbox(TimePoint now);
-  void on_call(const rack::ExplicitCall& call, TimePoint now);
   void publish(TimePoint now, bool force);
   void publish_port(TimePoint now);
   void update_metrics(const BusCounters& bus, TimePoint now);

@@ -160,11 +160,14 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
     return refuse_for_limits(call, fmt::format("{} transactions already in progress on port {}",
                                                by_request_id_.size(), call.port));
   }
-  if (auto it = executing_by_requester_.find(call.requester);
-      it != executing_by_requester_.end() && it->second >= limits_.per_requester) {
+  // Of at most limits_.in_progress, counted when asked.
+  const auto executing = static_cast<std::size_t>(
+      std::count_if(by_request_id_.begin(), by_request_id_.end(),
+                    [&](const auto& entry) { return entry.second.first == call.requester; }));
+  if (executing >= limits_.per_requester) {
     return refuse_for_limits(
         call, fmt::format("{} transactions of \"{}\" already in progress on port {} (at most {})",
-                          it->second, call.requester, call.port, limits_.per_requester));
+                          executing, call.requester, call.port, limits_.per_requester));
   }
 
   auto id = scanner_.request_explicit(*mac, request, now);
@@ -186,7 +189,6 @@ std::optional<ExplicitAnswer> ExplicitGateway::execute(const ExplicitCall& call,
   const Key key{call.requester, call.txid};
   transactions_[key] = Transaction{call, false, {}, {}};
   by_request_id_[*id] = key;
-  ++executing_by_requester_[call.requester];
   return std::nullopt;
 }
 
@@ -235,9 +237,6 @@ std::optional<ExplicitAnswer> ExplicitGateway::on_result(std::uint32_t request_i
   if (it == by_request_id_.end()) return std::nullopt;
   const Key key = it->second;
   by_request_id_.erase(it);
-  if (auto n = executing_by_requester_.find(key.first); n != executing_by_requester_.end()) {
-    if (--n->second == 0) executing_by_requester_.erase(n);
-  }
   Transaction& t = transactions_.at(key);
 
   ExplicitAnswer a = refuse(t.call, TransactionStatus::kSuccess, {});

@@ -162,7 +162,6 @@ class ExplicitGateway {
   std::array<std::uint64_t, kGuardedRequestKinds> refused_{};
   std::map<Key, Transaction> transactions_;
   std::map<std::uint32_t, Key> by_request_id_;  // executing
-  std::map<std::string, std::size_t> executing_by_requester_;
   std::uint64_t refused_for_limits_ = 0;
   std::deque<Key> done_order_;                  // completed, oldest first
   std::vector<Key> forgotten_;
