@@ -95,25 +95,6 @@ void DdsPublisher::explicit_reply(const std::string& port, const rack::ExplicitA
     if (!check(reply_writer_.write(**sample), "ExplicitReply")) undelivered(port);
   });
   if (!queued) undelivered(port);
-  // Completed transactions stay registered until their gateway forgets them
-  // (forget_reply); any other reply is kept for a while, then let go.
-  constexpr std::size_t kPassingReplies = 256;
-  std::vector<std::pair<std::string, std::uint32_t>> expired;
-  {
-    std::lock_guard lock(mutex_);
-    auto key = std::make_pair(answer.requester, answer.txid);
-    if (answer.retained) {
-      retained_replies_.insert(std::move(key));
-    } else {
-      passing_replies_.push_back(std::move(key));
-      while (passing_replies_.size() > kPassingReplies) {
-        if (!retained_replies_.count(passing_replies_.front()))
-          expired.push_back(passing_replies_.front());
-        passing_replies_.pop_front();
-      }
-    }
-  }
-  for (const auto& [requester, txid] : expired) unregister_reply(requester, txid);
 }
 
 void DdsPublisher::undelivered(const std::string& port) {
@@ -125,26 +106,6 @@ std::uint64_t DdsPublisher::replies_undelivered(const std::string& port) const {
   std::lock_guard lock(mutex_);
   auto it = undelivered_.find(port);
   return it == undelivered_.end() ? 0 : it->second;
-}
-
-void DdsPublisher::forget_reply(const std::string& requester, std::uint32_t txid) {
-  {
-    std::lock_guard lock(mutex_);
-    retained_replies_.erase({requester, txid});
-  }
-  unregister_reply(requester, txid);
-}
-
-void DdsPublisher::unregister_reply(const std::string& requester, std::uint32_t txid) {
-  // Readers keep an instance while any writer has it registered: replies the
-  // bridge no longer keeps are unregistered, or readers fill up. Never
-  // refused for the backlog: as many as replies were, and after them.
-  auto key = std::make_shared<dds::Owned<dnbridge_ExplicitReply>>();
-  dds::set_string((*key)->requester, requester);
-  (*key)->txid = txid;
-  reply_out_.post_always([this, key] {
-    check(reply_writer_.unregister_instance(**key), "ExplicitReply unregistration");
-  });
 }
 
 void DdsPublisher::port_stopped(const std::string& port) {

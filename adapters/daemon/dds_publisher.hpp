@@ -6,7 +6,6 @@
 // acknowledge can delay neither a poll nor the state topics. Each sample
 // carries the monotonic event time mapped to the wall clock as its source
 // timestamp.
-#include <deque>
 #include <map>
 #include <mutex>
 #include <set>
@@ -46,7 +45,6 @@ class DdsPublisher final : public port::PortPublisher {
                    TimePoint source_time) override;
   void port_status(const port::PortStatusView& status, TimePoint source_time) override;
   void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) override;
-  void forget_reply(const std::string& requester, std::uint32_t txid) override;
   void port_stopped(const std::string& port) override;
 
   // Waits (at most `timeout`) until what was handed over is written and every
@@ -80,15 +78,10 @@ class DdsPublisher final : public port::PortPublisher {
   dds::Writer<dnbridge_PortStatus> port_writer_;
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;
 
-  void unregister_reply(const std::string& requester, std::uint32_t txid);
   void undelivered(const std::string& port);
 
   mutable std::mutex mutex_;
   std::map<std::string, std::set<std::uint8_t>> written_;  // per port, the MACs written
-  // Replies the gateways do not retain (refusals, status answers, resets),
-  // oldest first: unregistered beyond a bound, or readers would fill up.
-  std::deque<std::pair<std::string, std::uint32_t>> passing_replies_;
-  std::set<std::pair<std::string, std::uint32_t>> retained_replies_;
   std::map<std::string, std::uint64_t> undelivered_;  // per port
   std::mutex log_mutex_;
   RateLimiter error_limit_;

@@ -32,12 +32,6 @@ Qos command_common() {
 // acknowledge) is given up soon; the requester repeats and gets it again.
 constexpr Duration kReplyMaxBlocking = milliseconds(10);
 
-Qos explicit_reader(Durability durability) {
-  Qos qos;
-  qos.reliable(kMaxBlocking).durability(durability).keep_last(kExplicitHistoryDepth);
-  return qos;
-}
-
 }  // namespace
 
 Qos state_writer_qos(Duration deadline) {
@@ -82,19 +76,26 @@ Qos request_writer_qos() {
   return qos;
 }
 
-Qos request_reader_qos() { return explicit_reader(Durability::kVolatile); }
+Qos request_reader_qos() {
+  Qos qos;
+  qos.reliable(kMaxBlocking).durability(Durability::kVolatile).keep_last(kExplicitHistoryDepth);
+  return qos;
+}
 
 Qos reply_writer_qos() {
   Qos qos;
   qos.reliable(kReplyMaxBlocking)
       .durability(Durability::kTransientLocal)
       .keep_all()
-      // Instances unlimited: the bridge bounds how many it keeps registered.
-      .resource_limits(kReplyWriterMaxSamples, -1, kExplicitHistoryDepth)
-      .durability_service_keep_last(1);
+      .resource_limits(kReplyWriterMaxSamples, 1, kReplyWriterMaxSamples)
+      .durability_service_keep_last(kRepliesForLateReaders);
   return qos;
 }
 
-Qos reply_reader_qos() { return explicit_reader(Durability::kTransientLocal); }
+Qos reply_reader_qos() {
+  Qos qos;
+  qos.reliable(kMaxBlocking).durability(Durability::kTransientLocal).keep_all();
+  return qos;
+}
 
 }  // namespace dnbridge::dds

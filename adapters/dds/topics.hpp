@@ -84,9 +84,9 @@ Qos command_reader_qos();
 // it can say so.
 //
 // A reader keeps an instance for as long as a writer has it registered, even
-// with no sample left, so each side unregisters a transaction's instance
-// once done with it (the requester after its reply, the bridge when it
-// forgets the transaction); readers skip the invalid samples that follow.
+// with no sample left, so a requester unregisters a transaction's request
+// instance once it has the reply; the bridge skips the invalid sample that
+// follows.
 inline constexpr int32_t kExplicitHistoryDepth = 4;
 
 // Requests are volatile: a bridge that starts must never execute requests
@@ -103,17 +103,28 @@ Qos request_reader_qos();
 // Replies are transient-local: the bridge may answer before its reply writer
 // has discovered the requester's reply reader (discovery of the two topics is
 // independent), and a volatile reply would then be lost. The writer keeps the
-// last reply of each transaction (durability service keep-last 1) for such a
-// late reader; the bridge unregisters a transaction's instance when it
-// forgets the transaction (explicit_retention), which releases it from that
-// cache and from every reader. The writer's history is keep-all, at most
-// kReplyWriterMaxSamples samples: when readers do not acknowledge, a write
-// waits a short max_blocking_time and fails, and what the writer holds stays
-// bounded (Cyclone 0.10.2 keeps each sample in a buffer of about 4 KB until
-// every reader acknowledged it; a keep-last writer, unbounded across
-// instances, held 170 MB under a burst). The bridge writes replies from a
-// thread of its own: a reply reader that does not acknowledge costs lost
-// replies (counted on PortStatus), never a poll.
+// last kRepliesForLateReaders replies (durability service keep-last) for
+// such a late reader.
+//
+// Replies have no key: one instance, never unregistered while the bridge
+// runs. Keyed per transaction, each reply would register an instance of its
+// own, and Cyclone DDS 0.10.2 keeps about 330 bytes per transient-local
+// writer instance for good once it is unregistered (its writer history
+// cache does not drop its reference to the instance's key; fixed upstream
+// in Cyclone DDS 11): a bridge answering one request a second would grow by
+// some 28 MB a day. Readers are keep-all, so that replies to other
+// requesters never push out a requester's own, and keep those with their
+// requester name.
+//
+// The writer's history is keep-all, at most kReplyWriterMaxSamples samples:
+// when readers do not acknowledge, a write waits a short max_blocking_time
+// and fails, and what the writer holds stays bounded (Cyclone 0.10.2 keeps
+// each sample in a buffer of about 4 KB until every reader acknowledged it;
+// a keep-last writer, unbounded across instances, held 170 MB under a
+// burst). The bridge writes replies from a thread of its own: a reply reader
+// that does not acknowledge costs lost replies (counted on PortStatus),
+// never a poll.
+inline constexpr int32_t kRepliesForLateReaders = 256;
 inline constexpr int32_t kReplyWriterMaxSamples = 4096;
 Qos reply_writer_qos();
 Qos reply_reader_qos();

@@ -54,7 +54,7 @@ bool Requester::execute(Client& client, ExplicitExchange& x, Deadline deadline) 
     auto samples = reader_.take();
     if (!samples) return;
     for (const auto& s : *samples) {
-      if (!s.valid_data()) continue;  // an instance another requester finished
+      if (!s.valid_data()) continue;  // the bridge left (its writer unregistered)
       const auto& r = s.data();
       if (dds::view(r.requester) != requester_ || r.txid != request->txid) continue;
       if (r.status == kStatusInProgress) continue;  // the final reply follows

@@ -135,7 +135,6 @@ bool PortLoop::drain_inbox(TimePoint now) {
       publisher_.explicit_reply(config_.port, *answer);
   }
   gateway_->expire(now);
-  forget_replies();
   return keep_running;
 }
 
@@ -351,13 +350,6 @@ void PortLoop::on_explicit_result(std::uint32_t id, MacId, const devicenet::Expl
                                   TimePoint at) {
   if (auto answer = gateway_->on_result(id, r, at))
     publisher_.explicit_reply(config_.port, *answer);
-  forget_replies();
-}
-
-void PortLoop::forget_replies() {
-  for (const auto& [requester, txid] : gateway_->take_forgotten()) {
-    publisher_.forget_reply(requester, txid);
-  }
 }
 
 }  // namespace dnbridge::port

@@ -103,7 +103,6 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void publish(TimePoint now, bool force);
   void publish_port(TimePoint now);
   void update_metrics(const BusCounters& bus, TimePoint now);
-  void forget_replies();
 
   // ScannerObserver: the rack model and the gateway hear the master first.
   void on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) override;

@@ -44,8 +44,6 @@ class PortPublisher {
   virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;
   // `port`: the port whose gateway answers; empty for a request no port took.
   virtual void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) = 0;
-  // The transaction is forgotten: a repeat would now execute again.
-  virtual void forget_reply(const std::string& requester, std::uint32_t txid) = 0;
   // The port has stopped: its instances are unregistered (never disposed).
   virtual void port_stopped(const std::string& port) = 0;
 };

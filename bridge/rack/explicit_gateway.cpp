@@ -97,7 +97,6 @@ std::optional<ExplicitAnswer> ExplicitGateway::on_request(const ExplicitCall& ca
         if (i->first.first == call.requester && i->second.done) {
           done_order_.erase(std::remove(done_order_.begin(), done_order_.end(), i->first),
                             done_order_.end());
-          forgotten_.push_back(i->first);
           i = transactions_.erase(i);
         } else {
           ++i;
@@ -270,7 +269,6 @@ std::optional<ExplicitAnswer> ExplicitGateway::on_result(std::uint32_t request_i
     transactions_.erase(key);
     return a;
   }
-  a.retained = true;
   t.done = true;
   t.answer = a;
   t.done_at = now;
@@ -297,7 +295,6 @@ TimePoint ExplicitGateway::next_expiry() const {
 
 void ExplicitGateway::forget_oldest() {
   transactions_.erase(done_order_.front());
-  forgotten_.push_back(done_order_.front());
   done_order_.pop_front();
 }
 

@@ -76,9 +76,6 @@ struct ExplicitAnswer {
   std::uint8_t additional_status = cip::kNoAdditionalCode;
   std::vector<std::uint8_t> data;
   std::string message;
-  // The gateway keeps this reply (a completed transaction) until it is
-  // forgotten (take_forgotten); other replies are not kept.
-  bool retained = false;
 };
 
 // A reply that refuses `call` without executing it.
@@ -113,12 +110,6 @@ class ExplicitGateway {
   void expire(TimePoint now);
   // The earliest time expire() has something to do; kNever when nothing.
   TimePoint next_expiry() const;
-
-  // Transactions forgotten since the last call (evicted from the retained
-  // replies, expired, or reset by their requester): their reply instances can go.
-  std::vector<std::pair<std::string, std::uint32_t>> take_forgotten() {
-    return std::exchange(forgotten_, {});
-  }
 
   std::size_t in_progress() const { return by_request_id_.size(); }
   std::size_t retained() const { return done_order_.size(); }
@@ -163,8 +154,7 @@ class ExplicitGateway {
   std::map<Key, Transaction> transactions_;
   std::map<std::uint32_t, Key> by_request_id_;  // executing
   std::uint64_t refused_for_limits_ = 0;
-  std::deque<Key> done_order_;                  // completed, oldest first
-  std::vector<Key> forgotten_;
+  std::deque<Key> done_order_;  // completed, oldest first
 };
 
 }  // namespace dnbridge::rack

@@ -37,9 +37,10 @@ inline std::filesystem::path write_simulated_rack_config(dds_domainid_t domain) 
 // destroyed (then killed, if it has not exited).
 class BridgeProcess {
  public:
-  explicit BridgeProcess(const std::string& binary = DNBRIDGE_BINARY)
+  explicit BridgeProcess(const std::string& binary = DNBRIDGE_BINARY,
+                         const ChildOptions& options = {})
       : config_(write_simulated_rack_config(dds::testing::test_domain())) {
-    child_.emplace(std::vector<std::string>{binary, "--config", config_.string()});
+    child_.emplace(std::vector<std::string>{binary, "--config", config_.string()}, options);
   }
   ~BridgeProcess() {
     child_.reset();

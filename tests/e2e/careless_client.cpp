@@ -25,10 +25,10 @@
 //       "written COUNT acked" or "written COUNT unacked" (whether the bridge
 //       acknowledged them within 5 s); stays until the end of stdin.
 //   stall-replies REQUESTER REPEATS GETS
-//       an ExplicitReply reader with the old reply QoS (keep-all, at most 4
-//       samples per instance), never taken from: once it holds 4 replies of a
-//       transaction it rejects the next, and Cyclone's delivery in this
-//       process waits for it. Writes one request (txid 1) again each time a
+//       an ExplicitReply reader with an early reply QoS (keep-all, at most 4
+//       samples per instance), never taken from: once it holds 4 replies it
+//       rejects the next, and Cyclone's delivery in this process waits for
+//       it. Writes one request (txid 1) again each time a
 //       reply came, until the reader rejects one (at most REPEATS times),
 //       prints "stalled after N" (or "not stalled after N"); then GETS Gets
 //       (txids 2..GETS+1, nodes 1..8 in turn), prints "sent OK FAILED" (writes
@@ -166,7 +166,7 @@ int requests(dds_domainid_t domain, const std::string& requester, std::uint32_t 
 
 // The reply reader's QoS before the bridge's readers stopped refusing
 // samples: keep-all within resource limits.
-dds::Qos old_reply_reader_qos() {
+dds::Qos rejecting_reply_reader_qos() {
   dds::Qos qos;
   qos.reliable(milliseconds(100))
       .durability(dds::Durability::kTransientLocal)
@@ -180,7 +180,8 @@ int stall_replies(dds_domainid_t domain, const std::string& requester, std::uint
   dds::Participant participant(domain, dds::Participant::ClientName{requester});
   dds::Topic<dnbridge_ExplicitRequest> request_topic(participant);
   dds::Topic<dnbridge_ExplicitReply> reply_topic(participant);
-  dds::Reader<dnbridge_ExplicitReply> replies(participant, reply_topic, old_reply_reader_qos());
+  dds::Reader<dnbridge_ExplicitReply> replies(participant, reply_topic,
+                                              rejecting_reply_reader_qos());
   dds::Writer<dnbridge_ExplicitRequest> writer(participant, request_topic,
                                                dds::request_writer_qos());
   await_writer(participant, replies, "the ExplicitReply reader");

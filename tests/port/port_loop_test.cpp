@@ -52,7 +52,6 @@ class RecordingPublisher final : public PortPublisher {
     replies.push_back(a);
     changed_.notify_all();
   }
-  void forget_reply(const std::string&, std::uint32_t) override {}
   void port_stopped(const std::string&) override {
     std::lock_guard lock(mutex_);
     stopped = true;
