@@ -975,99 +975,6 @@ DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporte
   return config;
 }
 
-// What `dnbridge --simulate` runs; also printed by --print-default-config, so
-// it is written for people to start from.
-constexpr std::string_view kDefaultConfig =
-    R"(# dnbridge: the configuration `dnbridge --simulate` runs.
-# Eight CDN127 pump interfaces on the in-process simulated bus.
-
-rack = "sim-rack"
-domain = 0
-master_mac = 0
-log_level = "info"
-
-# Explicit messaging (ExplicitRequest) may always Get; what else it may do
-# to a node is refused (status 8) unless allowed here. Each key, its risk:
-[explicit_policy]
-# Allocate/Release to the DeviceNet object: a Release drops the bridge's
-# connections; outputs go idle or fault until it reconnects.
-allow_allocate_release = false
-# Set, Delete, ... to the Connection object: can stop the I/O or turn the
-# device's lost-master watchdog off.
-allow_connection_changes = false
-# Set of DOP/AOP Value or Assembly data: bypasses PumpCommand's ownership;
-# can switch a pump nobody commands.
-allow_output_writes = false
-# Set of what the bridge configures (Configuration, fault/idle settings):
-# breaks I/O decoding or the safe state, unseen until the node restarts.
-allow_managed_attribute_writes = false
-# Reset of the Identity object: the device restarts; the pump is lost until
-# the bridge brings it back.
-allow_identity_reset = false
-# Set of the DeviceNet object (MAC ID, bit rate): the node may come back at
-# another scan-list entry's address, or not at all.
-allow_network_settings = false
-# Any other service (Multiple_Service_Packet, Start/Stop, Save/Restore,
-# vendor services): its effect is unknown to the bridge.
-allow_other_services = false
-
-[defaults]
-poll_period_ms = 100
-expected_packet_rate_ms = 500
-io = "cdn127"
-# Each output's safe state, downloaded into every node and read back before
-# it is polled: on a fault (the bridge's polls stop for 4 x the expected
-# packet rate) and when idle (no command). "off", "on" or "hold"; the analog
-# output a voltage or "hold".
-pump_on_fault = "off"
-pump_on_idle = "off"
-n2_ballast_on_fault = "off"
-n2_ballast_on_idle = "off"
-analog_output_on_fault = 0.0
-analog_output_on_idle = 0.0
-# After a loss (power cycle, cable, bus-off) a node is idle until a new
-# command arrives.
-resume = "new-command"
-
-[[port]]
-name = "A"
-interface = "simulated"
-bitrate = 500000
-
-  [[port.node]]
-  mac = 1
-  name = "pump-1"
-
-  [[port.node]]
-  mac = 2
-  name = "pump-2"
-
-  [[port.node]]
-  mac = 3
-  name = "pump-3"
-
-  [[port.node]]
-  mac = 4
-  name = "pump-4"
-
-  [[port.node]]
-  mac = 5
-  name = "pump-5"
-
-  [[port.node]]
-  mac = 6
-  name = "pump-6"
-
-  [[port.node]]
-  mac = 7
-  name = "pump-7"
-
-  [[port.node]]
-  mac = 8
-  name = "pump-8"
-  io = "cdn118"
-)";
-
 }  // namespace
 
 ConfigError::ConfigError(std::vector<std::string> problems)
@@ -1121,9 +1028,9 @@ DaemonConfig load_config_file(const std::filesystem::path& path) {
   return config;
 }
 
-std::string_view embedded_default_config_text() noexcept { return kDefaultConfig; }
-
-DaemonConfig embedded_default_config() { return parse_config(kDefaultConfig, "embedded default"); }
+DaemonConfig embedded_default_config() {
+  return parse_config(embedded_default_config_text(), "embedded default");
+}
 
 rack::PumpConfig to_pump_config(const NodeSettings& node) {
   rack::PumpConfig p;

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "adapters/daemon/host_identity.hpp"
@@ -96,6 +98,15 @@ TEST(ConfigFile, ExampleLoadsWithEveryValueWhereItWasWritten) {
   EXPECT_EQ(b.nodes[1].io, kCdn118);
   EXPECT_EQ(b.nodes[1].identity, (devicenet::ExpectedIdentity{
                                      .vendor_id = 59, .product_type = 27, .product_code = 1888}));
+}
+
+TEST(ConfigFile, EmbeddedDefaultIsTheShippedFile) {
+  std::ifstream in(DNBRIDGE_SOURCE_DIR "/deploy/config/default.toml", std::ios::binary);
+  ASSERT_TRUE(in);
+  std::ostringstream file;
+  file << in.rdbuf();
+  EXPECT_EQ(embedded_default_config_text(), file.str());
+  EXPECT_EQ(load_config_file(DNBRIDGE_SOURCE_DIR "/deploy/config/default.toml").rack, "sim-rack");
 }
 
 TEST(ConfigFile, EmbeddedDefaultIsTheSimulatedRack) {
