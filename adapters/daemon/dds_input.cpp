@@ -151,12 +151,10 @@ void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& 
   port::PortLoop* loop = port_of(dds::view(c.port));
   const auto mac = devicenet::MacId::from(c.mac);
   if (!loop || !mac || !loop->has_node(*mac)) {
-    unsigned suppressed = 0;
-    if (warn_limit_.allow(port::steady_now(), suppressed)) {
-      log_.warn("command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
-                info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "",
-                dds::view(c.port), c.mac);
-    }
+    warn_limit_.warn(log_, port::steady_now(),
+                     "command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
+                     info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "",
+                     dds::view(c.port), c.mac);
     return;
   }
   // No live commander left for this pump (all writers gone, or disposed):
@@ -180,15 +178,13 @@ void DdsInput::note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleI
   const auto ahead = info.source_timestamp() - dds::dds_now();
   if (ahead <= kClockSkewReported) return;
   ++commands_stamped_ahead_;
-  unsigned suppressed = 0;
-  if (skew_limit_.allow(port::steady_now(), suppressed)) {
-    log_.warn(
-        "command from \"{}\" for port \"{}\" MAC {} is stamped {:.1f} s ahead of this host's "
-        "clock ({} such commands so far): applied in the order received; check the commander's "
-        "clock synchronisation",
-        dds::view(c.issuer), dds::view(c.port), c.mac, std::chrono::duration<double>(ahead).count(),
-        commands_stamped_ahead_);
-  }
+  skew_limit_.warn(
+      log_, port::steady_now(),
+      "command from \"{}\" for port \"{}\" MAC {} is stamped {:.1f} s ahead of this host's "
+      "clock ({} such commands so far): applied in the order received; check the commander's "
+      "clock synchronisation",
+      dds::view(c.issuer), dds::view(c.port), c.mac, std::chrono::duration<double>(ahead).count(),
+      commands_stamped_ahead_);
 }
 
 bool DdsInput::take_requests() {
@@ -210,13 +206,10 @@ void DdsInput::on_request(const dnbridge_ExplicitRequest& r,
     // take each other's transactions. Not executed; the reply goes to the
     // part before the NUL (a C string cannot say more).
     ++requests_refused_for_names_;
-    unsigned suppressed = 0;
-    if (warn_limit_.allow(port::steady_now(), suppressed)) {
-      log_.warn(
-          "explicit request (txid {}) refused: its requester name \"{}\" goes on past a NUL "
-          "character ({} such requests so far)",
-          call.txid, call.requester, requests_refused_for_names_);
-    }
+    warn_limit_.warn(log_, port::steady_now(),
+                     "explicit request (txid {}) refused: its requester name \"{}\" goes on past "
+                     "a NUL character ({} such requests so far)",
+                     call.txid, call.requester, requests_refused_for_names_);
     publisher_.explicit_reply(
         {}, rack::refuse(call, rack::TransactionStatus::kInvalidCommand,
                          "the requester name holds a NUL character: use a name without one"));

@@ -49,8 +49,8 @@ class DdsInput {
   dds::GuardCondition stop_;
   dds::WaitSet waitset_;
   std::thread thread_;
-  RateLimiter warn_limit_;
-  RateLimiter skew_limit_;
+  RateLimitedLog warn_limit_;
+  RateLimitedLog skew_limit_;
   std::uint64_t commands_stamped_ahead_ = 0;
   std::uint64_t requests_refused_for_names_ = 0;
 };

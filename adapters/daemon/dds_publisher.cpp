@@ -43,11 +43,7 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
 bool DdsPublisher::check(Status s, const char* what) {
   if (s) return true;
   std::lock_guard lock(log_mutex_);
-  unsigned suppressed = 0;
-  if (error_limit_.allow(port::steady_now(), suppressed)) {
-    log_.error("writing {} failed: {}{}", what, s.error().message(),
-               suppressed ? fmt::format(" ({} more suppressed)", suppressed) : std::string());
-  }
+  error_limit_.error(log_, port::steady_now(), "writing {} failed: {}", what, s.error().message());
   return false;
 }
 

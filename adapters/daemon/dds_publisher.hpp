@@ -84,7 +84,7 @@ class DdsPublisher final : public port::PortPublisher {
   std::map<std::string, std::set<std::uint8_t>> written_;  // per port, the MACs written
   std::map<std::string, std::uint64_t> undelivered_;  // per port
   std::mutex log_mutex_;
-  RateLimiter error_limit_;
+  RateLimitedLog error_limit_;
   // Last: their threads end, after writing what waits, before the writers go.
   Outbox state_out_;
   Outbox reply_out_;

@@ -297,11 +297,8 @@ void SocketCanBackend::receive(port::FrameReceiver& receiver, bool& delivered, T
         go_down(r.error().message(), now);
         return;
       }
-      unsigned suppressed = 0;
-      if (error_log_limit_.allow(now, suppressed)) {
-        log_.warn("reading from {}: {} ({} more not logged)", options_.interface,
-                  r.error().message(), suppressed);
-      }
+      error_log_limit_.warn(log_, now, "reading from {}: {}", options_.interface,
+                            r.error().message());
       // A pending socket error is cleared by reading it.
       if (auto e = io_->take_error(socket_); e && interface_gone(e)) go_down(e.message(), now);
       return;
@@ -350,10 +347,7 @@ void SocketCanBackend::on_error_frame(const Received& r, TimePoint now) {
                                                                 : LogLevel::kWarn;
     log_.log(level, "bus {} -> {}: {}", to_string(before), to_string(bus_.state), describe(report));
   } else {
-    unsigned suppressed = 0;
-    if (error_log_limit_.allow(now, suppressed)) {
-      log_.warn("error frame: {} ({} more not logged)", describe(report), suppressed);
-    }
+    error_log_limit_.warn(log_, now, "error frame: {}", describe(report));
   }
 
   if (report.bus_off) {
@@ -435,22 +429,17 @@ bool SocketCanBackend::try_write(const can::CanFrame& frame, TimePoint now) {
   }
   // Refused for this frame alone (EINVAL, EMSGSIZE, ...): dropped.
   ++stats_.transmit_dropped;
-  unsigned suppressed = 0;
-  if (transmit_log_limit_.allow(now, suppressed)) {
-    log_.warn("frame 0x{:03X} not sent on {}: {} ({} more not logged)", frame.id,
-              options_.interface, e.message(), suppressed);
-  }
+  transmit_log_limit_.warn(log_, now, "frame 0x{:03X} not sent on {}: {}", frame.id,
+                           options_.interface, e.message());
   return true;  // nothing to retry
 }
 
 void SocketCanBackend::enqueue(const can::CanFrame& frame, TimePoint now) {
   if (queue_.size() >= options_.transmit_queue_limit) {
     ++stats_.transmit_dropped;
-    unsigned suppressed = 0;
-    if (transmit_log_limit_.allow(now, suppressed)) {
-      log_.warn("{}: {} frames wait for the interface; frame 0x{:03X} dropped ({} more not logged)",
-                options_.interface, queue_.size(), frame.id, suppressed);
-    }
+    transmit_log_limit_.warn(log_, now,
+                             "{}: {} frames wait for the interface; frame 0x{:03X} dropped",
+                             options_.interface, queue_.size(), frame.id);
     return;
   }
   ++stats_.transmit_deferred;

@@ -168,8 +168,8 @@ class SocketCanBackend final : public port::CanBackend {
   TimePoint armed_ = kNever;
   std::uint32_t last_drops_ = 0;
 
-  RateLimiter transmit_log_limit_;
-  RateLimiter error_log_limit_;
+  RateLimitedLog transmit_log_limit_;
+  RateLimitedLog error_log_limit_;
   std::unique_ptr<std::FILE, FileCloser> candump_;
 };
 

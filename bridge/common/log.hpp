@@ -1,6 +1,6 @@
 #pragma once
 // Logging through an injected sink. The core formats a message only when the
-// sink wants that level; anything on the frame path goes through a RateLimiter.
+// sink wants that level; anything on the frame path goes through a RateLimitedLog.
 #include <fmt/format.h>
 
 #include <cstdint>
@@ -67,16 +67,46 @@ class Logger {
   std::string component_;
 };
 
-// Lets through at most `burst` messages per `window`; counts the rest so the
-// next message that passes can say how many were suppressed.
-class RateLimiter {
+// A kind of message logged at most `burst` times per `window`: the rest are
+// counted, and the next one that passes says how many were not logged
+// ("... (12 more not logged)", or "(12 more refusals not logged)" with
+// `what` = "refusals"). One per kind of message, held by whoever logs it.
+class RateLimitedLog {
  public:
-  explicit RateLimiter(Duration window = seconds(10), unsigned burst = 5) noexcept
-      : window_(window), burst_(burst) {}
+  explicit RateLimitedLog(Duration window = seconds(10), unsigned burst = 5,
+                          std::string what = {}) noexcept
+      : window_(window), burst_(burst), what_(std::move(what)) {}
 
-  // True if a message may be logged now. `suppressed` receives the number of
-  // messages dropped since the last one that passed.
-  bool allow(TimePoint now, unsigned& suppressed) noexcept {
+  // Logs through `log` unless the limit is reached; true if it logged.
+  template <class... Args>
+  bool info(const Logger& log, TimePoint now, fmt::format_string<Args...> f, Args&&... a) {
+    return write(log, LogLevel::kInfo, now, f, std::forward<Args>(a)...);
+  }
+  template <class... Args>
+  bool warn(const Logger& log, TimePoint now, fmt::format_string<Args...> f, Args&&... a) {
+    return write(log, LogLevel::kWarn, now, f, std::forward<Args>(a)...);
+  }
+  template <class... Args>
+  bool error(const Logger& log, TimePoint now, fmt::format_string<Args...> f, Args&&... a) {
+    return write(log, LogLevel::kError, now, f, std::forward<Args>(a)...);
+  }
+
+ private:
+  template <class... Args>
+  bool write(const Logger& log, LogLevel level, TimePoint now, fmt::format_string<Args...> f,
+             Args&&... a) {
+    unsigned dropped = 0;
+    if (!allow(now, dropped)) return false;
+    if (dropped == 0) {
+      log.log(level, f, std::forward<Args>(a)...);
+    } else {
+      log.log(level, "{} ({} more{}{} not logged)", fmt::format(f, std::forward<Args>(a)...),
+              dropped, what_.empty() ? "" : " ", what_);
+    }
+    return true;
+  }
+
+  bool allow(TimePoint now, unsigned& dropped) noexcept {
     if (!started_ || now - window_start_ >= window_) {
       started_ = true;
       window_start_ = now;
@@ -87,14 +117,14 @@ class RateLimiter {
       return false;
     }
     ++passed_;
-    suppressed = dropped_;
+    dropped = dropped_;
     dropped_ = 0;
     return true;
   }
 
- private:
   Duration window_;
   unsigned burst_;
+  std::string what_;
   bool started_ = false;
   TimePoint window_start_{};
   unsigned passed_ = 0;

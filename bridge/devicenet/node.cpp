@@ -177,13 +177,9 @@ void Node::on_explicit_frame(Bytes payload, TimePoint now) {
       after.unexpected_frames == before.unexpected_frames) {
     return;
   }
-  unsigned suppressed = 0;
-  if (error_log_limit_.allow(now, suppressed)) {
-    log_.warn("{} explicit frame ignored: {}{}",
-              after.malformed_frames != before.malformed_frames ? "malformed" : "unexpected",
-              hex(payload),
-              suppressed ? fmt::format(" ({} similar suppressed)", suppressed) : std::string());
-  }
+  error_log_limit_.warn(
+      log_, now, "{} explicit frame ignored: {}",
+      after.malformed_frames != before.malformed_frames ? "malformed" : "unexpected", hex(payload));
 }
 
 void Node::on_duplicate_mac_request(TimePoint now) {

@@ -307,7 +307,7 @@ class Node final : private ExplicitClient::Listener {
 
   NodeCounters counters_;
   NodeError last_error_;
-  RateLimiter error_log_limit_;
+  RateLimitedLog error_log_limit_;
 };
 
 }  // namespace dnbridge::devicenet

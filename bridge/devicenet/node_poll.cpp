@@ -148,11 +148,7 @@ void Node::accept_poll_response(Bytes data, TimePoint now) {
 void Node::bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now) {
   ++counters_.errors;
   record(kind, now, got, static_cast<std::uint32_t>(config_.profile.produced_size));
-  unsigned suppressed = 0;
-  if (error_log_limit_.allow(now, suppressed)) {
-    log_.warn("{}{}", last_error_.describe(),
-              suppressed ? fmt::format(" ({} similar suppressed)", suppressed) : std::string());
-  }
+  error_log_limit_.warn(log_, now, "{}", last_error_.describe());
   if (state_ != NodeState::kOnline) return;
   poll_outstanding_ = false;
   poll_deadline_ = kNever;

@@ -165,10 +165,8 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
   auto id = decode_identifier(frame.id);
   if (!id) {
     ++counters_.invalid_identifiers;
-    unsigned suppressed = 0;
-    if (foreign_log_limit_.allow(rx_time, suppressed)) {
-      log_.warn("frame with a non-DeviceNet identifier 0x{:03X} ignored", frame.id);
-    }
+    foreign_log_limit_.warn(log_, rx_time, "frame with a non-DeviceNet identifier 0x{:03X} ignored",
+                            frame.id);
     return;
   }
   const Bytes payload = frame.payload();

@@ -89,7 +89,7 @@ class Scanner {
   std::string reason_ = "not started";
   std::uint32_t next_request_id_ = 1;
   PortCounters counters_;
-  RateLimiter foreign_log_limit_;
+  RateLimitedLog foreign_log_limit_;
 };
 
 }  // namespace dnbridge::devicenet

@@ -201,16 +201,13 @@ std::optional<ExplicitAnswer> ExplicitGateway::apply_policy(
     const ExplicitCall& call, const devicenet::RequestMessage& request, const devicenet::Node& node,
     TimePoint now) {
   const PolicyNode about{node.config().profile.settings};
-  unsigned suppressed = 0;
   if (auto refusal = check(policy_, request, about)) {
     const std::uint64_t count = ++refused_[static_cast<std::size_t>(refusal->kind)];
-    if (refusal_log_limit_.allow(now, suppressed)) {
-      log_.warn(
-          "explicit request from \"{}\" (txid {}) to node {} refused: {} ({} of this "
-          "class refused so far){}",
-          call.requester, call.txid, call.mac, refusal->message, count,
-          suppressed ? fmt::format(" ({} more refusals not logged)", suppressed) : std::string());
-    }
+    refusal_log_limit_.warn(
+        log_, now,
+        "explicit request from \"{}\" (txid {}) to node {} refused: {} ({} of this class "
+        "refused so far)",
+        call.requester, call.txid, call.mac, refusal->message, count);
     return refuse(call, TransactionStatus::kInvalidCommand, std::move(refusal->message));
   }
   return std::nullopt;
@@ -221,12 +218,10 @@ void ExplicitGateway::log_allowed(const ExplicitCall& call,
                                   const devicenet::Node& node, TimePoint now) {
   const PolicyNode about{node.config().profile.settings};
   const auto guarded = classify(request, about);
-  unsigned suppressed = 0;
-  if (guarded.empty() || !allowed_log_limit_.allow(now, suppressed)) return;
-  log_.info("explicit request from \"{}\" (txid {}) to node {} sent: {}, allowed by {}{}",
-            call.requester, call.txid, call.mac, guarded.front().what,
-            policy_key(guarded.front().kind),
-            suppressed ? fmt::format(" ({} more not logged)", suppressed) : std::string());
+  if (guarded.empty()) return;
+  allowed_log_limit_.info(
+      log_, now, "explicit request from \"{}\" (txid {}) to node {} sent: {}, allowed by {}",
+      call.requester, call.txid, call.mac, guarded.front().what, policy_key(guarded.front().kind));
 }
 
 std::optional<ExplicitAnswer> ExplicitGateway::on_result(std::uint32_t request_id,

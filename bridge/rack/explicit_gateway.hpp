@@ -148,8 +148,8 @@ class ExplicitGateway {
   Logger log_;
   // Refusals go to the log with their requester; a requester that keeps
   // trying must not flood it.
-  RateLimiter refusal_log_limit_;
-  RateLimiter allowed_log_limit_;
+  RateLimitedLog refusal_log_limit_{seconds(10), 5, "refusals"};
+  RateLimitedLog allowed_log_limit_;
   std::array<std::uint64_t, kGuardedRequestKinds> refused_{};
   std::map<Key, Transaction> transactions_;
   std::map<std::uint32_t, Key> by_request_id_;  // executing

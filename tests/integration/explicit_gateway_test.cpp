@@ -391,7 +391,7 @@ TEST_F(Gateway, RefusalsAreLoggedAtALimitedRate) {
     EXPECT_EQ(harness_.replies.back().status, TransactionStatus::kInvalidCommand);
   }
   EXPECT_EQ(gateway_->refused_by_policy(), 50u);
-  EXPECT_EQ(log_.warnings, 5u);  // RateLimiter's burst per window
+  EXPECT_EQ(log_.warnings, 5u);  // RateLimitedLog's burst per window
   run(seconds(11));
   harness_.request(release, now());
   EXPECT_EQ(log_.warnings, 6u);
