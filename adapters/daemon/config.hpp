@@ -133,7 +133,7 @@ DaemonConfig load_config_file(const std::filesystem::path& path);
 // and in DaemonConfig::source. Throws ConfigError.
 DaemonConfig parse_config(std::string_view text, std::string_view source_name);
 
-// What `dnbridge --simulate` runs: rack "sim-rack", eight CDN127 pumps on a
+// What `dnbridge-sim --simulate` runs: rack "sim-rack", eight CDN127 pumps on a
 // simulated 500 kbit/s port. The text is what --print-default-config prints.
 std::string_view embedded_default_config_text() noexcept;
 DaemonConfig embedded_default_config();

@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "adapters/daemon/host_identity.hpp"
-#include "adapters/port/sim_backend.hpp"
 #include "adapters/socketcan/socketcan_backend.hpp"
 
 namespace dnbridge::daemon {
@@ -39,9 +38,10 @@ port::PortLoopConfig loop_config(const DaemonConfig& rack, const PortConfig& p,
 BackendFactory default_backend_factory(LogSink& log) {
   return [&log](const PortConfig& p) -> std::unique_ptr<port::CanBackend> {
     if (p.interface == kSimulatedInterface) {
-      std::vector<devicenet::MacId> macs;
-      for (const auto& n : p.nodes) macs.push_back(n.mac);
-      return std::make_unique<port::SimBackend>(p.bitrate, macs, &log);
+      throw std::runtime_error(fmt::format(
+          "port {}: interface \"{}\" is the simulator's bus, and this program carries no "
+          "simulator: dnbridge-sim runs it",
+          p.name, p.interface));
     }
     socketcan::SocketCanOptions o;
     o.interface = p.interface;
@@ -101,7 +101,7 @@ void Daemon::toggle_candump(const std::string& directory) {
     const std::string path = fmt::format("{}/dnbridge-{}-candump.log", directory, p->name());
     p->post([path, this](port::CanBackend& backend) {
       auto* can = dynamic_cast<socketcan::SocketCanBackend*>(&backend);
-      if (!can) return;  // the simulated bus: nothing to log
+      if (!can) return;  // not SocketCAN (the simulator's bus): nothing to log
       if (can->candump_logging()) {
         can->stop_candump_log();
       } else if (auto s = can->start_candump_log(path); !s) {

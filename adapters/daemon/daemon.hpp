@@ -16,8 +16,10 @@
 
 namespace dnbridge::daemon {
 
-// Makes the CAN backend of a port: the simulated bus for interface
-// "simulated". Throws std::runtime_error for an interface it cannot open.
+// Makes the CAN backend of a port. default_backend_factory: SocketCAN; it
+// refuses interface "simulated" (simulated_backend_factory, in
+// dnbridge::daemon_sim, runs it). Throws std::runtime_error for an interface
+// it cannot open.
 using BackendFactory = std::function<std::unique_ptr<port::CanBackend>(const PortConfig&)>;
 BackendFactory default_backend_factory(LogSink& log);
 

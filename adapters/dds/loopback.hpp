@@ -1,7 +1,7 @@
 #pragma once
 // Cyclone DDS pinned to this host: the loopback interface, no multicast,
 // unicast discovery to 127.0.0.1 (as deploy/cyclonedds/loopback.xml).
-// `dnbridge --simulate` uses it when CYCLONEDDS_URI is not set; tests and the
+// `dnbridge-sim --simulate` uses it when CYCLONEDDS_URI is not set; tests and the
 // benchmark add a discovery tag of their own, so that participants of other
 // runs on the same host are never matched.
 #include <string>

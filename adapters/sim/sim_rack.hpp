@@ -15,7 +15,7 @@
 namespace dnbridge::sim {
 
 struct SimRackConfig {
-  BusConfig bus{kBitrate500k};
+  BusConfig bus{can::kBitrate500k};
   devicenet::ScannerConfig port;        // master MAC, timings; nodes come from `pumps`
   std::vector<rack::PumpConfig> pumps;  // the scan list
   bool create_devices = true;           // a CDN127 at each pump's MAC

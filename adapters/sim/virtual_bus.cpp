@@ -233,14 +233,14 @@ void VirtualBus::start_transmission(TimePoint t) {
   const can::CanFrame frame = winner->tx.front().frame;
   winner->tx.pop_front();
   const NodeHandle sender{static_cast<std::uint32_t>(winner_index)};
-  const std::uint32_t bits = frame_bits(frame);
+  const std::uint32_t bits = can::frame_bits(frame);
   ++stats_.transmitted;
   stats_.bits += bits;
   if (!timed()) {
     deliver(frame, sender, t);
     return;
   }
-  in_flight_ = InFlight{frame, sender, t, t + bits_duration(bits, config_.bitrate), false};
+  in_flight_ = InFlight{frame, sender, t, t + can::bits_duration(bits, config_.bitrate), false};
 }
 
 void VirtualBus::complete_transmission() {

@@ -6,7 +6,7 @@
 //  - 0, "ideal": a frame is delivered at the time it was sent, in send order.
 //  - 125k/250k/500k, "timed": one shared medium. When it is idle, arbitration
 //    picks the lowest identifier among the heads of the nodes' transmit queues
-//    (FIFO per node); the frame occupies the bus for frame_duration() and is
+//    (FIFO per node); the frame occupies the bus for can::frame_duration() and is
 //    delivered to every other attached node at its end.
 // A frame nobody else hears is not acknowledged: it is counted and dropped. A
 // real controller would retransmit it until an error counter took it off the
@@ -25,9 +25,9 @@
 #include <optional>
 #include <vector>
 
-#include "adapters/sim/can_timing.hpp"
 #include "adapters/sim/fault_injection.hpp"
 #include "bridge/can/can_frame.hpp"
+#include "bridge/can/can_timing.hpp"
 #include "bridge/can/frame_sink.hpp"
 #include "bridge/common/result.hpp"
 #include "bridge/common/time.hpp"
@@ -46,7 +46,7 @@ class BusPort {
 };
 
 struct BusConfig {
-  std::uint32_t bitrate = 0;  // 0: ideal; kBitrate125k/250k/500k: timed
+  std::uint32_t bitrate = 0;  // 0: ideal; can::kBitrate125k/250k/500k: timed
   std::uint64_t seed = FaultInjector::kDefaultSeed;
   // Events one advance() call handles at most, so that two nodes answering
   // each other at the same instant cannot loop for ever. Reaching it is

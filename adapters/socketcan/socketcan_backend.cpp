@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "adapters/sim/can_timing.hpp"
+#include "bridge/can/can_timing.hpp"
 #include "bridge/devicenet/identifier.hpp"
 
 namespace dnbridge::socketcan {
@@ -318,7 +318,7 @@ void SocketCanBackend::receive(port::FrameReceiver& receiver, bool& delivered, T
       case Received::Kind::kData:
         ++stats_.received;
         ++bus_.frames;
-        bus_.bits += sim::frame_bits(r->frame);
+        bus_.bits += can::frame_bits(r->frame);
         if (candump_) log_frame(r->frame, r->kernel_time.value_or(wall));
         receiver.on_frame(r->frame, rx);
         delivered = true;
@@ -404,7 +404,7 @@ bool SocketCanBackend::try_write(const can::CanFrame& frame, TimePoint now) {
   if (s) {
     ++stats_.transmitted;
     ++bus_.frames;
-    bus_.bits += sim::frame_bits(frame);
+    bus_.bits += can::frame_bits(frame);
     transmit_backoff_ = Duration::zero();
     if (candump_) log_frame(frame, wall_now());
     return true;

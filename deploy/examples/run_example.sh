@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Runs the example supervisor against `dnbridge --simulate`, both on this
+# Runs the example supervisor against `dnbridge-sim --simulate`, both on this
 # host only, with a discovery tag of their own so other DDS programs on the
 # host do not join in. Passes when the supervisor saw the rack, commanded a
 # pump, saw the echo, and saw the pump go idle once it left.
-# Usage: run_example.sh DNBRIDGE EXAMPLE_SUPERVISOR
+# Usage: run_example.sh DNBRIDGE_SIM EXAMPLE_SUPERVISOR
 set -euo pipefail
 bridge="$1"
 supervisor="$2"

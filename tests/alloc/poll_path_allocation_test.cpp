@@ -89,7 +89,7 @@ TEST(PollPath, NoHeapAllocationOncePollingAndCommanding) {
   devicenet::ScannerConfig port;
   port.master_mac = mac(0);
 
-  sim::SimWorld world(sim::BusConfig{sim::kBitrate500k});
+  sim::SimWorld world(sim::BusConfig{can::kBitrate500k});
   rack::PumpRack rack(pumps);
   CountedMaster master(world, rack::PumpRack::scanner_config(port, pumps), rack);
   rack.attach(master.scanner());

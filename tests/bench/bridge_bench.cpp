@@ -80,8 +80,8 @@
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
-#include "adapters/port/threaded_sim_backend.hpp"
-#include "adapters/sim/can_timing.hpp"
+#include "adapters/sim/threaded_sim_backend.hpp"
+#include "bridge/can/can_timing.hpp"
 #include "bridge/devicenet/identifier.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
@@ -605,7 +605,7 @@ int run_client(const ClientOptions& o) {
 
 // What the bus tap of one port sees, on that port's world thread.
 struct PortWire {
-  port::ThreadedSimBackend* backend = nullptr;
+  sim::ThreadedSimBackend* backend = nullptr;
   std::uint32_t bitrate = 0;
   bool ramp = false;            // a new analog input value before every poll
   bool record_outputs = false;  // the first poll frame of each new output value
@@ -698,7 +698,7 @@ struct PortWire {
         out && static_cast<int>(out->second) != last_output[mac]) {
       last_output[mac] = static_cast<int>(out->second);
       const auto end = wf.end.time_since_epoch().count();
-      const auto start = end - sim::frame_duration(wf.frame, bitrate).count();
+      const auto start = end - can::frame_duration(wf.frame, bitrate).count();
       std::lock_guard lock(mutex);
       output_frames.push_back({mac, out->second, start, end});
     }
@@ -710,7 +710,7 @@ struct PortWire {
 // the bus's (waiting for a frame already on the wire, arbitration) begins.
 class WrittenFramesBackend final : public port::CanBackend {
  public:
-  WrittenFramesBackend(std::unique_ptr<port::ThreadedSimBackend> inner, PortWire& wire)
+  WrittenFramesBackend(std::unique_ptr<sim::ThreadedSimBackend> inner, PortWire& wire)
       : inner_(std::move(inner)), wire_(wire), sink_(inner_->sink(), wire) {}
 
   can::FrameSink& sink() override { return sink_; }
@@ -750,7 +750,7 @@ class WrittenFramesBackend final : public port::CanBackend {
     port::FrameReceiver& inner_;
     PortWire& wire_;
   };
-  std::unique_ptr<port::ThreadedSimBackend> inner_;
+  std::unique_ptr<sim::ThreadedSimBackend> inner_;
   PortWire& wire_;
   Sink sink_;
 };
@@ -758,7 +758,7 @@ class WrittenFramesBackend final : public port::CanBackend {
 struct BridgeSetup {
   std::vector<std::string> ports;
   unsigned nodes = 0;
-  std::uint32_t bitrate = sim::kBitrate500k;
+  std::uint32_t bitrate = can::kBitrate500k;
   Duration poll_period = milliseconds(10);
   rack::PublishPolicy publish;
   bool ramp = false;
@@ -799,7 +799,7 @@ class Bridge {
                     layout](const daemon::PortConfig& p) -> std::unique_ptr<port::CanBackend> {
       std::vector<MacId> macs;
       for (const auto& n : p.nodes) macs.push_back(n.mac);
-      auto backend = std::make_unique<port::ThreadedSimBackend>(p.bitrate, macs, &log);
+      auto backend = std::make_unique<sim::ThreadedSimBackend>(p.bitrate, macs, &log);
       auto wire = std::make_unique<PortWire>();
       wire->backend = backend.get();
       wire->bitrate = p.bitrate;
@@ -885,7 +885,7 @@ class Bridge {
     return all;
   }
 
-  std::vector<port::ThreadedSimBackend*> backends_;
+  std::vector<sim::ThreadedSimBackend*> backends_;
   std::vector<std::unique_ptr<PortWire>> wires_;  // outlive the daemon (its backends' taps)
   std::unique_ptr<daemon::Daemon> daemon_;
 };
@@ -1147,7 +1147,7 @@ int run_bench(const Options& o) {
     BridgeSetup s;
     s.ports = {"A"};
     s.nodes = o.latency_nodes;
-    s.bitrate = sim::kBitrate500k;
+    s.bitrate = can::kBitrate500k;
     s.poll_period = milliseconds(poll_ms);
     s.publish = {seconds(1), 0.0};
     s.ramp = true;

@@ -15,6 +15,7 @@
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
+#include "adapters/daemon/simulated_backends.hpp"
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/reader.hpp"
@@ -47,7 +48,8 @@ class DnbctlEndToEnd : public ::testing::Test {
     for (auto& node : config.ports.at(0).nodes) {
       if (node.mac.value() == 3) node.no_commander = daemon::NoCommanderPolicy::kHoldLastOutputs;
     }
-    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), *log_);
+    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), *log_,
+                                               daemon::simulated_backend_factory(*log_));
     bridge_->start();
     observer_ = std::make_unique<Observer>();
   }

@@ -17,12 +17,13 @@
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
+#include "adapters/daemon/simulated_backends.hpp"
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dnbctl/client.hpp"
 #include "adapters/dnbctl/commander.hpp"
 #include "adapters/dnbctl/format.hpp"
-#include "adapters/port/sim_backend.hpp"
+#include "adapters/sim/sim_backend.hpp"
 #include "adapters/sim/sim_master.hpp"
 #include "adapters/sim/sim_rack.hpp"
 #include "adapters/sim/sim_slave.hpp"
@@ -89,7 +90,7 @@ class BusWithAnotherMaster final : public port::CanBackend {
     return rack::PumpRack::scanner_config(c, pumps);
   }
 
-  port::SimBackend bus_;
+  sim::SimBackend bus_;
   sim::SimSlave held_;
   devicenet::ScannerObserver observer_;  // what the other master sees is not under test
   sim::SimMaster other_;
@@ -140,7 +141,8 @@ class DnbctlRacks : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     log_ = std::make_unique<daemon::StderrLogSink>(LogLevel::kError);
-    north_ = std::make_unique<daemon::Daemon>(north_config(), *log_);
+    north_ = std::make_unique<daemon::Daemon>(north_config(), *log_,
+                                              daemon::simulated_backend_factory(*log_));
     north_->start();
     south_ = std::make_unique<daemon::Daemon>(
         south_config(), *log_,

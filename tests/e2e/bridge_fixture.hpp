@@ -1,5 +1,5 @@
 #pragma once
-// The bridge end to end: the dnbridge daemon of `dnbridge --simulate` running
+// The bridge end to end: the dnbridge daemon of `dnbridge-sim --simulate` running
 // in this process (Daemon on the embedded default rack: eight simulated CDN127s
 // on port "A"), and a supervisor, a DDS participant of its own that knows the
 // bridge only through the topics, on loopback (tests/dds/loopback_environment.cpp:
@@ -19,8 +19,8 @@
 #include <future>
 #include <memory>
 #include <mutex>
-#include <ostream>
 #include <optional>
+#include <ostream>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -30,12 +30,13 @@
 
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
+#include "adapters/daemon/simulated_backends.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/reader.hpp"
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
-#include "adapters/port/sim_backend.hpp"
+#include "adapters/sim/sim_backend.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "dds/dds_fixture.hpp"
 
@@ -228,11 +229,11 @@ inline auto pump_mac(unsigned mac) {
 // in time.
 template <class F>
 auto on_sim_port(daemon::Daemon& bridge, std::string_view port, F fn) {
-  using R = std::invoke_result_t<F&, port::SimBackend&>;
+  using R = std::invoke_result_t<F&, sim::SimBackend&>;
   auto done = std::make_shared<std::promise<R>>();
   auto result = done->get_future();
   bridge.port(port)->post([done, fn](port::CanBackend& backend) mutable {
-    auto& sim = static_cast<port::SimBackend&>(backend);
+    auto& sim = static_cast<sim::SimBackend&>(backend);
     if constexpr (std::is_void_v<R>) {
       fn(sim);
       done->set_value();
@@ -249,7 +250,7 @@ auto on_sim_port(daemon::Daemon& bridge, std::string_view port, F fn) {
 // The supervisor's side of the six topics, and the bridge it talks to.
 class BridgeTest : public ::testing::Test {
  protected:
-  // What `dnbridge --simulate` runs, on this process's domain.
+  // What `dnbridge-sim --simulate` runs, on this process's domain.
   static daemon::DaemonConfig rack_config() {
     auto c = daemon::embedded_default_config();
     c.domain_id = static_cast<std::uint32_t>(test_domain());
@@ -267,7 +268,8 @@ class BridgeTest : public ::testing::Test {
   // bridge have discovered each other on every topic.
   void make_bridge(daemon::DaemonConfig config = rack_config()) {
     created_wall_ = wall_now();
-    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), log_);
+    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), log_,
+                                               daemon::simulated_backend_factory(log_));
     ASSERT_TRUE(pumps_.matched(1));
     ASSERT_TRUE(nodes_.matched(1));
     ASSERT_TRUE(ports_.matched(1));
@@ -317,7 +319,7 @@ class BridgeTest : public ::testing::Test {
     return on_sim_port(*bridge_, kPort, std::move(fn));
   }
 
-  static sim::SimSlave& slave(port::SimBackend& backend, unsigned mac) {
+  static sim::SimSlave& slave(sim::SimBackend& backend, unsigned mac) {
     return backend.device(*devicenet::MacId::from(mac));
   }
 

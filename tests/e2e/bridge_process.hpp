@@ -1,5 +1,5 @@
 #pragma once
-// The dnbridge executable in a process of its own, on `dnbridge --simulate`'s
+// The bridge executable (dnbridge-sim) in a process of its own, on `dnbridge-sim --simulate`'s
 // configuration (the embedded default rack) on this process's domain,
 // logging warnings only. CYCLONEDDS_URI (loopback, this process's discovery
 // tag) is inherited.
@@ -18,7 +18,7 @@
 
 namespace dnbridge::e2e {
 
-// `dnbridge --simulate`'s configuration, on `domain`, logging warnings only.
+// `dnbridge-sim --simulate`'s configuration, on `domain`, logging warnings only.
 inline std::filesystem::path write_simulated_rack_config(dds_domainid_t domain) {
   std::string text(daemon::embedded_default_config_text());
   const auto replace = [&](std::string_view from, const std::string& to) {

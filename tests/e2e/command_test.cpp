@@ -66,10 +66,11 @@ class CommandTest : public BridgeTest {
            s->n2_ballast_on == n2 && s->analog_output_raw == analog && dds::view(s->commanded_by) == by;
   }
   PumpOutputs device_outputs(unsigned mac) {
-    return on_port([mac](port::SimBackend& b) { return slave(b, mac).device().outputs(); });
+    return on_port([mac](sim::SimBackend& b) { return slave(b, mac).device().outputs(); });
   }
   sim::OutputCause device_cause(unsigned mac) {
-    return on_port([mac](port::SimBackend& b) { return slave(b, mac).device().pump().last_cause(); });
+    return on_port(
+        [mac](sim::SimBackend& b) { return slave(b, mac).device().pump().last_cause(); });
   }
 };
 

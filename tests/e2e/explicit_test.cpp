@@ -55,7 +55,7 @@ std::vector<std::uint8_t> short_string(std::string_view s) {
 TEST_F(ExplicitTest, GetsIdentityAndFragmentedDeviceSupervisorStringsThroughDds) {
   ASSERT_NO_FATAL_FAILURE(start_online());
   auto wire = std::make_shared<WireCount>();
-  on_port([wire](port::SimBackend& b) {
+  on_port([wire](sim::SimBackend& b) {
     b.world().bus().set_tap([wire](const sim::WireFrame& w) {
       const auto& f = w.frame;
       if (f.id == group2_id(mac_id(1), Group2Message::kSlaveExplicitResponse) && f.len > 0 &&
@@ -132,7 +132,7 @@ TEST_F(ExplicitTest, ARequesterNameWithANulInsideIsRefused) {
 TEST_F(ExplicitTest, RepeatedRequestGetsTheSameReplyAndIsNotExecutedTwice) {
   ASSERT_NO_FATAL_FAILURE(start_online());
   auto wire = std::make_shared<WireCount>();
-  on_port([wire](port::SimBackend& b) {
+  on_port([wire](sim::SimBackend& b) {
     b.world().bus().set_tap([wire](const sim::WireFrame& w) {
       const auto& f = w.frame;
       if (f.id == group2_id(mac_id(1), Group2Message::kMasterExplicitRequest) && f.len == 5 &&
@@ -168,7 +168,7 @@ TEST_F(ExplicitTest, RepeatedRequestGetsTheSameReplyAndIsNotExecutedTwice) {
 
   // Executed once on the wire. The probe runs on the port's thread after
   // every frame so far, so the count is final.
-  EXPECT_EQ(on_port([wire](port::SimBackend&) { return wire->serial_number_requests.load(); }), 1u);
+  EXPECT_EQ(on_port([wire](sim::SimBackend&) { return wire->serial_number_requests.load(); }), 1u);
   EXPECT_EQ(reply_count(7), 3u);
 }
 
@@ -261,7 +261,7 @@ TEST_F(ExplicitTest, RefusalsHaveTheirStatusCodes) {
   ASSERT_NO_FATAL_FAILURE(send(other_rack));
 
   // 4: a node that went off the bus.
-  on_port([](port::SimBackend& b) { slave(b, 2).disconnect(); });
+  on_port([](sim::SimBackend& b) { slave(b, 2).disconnect(); });
   const auto pulled = SteadyClock::now();
   ASSERT_TRUE(pumps_.until([&] {
     const auto* s = pumps_.latest(pump_mac(2));
@@ -281,7 +281,7 @@ TEST_F(ExplicitTest, InProgressBusyAndOutOfBuffersUnderLoad) {
   // Slow devices: every explicit response of nodes 1..7 reaches the bus
   // 400 ms late, so that transactions stay in progress while more come.
   constexpr Duration kLate = milliseconds(400);
-  on_port([kLate](port::SimBackend& b) {
+  on_port([kLate](sim::SimBackend& b) {
     for (unsigned mac = 1; mac <= 7; ++mac) {
       b.world().bus().faults().add(
           sim::FaultRule::delay_by(group2_id(mac_id(mac), Group2Message::kSlaveExplicitResponse), kLate));

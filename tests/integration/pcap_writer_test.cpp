@@ -198,7 +198,7 @@ class Listener final : public BusPort {
 };
 
 TEST_F(PcapWriterTest, BusCaptureRecordsEveryFrameAtItsEndOfFrame) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   Listener a, b;
   const NodeHandle ha = bus.attach(a);
   const TimePoint start = at(seconds(1));
@@ -226,7 +226,7 @@ TEST_F(PcapWriterTest, BusCaptureRecordsEveryFrameAtItsEndOfFrame) {
   const auto usec = [](Duration d) {
     return static_cast<std::uint32_t>(std::chrono::duration_cast<microseconds>(d).count());
   };
-  const std::uint32_t end0 = usec(frame_duration(check, kBitrate500k));
+  const std::uint32_t end0 = usec(can::frame_duration(check, can::kBitrate500k));
   const ByteVec r0 = record(0);
   EXPECT_EQ(ByteVec(r0.begin() + 4, r0.begin() + 8),
             (ByteVec{static_cast<std::uint8_t>(end0), static_cast<std::uint8_t>(end0 >> 8), 0, 0}));
@@ -234,7 +234,8 @@ TEST_F(PcapWriterTest, BusCaptureRecordsEveryFrameAtItsEndOfFrame) {
                                                          0x00, 0x01, 0x00, 0x00, 0xDB, 0x00}));
   const ByteVec r1 = record(1);
   EXPECT_EQ(r1[19], 0x0B);
-  const std::uint32_t end1 = 2000 + usec(frame_duration(frame(0x40B, {0, 0xCB, 0}), kBitrate500k));
+  const std::uint32_t end1 =
+      2000 + usec(can::frame_duration(frame(0x40B, {0, 0xCB, 0}), can::kBitrate500k));
   EXPECT_EQ(ByteVec(r1.begin() + 4, r1.begin() + 8),
             (ByteVec{static_cast<std::uint8_t>(end1), static_cast<std::uint8_t>(end1 >> 8), 0, 0}));
 }

@@ -78,7 +78,7 @@ inline rack::PumpConfig pump(unsigned mac_value,
 
 inline sim::SimRackConfig rack_config(std::vector<unsigned> macs, unsigned master = 0) {
   sim::SimRackConfig c;
-  c.bus.bitrate = sim::kBitrate500k;
+  c.bus.bitrate = can::kBitrate500k;
   c.port.master_mac = mac(master);
   c.port.vendor_id = 59;
   c.port.serial_number = 0xDB000001;

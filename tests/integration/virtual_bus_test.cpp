@@ -115,7 +115,7 @@ TEST_F(BusTest, IdealModeFutureFrameWaitsForItsTime) {
 // ---------------------------------------------------------------- timed mode
 
 TEST_F(BusTest, ArbitrationSendsLowestIdentifierFirst) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_), b = bus.attach(b_), c = bus.attach(c_);
   bus.attach(listener_);
   const can::CanFrame fa = frame(0x300, {1, 2, 3}), fb = frame(0x100, {4}),
@@ -125,8 +125,9 @@ TEST_F(BusTest, ArbitrationSendsLowestIdentifierFirst) {
   bus.send(b, fb, t0);
   bus.send(c, fc, t0);
 
-  const Duration db = frame_duration(fb, kBitrate500k), dc = frame_duration(fc, kBitrate500k),
-                 da = frame_duration(fa, kBitrate500k);
+  const Duration db = can::frame_duration(fb, can::kBitrate500k),
+                 dc = can::frame_duration(fc, can::kBitrate500k),
+                 da = can::frame_duration(fa, can::kBitrate500k);
   EXPECT_EQ(bus.next_event(), t0);
   bus.advance(t0);
   EXPECT_TRUE(bus.busy());
@@ -137,14 +138,15 @@ TEST_F(BusTest, ArbitrationSendsLowestIdentifierFirst) {
   EXPECT_EQ(times(listener_.heard()),
             (std::vector<TimePoint>{t0 + db, t0 + db + dc, t0 + db + dc + da}));
   EXPECT_EQ(bus.stats().busy_time, db + dc + da);
-  EXPECT_EQ(bus.stats().bits, std::uint64_t{frame_bits(fa)} + frame_bits(fb) + frame_bits(fc));
+  EXPECT_EQ(bus.stats().bits,
+            std::uint64_t{can::frame_bits(fa)} + can::frame_bits(fb) + can::frame_bits(fc));
   EXPECT_EQ(bus.stats().collisions, 0u);
   EXPECT_FALSE(bus.busy());
 }
 
 TEST_F(BusTest, ExactDeliveryTimeOfOneFrame) {
   // ID 0, no data: 53 bits (can_timing_test), 8 us each at 125k = 424 us.
-  VirtualBus bus({.bitrate = kBitrate125k});
+  VirtualBus bus({.bitrate = can::kBitrate125k});
   const NodeHandle a = bus.attach(a_);
   bus.attach(listener_);
   bus.send(a, frame(0x000, {}), at(Duration::zero()));
@@ -157,13 +159,14 @@ TEST_F(BusTest, ExactDeliveryTimeOfOneFrame) {
 }
 
 TEST_F(BusTest, BusyBusDelaysEvenAHigherPriorityFrame) {
-  VirtualBus bus({.bitrate = kBitrate250k});
+  VirtualBus bus({.bitrate = can::kBitrate250k});
   const NodeHandle a = bus.attach(a_), b = bus.attach(b_), c = bus.attach(c_);
   bus.attach(listener_);
   const can::CanFrame fa = frame(0x400, {1, 2, 3, 4, 5, 6, 7, 8}), fb = frame(0x100, {}),
                       fc = frame(0x050, {});
-  const Duration da = frame_duration(fa, kBitrate250k), db = frame_duration(fb, kBitrate250k),
-                 dc = frame_duration(fc, kBitrate250k);
+  const Duration da = can::frame_duration(fa, can::kBitrate250k),
+                 db = can::frame_duration(fb, can::kBitrate250k),
+                 dc = can::frame_duration(fc, can::kBitrate250k);
   bus.send(a, fa, at(Duration::zero()));
   bus.advance(at(Duration::zero()));
   // Both queued while 0x400 is on the wire; no preemption, then 0x050 wins.
@@ -177,7 +180,7 @@ TEST_F(BusTest, BusyBusDelaysEvenAHigherPriorityFrame) {
 }
 
 TEST_F(BusTest, FrameQueuedOnIdleBusStartsAtItsSendTime) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_);
   bus.attach(listener_);
   const can::CanFrame f = frame(0x123, {0xAA});
@@ -185,11 +188,12 @@ TEST_F(BusTest, FrameQueuedOnIdleBusStartsAtItsSendTime) {
   bus.send(a, f, at(milliseconds(7)));
   bus.advance(at(seconds(1)));
   ASSERT_EQ(listener_.count(), 1u);
-  EXPECT_EQ(listener_.heard()[0].rx_time, at(milliseconds(7)) + frame_duration(f, kBitrate500k));
+  EXPECT_EQ(listener_.heard()[0].rx_time,
+            at(milliseconds(7)) + can::frame_duration(f, can::kBitrate500k));
 }
 
 TEST_F(BusTest, EqualIdentifiersFromTwoNodesCountAsCollision) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_), b = bus.attach(b_);
   bus.attach(listener_);
   bus.send(b, frame(0x200, {0xB}), at(Duration::zero()));
@@ -203,7 +207,7 @@ TEST_F(BusTest, EqualIdentifiersFromTwoNodesCountAsCollision) {
 
 TEST_F(BusTest, BusLoadOfAPeriodicFrame) {
   // One 53-bit frame (424 us at 125k) every millisecond: 42.4 % load.
-  VirtualBus bus({.bitrate = kBitrate125k});
+  VirtualBus bus({.bitrate = can::kBitrate125k});
   const NodeHandle a = bus.attach(a_);
   bus.attach(listener_);
   for (int i = 0; i < 10; ++i) {
@@ -230,7 +234,7 @@ TEST_F(BusTest, BusLoadOfAPeriodicFrame) {
 }
 
 TEST_F(BusTest, FrameWithoutListenerIsUnacknowledgedAndDropped) {
-  for (std::uint32_t bitrate : {0u, kBitrate500k}) {
+  for (std::uint32_t bitrate : {0u, can::kBitrate500k}) {
     SCOPED_TRACE(bitrate);
     VirtualBus bus({.bitrate = bitrate});
     const NodeHandle a = bus.attach(a_);
@@ -242,14 +246,14 @@ TEST_F(BusTest, FrameWithoutListenerIsUnacknowledgedAndDropped) {
     EXPECT_EQ(bus.stats().transmitted, 1u);
     EXPECT_EQ(bus.frames_with_id(0x3C3), 0u);
     // It still took the wire for its length.
-    EXPECT_EQ(bus.stats().busy_time, frame_duration(f, bitrate));
+    EXPECT_EQ(bus.stats().busy_time, can::frame_duration(f, bitrate));
     EXPECT_EQ(bus.next_event(), kNever);
     EXPECT_EQ(a_.count(), 0u);
   }
 }
 
 TEST_F(BusTest, DetachedListenerDoesNotAcknowledge) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_), l = bus.attach(listener_);
   ASSERT_TRUE(bus.detach(l).ok());
   bus.send(a, frame(0x100, {}), at(Duration::zero()));
@@ -278,15 +282,15 @@ TEST_F(BusTest, ReplyFromOnFrameIsDeliveredInTheSameAdvance) {
 }
 
 TEST_F(BusTest, TimedReplyFollowsTheRequest) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_), b = bus.attach(b_);
   const can::CanFrame request = frame(0x41C, {0x0E}), response = frame(0x41B, {0x8E, 1});
   b_.reply = [&](const can::CanFrame&, TimePoint t) { bus.sink(b).send(response, t); };
   bus.send(a, request, at(Duration::zero()));
   bus.advance(at(seconds(1)));
   ASSERT_EQ(a_.count(), 1u);
-  EXPECT_EQ(a_.heard()[0].rx_time,
-            at(frame_duration(request, kBitrate500k) + frame_duration(response, kBitrate500k)));
+  EXPECT_EQ(a_.heard()[0].rx_time, at(can::frame_duration(request, can::kBitrate500k) +
+                                      can::frame_duration(response, can::kBitrate500k)));
 }
 
 TEST_F(BusTest, EndlessPingPongStopsAtTheStepLimit) {
@@ -310,7 +314,7 @@ TEST_F(BusTest, EndlessPingPongStopsAtTheStepLimit) {
 // ---------------------------------------------------------------- node control
 
 TEST_F(BusTest, DetachedNodeNeitherSendsNorReceives) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_), b = bus.attach(b_);
   bus.attach(listener_);
   // b queues three frames; the first goes on the wire, then b loses power.
@@ -331,9 +335,9 @@ TEST_F(BusTest, DetachedNodeNeitherSendsNorReceives) {
   EXPECT_EQ(bus.stats().aborted, 1u);
   EXPECT_EQ(bus.stats().dropped_detached, 3u);  // 0x102, 0x103 flushed; 0x104 refused
   // The aborted frame still held the bus for its length.
-  const Duration d101 = frame_duration(frame(0x101, {}), kBitrate500k);
+  const Duration d101 = can::frame_duration(frame(0x101, {}), can::kBitrate500k);
   EXPECT_EQ(listener_.heard()[0].rx_time,
-            at(d101 + frame_duration(frame(0x200, {}), kBitrate500k)));
+            at(d101 + can::frame_duration(frame(0x200, {}), can::kBitrate500k)));
 
   // Power back: b sends and receives again.
   ASSERT_TRUE(bus.reattach(b).ok());
@@ -373,7 +377,7 @@ TEST_F(BusTest, UnknownHandles) {
 }
 
 TEST_F(BusTest, TransmitQueueCapacity) {
-  VirtualBus bus({.bitrate = kBitrate500k, .tx_queue_capacity = 2});
+  VirtualBus bus({.bitrate = can::kBitrate500k, .tx_queue_capacity = 2});
   const NodeHandle a = bus.attach(a_);
   bus.attach(listener_);
   for (std::uint32_t i = 0; i < 3; ++i) bus.send(a, frame(0x100 + i, {}), at(Duration::zero()));
@@ -462,7 +466,7 @@ TEST(BusFaults, DropAtFivePercentIsDeterministic) {
 }
 
 TEST_F(BusTest, DelayHoldsAFrameAndLetsLaterOnesPass) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_);
   bus.attach(listener_);
   bus.faults().add(FaultRule::delay_by(0x3C3, milliseconds(5)));
@@ -472,9 +476,10 @@ TEST_F(BusTest, DelayHoldsAFrameAndLetsLaterOnesPass) {
   EXPECT_EQ(bus.queued_frames(a), 1u);
   bus.advance(at(seconds(1)));
   EXPECT_EQ(ids(listener_.heard()), (std::vector<std::uint32_t>{0x3C4, 0x3C3}));
-  EXPECT_EQ(times(listener_.heard()),
-            (std::vector<TimePoint>{at(milliseconds(1) + frame_duration(fast, kBitrate500k)),
-                                    at(milliseconds(6) + frame_duration(slow, kBitrate500k))}));
+  EXPECT_EQ(
+      times(listener_.heard()),
+      (std::vector<TimePoint>{at(milliseconds(1) + can::frame_duration(fast, can::kBitrate500k)),
+                              at(milliseconds(6) + can::frame_duration(slow, can::kBitrate500k))}));
   EXPECT_EQ(bus.stats().fault_delayed, 1u);
 }
 
@@ -573,7 +578,7 @@ TEST_F(BusTest, NextNMatchingFrames) {
 std::vector<Reception> run_scene(std::uint64_t seed) {
   std::vector<Reception> log;
   RecordingPort p0("0", log), p1("1", log), p2("2", log);
-  VirtualBus bus({.bitrate = kBitrate250k, .seed = seed});
+  VirtualBus bus({.bitrate = can::kBitrate250k, .seed = seed});
   const std::array<NodeHandle, 3> nodes{bus.attach(p0), bus.attach(p1), bus.attach(p2)};
   FaultRule drop;
   drop.rate = 0.05;
@@ -617,7 +622,7 @@ TEST(BusFaults, SameSeedSameRun) {
 // ---------------------------------------------------------------- tap
 
 TEST_F(BusTest, TapSeesEveryCompletedFrameInWireOrderBeforeTheReceivers) {
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_), b = bus.attach(b_);
   bus.attach(listener_);
   std::vector<WireFrame> tapped;
@@ -636,11 +641,11 @@ TEST_F(BusTest, TapSeesEveryCompletedFrameInWireOrderBeforeTheReceivers) {
   // Arbitration order, each stamped with its end of frame and its sender.
   EXPECT_EQ(tapped[0].frame, fb);
   EXPECT_EQ(tapped[0].sender, b);
-  EXPECT_EQ(tapped[0].end, t0 + frame_duration(fb, kBitrate500k));
+  EXPECT_EQ(tapped[0].end, t0 + can::frame_duration(fb, can::kBitrate500k));
   EXPECT_TRUE(tapped[0].acknowledged);
   EXPECT_EQ(tapped[1].frame, fa);
   EXPECT_EQ(tapped[1].sender, a);
-  EXPECT_EQ(tapped[1].end, tapped[0].end + frame_duration(fa, kBitrate500k));
+  EXPECT_EQ(tapped[1].end, tapped[0].end + can::frame_duration(fa, can::kBitrate500k));
   // The same times the receivers are given, and before they are given them.
   EXPECT_EQ(times(listener_.heard()), (std::vector<TimePoint>{tapped[0].end, tapped[1].end}));
   EXPECT_EQ(heard_when_tapped, (std::vector<std::size_t>{0, 1}));
@@ -654,7 +659,7 @@ TEST_F(BusTest, TapSeesEveryCompletedFrameInWireOrderBeforeTheReceivers) {
 }
 
 TEST_F(BusTest, TapSeesUnacknowledgedFramesButNotAbortedOnes) {
-  for (std::uint32_t bitrate : {0u, kBitrate500k}) {
+  for (std::uint32_t bitrate : {0u, can::kBitrate500k}) {
     SCOPED_TRACE(bitrate);
     VirtualBus bus({.bitrate = bitrate});
     const NodeHandle a = bus.attach(a_);
@@ -665,11 +670,11 @@ TEST_F(BusTest, TapSeesUnacknowledgedFramesButNotAbortedOnes) {
     bus.advance(at(seconds(1)));
     ASSERT_EQ(tapped.size(), 1u);
     EXPECT_FALSE(tapped[0].acknowledged);
-    EXPECT_EQ(tapped[0].end, at(milliseconds(1)) + frame_duration(tapped[0].frame, bitrate));
+    EXPECT_EQ(tapped[0].end, at(milliseconds(1)) + can::frame_duration(tapped[0].frame, bitrate));
     EXPECT_EQ(bus.stats().unacknowledged, 1u);
   }
   // Cut off mid-way: never completed, not seen.
-  VirtualBus bus({.bitrate = kBitrate500k});
+  VirtualBus bus({.bitrate = can::kBitrate500k});
   const NodeHandle a = bus.attach(a_);
   bus.attach(listener_);
   std::vector<WireFrame> tapped;

@@ -14,8 +14,8 @@
 #include <map>
 #include <mutex>
 
-#include "adapters/port/sim_backend.hpp"
-#include "adapters/port/threaded_sim_backend.hpp"
+#include "adapters/sim/sim_backend.hpp"
+#include "adapters/sim/threaded_sim_backend.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 
 namespace dnbridge::port {
@@ -89,7 +89,7 @@ class RecordingPublisher final : public PortPublisher {
 // through either way.
 class UnpluggedBackend final : public CanBackend, private can::FrameSink {
  public:
-  explicit UnpluggedBackend(std::unique_ptr<SimBackend> bus) : bus_(std::move(bus)) {}
+  explicit UnpluggedBackend(std::unique_ptr<sim::SimBackend> bus) : bus_(std::move(bus)) {}
   // Any thread.
   void plug_in() {
     plugged_ = true;
@@ -133,7 +133,7 @@ class UnpluggedBackend final : public CanBackend, private can::FrameSink {
     }
   }
 
-  std::unique_ptr<SimBackend> bus_;
+  std::unique_ptr<sim::SimBackend> bus_;
   std::atomic<bool> plugged_{false};
   std::atomic<std::uint64_t> dropped_{0};
 };
@@ -161,8 +161,8 @@ TEST(PortLoop, RunsARackOnItsOwnThread) {
   const std::vector<unsigned> macs{1, 2, 3};
   std::vector<MacId> devices;
   for (unsigned m : macs) devices.push_back(mac(m));
-  PortLoop loop(config_for(macs), std::make_unique<SimBackend>(sim::kBitrate500k, devices), publisher,
-                null_log_sink());
+  PortLoop loop(config_for(macs), std::make_unique<sim::SimBackend>(can::kBitrate500k, devices),
+                publisher, null_log_sink());
   loop.start();
 
   ASSERT_TRUE(publisher.wait_for([&] {
@@ -210,7 +210,7 @@ TEST(PortLoop, RunsARackOnItsOwnThread) {
   // The simulated device really applies what was commanded.
   std::promise<bool> pump_on;
   loop.post([&](CanBackend& b) {
-    pump_on.set_value(static_cast<SimBackend&>(b).device(mac(2)).device().outputs().pump_on);
+    pump_on.set_value(static_cast<sim::SimBackend&>(b).device(mac(2)).device().outputs().pump_on);
   });
   EXPECT_TRUE(pump_on.get_future().get());
 
@@ -228,7 +228,7 @@ TEST(PortLoop, TheExplicitGatewayFollowsTheConfiguredPolicy) {
   PortLoopConfig config = config_for({5});
   config.explicit_policy.allow_output_writes = true;
   PortLoop loop(std::move(config),
-                std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(5)}),
+                std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(5)}),
                 publisher, null_log_sink());
   loop.start();
   ASSERT_TRUE(
@@ -267,7 +267,8 @@ TEST(PortLoop, TheExplicitGatewayFollowsTheConfiguredPolicy) {
 
 TEST(PortLoop, BadCommandsAreRefusedAndReported) {
   RecordingPublisher publisher;
-  PortLoop loop(config_for({4}), std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(4)}),
+  PortLoop loop(config_for({4}),
+                std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(4)}),
                 publisher, null_log_sink());
   loop.start();
   ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps.count(4) && publisher.pumps[4].online; }));
@@ -288,8 +289,8 @@ TEST(PortLoop, RunsOnTheThreadedSimulatedBus) {
   const std::vector<unsigned> macs{1, 2};
   std::vector<MacId> devices;
   for (unsigned m : macs) devices.push_back(mac(m));
-  auto backend = std::make_unique<ThreadedSimBackend>(sim::kBitrate500k, devices);
-  ThreadedSimBackend* world = backend.get();
+  auto backend = std::make_unique<sim::ThreadedSimBackend>(can::kBitrate500k, devices);
+  sim::ThreadedSimBackend* world = backend.get();
   PortLoop loop(config_for(macs), std::move(backend), publisher, null_log_sink());
   loop.start();
 
@@ -343,7 +344,7 @@ TEST(PortLoop, RunsOnTheThreadedSimulatedBus) {
 TEST(PortLoop, AnInterfaceAbsentAtStartEndsTheStartUpChecksAndTheMasterWaitsForIt) {
   RecordingPublisher publisher;
   auto backend = std::make_unique<UnpluggedBackend>(
-      std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(1)}));
+      std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(1)}));
   UnpluggedBackend* interface = backend.get();
   PortLoop loop(config_for({1}), std::move(backend), publisher, null_log_sink());
   EXPECT_FALSE(loop.started_up());
@@ -377,7 +378,7 @@ TEST(PortLoop, AnInterfaceAbsentAtStartEndsTheStartUpChecksAndTheMasterWaitsForI
 TEST(PortLoop, AnInterfaceBackUpMakesTheMasterCheckItsMacAgain) {
   RecordingPublisher publisher;
   auto backend = std::make_unique<UnpluggedBackend>(
-      std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(1)}));
+      std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(1)}));
   UnpluggedBackend* interface = backend.get();
   interface->plug_in();
   PortLoop loop(config_for({1}), std::move(backend), publisher, null_log_sink());
@@ -405,8 +406,8 @@ TEST(PortLoop, AnInterfaceBackUpMakesTheMasterCheckItsMacAgain) {
 TEST(PortLoop, APortWaitingForItsInterfaceStopsAtOnce) {
   RecordingPublisher publisher;
   PortLoop loop(config_for({1}),
-                std::make_unique<UnpluggedBackend>(
-                    std::make_unique<SimBackend>(sim::kBitrate500k, std::vector<MacId>{mac(1)})),
+                std::make_unique<UnpluggedBackend>(std::make_unique<sim::SimBackend>(
+                    can::kBitrate500k, std::vector<MacId>{mac(1)})),
                 publisher, null_log_sink());
   loop.start();
   ASSERT_TRUE(publisher.wait_for([&] { return publisher.port_samples >= 1; }));

@@ -24,6 +24,7 @@
 
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
+#include "adapters/daemon/simulated_backends.hpp"
 #include "adapters/dds/loopback.hpp"
 #include "adapters/security/check.hpp"
 #include "adapters/security/toml_settings.hpp"
@@ -61,7 +62,7 @@ std::string security_table(const security::Settings& s) {
   return t.str();
 }
 
-// `dnbridge --simulate`'s rack on the PKI's domain, as a file, with `security`.
+// `dnbridge-sim --simulate`'s rack on the PKI's domain, as a file, with `security`.
 fs::path write_rack_config(const std::string& name, const std::string& security,
                            int domain = kDomain) {
   std::string text(daemon::embedded_default_config_text());
@@ -151,7 +152,8 @@ class SecureBridgeTest : public ::testing::Test {
   // Started, and every node online as the port reports it (checked every
   // 20 ms, at most 10 s).
   void start_online(daemon::DaemonConfig config = rack_config()) {
-    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), log_);
+    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), log_,
+                                               daemon::simulated_backend_factory(log_));
     bridge_->start();
     auto* port = bridge_->port(e2e::kPort);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
@@ -163,7 +165,7 @@ class SecureBridgeTest : public ::testing::Test {
 
   // What the simulated CDN127 at `mac` drives on its outputs now.
   PumpOutputs device_outputs(unsigned mac) {
-    return e2e::on_sim_port(*bridge_, e2e::kPort, [mac](port::SimBackend& b) {
+    return e2e::on_sim_port(*bridge_, e2e::kPort, [mac](sim::SimBackend& b) {
       return b.device(*devicenet::MacId::from(mac)).device().outputs();
     });
   }

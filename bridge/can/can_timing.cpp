@@ -1,9 +1,9 @@
-#include "adapters/sim/can_timing.hpp"
+#include "bridge/can/can_timing.hpp"
 
 #include <algorithm>
 #include <array>
 
-namespace dnbridge::sim {
+namespace dnbridge::can {
 namespace {
 
 constexpr std::uint16_t kCrcPolynomial = 0x4599;
@@ -34,12 +34,12 @@ class BitString {
   std::size_t size_ = 0;
 };
 
-std::uint8_t data_length(const can::CanFrame& frame) noexcept {
+std::uint8_t data_length(const CanFrame& frame) noexcept {
   return static_cast<std::uint8_t>(std::min<std::size_t>(frame.len, can::kMaxDataLength));
 }
 
 // SOF through the data field: what the CRC covers.
-BitString crc_region(const can::CanFrame& frame) noexcept {
+BitString crc_region(const CanFrame& frame) noexcept {
   BitString s;
   const std::uint8_t n = data_length(frame);
   s.push(0, 1);                                // SOF, dominant
@@ -66,9 +66,9 @@ std::uint16_t crc15(Bytes bytes) noexcept {
   return crc;
 }
 
-std::uint16_t frame_crc(const can::CanFrame& frame) noexcept { return crc_of(crc_region(frame)); }
+std::uint16_t frame_crc(const CanFrame& frame) noexcept { return crc_of(crc_region(frame)); }
 
-std::uint32_t stuff_bits(const can::CanFrame& frame) noexcept {
+std::uint32_t stuff_bits(const CanFrame& frame) noexcept {
   BitString s = crc_region(frame);
   s.push(crc_of(s), 15);
   // After five equal bits the transmitter inserts their complement; that bit
@@ -95,7 +95,7 @@ std::uint32_t stuff_bits(const can::CanFrame& frame) noexcept {
   return inserted;
 }
 
-std::uint32_t frame_bits(const can::CanFrame& frame) noexcept {
+std::uint32_t frame_bits(const CanFrame& frame) noexcept {
   const std::uint32_t n = data_length(frame);
   return 1 + 11 + 3 + 4 + 8 * n + 15 + stuff_bits(frame) + kTailBits;
 }
@@ -106,8 +106,8 @@ Duration bits_duration(std::uint64_t bits, std::uint32_t bitrate) noexcept {
   return Duration(static_cast<Duration::rep>((bits * kNanosPerSecond + bitrate - 1) / bitrate));
 }
 
-Duration frame_duration(const can::CanFrame& frame, std::uint32_t bitrate) noexcept {
+Duration frame_duration(const CanFrame& frame, std::uint32_t bitrate) noexcept {
   return bits_duration(frame_bits(frame), bitrate);
 }
 
-}  // namespace dnbridge::sim
+}  // namespace dnbridge::can

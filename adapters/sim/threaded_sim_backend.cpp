@@ -1,4 +1,4 @@
-#include "adapters/port/threaded_sim_backend.hpp"
+#include "adapters/sim/threaded_sim_backend.hpp"
 
 #include <fmt/format.h>
 #include <pthread.h>
@@ -12,25 +12,25 @@
 #include "adapters/port/thread_name.hpp"
 #include "adapters/sim/sim_rack.hpp"
 
-namespace dnbridge::port {
+namespace dnbridge::sim {
 
 ThreadedSimBackend::ThreadedSimBackend(std::uint32_t bitrate,
                                        const std::vector<devicenet::MacId>& device_macs,
                                        LogSink* log)
     : bitrate_(bitrate),
-      world_(sim::BusConfig{bitrate}, steady_now()),
+      world_(BusConfig{bitrate}, port::steady_now()),
       handle_(world_.bus().attach(master_port_)) {
   for (auto mac : device_macs) {
     Logger device_log = log ? Logger(*log, fmt::format("sim {}", mac.value())) : Logger();
-    devices_[mac.value()] = std::make_unique<sim::SimSlave>(world_, sim::default_slave_options(mac),
-                                                            world_.now(), std::move(device_log));
+    devices_[mac.value()] = std::make_unique<SimSlave>(world_, sim::default_slave_options(mac),
+                                                       world_.now(), std::move(device_log));
   }
   to_world_.reserve(64);
   to_port_.reserve(64);
   receiving_.reserve(64);
   delivered_.reserve(64);
   thread_ = std::thread([this] { run(); });
-  name_thread(thread_, "sim bus");
+  port::name_thread(thread_, "sim bus");
   if (pthread_getcpuclockid(thread_.native_handle(), &sim_clock_) != 0) sim_clock_ = -1;
 }
 
@@ -44,9 +44,9 @@ ThreadedSimBackend::~ThreadedSimBackend() {
   (void)world_.bus().detach(handle_);
 }
 
-TimePoint ThreadedSimBackend::now() const { return steady_now(); }
+TimePoint ThreadedSimBackend::now() const { return port::steady_now(); }
 
-sim::SimSlave& ThreadedSimBackend::device(devicenet::MacId mac) {
+SimSlave& ThreadedSimBackend::device(devicenet::MacId mac) {
   auto it = devices_.find(mac.value());
   if (it == devices_.end())
     throw std::out_of_range(fmt::format("no simulated device {}", mac.value()));
@@ -77,7 +77,7 @@ void ThreadedSimBackend::hand_over() {
   if (delivered_.empty()) return;
   // Stamped when handed over: the master cannot have had the frame earlier,
   // even when this thread was late for its simulated end of frame.
-  const TimePoint handed = steady_now();
+  const TimePoint handed = port::steady_now();
   {
     std::lock_guard lock(port_mutex_);
     for (const auto& [frame, end] : delivered_) to_port_.emplace_back(frame, std::max(end, handed));
@@ -111,7 +111,7 @@ void ThreadedSimBackend::run() {
       world_.bus().send(handle_, frame, at);
     }
     sending.clear();
-    world_.run_until(std::max(world_.now(), steady_now()));
+    world_.run_until(std::max(world_.now(), port::steady_now()));
     frames_.store(world_.bus().stats().transmitted, std::memory_order_relaxed);
     bits_.store(world_.bus().stats().bits, std::memory_order_relaxed);
     hand_over();
@@ -122,13 +122,13 @@ void ThreadedSimBackend::run() {
     if (stop_ || !to_world_.empty() || !posted_.empty()) continue;
     if (next == kNever) {
       world_woken_.wait(lock);
-    } else if (next > steady_now()) {
-      world_woken_.wait_until(lock, to_steady(next));
+    } else if (next > port::steady_now()) {
+      world_woken_.wait_until(lock, port::to_steady(next));
     }
   }
 }
 
-void ThreadedSimBackend::wait(TimePoint deadline, FrameReceiver& receiver) {
+void ThreadedSimBackend::wait(TimePoint deadline, port::FrameReceiver& receiver) {
   // Frames the world has not taken yet: wake it for them.
   bool queued = false;
   {
@@ -142,7 +142,7 @@ void ThreadedSimBackend::wait(TimePoint deadline, FrameReceiver& receiver) {
     if (deadline == kNever) {
       port_woken_.wait(lock, ready);
     } else {
-      port_woken_.wait_until(lock, to_steady(deadline), ready);
+      port_woken_.wait_until(lock, port::to_steady(deadline), ready);
     }
     wake_ = false;
     receiving_.swap(to_port_);
@@ -159,9 +159,9 @@ void ThreadedSimBackend::wake() {
   port_woken_.notify_one();
 }
 
-BusCounters ThreadedSimBackend::counters() const {
-  BusCounters c;
-  c.state = BusState::kErrorActive;  // the simulated bus has no error confinement
+port::BusCounters ThreadedSimBackend::counters() const {
+  port::BusCounters c;
+  c.state = port::BusState::kErrorActive;  // the simulated bus has no error confinement
   c.frames = frames_.load(std::memory_order_relaxed);
   c.bits = bits_.load(std::memory_order_relaxed);
   return c;
@@ -173,4 +173,4 @@ Duration ThreadedSimBackend::sim_thread_cpu_time() const {
   return seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
 }
 
-}  // namespace dnbridge::port
+}  // namespace dnbridge::sim

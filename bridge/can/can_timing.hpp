@@ -8,7 +8,7 @@
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
 
-namespace dnbridge::sim {
+namespace dnbridge::can {
 
 // DeviceNet's three bit rates (devicenet-facts §8; DeviceNet Object attribute 2).
 inline constexpr std::uint32_t kBitrate125k = 125000;
@@ -27,19 +27,19 @@ std::uint16_t crc15(Bytes bytes) noexcept;
 
 // The CRC sequence of a data frame, computed over SOF, identifier, RTR, IDE,
 // r0, DLC and data. A len over 8 is treated as 8.
-std::uint16_t frame_crc(const can::CanFrame& frame) noexcept;
+std::uint16_t frame_crc(const CanFrame& frame) noexcept;
 
 // Stuff bits the transmitter inserts between SOF and the end of the CRC.
-std::uint32_t stuff_bits(const can::CanFrame& frame) noexcept;
+std::uint32_t stuff_bits(const CanFrame& frame) noexcept;
 
 // Exact length in bits: SOF..CRC with stuffing, then CRC delimiter, ACK slot,
 // ACK delimiter, 7 bits EOF and 3 bits intermission.
-std::uint32_t frame_bits(const can::CanFrame& frame) noexcept;
+std::uint32_t frame_bits(const CanFrame& frame) noexcept;
 
 // frame_bits at `bitrate` bit/s, rounded up to the nanosecond. bitrate 0 gives 0.
-Duration frame_duration(const can::CanFrame& frame, std::uint32_t bitrate) noexcept;
+Duration frame_duration(const CanFrame& frame, std::uint32_t bitrate) noexcept;
 
 // The time `bits` bit times take at `bitrate`, rounded up to the nanosecond.
 Duration bits_duration(std::uint64_t bits, std::uint32_t bitrate) noexcept;
 
-}  // namespace dnbridge::sim
+}  // namespace dnbridge::can

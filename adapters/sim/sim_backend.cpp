@@ -1,4 +1,4 @@
-#include "adapters/port/sim_backend.hpp"
+#include "adapters/sim/sim_backend.hpp"
 
 #include <fmt/format.h>
 
@@ -8,23 +8,23 @@
 #include "adapters/port/steady_time.hpp"
 #include "adapters/sim/sim_rack.hpp"
 
-namespace dnbridge::port {
+namespace dnbridge::sim {
 
 SimBackend::SimBackend(std::uint32_t bitrate, const std::vector<devicenet::MacId>& device_macs,
                        LogSink* log)
-    : world_(sim::BusConfig{bitrate}, steady_now()), handle_(world_.bus().attach(*this)) {
+    : world_(BusConfig{bitrate}, port::steady_now()), handle_(world_.bus().attach(*this)) {
   for (auto mac : device_macs) {
     Logger device_log = log ? Logger(*log, fmt::format("sim {}", mac.value())) : Logger();
-    devices_[mac.value()] = std::make_unique<sim::SimSlave>(world_, sim::default_slave_options(mac),
-                                                            world_.now(), std::move(device_log));
+    devices_[mac.value()] = std::make_unique<SimSlave>(world_, sim::default_slave_options(mac),
+                                                       world_.now(), std::move(device_log));
   }
 }
 
 SimBackend::~SimBackend() { (void)world_.bus().detach(handle_); }
 
-TimePoint SimBackend::now() const { return steady_now(); }
+TimePoint SimBackend::now() const { return port::steady_now(); }
 
-sim::SimSlave& SimBackend::device(devicenet::MacId mac) {
+SimSlave& SimBackend::device(devicenet::MacId mac) {
   auto it = devices_.find(mac.value());
   if (it == devices_.end())
     throw std::out_of_range(fmt::format("no simulated device {}", mac.value()));
@@ -35,7 +35,7 @@ void SimBackend::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
   received_.emplace_back(frame, rx_time);
 }
 
-void SimBackend::wait(TimePoint deadline, FrameReceiver& receiver) {
+void SimBackend::wait(TimePoint deadline, port::FrameReceiver& receiver) {
   for (;;) {
     // Bring the simulated world up to the real time; what it sends the
     // master is handed over with its simulated receive time.
@@ -56,7 +56,7 @@ void SimBackend::wait(TimePoint deadline, FrameReceiver& receiver) {
       return;
     }
     if (now() >= deadline) return;
-    woken_.wait_until(lock, to_steady(until), [&] { return wake_; });
+    woken_.wait_until(lock, port::to_steady(until), [&] { return wake_; });
     if (wake_) {
       wake_ = false;
       return;
@@ -72,12 +72,12 @@ void SimBackend::wake() {
   woken_.notify_one();
 }
 
-BusCounters SimBackend::counters() const {
-  BusCounters c;
-  c.state = BusState::kErrorActive;  // the simulated bus has no error confinement
+port::BusCounters SimBackend::counters() const {
+  port::BusCounters c;
+  c.state = port::BusState::kErrorActive;  // the simulated bus has no error confinement
   c.frames = world_.bus().stats().transmitted;
   c.bits = world_.bus().stats().bits;
   return c;
 }
 
-}  // namespace dnbridge::port
+}  // namespace dnbridge::sim

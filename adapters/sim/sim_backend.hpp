@@ -14,9 +14,9 @@
 #include "adapters/sim/sim_slave.hpp"
 #include "adapters/sim/sim_world.hpp"
 
-namespace dnbridge::port {
+namespace dnbridge::sim {
 
-class SimBackend final : public CanBackend, private sim::BusPort {
+class SimBackend final : public port::CanBackend, private BusPort {
  public:
   // A simulated bus at `bitrate` with a CDN127 at each of `device_macs`,
   // powered on now.
@@ -26,22 +26,22 @@ class SimBackend final : public CanBackend, private sim::BusPort {
 
   can::FrameSink& sink() override { return world_.bus().sink(handle_); }
   TimePoint now() const override;
-  void wait(TimePoint deadline, FrameReceiver& receiver) override;
+  void wait(TimePoint deadline, port::FrameReceiver& receiver) override;
   void wake() override;
-  BusCounters counters() const override;
+  port::BusCounters counters() const override;
   std::string interface_name() const override { return "simulated"; }
   std::uint32_t bitrate() const override { return world_.bus().bitrate(); }
 
   // The simulated devices, for tests and demonstrations (port thread only).
-  sim::SimWorld& world() { return world_; }
-  sim::SimSlave& device(devicenet::MacId mac);
+  SimWorld& world() { return world_; }
+  SimSlave& device(devicenet::MacId mac);
 
  private:
   void on_frame(const can::CanFrame& frame, TimePoint rx_time) override;
 
-  sim::SimWorld world_;
-  sim::NodeHandle handle_;
-  std::map<unsigned, std::unique_ptr<sim::SimSlave>> devices_;
+  SimWorld world_;
+  NodeHandle handle_;
+  std::map<unsigned, std::unique_ptr<SimSlave>> devices_;
   std::deque<std::pair<can::CanFrame, TimePoint>> received_;
 
   std::mutex mutex_;
@@ -49,4 +49,4 @@ class SimBackend final : public CanBackend, private sim::BusPort {
   bool wake_ = false;
 };
 
-}  // namespace dnbridge::port
+}  // namespace dnbridge::sim

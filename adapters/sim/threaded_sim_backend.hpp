@@ -26,11 +26,11 @@
 #include "adapters/sim/sim_slave.hpp"
 #include "adapters/sim/sim_world.hpp"
 
-namespace dnbridge::port {
+namespace dnbridge::sim {
 
-class ThreadedSimBackend final : public CanBackend {
+class ThreadedSimBackend final : public port::CanBackend {
  public:
-  // A simulated bus at `bitrate` (0: ideal, see sim::BusConfig) with a CDN127
+  // A simulated bus at `bitrate` (0: ideal, see BusConfig) with a CDN127
   // at each of `device_macs`, powered on now; the world's thread starts here.
   ThreadedSimBackend(std::uint32_t bitrate, const std::vector<devicenet::MacId>& device_macs,
                      LogSink* log = nullptr);
@@ -40,9 +40,9 @@ class ThreadedSimBackend final : public CanBackend {
 
   can::FrameSink& sink() override { return sink_; }
   TimePoint now() const override;
-  void wait(TimePoint deadline, FrameReceiver& receiver) override;
+  void wait(TimePoint deadline, port::FrameReceiver& receiver) override;
   void wake() override;
-  BusCounters counters() const override;
+  port::BusCounters counters() const override;
   std::string interface_name() const override { return "simulated"; }
   std::uint32_t bitrate() const override { return bitrate_; }
 
@@ -50,8 +50,8 @@ class ThreadedSimBackend final : public CanBackend {
   void post(std::function<void()> fn);
   // The simulated devices and the world: on the world's thread only (from a
   // posted function or a bus tap).
-  sim::SimWorld& world() { return world_; }
-  sim::SimSlave& device(devicenet::MacId mac);
+  SimWorld& world() { return world_; }
+  SimSlave& device(devicenet::MacId mac);
 
   // CPU time the world's thread has used so far. Any thread.
   Duration sim_thread_cpu_time() const;
@@ -67,7 +67,7 @@ class ThreadedSimBackend final : public CanBackend {
     ThreadedSimBackend& owner_;
   };
   // The master's node on the bus: what the world delivers to it.
-  class MasterPort final : public sim::BusPort {
+  class MasterPort final : public BusPort {
    public:
     explicit MasterPort(ThreadedSimBackend& owner) : owner_(owner) {}
     void on_frame(const can::CanFrame& frame, TimePoint rx_time) override;
@@ -80,11 +80,11 @@ class ThreadedSimBackend final : public CanBackend {
   void hand_over();  // frames the world delivered to the master, to the port
 
   const std::uint32_t bitrate_;
-  sim::SimWorld world_;
+  SimWorld world_;
   MasterSink sink_{*this};
   MasterPort master_port_{*this};
-  sim::NodeHandle handle_;
-  std::map<unsigned, std::unique_ptr<sim::SimSlave>> devices_;
+  NodeHandle handle_;
+  std::map<unsigned, std::unique_ptr<SimSlave>> devices_;
   std::vector<std::pair<can::CanFrame, TimePoint>> delivered_;  // world's thread only
 
   // Port -> world.
@@ -108,4 +108,4 @@ class ThreadedSimBackend final : public CanBackend {
   clockid_t sim_clock_ = -1;  // the world's thread's CPU-time clock
 };
 
-}  // namespace dnbridge::port
+}  // namespace dnbridge::sim

@@ -1,4 +1,4 @@
-#include "adapters/sim/can_timing.hpp"
+#include "bridge/can/can_timing.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 
 #include "support/bytes.hpp"
 
-namespace dnbridge::sim {
+namespace dnbridge::can {
 namespace {
 
 using test::frame;
@@ -152,4 +152,4 @@ TEST(CanTiming, OversizedLengthCountsAsEightBytes) {
 }
 
 }  // namespace
-}  // namespace dnbridge::sim
+}  // namespace dnbridge::can

@@ -1,0 +1,19 @@
+#include "adapters/daemon/simulated_backends.hpp"
+
+#include <vector>
+
+#include "adapters/sim/sim_backend.hpp"
+
+namespace dnbridge::daemon {
+
+BackendFactory simulated_backend_factory(LogSink& log) {
+  return [&log, others = default_backend_factory(log)](
+             const PortConfig& p) -> std::unique_ptr<port::CanBackend> {
+    if (p.interface != kSimulatedInterface) return others(p);
+    std::vector<devicenet::MacId> macs;
+    for (const auto& n : p.nodes) macs.push_back(n.mac);
+    return std::make_unique<sim::SimBackend>(p.bitrate, macs, &log);
+  };
+}
+
+}  // namespace dnbridge::daemon

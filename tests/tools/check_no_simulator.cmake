@@ -1,0 +1,20 @@
+# The production dnbridge links no simulator code: no symbol of namespace
+# dnbridge::sim in it (dnbridge-sim has them all).
+#   cmake -DBINARY=path/to/dnbridge -DNM=nm -P check_no_simulator.cmake
+execute_process(COMMAND ${NM} -C ${BINARY} OUTPUT_VARIABLE symbols RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${NM} ${BINARY} failed (${rc})")
+endif()
+string(REGEX MATCHALL "[^\n]*dnbridge::sim::[^\n]*" found "${symbols}")
+list(LENGTH found count)
+if(count GREATER 0)
+  list(SUBLIST found 0 5 first)
+  string(REPLACE ";" "\n" first "${first}")
+  message(FATAL_ERROR "${BINARY} carries ${count} simulator symbol(s), e.g.\n${first}")
+endif()
+string(REGEX MATCHALL "[^\n]*dnbridge::daemon::[^\n]*" daemon "${symbols}")
+list(LENGTH daemon daemon_count)
+if(daemon_count EQUAL 0)
+  message(FATAL_ERROR "${BINARY} has no dnbridge::daemon symbol: not the bridge, or stripped")
+endif()
+message(STATUS "${BINARY}: no simulator symbol (${daemon_count} of the daemon's)")
