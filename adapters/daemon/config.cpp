@@ -196,7 +196,7 @@ std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Reporte
 constexpr std::string_view kProfileCdn127 = "cdn127";
 
 // Every key of a node; [defaults] takes all but mac and name.
-constexpr std::array<std::string_view, 23> kNodeKeys{"mac",
+constexpr std::array<std::string_view, 24> kNodeKeys{"mac",
                                                      "name",
                                                      "serial",
                                                      "profile",
@@ -206,6 +206,7 @@ constexpr std::array<std::string_view, 23> kNodeKeys{"mac",
                                                      "expected_packet_rate_ms",
                                                      "explicit_packet_rate_ms",
                                                      "immediate_poll",
+                                                     "immediate_poll_min_gap_ms",
                                                      "publish_max_period_ms",
                                                      "analog_deadband_volts",
                                                      "no_commander",
@@ -605,6 +606,28 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
   }
   if (Found f = layers.find("immediate_poll"); f.value) {
     if (auto v = read_bool(*f.value, "immediate_poll", r)) s.immediate_poll_on_change = *v;
+  }
+  if (const Found gap = layers.find("immediate_poll_min_gap_ms"); gap.value) {
+    if (auto v = read_ms(*gap.value, "immediate_poll_min_gap_ms", 0, kMaxPacketRateMs, r)) {
+      s.immediate_poll_min_gap = *v;
+      // Longer than the poll period it would only hold back changes the
+      // node's next slot carries anyway: a mistake, not a setting.
+      if (per_node && poll_ok && *v > s.poll_period) {
+        const bool at_gap = gap.level >= poll.level;
+        const Found& here = at_gap ? gap : poll;
+        r.error(at(here.value->source()),
+                fmt::format("immediate_poll_min_gap_ms = {}{} is longer than poll_period_ms = "
+                            "{}{}: polls for changed outputs may be held back at most a poll "
+                            "period",
+                            std::chrono::duration_cast<milliseconds>(*v).count(),
+                            at_gap ? std::string() : origin(gap),
+                            std::chrono::duration_cast<milliseconds>(s.poll_period).count(),
+                            at_gap ? origin(poll) : std::string()));
+      }
+    }
+  } else if (per_node && poll_ok) {
+    // The built-in gap, for a node polled faster than it: the poll period.
+    s.immediate_poll_min_gap = std::min(s.immediate_poll_min_gap, s.poll_period);
   }
   if (Found f = layers.find("publish_max_period_ms"); f.value) {
     if (auto v = read_ms(*f.value, "publish_max_period_ms", 1, kMaxPublishPeriodMs, r)) {
@@ -1040,6 +1063,7 @@ rack::PumpConfig to_pump_config(const NodeSettings& node) {
   p.node.expected_packet_rate = node.expected_packet_rate;
   p.node.explicit_packet_rate = node.explicit_packet_rate;
   p.node.immediate_poll_on_change = node.immediate_poll_on_change;
+  p.node.immediate_poll_min_gap = node.immediate_poll_min_gap;
   p.node.serial_number = node.serial_number;
   p.node.explicit_response_timeout = node.explicit_response_timeout;
   p.node.poll_response_timeout = node.poll_response_timeout;

@@ -44,6 +44,8 @@ struct NodeSettings {
   Duration expected_packet_rate = devicenet::NodeConfig{}.expected_packet_rate;
   Duration explicit_packet_rate = devicenet::NodeConfig{}.explicit_packet_rate;
   bool immediate_poll_on_change = devicenet::NodeConfig{}.immediate_poll_on_change;
+  // At most the poll period; the built-in value is cut to a shorter one.
+  Duration immediate_poll_min_gap = devicenet::NodeConfig{}.immediate_poll_min_gap;
   PublishPolicy publish;
   NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
   // The outputs' fault and idle actions downloaded at start-up (off, 0 V), or

@@ -89,6 +89,7 @@ Duration Node::next_backoff() {
 
 void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
   next_poll_ = kNever;
+  deferred_poll_ = kNever;
   poll_deadline_ = kNever;
   keepalive_at_ = kNever;
   poll_outstanding_ = false;
@@ -125,6 +126,10 @@ void Node::begin_shutdown(TimePoint now) {
   if (state_ == NodeState::kOnline) {
     // Outputs to the device's own idle state first: one idle poll (after the
     // one outstanding, if any); the Release follows its answer or timeout.
+    // The minimum gap of polls for changed outputs does not hold it back: it
+    // is one poll per node, so it cannot flood the bus, and a delay would
+    // only leave the device in its commanded state longer. It supersedes a
+    // poll held back by the gap (shutdown stops the node's timers).
     idle_ = true;
     outputs_dirty_ = true;
     if (!poll_outstanding_) send_poll(now);
@@ -147,6 +152,7 @@ void Node::release_for_shutdown(TimePoint now) {
 void Node::forget_connections(Errc why, TimePoint now) {
   retry_at_ = kNever;
   next_poll_ = kNever;
+  deferred_poll_ = kNever;
   poll_deadline_ = kNever;
   keepalive_at_ = kNever;
   poll_outstanding_ = false;
@@ -218,6 +224,16 @@ void Node::on_timer(TimePoint now) {
     next_poll_ = next_poll_slot(now + Duration(1));
     if (!poll_outstanding_) send_poll(now);
   }
+  if (now >= deferred_poll_) {
+    // The end of the minimum gap after the last poll for changed outputs. A
+    // poll outstanding now (none should be: any poll sent clears this) leaves
+    // the changes to its response, as without the gap.
+    deferred_poll_ = kNever;
+    if (outputs_dirty_ && !poll_outstanding_) {
+      last_change_poll_ = now;
+      send_poll(now);
+    }
+  }
   if (now >= keepalive_at_) {
     keepalive_at_ = now + explicit_epr_;
     // The keep-alive reads the device's health: Identity.Status (fault bits)
@@ -240,7 +256,7 @@ TimePoint Node::deadline() const {
   if (shutting_down_) return t;
   t = std::min(t, retry_at_);
   if (state_ == NodeState::kOnline) {
-    t = std::min({t, next_poll_, keepalive_at_, last_response_ + 4 * poll_epr_});
+    t = std::min({t, next_poll_, deferred_poll_, keepalive_at_, last_response_ + 4 * poll_epr_});
   }
   return t;
 }

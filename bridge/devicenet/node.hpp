@@ -227,6 +227,9 @@ class Node final : private ExplicitClient::Listener {
   Duration next_backoff();
 
   void send_poll(TimePoint now);
+  // The poll for outputs that changed: now, or at the end of the minimum gap
+  // after the last one (NodeConfig::immediate_poll_min_gap).
+  void poll_on_change(TimePoint now);
   void accept_poll_response(Bytes data, TimePoint now);
   void bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now);
   TimePoint next_poll_slot(TimePoint after) const;
@@ -295,6 +298,10 @@ class Node final : private ExplicitClient::Listener {
   bool poll_outstanding_ = false;
   bool poll_unanswered_ = false;  // the last poll timed out: the next is a retry
   bool outputs_dirty_ = false;
+  // The last poll sent early because the outputs changed, and the time of the
+  // one held back until the minimum gap after it has elapsed (kNever: none).
+  TimePoint last_change_poll_ = TimePoint::min();
+  TimePoint deferred_poll_ = kNever;
   bool idle_ = true;  // no outputs until the layer above sets them
   unsigned consecutive_errors_ = 0;
   TimePoint last_explicit_answer_{};  // last explicit response, error or not

@@ -61,10 +61,27 @@ void Node::send_poll(TimePoint now) {
   sent_idle_ = idle;
   sent_outputs_ = outputs_;
   outputs_dirty_ = false;
+  deferred_poll_ = kNever;  // whatever poll goes out carries the latest outputs
   poll_outstanding_ = true;
   poll_deadline_ =
       now + std::min(config_.poll_response_timeout.value_or(port_.poll_response_timeout),
                      config_.poll_period);
+}
+
+void Node::poll_on_change(TimePoint now) {
+  // A command flood would otherwise poll the node as fast as the bus allows
+  // and take the bus from every other node; a change that comes alone still
+  // goes out at once.
+  const TimePoint earliest = last_change_poll_ + config_.immediate_poll_min_gap;
+  if (now >= earliest) {
+    last_change_poll_ = now;
+    send_poll(now);
+    return;
+  }
+  // One poll at the end of the gap carries every change made meanwhile; the
+  // node's slot, if it comes first, carries them instead (send_poll clears
+  // deferred_poll_), so no change waits longer than it did without the gap.
+  deferred_poll_ = earliest;
 }
 
 void Node::on_poll_response(Bytes payload, TimePoint now) {
@@ -142,7 +159,7 @@ void Node::accept_poll_response(Bytes data, TimePoint now) {
     }
     return;
   }
-  if (outputs_dirty_ && config_.immediate_poll_on_change) send_poll(now);
+  if (outputs_dirty_ && config_.immediate_poll_on_change) poll_on_change(now);
 }
 
 void Node::bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now) {
@@ -168,7 +185,7 @@ Status Node::set_outputs(Bytes data, TimePoint now) {
   if (!changed) return {};
   outputs_dirty_ = true;
   if (state_ == NodeState::kOnline && config_.immediate_poll_on_change && !poll_outstanding_) {
-    send_poll(now);
+    poll_on_change(now);
   }
   return {};
 }
@@ -178,7 +195,7 @@ void Node::set_idle(bool idle, TimePoint now) {
   idle_ = idle;
   outputs_dirty_ = true;
   if (state_ == NodeState::kOnline && config_.immediate_poll_on_change && !poll_outstanding_) {
-    send_poll(now);
+    poll_on_change(now);
   }
 }
 

@@ -33,6 +33,10 @@ void validate(const ScannerConfig& c) {
     if (n.poll_period <= Duration::zero()) {
       throw std::invalid_argument(fmt::format("node {}: poll period must be positive", mac));
     }
+    if (n.immediate_poll_min_gap < Duration::zero()) {
+      throw std::invalid_argument(
+          fmt::format("node {}: immediate poll minimum gap must not be negative", mac));
+    }
     if (n.expected_packet_rate < n.poll_period) {
       throw std::invalid_argument(
           fmt::format("node {}: expected packet rate shorter than the poll period", mac));

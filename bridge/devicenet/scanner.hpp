@@ -37,7 +37,8 @@ class Scanner {
  public:
   // Throws std::invalid_argument for a scan list that cannot work (duplicate
   // or out-of-range MACs, the master's MAC in it, periods of zero, EPR shorter
-  // than the poll period, a poll message over Node::kMaxIoSize).
+  // than the poll period, a poll message over Node::kMaxIoSize, a negative
+  // immediate poll gap).
   Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& observer, Logger log);
   Scanner(const Scanner&) = delete;
   Scanner& operator=(const Scanner&) = delete;

@@ -50,7 +50,8 @@ class ScannerObserver {
                              const std::string& /*reason*/, TimePoint /*at*/) {}
   virtual void on_node_identity(MacId /*mac*/, const NodeIdentity& /*identity*/, TimePoint /*at*/) {
   }
-  // A poll response of the expected size; `rx_time` is the CAN receive time.
+  // A poll response of the expected size, or empty: an idle poll answered
+  // with no data (Node::applied_idle()); `rx_time` is the CAN receive time.
   virtual void on_poll_response(MacId /*mac*/, Bytes /*data*/, TimePoint /*rx_time*/) {}
   // Identity object State (attribute 8) read by the keep-alive, when it changes.
   virtual void on_device_state(MacId /*mac*/, std::uint8_t /*state*/, TimePoint /*at*/) {}

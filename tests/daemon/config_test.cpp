@@ -538,6 +538,94 @@ TEST(ConfigErrors, ExpectedPacketRateShorterThanThePollPeriod) {
             "(none)");
 }
 
+TEST(ConfigFile, ImmediatePollMinGapFromDefaultsNodesAndTheBuiltInValue) {
+  const DaemonConfig c = parse_config(
+      "rack = \"r\"\n"
+      "[defaults]\n"
+      "immediate_poll_min_gap_ms = 20\n"
+      "[[port]]\n"
+      "name = \"A\"\n"
+      "interface = \"simulated\"\n"
+      "bitrate = 500000\n"
+      "[[port.node]]\n"
+      "mac = 1\n"
+      "name = \"inherits\"\n"
+      "[[port.node]]\n"
+      "mac = 2\n"
+      "name = \"every change at once\"\n"
+      "immediate_poll_min_gap_ms = 0\n"
+      "[[port.node]]\n"
+      "mac = 3\n"
+      "name = \"a poll period\"\n"
+      "poll_period_ms = 50\n"
+      "immediate_poll_min_gap_ms = 50\n",
+      "t.toml");
+  const auto& nodes = c.ports.at(0).nodes;
+  ASSERT_EQ(nodes.size(), 3u);
+  EXPECT_EQ(nodes[0].immediate_poll_min_gap, milliseconds(20));
+  EXPECT_EQ(nodes[1].immediate_poll_min_gap, Duration::zero());
+  EXPECT_EQ(nodes[2].immediate_poll_min_gap, milliseconds(50));
+  EXPECT_EQ(to_pump_config(nodes[0]).node.immediate_poll_min_gap, milliseconds(20));
+
+  // Not given: the built-in 10 ms, or the poll period where that is shorter.
+  const DaemonConfig d = parse_config(ONE_PORT
+                                      "[[port.node]]\n"
+                                      "mac = 1\n"
+                                      "name = \"p\"\n"
+                                      "[[port.node]]\n"
+                                      "mac = 2\n"
+                                      "name = \"q\"\n"
+                                      "poll_period_ms = 4\n",
+                                      "t.toml");
+  EXPECT_EQ(d.ports.at(0).nodes.at(0).immediate_poll_min_gap,
+            devicenet::NodeConfig{}.immediate_poll_min_gap);
+  EXPECT_EQ(devicenet::NodeConfig{}.immediate_poll_min_gap, milliseconds(10));
+  EXPECT_EQ(d.ports.at(0).nodes.at(1).immediate_poll_min_gap, milliseconds(4));
+}
+
+TEST(ConfigErrors, ImmediatePollMinGapNegativeOrLongerThanThePollPeriod) {
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "immediate_poll_min_gap_ms = -1\n"),
+            "t.toml:9:29: immediate_poll_min_gap_ms = -1 is out of range (0..65535 ms)");
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "poll_period_ms = 100\n"
+                              "immediate_poll_min_gap_ms = 150\n"),
+            "t.toml:10:29: immediate_poll_min_gap_ms = 150 is longer than poll_period_ms = 100: "
+            "polls for changed outputs may be held back at most a poll period");
+  // Against the built-in poll period (100 ms).
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "immediate_poll_min_gap_ms = 101\n"),
+            "t.toml:9:29: immediate_poll_min_gap_ms = 101 is longer than poll_period_ms = 100 "
+            "(the default): polls for changed outputs may be held back at most a poll period");
+  // The gap from [defaults], a node's shorter period: at the period.
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "[defaults]\n"
+                     "immediate_poll_min_gap_ms = 20\n"
+                     "[[port]]\n"
+                     "name = \"A\"\n"
+                     "interface = \"simulated\"\n"
+                     "bitrate = 500000\n"
+                     "[[port.node]]\n"
+                     "mac = 1\n"
+                     "name = \"p\"\n"
+                     "poll_period_ms = 10\n"),
+            "t.toml:11:18: immediate_poll_min_gap_ms = 20 (from [defaults], line 3) is longer "
+            "than poll_period_ms = 10: polls for changed outputs may be held back at most a poll "
+            "period");
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "immediate_poll_min_gap_ms = 2.5\n"),
+            "t.toml:9:29: immediate_poll_min_gap_ms must be an integer, not a floating-point "
+            "number");
+}
+
 TEST(ConfigErrors, ProblemInDefaultsIsReportedOnceForAllNodes) {
   EXPECT_EQ(problems("rack = \"r\"\n"
                      "[defaults]\n"

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <vector>
 
 namespace dnbridge::devicenet {
@@ -91,6 +92,16 @@ TEST(Scanner, ABusBackDuringTheMacCheckStartsTheCheckAgain) {
   EXPECT_EQ(scanner.state(), PortState::kRunning);
   EXPECT_EQ(now - again, seconds(2)) << "two windows from the new check";
   EXPECT_EQ(sink.checks.size(), 3u);
+}
+
+TEST(Scanner, ANegativeImmediatePollGapIsRefused) {
+  DiscardSink sink;
+  StateTimes observer;
+  ScannerConfig config = three_nodes();
+  config.nodes[1].immediate_poll_min_gap = -milliseconds(1);
+  EXPECT_THROW(Scanner(config, sink, observer, Logger()), std::invalid_argument);
+  config.nodes[1].immediate_poll_min_gap = Duration::zero();  // every change polled at once
+  EXPECT_NO_THROW(Scanner(config, sink, observer, Logger()));
 }
 
 }  // namespace
