@@ -16,7 +16,7 @@ namespace alloc = devicenet::allocation;
 
 namespace {
 
-// Allocate/Release additional codes (devicenet-facts §2).
+// Allocate/Release additional codes (bridge/PROTOCOL.md §3).
 constexpr std::uint8_t kAllocationConflict = 0x01;
 constexpr std::uint8_t kInvalidChoice = 0x02;
 
@@ -238,7 +238,7 @@ Reply Cdn127Device::set_expected_packet_rate(std::uint16_t instance, std::uint16
   actual = round_rate(requested_ms);
   c->expected_packet_rate_ms = actual;
   // Setting the rate is what moves a Configuring I/O connection to
-  // Established (devicenet-facts §5).
+  // Established (bridge/PROTOCOL.md §7).
   if (c->state == ConnectionState::kConfiguring) {
     c->state = ConnectionState::kEstablished;
     poll_running_ = false;
@@ -571,7 +571,7 @@ void Cdn127Device::release_if_nothing_established() noexcept {
     return;
   }
   // With nothing left established the slave drops the whole set; the master
-  // must allocate again (devicenet-facts §5).
+  // must allocate again (bridge/PROTOCOL.md §7).
   drop_connection_set();
 }
 

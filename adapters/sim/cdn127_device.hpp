@@ -21,7 +21,7 @@
 
 namespace dnbridge::sim {
 
-// Connection object attribute 1 (devicenet-facts §5).
+// Connection object attribute 1 (bridge/PROTOCOL.md §7).
 enum class ConnectionState : std::uint8_t {
   kNonExistent = 0,
   kConfiguring = 1,
@@ -31,7 +31,7 @@ enum class ConnectionState : std::uint8_t {
   kDeferredDelete = 5,
 };
 
-// Connection object attribute 12 (devicenet-facts §5).
+// Connection object attribute 12 (bridge/PROTOCOL.md §7).
 enum class WatchdogAction : std::uint8_t {
   kTimedOut = 0,
   kAutoDelete = 1,
@@ -53,7 +53,7 @@ constexpr Reply reply_error(cip::GeneralStatus s,
   return Reply{s, additional};
 }
 
-// The Group 4 Offline Connection Set (devicenet-facts §7, UNVERIFIED; layouts
+// The Group 4 Offline Connection Set (bridge/PROTOCOL.md §9, UNVERIFIED; layouts
 // and sources in bridge/devicenet/offline_connection.hpp). Where the sources
 // disagree or are silent, the choice is here.
 struct OfflineOptions {
@@ -139,7 +139,7 @@ struct SlaveOptions {
   // The manual lists the explicit connection's attribute 12 as Get, "fixed
   // value" 1; some devices accept 1 or 3.
   bool explicit_timeout_action_settable = false;
-  // Expected packet rates are rounded up to this (devicenet-facts §5); the
+  // Expected packet rates are rounded up to this (bridge/PROTOCOL.md §7); the
   // Set answers the rate kept (2 bytes). 100 ms: a coarse device.
   Duration timer_resolution = milliseconds(10);
   // Configuration object values in E2 before the first power-up.
@@ -196,8 +196,8 @@ struct SlaveOptions {
   // A request in acknowledged fragments: every fragment is acked but the
   // last, which the response itself answers (sent at once, no ack before
   // it). Off: the last fragment is acked too, then the response follows
-  // (devicenet-facts §3: "the receiver acks every fragment, the last
-  // included").
+  // (bridge/PROTOCOL.md §5: the receiver acks every fragment, the last
+  // included).
   bool no_ack_of_last_request_fragment = false;
   // A slow device: every explicit response (success or error, on the
   // explicit connection or the unconnected port: Allocate/Release answers
@@ -327,7 +327,7 @@ class Cdn127Device {
   Reply set_mac(std::uint8_t mac) noexcept;
   Reply set_baud(std::uint8_t baud) noexcept;
 
-  // --- allocation (devicenet-facts §2) ---
+  // --- allocation (bridge/PROTOCOL.md §3) ---
   // 255 when no master owns the connection set.
   std::uint8_t owner() const noexcept { return owner_; }
   bool owned() const noexcept { return owner_ != devicenet::MacId::kNone; }

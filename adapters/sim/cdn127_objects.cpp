@@ -315,7 +315,7 @@ const AttributeDef kConnectionAttributes[] = {
      [](const RequestContext& c, ByteWriter& w) noexcept {
        return put_u16(w, c.device.connection(c.instance)->expected_packet_rate_ms);
      },
-     // The response carries the rate kept, rounded up (devicenet-facts §5).
+     // The response carries the rate kept, rounded up (bridge/PROTOCOL.md §7).
      [](const RequestContext& c, Bytes data, ByteWriter& w) noexcept {
        std::uint16_t requested = 0;
        Reply r = read_u16(data, requested);

@@ -40,7 +40,7 @@ ExplicitFragmentSender::Config sender_config(const SlaveOptions& o) noexcept {
   return c;
 }
 
-// Unconnected-port additional code: invalid Group 2 only request (devicenet-facts §2).
+// Unconnected-port additional code: invalid Group 2 only request (bridge/PROTOCOL.md §3).
 constexpr std::uint8_t kInvalidGroup2Request = 0x03;
 constexpr std::uint8_t kFragBit = 0x80;
 

@@ -6,7 +6,7 @@
 // it when now >= next_deadline()), frames go out through the FrameSink given
 // at construction. No threads, no clocks.
 //
-// Wire behaviour (devicenet-facts §1..§5, CDN127 manual "DeviceNet Message
+// Wire behaviour (bridge/PROTOCOL.md §1..§7, CDN127 manual "DeviceNet Message
 // Types"): it listens to Group 2 messages 4 (explicit request), 5 (poll
 // command), 6 (Allocate/Release) and 7 (duplicate MAC check) for its MAC, and
 // answers on Group 2 message 3 (explicit and unconnected responses), Group 1

@@ -3,7 +3,7 @@
 // LINKTYPE_CAN_SOCKETCAN (227), the format of a SocketCAN capture, so the same
 // tools work on simulated and real buses. Decode DeviceNet with
 //   tshark -r FILE -d 'can.subdissector,devicenet'
-// (the DeviceNet dissector has no heuristic; facts sheet §9).
+// (the DeviceNet dissector has no heuristic; bridge/PROTOCOL.md §11).
 #include <array>
 #include <chrono>
 #include <cstdint>

@@ -58,7 +58,7 @@ std::vector<CanFilter> master_filters() {
   using devicenet::Group1Message;
   using devicenet::Group2Message;
   // Group 1: 0 MMMM SSSSSS (message, source MAC); Group 2: 10 SSSSSS MMM
-  // (MAC, message); Group 4: 11111 MMMMMM (devicenet-facts §1).
+  // (MAC, message); Group 4: 11111 MMMMMM (bridge/PROTOCOL.md §1).
   const auto g1 = [](Group1Message m) {
     return CanFilter{static_cast<std::uint32_t>(m) << 6, 0x7C0};
   };

@@ -1,7 +1,7 @@
 #pragma once
 // On-wire length of a classic CAN 2.0A data frame, bit stuffing included, and
 // the time it occupies the bus. The simulated bus uses this to place deliveries
-// where a real bus would (devicenet-facts §8).
+// where a real bus would (bridge/PROTOCOL.md §10).
 #include <cstdint>
 
 #include "bridge/can/can_frame.hpp"
@@ -10,7 +10,7 @@
 
 namespace dnbridge::can {
 
-// DeviceNet's three bit rates (devicenet-facts §8; DeviceNet Object attribute 2).
+// DeviceNet's three bit rates (bridge/PROTOCOL.md §10; DeviceNet Object attribute 2).
 inline constexpr std::uint32_t kBitrate125k = 125000;
 inline constexpr std::uint32_t kBitrate250k = 250000;
 inline constexpr std::uint32_t kBitrate500k = 500000;

@@ -1,6 +1,6 @@
 #pragma once
 // CIP EPATH of logical segments, in the packed form DeviceNet uses
-// (devicenet-facts §6): each segment is a segment byte
+// (bridge/PROTOCOL.md §8): each segment is a segment byte
 //   0x20 | (logical type << 2) | format
 // followed by the value, 1, 2 or 4 bytes little-endian, with no pad byte.
 //   20 04 24 01 30 03           class 4, instance 1, attribute 3

@@ -1,5 +1,5 @@
 #pragma once
-// CIP general status codes (devicenet-facts §2), every code named. A device's
+// CIP general status codes (bridge/PROTOCOL.md §4), every code named. A device's
 // error reply is data, carried as a Status value, never an exception.
 #include <cstdint>
 #include <string_view>

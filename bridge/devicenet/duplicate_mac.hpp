@@ -1,5 +1,5 @@
 #pragma once
-// Duplicate MAC ID check (devicenet-facts §4).
+// Duplicate MAC ID check (bridge/PROTOCOL.md §6).
 //
 // Message on Group 2 message 7, CAN ID 0x407 + (MAC << 3), 7 bytes:
 //   [R/R:1 | physical port:7][vendor id LE:2][serial number LE:4]

@@ -195,7 +195,7 @@ void ExplicitClient::end_request_transfer(TimePoint now) noexcept {
 }
 
 // The slave resends the last fragment of a response when it misses the ack
-// (devicenet-facts §3), by then the transaction is over (and the next one may
+// (bridge/PROTOCOL.md §5), by then the transaction is over (and the next one may
 // be under way with the other XID). Re-ack it, or the slave gives up on a
 // response that arrived. Nothing else of an ended transfer is acked.
 bool ExplicitClient::reack_final_fragment(Bytes payload, TimePoint now) noexcept {

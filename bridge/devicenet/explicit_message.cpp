@@ -30,8 +30,8 @@ void write_field(ByteWriter& w, std::uint16_t value, bool wide) noexcept {
 
 std::uint16_t read_field(ByteReader& r, bool wide) noexcept { return wide ? r.u16le() : r.u8(); }
 
-// Allocate/Release refuse choice 0 (the slave answers 0x09/0x02, devicenet-facts
-// §2) and the reserved bit 0x80.
+// Allocate/Release refuse choice 0 (the slave answers 0x09/0x02, bridge/PROTOCOL.md
+// §3) and the reserved bit 0x80.
 constexpr bool valid_choice(std::uint8_t choice) noexcept {
   return choice != 0 && (choice & 0x80) == 0;
 }

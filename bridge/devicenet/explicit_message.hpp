@@ -1,6 +1,6 @@
 #pragma once
 // Explicit messages of the predefined master/slave connection set
-// (devicenet-facts §2).
+// (bridge/PROTOCOL.md §2).
 //
 // On the wire every explicit frame starts with a header byte:
 //   bit 7 Frag, bit 6 XID, bits 5..0 MAC (on Group 2 always the master's MAC).
@@ -98,7 +98,7 @@ Result<std::size_t> encode_error_response(cip::GeneralStatus status, std::uint8_
 // additional code are ignored.
 Result<ResponseMessage> decode_response(Bytes message) noexcept;
 
-// Allocation choice bits (devicenet-facts §2).
+// Allocation choice bits (bridge/PROTOCOL.md §3).
 namespace allocation {
 inline constexpr std::uint8_t kExplicit = 0x01;
 inline constexpr std::uint8_t kPoll = 0x02;

@@ -1,5 +1,5 @@
 #pragma once
-// DeviceNet fragmentation (devicenet-facts §3).
+// DeviceNet fragmentation (bridge/PROTOCOL.md §5).
 //
 // Fragment byte: bits 7..6 type (0 first, 1 middle, 2 last, 3 ack), bits 5..0
 // count (first = 0, then +1 each, modulo 64).

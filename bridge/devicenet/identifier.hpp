@@ -1,5 +1,5 @@
 #pragma once
-// DeviceNet use of the 11-bit CAN identifier (devicenet-facts §1):
+// DeviceNet use of the 11-bit CAN identifier (bridge/PROTOCOL.md §1):
 //   Group 1: 0 mmmm ssssss     0x000-0x3FF   message id 0..15, source MAC
 //   Group 2: 1 0 MMMMMM iii    0x400-0x5FF   MAC, message id 0..7
 //   Group 3: 1 1 iii ssssss    0x600-0x7BF   message id 0..6, source MAC

@@ -1,5 +1,5 @@
 #pragma once
-// The Group 4 Offline Connection Set (devicenet-facts §7; CDN127 manual,
+// The Group 4 Offline Connection Set (bridge/PROTOCOL.md §9; CDN127 manual,
 // "DeviceNet Message Types"): lets a tool reach a node stuck in Communication
 // Fault (e.g. after a duplicate MAC) without a power cycle, naming it by vendor
 // ID + serial number, and change its MAC.

@@ -183,7 +183,7 @@ class Cdn127SlaveTest : public ::testing::Test {
 };
 
 // ---------------------------------------------------------------------------
-// Duplicate MAC ID check (devicenet-facts §4)
+// Duplicate MAC ID check (bridge/PROTOCOL.md §6)
 
 TEST_F(Cdn127SlaveTest, PowerUpSendsTwoDuplicateMacRequestsThenGoesOnline) {
   slave_->power_on(now_);
@@ -252,7 +252,7 @@ TEST_F(Cdn127SlaveTest, IgnoresOtherNodesDuplicateMacChecks) {
 }
 
 // ---------------------------------------------------------------------------
-// Allocation (devicenet-facts §2)
+// Allocation (bridge/PROTOCOL.md §3)
 
 TEST_F(Cdn127SlaveTest, AllocateExplicitAndPoll) {
   boot();
@@ -406,7 +406,7 @@ TEST_F(Cdn127SlaveTest, FragmentedRequestIsReassembled) {
 TEST_F(Cdn127SlaveTest, ExpectedPacketRateRoundsUpToTheTimerResolution) {
   boot();
   allocate();
-  // Set EPR 3594 ms -> the device keeps and returns 3600 (devicenet-facts §5).
+  // Set EPR 3594 ms -> the device keeps and returns 3600 (bridge/PROTOCOL.md §7).
   EXPECT_EQ(single(kRequestId, {kMaster, 0x10, 0x05, 0x02, 0x09, 0x0A, 0x0E}),
             (ByteVec{kMaster, 0x90, 0x10, 0x0E}));
   EXPECT_EQ(slave_->poll_state(), ConnectionState::kEstablished);

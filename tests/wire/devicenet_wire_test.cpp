@@ -261,7 +261,7 @@ TEST_F(Wire, DuplicateMacChecksCarryVendorAndSerialNumber) {
     SCOPED_TRACE("MAC " + std::to_string(e.mac));
     const auto checks = group2(7, e.mac);
     // Two requests one second apart at power-up, then silence: nobody
-    // claimed the MAC (facts sheet §4).
+    // claimed the MAC (bridge/PROTOCOL.md §6).
     ASSERT_EQ(checks.size(), 2u);
     for (const WireRow* r : checks) {
       EXPECT_EQ(r->can_id, 0x407u + (e.mac << 3));
@@ -368,7 +368,7 @@ TEST_F(Wire, FragmentedSupervisorStringIsAcknowledgedFragmentByFragment) {
   ASSERT_EQ(supervisor_name_, std::string("\x0b") + "D.I.P. Inc.");
   // The slave's fragments (message 3 from pump B, Frag bit set) carrying the
   // response [8E][SHORT_STRING], each acked by the master on message 4 with
-  // [hdr | Frag][C0 | count][00] (facts sheet §3).
+  // [hdr | Frag][C0 | count][00] (bridge/PROTOCOL.md §5).
   const auto from_slave = group2(3, kPumpB);
   auto first = std::find_if(from_slave.begin(), from_slave.end(), [](const WireRow* r) {
     return r->data.size() >= 4 && (r->data[0] & 0x80) && r->data[1] == 0x00 && r->data[2] == 0x8E &&

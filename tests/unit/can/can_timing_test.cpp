@@ -99,7 +99,7 @@ TEST(CanTiming, DeviceNetExplicitRequest) {
 }
 
 TEST(CanTiming, BoundsMatchFactsSheet) {
-  // devicenet-facts §8: 47 + 8n unstuffed, 55 + 10n worst case; at 500k the
+  // bridge/PROTOCOL.md §10: 47 + 8n unstuffed, 55 + 10n worst case; at 500k the
   // worst case is 110 us (0 bytes) to 270 us (8 bytes), at 125k 440 to 1080 us.
   EXPECT_EQ(unstuffed_frame_bits(0), 47u);
   EXPECT_EQ(max_frame_bits(8), 135u);

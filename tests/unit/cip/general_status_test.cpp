@@ -6,7 +6,7 @@ namespace dnbridge::cip {
 namespace {
 
 TEST(GeneralStatusTest, EveryCodeOfTheTableIsNamed) {
-  // devicenet-facts §2: 0x00..0x2A and 0x2C.
+  // bridge/PROTOCOL.md §4: 0x00..0x2A and 0x2C.
   for (unsigned code = 0; code <= 0x2A; ++code) {
     EXPECT_TRUE(is_known(static_cast<std::uint8_t>(code))) << std::hex << code;
   }

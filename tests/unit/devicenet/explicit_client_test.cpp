@@ -92,7 +92,7 @@ class ExplicitClientTest : public ::testing::Test {
 };
 
 // ---------------------------------------------------------------------------
-// Allocate, the golden exchange of devicenet-facts §2 (master 10, slave 3).
+// Allocate, the golden exchange of bridge/PROTOCOL.md §3 (master 10, slave 3).
 
 TEST_F(ExplicitClientTest, AllocateGoldenExchange) {
   EXPECT_EQ(client.deadline(), kNever);
@@ -140,7 +140,7 @@ TEST_F(ExplicitClientTest, AnswerWithWrongXidMacOrServiceIsUnexpectedAndIgnored)
   const ByteVec data = {0x03, 0x0A};
   ASSERT_TRUE(client.submit(1, {0x4B, 0x03, 0x01, std::nullopt, data}, true, now).ok());
 
-  answer({0x0A, 0xCB, 0x00});  // XID 0: the literal of the facts, not this transaction's
+  answer({0x0A, 0xCB, 0x00});  // XID 0, as in bridge/PROTOCOL.md §3: not this transaction's
   EXPECT_EQ(client.counters().unexpected_frames, 1u);
   answer({0x4B, 0xCB, 0x00});  // MAC 11: another master's conversation
   EXPECT_EQ(client.counters().unexpected_frames, 2u);
@@ -576,7 +576,7 @@ TEST_F(ExplicitClientTest, FinalResponseFragmentRepeatedAfterCompletionIsReAcked
 
   // The slave missed our ack of its last fragment and sends it again after
   // its 1 s ack timeout: re-acked so that it does not abort a response that
-  // arrived (devicenet-facts §3), and not taken as an answer to request 2.
+  // arrived (bridge/PROTOCOL.md §5), and not taken as an answer to request 2.
   advance(seconds(1));
   answer({0xCA, 0x81, 0x32, 0x37});
   ASSERT_EQ(sink.frames.size(), sent + 1);

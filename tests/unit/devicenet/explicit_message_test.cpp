@@ -53,7 +53,7 @@ TEST(ExplicitHeader, BitsAreFragXidMac) {
 }
 
 // ---------------------------------------------------------------------------
-// Allocate / Release (devicenet-facts §2), slave 3, master 10.
+// Allocate / Release (bridge/PROTOCOL.md §3), slave 3, master 10.
 
 TEST(Allocate, RequestFrameGolden) {
   auto f = make_allocate_frame(mac(3), mac(10), allocation::kExplicit | allocation::kPoll);
@@ -248,7 +248,7 @@ TEST(Request, DecodeRefusesResponse) {
 }
 
 // ---------------------------------------------------------------------------
-// Expected packet rate (devicenet-facts §5, §6).
+// Expected packet rate (bridge/PROTOCOL.md §7, §8).
 
 TEST(ExpectedPacketRate, SetRequestAndResponseGolden) {
   const ByteVec data = {0x0A, 0x0E};  // 3594 ms, UINT LE

@@ -63,7 +63,7 @@ TEST(FragmentByte, TypeAndCount) {
 }
 
 // ---------------------------------------------------------------------------
-// The 1760-DNET worked example (devicenet-facts §3): master MAC 0, slave 3.
+// The 1760-DNET worked example (bridge/PROTOCOL.md §5): master MAC 0, slave 3.
 
 TEST(ExplicitFragmentation, Rockwell1760DnetRequestFirstFragment) {
   // The example shows the request's first fragment only: 32 64 01 93 05 00.

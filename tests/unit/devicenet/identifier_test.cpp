@@ -8,7 +8,7 @@ namespace {
 MacId mac(unsigned v) { return MacId::from(v).value(); }
 
 TEST(Identifier, PredefinedSetIdsMatchFactsSheet) {
-  // devicenet-facts §1, with slave 3 and master 10.
+  // bridge/PROTOCOL.md §1, with slave 3 and master 10.
   EXPECT_EQ(group1_id(Group1Message::kSlavePollResponse, mac(3)), 0x3C3u);
   EXPECT_EQ(group1_id(Group1Message::kSlaveCosCyclic, mac(3)), 0x343u);
   EXPECT_EQ(group1_id(Group1Message::kSlaveBitStrobeResponse, mac(3)), 0x383u);

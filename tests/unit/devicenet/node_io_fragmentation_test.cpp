@@ -1,6 +1,6 @@
 // A node whose poll messages are over 8 bytes: the master fragments its poll
 // commands and reassembles the responses (unacknowledged I/O fragmentation,
-// devicenet-facts §3). The CDN127's formats fit one frame, so this runs
+// bridge/PROTOCOL.md §5). The CDN127's formats fit one frame, so this runs
 // against a small scripted Group 2 slave with 12 bytes consumed, 10 produced.
 #include <gtest/gtest.h>
 
