@@ -98,7 +98,7 @@ TEST_F(ImmediatePollGap, AFloodOfChangesIsPolledAtMostOncePerGap) {
   // The 500 kbit/s bus: without the gap, every response to a poll with
   // outputs changed meanwhile is followed by the next poll at once, about
   // 2 600 polls a second for one node, the bus all but full.
-  build({kGap}, sim::kBitrate500k);
+  build({kGap}, can::kBitrate500k);
   const TimePoint start = now();
   const auto polls_before = node(1).counters().polls;
   unsigned n = 0;
