@@ -6,72 +6,14 @@
 #include <limits>
 
 #include "adapters/dds/fields.hpp"
+#include "adapters/dds/states.hpp"
 
 namespace dnbridge::daemon {
 
 namespace cdn127 = profiles::cdn127;
 using dds::set_octets;
 using dds::set_string;
-
-dnbridge_NodeLifecycle to_idl(devicenet::NodeState s) {
-  switch (s) {
-    case devicenet::NodeState::kAbsent:
-      return dnbridge_NODE_ABSENT;
-    case devicenet::NodeState::kIdentifying:
-      return dnbridge_NODE_IDENTIFYING;
-    case devicenet::NodeState::kConfiguring:
-      return dnbridge_NODE_CONFIGURING;
-    case devicenet::NodeState::kVerifying:
-      return dnbridge_NODE_VERIFYING;
-    case devicenet::NodeState::kOnline:
-      return dnbridge_NODE_ONLINE;
-    case devicenet::NodeState::kWrongDevice:
-      return dnbridge_NODE_WRONG_DEVICE;
-    case devicenet::NodeState::kConfigurationFault:
-      return dnbridge_NODE_CONFIGURATION_FAULT;
-    case devicenet::NodeState::kOwnedByOtherMaster:
-      return dnbridge_NODE_OWNED_BY_OTHER_MASTER;
-    case devicenet::NodeState::kStopped:
-      return dnbridge_NODE_STOPPED;
-    case devicenet::NodeState::kDeviceFault:
-      return dnbridge_NODE_DEVICE_FAULT;
-  }
-  return dnbridge_NODE_ABSENT;
-}
-
-dnbridge_PortLifecycle to_idl(devicenet::PortState s) {
-  switch (s) {
-    case devicenet::PortState::kStopped:
-      return dnbridge_PORT_STOPPED;
-    case devicenet::PortState::kCheckingMac:
-      return dnbridge_PORT_CHECKING_MAC;
-    case devicenet::PortState::kRunning:
-      return dnbridge_PORT_RUNNING;
-    case devicenet::PortState::kStopping:
-      return dnbridge_PORT_STOPPING;
-    case devicenet::PortState::kDuplicateMac:
-      return dnbridge_PORT_DUPLICATE_MAC;
-  }
-  return dnbridge_PORT_STOPPED;
-}
-
-dnbridge_BusState to_idl(port::BusState s) {
-  switch (s) {
-    case port::BusState::kErrorActive:
-      return dnbridge_BUS_ERROR_ACTIVE;
-    case port::BusState::kErrorWarning:
-      return dnbridge_BUS_ERROR_WARNING;
-    case port::BusState::kErrorPassive:
-      return dnbridge_BUS_ERROR_PASSIVE;
-    case port::BusState::kBusOff:
-      return dnbridge_BUS_OFF;
-    case port::BusState::kUnknown:
-      return dnbridge_BUS_STATE_UNKNOWN;
-    case port::BusState::kDown:
-      return dnbridge_BUS_DOWN;
-  }
-  return dnbridge_BUS_STATE_UNKNOWN;
-}
+using dds::to_idl;
 
 std::string_view device_state_text(std::uint8_t state) {
   // CDN127 manual, Identity object, "Device State - Attribute 8".

@@ -26,10 +26,6 @@ profiles::cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& command);
 // A request sample as the explicit gateway takes it.
 rack::ExplicitCall call_of(const dnbridge_ExplicitRequest& request);
 
-dnbridge_NodeLifecycle to_idl(devicenet::NodeState state);
-dnbridge_PortLifecycle to_idl(devicenet::PortState state);
-dnbridge_BusState to_idl(port::BusState state);
-
 // Identity object State (attribute 8), for people.
 std::string_view device_state_text(std::uint8_t state);
 

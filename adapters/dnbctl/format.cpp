@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "adapters/dds/fields.hpp"
+#include "adapters/dds/states.hpp"
 #include "bridge/cip/general_status.hpp"
 #include "bridge/cip/service.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
@@ -15,45 +16,9 @@ namespace dnbridge::dnbctl {
 
 using dds::view;
 
-std::string_view to_text(dnbridge_NodeLifecycle state) {
-  switch (state) {
-    case dnbridge_NODE_ABSENT: return "absent";
-    case dnbridge_NODE_IDENTIFYING: return "identifying";
-    case dnbridge_NODE_CONFIGURING: return "configuring";
-    case dnbridge_NODE_VERIFYING: return "verifying";
-    case dnbridge_NODE_ONLINE: return "online";
-    case dnbridge_NODE_WRONG_DEVICE: return "wrong device";
-    case dnbridge_NODE_CONFIGURATION_FAULT: return "configuration fault";
-    case dnbridge_NODE_OWNED_BY_OTHER_MASTER: return "owned by other master";
-    case dnbridge_NODE_STOPPED: return "stopped";
-    case dnbridge_NODE_DEVICE_FAULT:
-      return "device fault";
-  }
-  return "unknown";
-}
-
-std::string_view to_text(dnbridge_PortLifecycle state) {
-  switch (state) {
-    case dnbridge_PORT_STOPPED: return "stopped";
-    case dnbridge_PORT_CHECKING_MAC: return "checking MAC";
-    case dnbridge_PORT_RUNNING: return "running";
-    case dnbridge_PORT_STOPPING: return "stopping";
-    case dnbridge_PORT_DUPLICATE_MAC: return "duplicate MAC";
-  }
-  return "unknown";
-}
-
-std::string_view to_text(dnbridge_BusState state) {
-  switch (state) {
-    case dnbridge_BUS_ERROR_ACTIVE: return "error active";
-    case dnbridge_BUS_ERROR_WARNING: return "error warning";
-    case dnbridge_BUS_ERROR_PASSIVE: return "error passive";
-    case dnbridge_BUS_OFF: return "bus off";
-    case dnbridge_BUS_STATE_UNKNOWN: return "unknown";
-    case dnbridge_BUS_DOWN: return "interface down";
-  }
-  return "unknown";
-}
+std::string_view to_text(dnbridge_NodeLifecycle state) { return dds::name_of(state); }
+std::string_view to_text(dnbridge_PortLifecycle state) { return dds::name_of(state); }
+std::string_view to_text(dnbridge_BusState state) { return dds::name_of(state); }
 
 std::string transaction_status_text(std::uint8_t status) {
   // The bridge's own names (rack::TransactionStatus); 7 is unassigned.

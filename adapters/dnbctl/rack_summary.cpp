@@ -19,7 +19,7 @@ constexpr std::array<NodeClass, kNodeClasses> kClasses{
     NodeClass::kFaulted, NodeClass::kOtherMaster, NodeClass::kStopped,  NodeClass::kUnknown};
 
 // A port that needs no attention: its bridge is there, its master scans, and
-// the controller is error active (or does not say).
+// the controller is error-active (or does not say).
 bool healthy(const PortRow& r) {
   const auto& p = *r.port;
   return r.alive && p.state == dnbridge_PORT_RUNNING &&
@@ -49,7 +49,7 @@ std::string_view to_text(NodeClass c) {
     case NodeClass::kFaulted:
       return "faulted";
     case NodeClass::kOtherMaster:
-      return "owned by other master";
+      return "owned by another master";
     case NodeClass::kStopped:
       return "stopped";
     case NodeClass::kUnknown:

@@ -3,6 +3,7 @@
 // a SocketCAN interface. Used from the port's own thread only, except wake().
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "bridge/can/can_frame.hpp"
 #include "bridge/can/frame_sink.hpp"
@@ -25,6 +26,26 @@ enum class BusState : std::uint8_t {
   kUnknown,
   kDown  // the interface is down or absent: nothing goes out or comes in
 };
+
+// "error-active", "bus-off", "interface down", ...: the one name of each
+// state, in the logs, on dnbctl and in its JSON.
+constexpr std::string_view to_string(BusState s) noexcept {
+  switch (s) {
+    case BusState::kErrorActive:
+      return "error-active";
+    case BusState::kErrorWarning:
+      return "error-warning";
+    case BusState::kErrorPassive:
+      return "error-passive";
+    case BusState::kBusOff:
+      return "bus-off";
+    case BusState::kUnknown:
+      return "unknown";
+    case BusState::kDown:
+      return "interface down";
+  }
+  return "?";
+}
 
 struct BusCounters {
   BusState state = BusState::kUnknown;

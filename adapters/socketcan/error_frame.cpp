@@ -45,24 +45,6 @@ ErrorFrameReport decode_error_frame(std::uint32_t error_class,
   return r;
 }
 
-const char* to_string(BusState s) noexcept {
-  switch (s) {
-    case BusState::kErrorActive:
-      return "error-active";
-    case BusState::kErrorWarning:
-      return "error-warning";
-    case BusState::kErrorPassive:
-      return "error-passive";
-    case BusState::kBusOff:
-      return "bus-off";
-    case BusState::kDown:
-      return "interface down";
-    case BusState::kUnknown:
-      return "unknown";
-  }
-  return "?";
-}
-
 std::string describe(const ErrorFrameReport& r) {
   std::string s;
   auto add = [&s](std::string_view part) {

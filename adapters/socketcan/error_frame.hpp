@@ -35,6 +35,4 @@ ErrorFrameReport decode_error_frame(std::uint32_t error_class,
 // "bus-off", "error-passive (tx 128, rx 0), no ACK", ... for logs.
 std::string describe(const ErrorFrameReport& report);
 
-const char* to_string(port::BusState s) noexcept;
-
 }  // namespace dnbridge::socketcan

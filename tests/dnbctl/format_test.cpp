@@ -146,7 +146,7 @@ TEST(Names, StatusesHaveTheirNames) {
   EXPECT_EQ(service_text(0x4E), "service 0x4E");
   EXPECT_EQ(to_text(dnbridge_NODE_WRONG_DEVICE), "wrong device");
   EXPECT_EQ(to_text(dnbridge_PORT_DUPLICATE_MAC), "duplicate MAC");
-  EXPECT_EQ(to_text(dnbridge_BUS_OFF), "bus off");
+  EXPECT_EQ(to_text(dnbridge_BUS_OFF), "bus-off");
 }
 
 TEST(PumpLine, ShowsInputsAndAppliedOutputs) {
@@ -205,7 +205,7 @@ TEST(List, TablesAndJsonNestNodesUnderPorts) {
   EXPECT_EQ(ports_table(ports),
             "RACK      PORT  BRIDGE  STATE    BUS           LOAD  FRAMES/S  NODES       "
             "INTERFACE                REASON\n"
-            "sim-rack  A     live    running  error active  2.7%  176       1/2 online  "
+            "sim-rack  A     live    running  error-active  2.7%  176       1/2 online  "
             "simulated 500k master 0  scanning\n");
   const std::string table = nodes_table(nodes);
   EXPECT_NE(table.find("sim-rack  A     2    pump-2  absent  no      CDN127   no answer to allocation"),

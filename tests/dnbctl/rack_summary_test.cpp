@@ -78,7 +78,7 @@ TEST(RackSummary, EveryLifeCycleStateHasAClass) {
   EXPECT_EQ(classify(s.node("r", 1, dnbridge_NODE_ONLINE, "polled", false, false)),
             NodeClass::kUnknown);
   EXPECT_EQ(json_name(NodeClass::kOtherMaster), "owned_by_other_master");
-  EXPECT_EQ(to_text(NodeClass::kOtherMaster), "owned by other master");
+  EXPECT_EQ(to_text(NodeClass::kOtherMaster), "owned by another master");
 }
 
 TEST(RackSummary, ReasonsSayWhatToLookAt) {
@@ -138,7 +138,7 @@ TEST(RackSummary, BridgesAreLiveSilentOrGone) {
       << text;
   // The gone bridge's port needs attention; its node and the stopped one are listed.
   EXPECT_NE(text.find("\nRACK  PORT  STATE        BUS           REASON\n"
-                      "gone  A     bridge gone  error active  scanning\n"),
+                      "gone  A     bridge gone  error-active  scanning\n"),
             std::string::npos)
       << text;
   EXPECT_NE(text.find("gone  A     1    pump-1  unknown  online   no longer published by a bridge; "
@@ -153,19 +153,19 @@ TEST(RackSummary, BridgesAreLiveSilentOrGone) {
 TEST(RackSummary, PortsOffTheirBusAreShownAndAnAllOnlineRackSaysSo) {
   Samples s;
   const std::vector<PortRow> ports{
-      s.port("r", dnbridge_PORT_RUNNING, dnbridge_BUS_OFF, "can0: bus off")};
+      s.port("r", dnbridge_PORT_RUNNING, dnbridge_BUS_OFF, "can0: bus-off")};
   const std::vector<NodeRow> nodes{s.node("r", 1, dnbridge_NODE_ONLINE, "polled", false)};
   const auto racks = summarize_racks(ports, nodes, {{"r", 1}});
   const std::string text = racks_text(racks);
   EXPECT_NE(text.find("\nRACK  PORT  STATE    BUS      REASON\n"
-                      "r     A     running  bus off  can0: bus off\n"),
+                      "r     A     running  bus-off  can0: bus-off\n"),
             std::string::npos)
       << text;
   EXPECT_NE(text.find("\nevery node reported is online\n"), std::string::npos) << text;
 
   JsonWriter out(false);
   racks_json(out, racks);
-  EXPECT_NE(out.str().find(R"("bus_state":"bus off",)"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find(R"("bus_state":"bus-off",)"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find(R"("bridge_alive":true,"healthy":false})"), std::string::npos)
       << out.str();
   EXPECT_NE(out.str().find(R"({"port":"A","mac":1,"name":"pump-1","class":"online",)"),

@@ -241,7 +241,8 @@ TEST_F(DnbctlRacks, ShowsEachRacksNodesByClassWithTheReason) {
            " Allocate attempts; last error: explicit request timed out) "
            "rack-south A 3 pump-3 faulted wrong device expected vendor 59 product type 27 "
            "product code 1999, found vendor 59 product type 27 product code 1888 "
-           "rack-south A 4 pump-4 owned by other master owned by other master Allocate refused: "
+           "rack-south A 4 pump-4 owned by another master owned by another master Allocate "
+           "refused: "
            "owned by another master (0x0C/0x01) ",
        }) {
     EXPECT_NE(t.find(expected), std::string::npos) << "missing: " << expected << "\nin:\n"
@@ -270,7 +271,7 @@ TEST_F(DnbctlRacks, ShowsEachRacksNodesByClassWithTheReason) {
       R"j("mac": 2, "name": "pump-2", "class": "absent", "state": "absent", )j",
       R"j("mac": 3, "name": "pump-3", "class": "faulted", "state": "wrong device", )j",
       R"j("mac": 4, "name": "pump-4", "class": "owned_by_other_master", )j"
-      R"j("state": "owned by other master", )j"
+      R"j("state": "owned by another master", )j"
       R"j("reason": "Allocate refused: owned by another master (0x0C/0x01)", )j",
   };
   for (const char* expected : expected_json) {

@@ -1,0 +1,31 @@
+#pragma once
+// The data model's state enums and the bridge's own, one table per enum
+// (states.cpp) for both directions; and one name per state, the core's,
+// which the logs, dnbctl's text and its JSON all use.
+#include <optional>
+#include <string_view>
+
+#include "adapters/port/can_backend.hpp"
+#include "bridge/devicenet/node_state.hpp"
+#include "bridge/devicenet/scanner_events.hpp"
+#include "dnbridge.h"
+
+namespace dnbridge::dds {
+
+dnbridge_NodeLifecycle to_idl(devicenet::NodeState state);
+dnbridge_PortLifecycle to_idl(devicenet::PortState state);
+dnbridge_BusState to_idl(port::BusState state);
+
+// nullopt: a value this program does not know (a newer bridge's).
+std::optional<devicenet::NodeState> from_idl(dnbridge_NodeLifecycle state);
+std::optional<devicenet::PortState> from_idl(dnbridge_PortLifecycle state);
+std::optional<port::BusState> from_idl(dnbridge_BusState state);
+
+// "online", "owned by another master", ...; "unknown" for a value not known.
+std::string_view name_of(dnbridge_NodeLifecycle state);
+// "running", "duplicate MAC", ...
+std::string_view name_of(dnbridge_PortLifecycle state);
+// "error-active", "bus-off", "interface down", ...
+std::string_view name_of(dnbridge_BusState state);
+
+}  // namespace dnbridge::dds
