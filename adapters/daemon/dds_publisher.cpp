@@ -67,7 +67,7 @@ void DdsPublisher::pump_state(const std::string& port, const rack::PumpView& pum
 }
 
 void DdsPublisher::node_status(const std::string& port, const rack::PumpView& pump,
-                               const devicenet::Node& node, TimePoint source_time) {
+                               const port::NodeStatusView& node, TimePoint source_time) {
   auto sample = std::make_shared<dds::Owned<dnbridge_NodeStatus>>();
   fill_node_status(**sample, rack_, port, pump, node);
   const auto at = clock_.to_wall(source_time);

@@ -41,8 +41,8 @@ class DdsPublisher final : public port::PortPublisher {
 
   void pump_state(const std::string& port, const rack::PumpView& pump,
                   TimePoint source_time) override;
-  void node_status(const std::string& port, const rack::PumpView& pump, const devicenet::Node& node,
-                   TimePoint source_time) override;
+  void node_status(const std::string& port, const rack::PumpView& pump,
+                   const port::NodeStatusView& node, TimePoint source_time) override;
   void port_status(const port::PortStatusView& status, TimePoint source_time) override;
   void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) override;
   void port_stopped(const std::string& port) override;

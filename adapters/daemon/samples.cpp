@@ -137,15 +137,15 @@ void fill_safe_state(dnbridge_SafeState& out, const rack::PumpView& v) {
 }  // namespace
 
 void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
-                      const rack::PumpView& v, const devicenet::Node& node) {
+                      const rack::PumpView& v, const port::NodeStatusView& node) {
   set_string(out.rack, rack);
   set_string(out.port, port);
   out.mac = v.mac.value();
   set_string(out.name, v.name);
-  out.state = to_idl(node.state());
-  set_string(out.reason, node.reason());
+  out.state = to_idl(node.state);
+  set_string(out.reason, node.reason);
 
-  const auto& id = node.identity();
+  const auto& id = node.identity;
   out.vendor_id = id.vendor_id;
   out.product_type = id.product_type;
   out.product_code = id.product_code;
@@ -153,24 +153,24 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.minor_revision = id.minor_revision;
   out.serial_number = id.serial_number;
   set_string(out.product_name, id.product_name);
-  out.device_state_valid = node.device_state().has_value();
-  out.device_state = node.device_state().value_or(0);
+  out.device_state_valid = node.device_state.has_value();
+  out.device_state = node.device_state.value_or(0);
   // Identity.State is optional: a device read at start-up (its status
   // answered) that has none is in a state unknown, not at fault.
-  set_string(out.device_state_text, node.device_state() ? device_state_text(*node.device_state())
-                                    : node.identity().status
+  set_string(out.device_state_text, node.device_state ? device_state_text(*node.device_state)
+                                    : node.identity.status
                                         ? std::string_view{"state unknown (no Identity.State)"}
                                         : std::string_view{});
 
   const auto ms = [](Duration d) {
     return static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(d).count());
   };
-  out.poll_period_ms = ms(node.config().poll_period);
-  out.expected_packet_rate_ms = ms(node.poll_epr());
-  out.produced_size = static_cast<std::uint16_t>(node.config().profile.produced_size);
-  out.consumed_size = static_cast<std::uint16_t>(node.config().profile.consumed_size);
+  out.poll_period_ms = ms(node.poll_period);
+  out.expected_packet_rate_ms = ms(node.poll_epr);
+  out.produced_size = static_cast<std::uint16_t>(node.produced_size);
+  out.consumed_size = static_cast<std::uint16_t>(node.consumed_size);
 
-  const auto& error = node.last_error();
+  const auto& error = node.last_error;
   set_string(out.last_error,
              error.kind == devicenet::NodeError::Kind::kNone ? std::string{} : error.describe());
   out.last_error_general_status = static_cast<std::uint8_t>(error.general_status);
@@ -192,8 +192,8 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   fill_safe_state(out.safe_state, v);
   set_string(out.idle_reason, v.idle_reason());
 
-  const auto& c = node.counters();
-  const auto& e = node.explicit_counters();
+  const auto& c = node.counters;
+  const auto& e = node.explicit_counters;
   out.counters.polls = c.polls;
   out.counters.idle_polls = c.idle_polls;
   out.counters.poll_responses = c.responses;

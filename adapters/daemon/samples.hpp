@@ -6,7 +6,6 @@
 
 #include "adapters/dds/sample.hpp"
 #include "adapters/port/port_publisher.hpp"
-#include "bridge/devicenet/node.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
 #include "bridge/rack/pump_rack.hpp"
 #include "dnbridge.h"
@@ -16,7 +15,7 @@ namespace dnbridge::daemon {
 void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string_view port,
                      const rack::PumpView& pump);
 void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
-                      const rack::PumpView& pump, const devicenet::Node& node);
+                      const rack::PumpView& pump, const port::NodeStatusView& node);
 void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,
                       const port::PortStatusView& status);
 void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer& answer);

@@ -228,7 +228,7 @@ void PortLoop::publish(TimePoint now, bool force) {
     }
     if (force || !p.status_once || v.status_changes != p.changes ||
         now >= p.status_time + config_.status_period) {
-      publisher_.node_status(config_.port, v, *scanner_->node(v.mac),
+      publisher_.node_status(config_.port, v, NodeStatusView::of(*scanner_->node(v.mac)),
                              std::max(source, p.status_time));
       p.changes = v.status_changes;
       p.status_time = now;
@@ -350,6 +350,22 @@ void PortLoop::on_explicit_result(std::uint32_t id, MacId, const devicenet::Expl
                                   TimePoint at) {
   if (auto answer = gateway_->on_result(id, r, at))
     publisher_.explicit_reply(config_.port, *answer);
+}
+
+NodeStatusView NodeStatusView::of(const devicenet::Node& node) {
+  NodeStatusView v;
+  v.state = node.state();
+  v.reason = node.reason();
+  v.identity = node.identity();
+  v.device_state = node.device_state();
+  v.poll_period = node.config().poll_period;
+  v.poll_epr = node.poll_epr();
+  v.produced_size = node.config().profile.produced_size;
+  v.consumed_size = node.config().profile.consumed_size;
+  v.last_error = node.last_error();
+  v.counters = node.counters();
+  v.explicit_counters = node.explicit_counters();
+  return v;
 }
 
 }  // namespace dnbridge::port

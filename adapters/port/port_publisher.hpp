@@ -1,7 +1,9 @@
 #pragma once
 // What a port's loop hands to the DDS face: plain views, called on the
 // port's own thread. Implementations copy what they need and return quickly.
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "adapters/port/can_backend.hpp"
@@ -31,6 +33,24 @@ struct PortStatusView {
   double loop_longest_pass_ms = 0;  // since the previous PortStatus
 };
 
+// A node as the master sees it, copied on the port's thread: what NodeStatus
+// says of it. No live devicenet::Node crosses into the DDS face.
+struct NodeStatusView {
+  devicenet::NodeState state = devicenet::NodeState::kAbsent;
+  std::string reason;
+  devicenet::NodeIdentity identity;
+  std::optional<std::uint8_t> device_state;
+  Duration poll_period{};
+  Duration poll_epr{};
+  std::size_t produced_size = 0;
+  std::size_t consumed_size = 0;
+  devicenet::NodeError last_error;
+  devicenet::NodeCounters counters;
+  devicenet::ExplicitCounters explicit_counters;
+
+  static NodeStatusView of(const devicenet::Node& node);
+};
+
 class PortPublisher {
  public:
   virtual ~PortPublisher() = default;
@@ -40,7 +60,7 @@ class PortPublisher {
   virtual void pump_state(const std::string& port, const rack::PumpView& pump,
                           TimePoint source_time) = 0;
   virtual void node_status(const std::string& port, const rack::PumpView& pump,
-                           const devicenet::Node& node, TimePoint source_time) = 0;
+                           const NodeStatusView& node, TimePoint source_time) = 0;
   virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;
   // `port`: the port whose gateway answers; empty for a request no port took.
   virtual void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) = 0;

@@ -48,7 +48,7 @@ TEST(Samples, AnAnalogInputOffTheScaleIsInvalidAndNamed) {
   EXPECT_TRUE(std::isnan(state->analog_input_volts[1]));
 
   dds::Owned<dnbridge_NodeStatus> status;
-  fill_node_status(*status, "r", "A", view, *scanner.node(pump.node.mac));
+  fill_node_status(*status, "r", "A", view, port::NodeStatusView::of(*scanner.node(pump.node.mac)));
   EXPECT_STREQ(status->invalid_inputs, "analog input 2: 65535 counts, above 4095");
   EXPECT_EQ(status->counters.responses_with_invalid_inputs, 1u);
 
@@ -57,7 +57,7 @@ TEST(Samples, AnAnalogInputOffTheScaleIsInvalidAndNamed) {
   rack.on_poll_response(pump.node.mac, Bytes(good), TimePoint{} + seconds(2));
   fill_pump_state(*state, "r", "A", view);
   EXPECT_TRUE(state->analog_input_valid[1]);
-  fill_node_status(*status, "r", "A", view, *scanner.node(pump.node.mac));
+  fill_node_status(*status, "r", "A", view, port::NodeStatusView::of(*scanner.node(pump.node.mac)));
   EXPECT_STREQ(status->invalid_inputs, "");
   EXPECT_EQ(status->counters.responses_with_invalid_inputs, 1u);
 }

@@ -33,10 +33,10 @@ class RecordingPublisher final : public PortPublisher {
     ++pump_samples;
     changed_.notify_all();
   }
-  void node_status(const std::string&, const rack::PumpView& pump, const devicenet::Node& node,
+  void node_status(const std::string&, const rack::PumpView& pump, const NodeStatusView& node,
                    TimePoint) override {
     std::lock_guard lock(mutex_);
-    node_states[pump.mac.value()] = node.state();
+    node_states[pump.mac.value()] = node.state;
     ++status_samples;
     changed_.notify_all();
   }
