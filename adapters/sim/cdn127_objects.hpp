@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string_view>
 
 #include "adapters/sim/cdn127_device.hpp"
 #include "bridge/common/bytes.hpp"
@@ -47,7 +48,7 @@ struct ClassAttributeDef {
 
 struct ClassDef {
   std::uint8_t id;
-  const char* name;
+  std::string_view name;  // cip::class_name for the common classes
   std::span<const ClassAttributeDef> class_attributes;
   std::span<const AttributeDef> instance_attributes;
   // Services the manual's "Common Services" table lists ("Class" / "Instance" columns).

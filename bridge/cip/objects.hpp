@@ -1,8 +1,11 @@
 #pragma once
-// The ODVA common objects a DeviceNet master addresses in every device, by
-// name: the Identity object (class 0x01), the DeviceNet object (0x03) and the
-// Connection object (0x05) with its two predefined Group 2 instances. A
-// profile's own objects are its profile's (profiles/cdn127/objects.hpp).
+// The ODVA objects, by number and by name: the class codes of the common
+// objects (one table, class_name), the attribute numbers of the objects every
+// DeviceNet device has (Identity, DeviceNet, Connection with its two
+// predefined Group 2 instances), and the attributes the master addresses by
+// name (AttributeRef). What a profile defines itself (its vendor classes,
+// the attribute numbers its manual gives for its I/O points) is its
+// profile's (profiles/cdn127/objects.hpp).
 #include <cstdint>
 #include <string_view>
 
@@ -20,43 +23,122 @@ struct AttributeRef {
   }
 };
 
+namespace class_id {
+inline constexpr std::uint16_t kIdentity = 0x01;
+inline constexpr std::uint16_t kMessageRouter = 0x02;
+inline constexpr std::uint16_t kDeviceNet = 0x03;
+inline constexpr std::uint16_t kAssembly = 0x04;
+inline constexpr std::uint16_t kConnection = 0x05;
+inline constexpr std::uint16_t kDiscreteInputPoint = 0x08;
+inline constexpr std::uint16_t kDiscreteOutputPoint = 0x09;
+inline constexpr std::uint16_t kAnalogInputPoint = 0x0A;
+inline constexpr std::uint16_t kAnalogOutputPoint = 0x0B;
+}  // namespace class_id
+
+// "Identity", "Discrete Output Point", ...; empty for a class not above.
+constexpr std::string_view class_name(std::uint16_t class_id) noexcept {
+  switch (class_id) {
+    case class_id::kIdentity:
+      return "Identity";
+    case class_id::kMessageRouter:
+      return "Message Router";
+    case class_id::kDeviceNet:
+      return "DeviceNet";
+    case class_id::kAssembly:
+      return "Assembly";
+    case class_id::kConnection:
+      return "Connection";
+    case class_id::kDiscreteInputPoint:
+      return "Discrete Input Point";
+    case class_id::kDiscreteOutputPoint:
+      return "Discrete Output Point";
+    case class_id::kAnalogInputPoint:
+      return "Analog Input Point";
+    case class_id::kAnalogOutputPoint:
+      return "Analog Output Point";
+    default:
+      return {};
+  }
+}
+
+// Attribute numbers of the objects every device has.
+namespace identity_attr {
+inline constexpr std::uint8_t kVendor = 1, kProductType = 2, kProductCode = 3, kRevision = 4,
+                              kStatus = 5, kSerialNumber = 6, kProductName = 7, kState = 8;
+}
+namespace devicenet_attr {
+inline constexpr std::uint8_t kMacId = 1, kBaudRate = 2, kBusOffInterrupt = 3, kBusOffCounter = 4,
+                              kAllocationInfo = 5, kMacSwitchChanged = 6, kBaudSwitchChanged = 7,
+                              kMacSwitchValue = 8, kBaudSwitchValue = 9;
+}
+namespace connection_instance {
+inline constexpr std::uint16_t kExplicit = 1, kPoll = 2;
+}
+namespace connection_attr {
+inline constexpr std::uint8_t kState = 1, kInstanceType = 2, kTransportClassTrigger = 3,
+                              kProducedConnectionId = 4, kConsumedConnectionId = 5,
+                              kInitialCommCharacteristics = 6, kProducedSize = 7, kConsumedSize = 8,
+                              kExpectedPacketRate = 9, kWatchdogTimeoutAction = 12,
+                              kProducedPathLength = 13, kProducedPath = 14,
+                              kConsumedPathLength = 15, kConsumedPath = 16, kInhibitTime = 17;
+}
+// Class attributes (instance 0) common to the objects.
+namespace class_attr {
+inline constexpr std::uint8_t kRevision = 1, kMaxInstance = 2, kMaxClassId = 6,
+                              kMaxInstanceAttribute = 7;
+}
+// The Assembly object's data.
+namespace assembly_attr {
+inline constexpr std::uint8_t kData = 3;
+}
+
 namespace identity {
-inline constexpr std::uint16_t kClass = 0x01;
-inline constexpr AttributeRef kVendorId{kClass, 1, 1, "Identity.VendorID"};
-inline constexpr AttributeRef kProductType{kClass, 1, 2, "Identity.ProductType"};
-inline constexpr AttributeRef kProductCode{kClass, 1, 3, "Identity.ProductCode"};
-inline constexpr AttributeRef kRevision{kClass, 1, 4, "Identity.Revision"};
-inline constexpr AttributeRef kStatus{kClass, 1, 5, "Identity.Status"};
-inline constexpr AttributeRef kSerialNumber{kClass, 1, 6, "Identity.SerialNumber"};
-inline constexpr AttributeRef kProductName{kClass, 1, 7, "Identity.ProductName"};
-inline constexpr AttributeRef kState{kClass, 1, 8, "Identity.State"};
+inline constexpr std::uint16_t kClass = class_id::kIdentity;
+inline constexpr AttributeRef kVendorId{kClass, 1, identity_attr::kVendor, "Identity.VendorID"};
+inline constexpr AttributeRef kProductType{kClass, 1, identity_attr::kProductType,
+                                           "Identity.ProductType"};
+inline constexpr AttributeRef kProductCode{kClass, 1, identity_attr::kProductCode,
+                                           "Identity.ProductCode"};
+inline constexpr AttributeRef kRevision{kClass, 1, identity_attr::kRevision, "Identity.Revision"};
+inline constexpr AttributeRef kStatus{kClass, 1, identity_attr::kStatus, "Identity.Status"};
+inline constexpr AttributeRef kSerialNumber{kClass, 1, identity_attr::kSerialNumber,
+                                            "Identity.SerialNumber"};
+inline constexpr AttributeRef kProductName{kClass, 1, identity_attr::kProductName,
+                                           "Identity.ProductName"};
+inline constexpr AttributeRef kState{kClass, 1, identity_attr::kState, "Identity.State"};
 }  // namespace identity
 
 namespace devicenet_object {
-inline constexpr std::uint16_t kClass = 0x03;
+inline constexpr std::uint16_t kClass = class_id::kDeviceNet;
 // {allocation choice BYTE, master MAC USINT (255: none)}
-inline constexpr AttributeRef kAllocationInformation{kClass, 1, 5,
+inline constexpr AttributeRef kAllocationInformation{kClass, 1, devicenet_attr::kAllocationInfo,
                                                      "DeviceNet.AllocationInformation"};
 }  // namespace devicenet_object
 
 namespace connection {
-inline constexpr std::uint16_t kClass = 0x05;
-inline constexpr std::uint16_t kExplicitInstance = 1;  // explicit messaging
-inline constexpr std::uint16_t kPollInstance = 2;      // polled I/O
+inline constexpr std::uint16_t kClass = class_id::kConnection;
+inline constexpr std::uint16_t kExplicitInstance = connection_instance::kExplicit;
+inline constexpr std::uint16_t kPollInstance = connection_instance::kPoll;
 
 inline constexpr AttributeRef kExplicitExpectedPacketRate{
-    kClass, kExplicitInstance, 9, "Connection 1 (explicit).ExpectedPacketRate"};
-inline constexpr AttributeRef kPollProducedSize{kClass, kPollInstance, 7,
+    kClass, kExplicitInstance, connection_attr::kExpectedPacketRate,
+    "Connection 1 (explicit).ExpectedPacketRate"};
+inline constexpr AttributeRef kPollProducedSize{kClass, kPollInstance,
+                                                connection_attr::kProducedSize,
                                                 "Connection 2 (poll).ProducedConnectionSize"};
-inline constexpr AttributeRef kPollConsumedSize{kClass, kPollInstance, 8,
+inline constexpr AttributeRef kPollConsumedSize{kClass, kPollInstance,
+                                                connection_attr::kConsumedSize,
                                                 "Connection 2 (poll).ConsumedConnectionSize"};
-inline constexpr AttributeRef kPollExpectedPacketRate{kClass, kPollInstance, 9,
+inline constexpr AttributeRef kPollExpectedPacketRate{kClass, kPollInstance,
+                                                      connection_attr::kExpectedPacketRate,
                                                       "Connection 2 (poll).ExpectedPacketRate"};
 // The CDN127 manual labels attribute 16 "Production Path" too; it is the
 // consumed path (the ODVA Connection object's attribute 16).
-inline constexpr AttributeRef kPollProducedPath{kClass, kPollInstance, 14,
+inline constexpr AttributeRef kPollProducedPath{kClass, kPollInstance,
+                                                connection_attr::kProducedPath,
                                                 "Connection 2 (poll).ProducedConnectionPath"};
-inline constexpr AttributeRef kPollConsumedPath{kClass, kPollInstance, 16,
+inline constexpr AttributeRef kPollConsumedPath{kClass, kPollInstance,
+                                                connection_attr::kConsumedPath,
                                                 "Connection 2 (poll).ConsumedConnectionPath"};
 }  // namespace connection
 

@@ -94,24 +94,21 @@ std::optional<std::string> identity_reset(const RequestMessage& r) {
 }
 
 std::optional<std::string> output_write(const RequestMessage& r) {
-  std::string_view object;
   std::uint8_t value_attribute = 0;
   switch (r.class_id) {
     case cdn127::class_id::kDiscreteOutputPoint:
-      object = "Discrete Output Point";
       value_attribute = cdn127::dop_attr::kValue;
       break;
     case cdn127::class_id::kAnalogOutputPoint:
-      object = "Analog Output Point";
       value_attribute = cdn127::aop_attr::kValue;
       break;
     case cdn127::class_id::kAssembly:
-      object = "Assembly";
-      value_attribute = 3;  // Data
+      value_attribute = cip::assembly_attr::kData;
       break;
     default:
       return std::nullopt;
   }
+  const std::string_view object = cip::class_name(r.class_id);
   // Instance 0 is the class itself: its attribute 3 is not the value.
   if (r.instance_id == 0 || !writes_attribute(r, value_attribute)) return std::nullopt;
   return fmt::format("{} of {} instance {} {}", service_name(r), object, r.instance_id,

@@ -3,6 +3,8 @@
 // values, as the CDN127 DeviceNet Specifications (rev 1.6) list them.
 #include <cstdint>
 
+#include "bridge/cip/objects.hpp"
+
 namespace dnbridge::profiles::cdn127 {
 
 // Identity object values for a CDN127.
@@ -10,40 +12,22 @@ inline constexpr std::uint16_t kVendorId = 59;       // D.I.P. Inc.
 inline constexpr std::uint16_t kProductType = 27;    // Dry Pump Device
 inline constexpr std::uint16_t kProductCode = 1888;  // CDN127
 
+// Classes: the ODVA common ones (cip::class_id, bridge/cip/objects.hpp) and
+// the two the CDN127 manual adds.
 namespace class_id {
-inline constexpr std::uint8_t kIdentity = 0x01;
-inline constexpr std::uint8_t kRouter = 0x02;
-inline constexpr std::uint8_t kDeviceNet = 0x03;
-inline constexpr std::uint8_t kAssembly = 0x04;
-inline constexpr std::uint8_t kConnection = 0x05;
-inline constexpr std::uint8_t kDiscreteInputPoint = 0x08;
-inline constexpr std::uint8_t kDiscreteOutputPoint = 0x09;
-inline constexpr std::uint8_t kAnalogInputPoint = 0x0A;
-inline constexpr std::uint8_t kAnalogOutputPoint = 0x0B;
-inline constexpr std::uint8_t kDeviceSupervisor = 0x32;
-inline constexpr std::uint8_t kConfiguration = 0x40;
+using namespace cip::class_id;
+inline constexpr std::uint16_t kDeviceSupervisor = 0x32;
+inline constexpr std::uint16_t kConfiguration = 0x40;
 }  // namespace class_id
 
-namespace identity_attr {
-inline constexpr std::uint8_t kVendor = 1, kProductType = 2, kProductCode = 3, kRevision = 4,
-                              kStatus = 5, kSerialNumber = 6, kProductName = 7, kState = 8;
-}
-namespace devicenet_attr {
-inline constexpr std::uint8_t kMacId = 1, kBaudRate = 2, kBusOffInterrupt = 3, kBusOffCounter = 4,
-                              kAllocationInfo = 5, kMacSwitchChanged = 6, kBaudSwitchChanged = 7,
-                              kMacSwitchValue = 8, kBaudSwitchValue = 9;
-}
-namespace connection_instance {
-inline constexpr std::uint8_t kExplicit = 1, kPoll = 2;
-}
-namespace connection_attr {
-inline constexpr std::uint8_t kState = 1, kInstanceType = 2, kTransportClassTrigger = 3,
-                              kProducedConnectionId = 4, kConsumedConnectionId = 5,
-                              kInitialCommCharacteristics = 6, kProducedSize = 7,
-                              kConsumedSize = 8, kExpectedPacketRate = 9, kWatchdogTimeoutAction = 12,
-                              kProducedPathLength = 13, kProducedPath = 14,
-                              kConsumedPathLength = 15, kConsumedPath = 16, kInhibitTime = 17;
-}
+// The attributes of the objects every device has are cip's.
+namespace identity_attr = cip::identity_attr;
+namespace devicenet_attr = cip::devicenet_attr;
+namespace connection_instance = cip::connection_instance;
+namespace connection_attr = cip::connection_attr;
+namespace class_attr = cip::class_attr;
+
+// The attributes of the CDN127's I/O points, as its manual numbers them.
 namespace dip_attr {
 inline constexpr std::uint8_t kValue = 3, kStatus = 4;
 }
@@ -69,11 +53,6 @@ namespace configuration_attr {
 inline constexpr std::uint8_t kMode = 1, kNumDigitalInput = 2, kNumDigitalOutput = 3,
                               kNumAnalogInput = 4, kNumAnalogOutput = 5, kNoNcMask = 10,
                               kNumberProduced = 16, kNumberConsumed = 17;
-}
-// Class attributes common to the objects.
-namespace class_attr {
-inline constexpr std::uint8_t kRevision = 1, kMaxInstance = 2, kMaxClassId = 6,
-                              kMaxInstanceAttribute = 7;
 }
 
 // Argument of the Configuration object's Reset service.
