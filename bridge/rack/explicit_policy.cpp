@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 
 #include "bridge/cip/objects.hpp"
 #include "bridge/cip/service.hpp"
@@ -137,138 +138,93 @@ std::optional<std::string> managed_write(const RequestMessage& r, const PolicyNo
                      count > 1 ? fmt::format(" and {} more", count - 1) : std::string());
 }
 
+// Each kind of guarded request, in the order the enum and classify() list
+// them: its key, its name, its risk, its switch and how to recognise it.
+struct GuardDef {
+  GuardedRequest kind;
+  std::string_view key;
+  std::string_view name;
+  std::string_view risk;
+  bool ExplicitPolicy::*allowed;
+  std::optional<std::string> (*recognise)(const RequestMessage&, const PolicyNode&);
+};
+
+constexpr std::array<GuardDef, kGuardedRequestKinds> kGuards{{
+    {GuardedRequest::kAllocateRelease, "allow_allocate_release",
+     "an allocation or release of connections",
+     "the node's connections are the bridge's: a Release drops them and the pump's outputs go "
+     "to their idle or fault values until the bridge has reconnected; an Allocate takes "
+     "connections the bridge does not run",
+     &ExplicitPolicy::allow_allocate_release,
+     [](const RequestMessage& r, const PolicyNode&) { return allocate_release(r); }},
+    {GuardedRequest::kConnectionChange, "allow_connection_changes", "a connection change",
+     "the bridge's connections run with the paths, sizes, expected packet rates and watchdog "
+     "actions it set: a change can stop the I/O, or keep the device from noticing a lost master "
+     "(an expected packet rate of 0 turns its watchdog off)",
+     &ExplicitPolicy::allow_connection_changes,
+     [](const RequestMessage& r, const PolicyNode&) { return connection_change(r); }},
+    {GuardedRequest::kOutputWrite, "allow_output_writes", "an output write",
+     "outputs belong to PumpCommand, whose DDS ownership decides who commands a pump: a direct "
+     "write bypasses it, and can switch a pump that nobody commands",
+     &ExplicitPolicy::allow_output_writes,
+     [](const RequestMessage& r, const PolicyNode&) { return output_write(r); }},
+    {GuardedRequest::kManagedAttributeWrite, "allow_managed_attribute_writes",
+     "a write of an attribute the bridge manages",
+     "the bridge decodes the node's I/O and sets its safe state with these values, read back "
+     "during start-up: a change afterwards breaks decoding or the outputs' fault and idle "
+     "behaviour, unseen, until the node restarts and the bridge writes its own back",
+     &ExplicitPolicy::allow_managed_attribute_writes,
+     [](const RequestMessage& r, const PolicyNode& n) { return managed_write(r, n); }},
+    {GuardedRequest::kIdentityReset, "allow_identity_reset", "a device reset",
+     "the device restarts: its outputs go to their power-up state and the pump is lost until "
+     "the bridge has brought it online again",
+     &ExplicitPolicy::allow_identity_reset,
+     [](const RequestMessage& r, const PolicyNode&) { return identity_reset(r); }},
+    {GuardedRequest::kNetworkSettings, "allow_network_settings",
+     "a change of the node's network settings",
+     "a new MAC ID or bit rate takes the node off this port at its next restart, or puts it at "
+     "another scan-list entry's address, where the bridge would command the wrong pump unless "
+     "that entry pins a serial number",
+     &ExplicitPolicy::allow_network_settings,
+     [](const RequestMessage& r, const PolicyNode&) { return network_setting(r); }},
+    {GuardedRequest::kOtherService, "allow_other_services", "a service the policy does not know",
+     "its effect is unknown to the bridge: it may carry requests of its own "
+     "(Multiple_Service_Packet) or change the device in ways no other key covers",
+     &ExplicitPolicy::allow_other_services,
+     [](const RequestMessage& r, const PolicyNode&) { return other_service(r); }},
+}};
+
+constexpr bool in_enum_order() {
+  for (std::size_t i = 0; i < kGuards.size(); ++i) {
+    if (static_cast<std::size_t>(kGuards[i].kind) != i) return false;
+  }
+  return true;
+}
+static_assert(in_enum_order(), "kGuards lists the kinds in the order of GuardedRequest");
+
+const GuardDef& guard(GuardedRequest kind) noexcept {
+  return kGuards[static_cast<std::size_t>(kind)];
+}
+
 }  // namespace
 
-std::string_view policy_key(GuardedRequest kind) noexcept {
-  switch (kind) {
-    case GuardedRequest::kAllocateRelease:
-      return "allow_allocate_release";
-    case GuardedRequest::kConnectionChange:
-      return "allow_connection_changes";
-    case GuardedRequest::kOutputWrite:
-      return "allow_output_writes";
-    case GuardedRequest::kManagedAttributeWrite:
-      return "allow_managed_attribute_writes";
-    case GuardedRequest::kIdentityReset:
-      return "allow_identity_reset";
-    case GuardedRequest::kNetworkSettings:
-      return "allow_network_settings";
-    case GuardedRequest::kOtherService:
-      return "allow_other_services";
-  }
-  return "?";
-}
-
-std::string_view name_of(GuardedRequest kind) noexcept {
-  switch (kind) {
-    case GuardedRequest::kAllocateRelease:
-      return "an allocation or release of connections";
-    case GuardedRequest::kConnectionChange:
-      return "a connection change";
-    case GuardedRequest::kOutputWrite:
-      return "an output write";
-    case GuardedRequest::kManagedAttributeWrite:
-      return "a write of an attribute the bridge manages";
-    case GuardedRequest::kIdentityReset:
-      return "a device reset";
-    case GuardedRequest::kNetworkSettings:
-      return "a change of the node's network settings";
-    case GuardedRequest::kOtherService:
-      return "a service the policy does not know";
-  }
-  return "?";
-}
-
-std::string_view risk_of(GuardedRequest kind) noexcept {
-  switch (kind) {
-    case GuardedRequest::kAllocateRelease:
-      return "the node's connections are the bridge's: a Release drops them and the pump's "
-             "outputs go to their idle or fault values until the bridge has reconnected; an "
-             "Allocate takes connections the bridge does not run";
-    case GuardedRequest::kConnectionChange:
-      return "the bridge's connections run with the paths, sizes, expected packet rates and "
-             "watchdog actions it set: a change can stop the I/O, or keep the device from "
-             "noticing a lost master (an expected packet rate of 0 turns its watchdog off)";
-    case GuardedRequest::kOutputWrite:
-      return "outputs belong to PumpCommand, whose DDS ownership decides who commands a pump: "
-             "a direct write bypasses it, and can switch a pump that nobody commands";
-    case GuardedRequest::kManagedAttributeWrite:
-      return "the bridge decodes the node's I/O and sets its safe state with these values, "
-             "read back during start-up: a change afterwards breaks decoding or the outputs' "
-             "fault and idle behaviour, unseen, until the node restarts and the bridge writes "
-             "its own back";
-    case GuardedRequest::kIdentityReset:
-      return "the device restarts: its outputs go to their power-up state and the pump is "
-             "lost until the bridge has brought it online again";
-    case GuardedRequest::kNetworkSettings:
-      return "a new MAC ID or bit rate takes the node off this port at its next restart, or "
-             "puts it at another scan-list entry's address, where the bridge would command "
-             "the wrong pump unless that entry pins a serial number";
-    case GuardedRequest::kOtherService:
-      return "its effect is unknown to the bridge: it may carry requests of its own "
-             "(Multiple_Service_Packet) or change the device in ways no other key covers";
-  }
-  return "?";
-}
+std::string_view policy_key(GuardedRequest kind) noexcept { return guard(kind).key; }
+std::string_view name_of(GuardedRequest kind) noexcept { return guard(kind).name; }
+std::string_view risk_of(GuardedRequest kind) noexcept { return guard(kind).risk; }
 
 bool ExplicitPolicy::allows(GuardedRequest kind) const noexcept {
-  switch (kind) {
-    case GuardedRequest::kAllocateRelease:
-      return allow_allocate_release;
-    case GuardedRequest::kConnectionChange:
-      return allow_connection_changes;
-    case GuardedRequest::kOutputWrite:
-      return allow_output_writes;
-    case GuardedRequest::kManagedAttributeWrite:
-      return allow_managed_attribute_writes;
-    case GuardedRequest::kIdentityReset:
-      return allow_identity_reset;
-    case GuardedRequest::kNetworkSettings:
-      return allow_network_settings;
-    case GuardedRequest::kOtherService:
-      return allow_other_services;
-  }
-  return false;
+  return this->*guard(kind).allowed;
 }
 
 void ExplicitPolicy::allow(GuardedRequest kind, bool allowed) noexcept {
-  switch (kind) {
-    case GuardedRequest::kAllocateRelease:
-      allow_allocate_release = allowed;
-      return;
-    case GuardedRequest::kConnectionChange:
-      allow_connection_changes = allowed;
-      return;
-    case GuardedRequest::kOutputWrite:
-      allow_output_writes = allowed;
-      return;
-    case GuardedRequest::kManagedAttributeWrite:
-      allow_managed_attribute_writes = allowed;
-      return;
-    case GuardedRequest::kIdentityReset:
-      allow_identity_reset = allowed;
-      return;
-    case GuardedRequest::kNetworkSettings:
-      allow_network_settings = allowed;
-      return;
-    case GuardedRequest::kOtherService:
-      allow_other_services = allowed;
-      return;
-  }
+  this->*guard(kind).allowed = allowed;
 }
 
 std::vector<Guarded> classify(const RequestMessage& request, const PolicyNode& node) {
   std::vector<Guarded> out;
-  const auto add = [&](GuardedRequest kind, std::optional<std::string> what) {
-    if (what) out.push_back({kind, std::move(*what)});
-  };
-  add(GuardedRequest::kAllocateRelease, allocate_release(request));
-  add(GuardedRequest::kConnectionChange, connection_change(request));
-  add(GuardedRequest::kOutputWrite, output_write(request));
-  add(GuardedRequest::kManagedAttributeWrite, managed_write(request, node));
-  add(GuardedRequest::kIdentityReset, identity_reset(request));
-  add(GuardedRequest::kNetworkSettings, network_setting(request));
-  add(GuardedRequest::kOtherService, other_service(request));
+  for (const GuardDef& g : kGuards) {
+    if (auto what = g.recognise(request, node)) out.push_back({g.kind, std::move(*what)});
+  }
   return out;
 }
 
