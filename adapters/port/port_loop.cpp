@@ -24,9 +24,11 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
       publisher_(publisher),
       log_(log, fmt::format("port {}", config_.port)),
       rack_(config_.pumps) {
-  devicenet::ScannerObserver& observer = *this;
+  // The master's events reach the rack model first, then this loop.
+  observers_.add(rack_);
+  observers_.add(static_cast<devicenet::ScannerObserver&>(*this));
   scanner_.emplace(rack::PumpRack::scanner_config(config_.scanner, config_.pumps), backend_->sink(),
-                   observer, Logger(log, fmt::format("port {}", config_.port)));
+                   observers_, Logger(log, fmt::format("port {}", config_.port)));
   rack_.attach(*scanner_);
   gateway_.emplace(*scanner_, rack::ExplicitGateway::Limits{}, config_.explicit_policy,
                    Logger(log, fmt::format("port {}", config_.port)));
@@ -320,8 +322,7 @@ void PortLoop::note_busy(std::chrono::steady_clock::time_point since) {
                                                         std::chrono::steady_clock::now() - since));
 }
 
-void PortLoop::on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) {
-  rack_.on_port_state(s, r, at);
+void PortLoop::on_port_state(devicenet::PortState s, const std::string&, TimePoint at) {
   if (s == devicenet::PortState::kRunning || s == devicenet::PortState::kDuplicateMac) {
     started_up_.store(true, std::memory_order_relaxed);
   }
@@ -329,22 +330,12 @@ void PortLoop::on_port_state(devicenet::PortState s, const std::string& r, TimeP
   port_event_time_ = at;
 }
 void PortLoop::on_node_state(MacId m, devicenet::NodeState f, devicenet::NodeState t,
-                             const std::string& r, TimePoint at) {
+                             const std::string& r, TimePoint) {
   if (t == devicenet::NodeState::kOnline || f == devicenet::NodeState::kOnline) {
     log_.info("node {} {} -> {}: {}", m.value(), devicenet::to_string(f), devicenet::to_string(t),
               r);
   }
-  rack_.on_node_state(m, f, t, r, at);
   port_dirty_ = true;
-}
-void PortLoop::on_node_identity(MacId m, const devicenet::NodeIdentity& i, TimePoint at) {
-  rack_.on_node_identity(m, i, at);
-}
-void PortLoop::on_poll_response(MacId m, Bytes d, TimePoint at) {
-  rack_.on_poll_response(m, d, at);
-}
-void PortLoop::on_device_state(MacId m, std::uint8_t s, TimePoint at) {
-  rack_.on_device_state(m, s, at);
 }
 void PortLoop::on_explicit_result(std::uint32_t id, MacId, const devicenet::ExplicitResult& r,
                                   TimePoint at) {

@@ -104,14 +104,12 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void publish_port(TimePoint now);
   void update_metrics(const BusCounters& bus, TimePoint now);
 
-  // ScannerObserver: the rack model and the gateway hear the master first.
+  // ScannerObserver, after the rack model (observers_): what the loop itself
+  // does with the master's events (the port's status, a log line, the
+  // gateway's replies).
   void on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) override;
   void on_node_state(devicenet::MacId m, devicenet::NodeState f, devicenet::NodeState t,
                      const std::string& r, TimePoint at) override;
-  void on_node_identity(devicenet::MacId m, const devicenet::NodeIdentity& i,
-                        TimePoint at) override;
-  void on_poll_response(devicenet::MacId m, Bytes d, TimePoint at) override;
-  void on_device_state(devicenet::MacId m, std::uint8_t s, TimePoint at) override;
   void on_explicit_result(std::uint32_t id, devicenet::MacId m, const devicenet::ExplicitResult& r,
                           TimePoint at) override;
   // FrameReceiver
@@ -122,6 +120,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   PortPublisher& publisher_;
   Logger log_;
   rack::PumpRack rack_;
+  devicenet::ObserverFanout observers_;
   std::optional<devicenet::Scanner> scanner_;
   std::optional<rack::ExplicitGateway> gateway_;
 
