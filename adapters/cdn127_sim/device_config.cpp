@@ -15,7 +15,7 @@
 #include <tuple>
 #include <utility>
 
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 #include "adapters/toml/problems.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 

@@ -39,7 +39,7 @@
 #include <string_view>
 #include <vector>
 
-#include "adapters/sim/cdn127_device.hpp"
+#include "adapters/sim/cdn127/cdn127_device.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/mac_id.hpp"
 

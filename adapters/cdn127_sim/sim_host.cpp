@@ -15,7 +15,7 @@
 
 #include "adapters/cdn127_sim/device_config.hpp"
 #include "adapters/port/steady_time.hpp"
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 
 namespace dnbridge::cdn127_sim {

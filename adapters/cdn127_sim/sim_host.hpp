@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "adapters/cdn127_sim/control.hpp"
-#include "adapters/sim/cdn127_slave.hpp"
+#include "adapters/sim/cdn127/cdn127_slave.hpp"
 #include "adapters/socketcan/can_socket.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/mac_id.hpp"

@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "adapters/sim/sim_backend.hpp"
+#include "adapters/sim/world/sim_backend.hpp"
 
 namespace dnbridge::daemon {
 

@@ -1,9 +1,9 @@
 // dnbridge-demo: the DeviceNet master scanning a simulated rack of CDN127
 // pump interfaces in real time, with a scripted scenario and a live table.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -17,8 +17,8 @@
 
 #include "adapters/demo/rack_table.hpp"
 #include "adapters/demo/scenario.hpp"
-#include "adapters/sim/pcap_writer.hpp"
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/bus/pcap_writer.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 
 namespace {
 

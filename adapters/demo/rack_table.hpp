@@ -3,7 +3,7 @@
 #include <deque>
 #include <string>
 
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 
 namespace dnbridge::demo {
 

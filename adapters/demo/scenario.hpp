@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 
 namespace dnbridge::demo {
 

@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <new>
 
-#include "adapters/sim/sim_rack.hpp"
-#include "adapters/sim/sim_world.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
+#include "adapters/sim/world/sim_world.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 
 namespace {

@@ -80,7 +80,7 @@
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
-#include "adapters/sim/threaded_sim_backend.hpp"
+#include "adapters/sim/world/threaded_sim_backend.hpp"
 #include "bridge/can/can_timing.hpp"
 #include "bridge/devicenet/identifier.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"

@@ -36,7 +36,7 @@
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
-#include "adapters/sim/sim_backend.hpp"
+#include "adapters/sim/world/sim_backend.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "dds/dds_fixture.hpp"
 

@@ -3,7 +3,7 @@
 //   0x41B explicit/unconnected response   0x41C explicit request
 //   0x41D poll command                    0x41E Allocate/Release
 //   0x41F duplicate MAC check             0x3C3 poll response
-#include "adapters/sim/cdn127_slave.hpp"
+#include "adapters/sim/cdn127/cdn127_slave.hpp"
 
 #include <gtest/gtest.h>
 

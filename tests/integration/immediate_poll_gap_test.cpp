@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 #include "bridge/devicenet/identifier.hpp"
 #include "integration/rack_fixture.hpp"
 

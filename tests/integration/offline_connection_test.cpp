@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "adapters/sim/cdn127_slave.hpp"
+#include "adapters/sim/cdn127/cdn127_slave.hpp"
 #include "support/bytes.hpp"
 #include "support/sim_slave_driver.hpp"
 

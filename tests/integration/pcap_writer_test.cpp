@@ -1,4 +1,4 @@
-#include "adapters/sim/pcap_writer.hpp"
+#include "adapters/sim/bus/pcap_writer.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -8,7 +8,7 @@
 #include <set>
 #include <vector>
 
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 #include "bridge/devicenet/identifier.hpp"
 #include "integration/rack_fixture.hpp"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 
 namespace dnbridge::test {

@@ -1,4 +1,4 @@
-#include "adapters/sim/virtual_bus.hpp"
+#include "adapters/sim/bus/virtual_bus.hpp"
 
 #include <gtest/gtest.h>
 

@@ -14,8 +14,8 @@
 #include <map>
 #include <mutex>
 
-#include "adapters/sim/sim_backend.hpp"
-#include "adapters/sim/threaded_sim_backend.hpp"
+#include "adapters/sim/world/sim_backend.hpp"
+#include "adapters/sim/world/threaded_sim_backend.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 
 namespace dnbridge::port {

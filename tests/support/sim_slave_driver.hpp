@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "adapters/sim/cdn127_slave.hpp"
+#include "adapters/sim/cdn127/cdn127_slave.hpp"
 #include "bridge/can/frame_sink.hpp"
 
 namespace dnbridge::test {

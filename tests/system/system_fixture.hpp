@@ -22,7 +22,7 @@
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
-#include "adapters/sim/pcap_writer.hpp"
+#include "adapters/sim/bus/pcap_writer.hpp"
 #include "adapters/socketcan/can_socket.hpp"
 
 namespace dnbridge::system_test {

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/sim/pcap_writer.hpp"
+#include "adapters/sim/bus/pcap_writer.hpp"
 #include "bridge/cip/service.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 #include "integration/rack_fixture.hpp"

@@ -5,10 +5,11 @@
 // valid CAN 2.0A frame from this device's MAC; a device in Communication
 // Fault answers only the Offline Connection Set (Group 4), which exists to
 // reach it there; its state stays within what the device can hold.
+#include "adapters/sim/cdn127/cdn127_slave.hpp"
+
 #include <cstddef>
 #include <cstdint>
 
-#include "adapters/sim/cdn127_slave.hpp"
 #include "bridge/devicenet/identifier.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 #include "tests/fuzz/support/session_records.hpp"

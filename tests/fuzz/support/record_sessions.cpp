@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/sim/cdn127_slave.hpp"
+#include "adapters/sim/cdn127/cdn127_slave.hpp"
 #include "bridge/devicenet/scanner.hpp"
 #include "tests/fuzz/support/session_records.hpp"
 

@@ -15,8 +15,8 @@
 #include <optional>
 #include <vector>
 
-#include "adapters/sim/cdn127_device.hpp"
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/cdn127/cdn127_device.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/scan_list.hpp"

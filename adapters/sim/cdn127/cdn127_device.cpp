@@ -1,4 +1,4 @@
-#include "adapters/sim/cdn127_device.hpp"
+#include "adapters/sim/cdn127/cdn127_device.hpp"
 
 #include <algorithm>
 #include <utility>
@@ -39,10 +39,14 @@ bool is_consumed_assembly(std::uint8_t a) noexcept { return a == 5 || a == 100 |
 
 std::uint16_t aop_action(std::uint8_t state, std::uint16_t value, std::uint16_t current) noexcept {
   switch (state) {
-    case 1: return 0;
-    case 2: return profiles::cdn127::kAnalogMaxRaw;
-    case 3: return value;
-    default: return current;  // 0: hold the last value
+    case 1:
+      return 0;
+    case 2:
+      return profiles::cdn127::kAnalogMaxRaw;
+    case 3:
+      return value;
+    default:
+      return current;  // 0: hold the last value
   }
 }
 
@@ -295,13 +299,15 @@ Reply Cdn127Device::reset_connection(std::uint16_t instance, TimePoint now) noex
 
 std::uint16_t Cdn127Device::produced_size(std::uint16_t instance) const noexcept {
   if (instance == profiles::cdn127::connection_instance::kExplicit) return kExplicitMessageSize;
-  auto layout = profiles::cdn127::produced_assembly_layout(poll_.produced_assembly, e2_.configuration);
+  auto layout =
+      profiles::cdn127::produced_assembly_layout(poll_.produced_assembly, e2_.configuration);
   return layout.ok() ? static_cast<std::uint16_t>(layout->size) : 0;
 }
 
 std::uint16_t Cdn127Device::consumed_size(std::uint16_t instance) const noexcept {
   if (instance == profiles::cdn127::connection_instance::kExplicit) return kExplicitMessageSize;
-  auto layout = profiles::cdn127::consumed_assembly_layout(poll_.consumed_assembly, e2_.configuration);
+  auto layout =
+      profiles::cdn127::consumed_assembly_layout(poll_.consumed_assembly, e2_.configuration);
   return layout.ok() ? static_cast<std::uint16_t>(layout->size) : 0;
 }
 
@@ -310,7 +316,8 @@ void Cdn127Device::explicit_consumed(TimePoint now) noexcept {
   if (explicit_.state == ConnectionState::kEstablished) restart_watchdog(explicit_, now);
 }
 
-std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout, MutableBytes out) noexcept {
+std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout,
+                                         MutableBytes out) noexcept {
   pump_.advance(now_);
   const std::uint8_t bits = pump_.inputs().encode(e2_.configuration.no_nc_mask);
   auto size = profiles::cdn127::encode_poll_response(layout, exception_status_byte(), bits,
@@ -364,7 +371,8 @@ PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {
       apply_idle_actions(now);
       poll_running_ = false;
     } else if (result.outcome == PollOutcome::kApplied) {
-      if (request_layout->size > 0) apply_decoded_outputs(*request_layout, decoded, OutputCause::kPoll, now);
+      if (request_layout->size > 0)
+        apply_decoded_outputs(*request_layout, decoded, OutputCause::kPoll, now);
       poll_running_ = true;
     }
   };
@@ -395,7 +403,8 @@ std::size_t Cdn127Device::consumed_data(std::uint8_t assembly, MutableBytes out)
   return size.ok() ? *size : 0;
 }
 
-Reply Cdn127Device::set_consumed_assembly(std::uint8_t assembly, Bytes data, TimePoint now) noexcept {
+Reply Cdn127Device::set_consumed_assembly(std::uint8_t assembly, Bytes data,
+                                          TimePoint now) noexcept {
   now_ = now;
   auto layout = profiles::cdn127::consumed_assembly_layout(assembly, e2_.configuration);
   if (!layout.ok()) return reply_error(GeneralStatus::kAttributeNotSettable);
@@ -413,8 +422,9 @@ Reply Cdn127Device::set_consumed_assembly(std::uint8_t assembly, Bytes data, Tim
   return kReplyOk;
 }
 
-void Cdn127Device::apply_decoded_outputs(const PollRequestLayout& layout, const PumpOutputs& decoded,
-                                         OutputCause cause, TimePoint now) noexcept {
+void Cdn127Device::apply_decoded_outputs(const PollRequestLayout& layout,
+                                         const PumpOutputs& decoded, OutputCause cause,
+                                         TimePoint now) noexcept {
   // Fields the layout does not carry keep their values.
   PumpOutputs next = pump_.outputs();
   if (layout.dout_size > 0) {
@@ -497,10 +507,10 @@ void Cdn127Device::set_faults(const IdentityFaults& faults, TimePoint now) noexc
 // S-Device Supervisor stops in Abort on a recoverable fault and in Critical
 // Fault on an unrecoverable one.
 std::uint8_t Cdn127Device::supervisor_device_status() const noexcept {
-  if (faults_.major_unrecoverable) return 6;  // Critical Fault
-  if (faults_.major_recoverable) return 5;    // Abort
+  if (faults_.major_unrecoverable) return 6;                                    // Critical Fault
+  if (faults_.major_recoverable) return 5;                                      // Abort
   if (poll_.state == ConnectionState::kEstablished && poll_running_) return 4;  // Executing
-  return 2;  // Idle
+  return 2;                                                                     // Idle
 }
 
 std::uint8_t Cdn127Device::exception_status_byte() noexcept {
@@ -567,7 +577,8 @@ void Cdn127Device::poll_timeout(TimePoint now) noexcept {
 
 void Cdn127Device::release_if_nothing_established() noexcept {
   if (!owned()) return;
-  if (explicit_.state == ConnectionState::kEstablished || poll_.state == ConnectionState::kEstablished) {
+  if (explicit_.state == ConnectionState::kEstablished ||
+      poll_.state == ConnectionState::kEstablished) {
     return;
   }
   // With nothing left established the slave drops the whole set; the master
@@ -607,7 +618,8 @@ void Cdn127Device::on_timer(TimePoint now) noexcept {
 
 TimePoint Cdn127Device::next_deadline() const noexcept {
   TimePoint t = pump_.next_deadline();
-  if (explicit_.state == ConnectionState::kEstablished) t = std::min(t, explicit_.watchdog_deadline);
+  if (explicit_.state == ConnectionState::kEstablished)
+    t = std::min(t, explicit_.watchdog_deadline);
   if (poll_.state == ConnectionState::kEstablished) t = std::min(t, poll_.watchdog_deadline);
   return t;
 }

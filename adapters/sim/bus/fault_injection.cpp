@@ -1,4 +1,4 @@
-#include "adapters/sim/fault_injection.hpp"
+#include "adapters/sim/bus/fault_injection.hpp"
 
 #include <algorithm>
 #include <array>

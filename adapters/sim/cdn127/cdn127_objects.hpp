@@ -10,7 +10,7 @@
 #include <span>
 #include <string_view>
 
-#include "adapters/sim/cdn127_device.hpp"
+#include "adapters/sim/cdn127/cdn127_device.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/explicit_message.hpp"

@@ -1,4 +1,4 @@
-#include "adapters/sim/sim_world.hpp"
+#include "adapters/sim/world/sim_world.hpp"
 
 #include <algorithm>
 #include <stdexcept>

@@ -7,9 +7,9 @@
 #include <optional>
 #include <vector>
 
-#include "adapters/sim/sim_master.hpp"
-#include "adapters/sim/sim_slave.hpp"
-#include "adapters/sim/sim_world.hpp"
+#include "adapters/sim/world/sim_master.hpp"
+#include "adapters/sim/world/sim_slave.hpp"
+#include "adapters/sim/world/sim_world.hpp"
 #include "bridge/rack/pump_rack.hpp"
 
 namespace dnbridge::sim {

@@ -1,4 +1,4 @@
-#include "adapters/sim/sim_slave.hpp"
+#include "adapters/sim/world/sim_slave.hpp"
 
 namespace dnbridge::sim {
 

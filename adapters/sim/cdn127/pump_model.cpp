@@ -1,4 +1,4 @@
-#include "adapters/sim/pump_model.hpp"
+#include "adapters/sim/cdn127/pump_model.hpp"
 
 namespace dnbridge::sim {
 

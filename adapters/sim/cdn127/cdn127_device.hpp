@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "adapters/sim/pump_model.hpp"
+#include "adapters/sim/cdn127/pump_model.hpp"
 #include "bridge/cip/general_status.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
@@ -254,7 +254,7 @@ struct Connection {
 // attribute 8); the manual names no exit for the minor one, which is taken to
 // be the same. An Identity Reset is no power cycle: it clears neither.
 struct IdentityFaults {
-  bool minor_recoverable = false;    // DOP short circuit
+  bool minor_recoverable = false;  // DOP short circuit
   bool minor_unrecoverable = false;
   bool major_recoverable = false;    // loss of +24 Vdc
   bool major_unrecoverable = false;  // checksum, A/D
@@ -318,7 +318,9 @@ class Cdn127Device {
   void set_switches(std::uint8_t mac_switch, std::uint8_t baud_switch) noexcept;
   std::uint8_t mac_switch() const noexcept { return mac_switch_; }
   std::uint8_t baud_switch() const noexcept { return baud_switch_; }
-  bool mac_switch_in_program_position() const noexcept { return mac_switch_ > devicenet::MacId::kMax; }
+  bool mac_switch_in_program_position() const noexcept {
+    return mac_switch_ > devicenet::MacId::kMax;
+  }
   bool baud_switch_in_program_position() const noexcept { return baud_switch_ > 2; }
   bool mac_switch_changed() const noexcept { return mac_switch_ != mac_switch_at_power_up_; }
   bool baud_switch_changed() const noexcept { return baud_switch_ != baud_switch_at_power_up_; }
@@ -355,7 +357,9 @@ class Cdn127Device {
   std::uint16_t consumed_size(std::uint16_t instance) const noexcept;
   // Every message the explicit connection consumes restarts its watchdog.
   void explicit_consumed(TimePoint now) noexcept;
-  bool explicit_established() const noexcept { return explicit_.state == ConnectionState::kEstablished; }
+  bool explicit_established() const noexcept {
+    return explicit_.state == ConnectionState::kEstablished;
+  }
 
   // --- poll I/O ---
   PollResult on_poll(Bytes command, TimePoint now) noexcept;
@@ -374,7 +378,9 @@ class Cdn127Device {
   void apply_idle_actions(TimePoint now) noexcept;
 
   // --- Configuration object ---
-  const profiles::cdn127::IoConfiguration& configuration() const noexcept { return e2_.configuration; }
+  const profiles::cdn127::IoConfiguration& configuration() const noexcept {
+    return e2_.configuration;
+  }
   // Refused with 0x0C while the poll connection is established (manual,
   // NOTE 1), or while it exists at all with
   // SlaveOptions::configuration_locked_while_poll_allocated.

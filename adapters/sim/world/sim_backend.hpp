@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "adapters/port/can_backend.hpp"
-#include "adapters/sim/sim_slave.hpp"
-#include "adapters/sim/sim_world.hpp"
+#include "adapters/sim/world/sim_slave.hpp"
+#include "adapters/sim/world/sim_world.hpp"
 
 namespace dnbridge::sim {
 

@@ -1,4 +1,4 @@
-#include "adapters/sim/cdn127_objects.hpp"
+#include "adapters/sim/cdn127/cdn127_objects.hpp"
 
 #include <array>
 #include <optional>
@@ -85,9 +85,21 @@ bool single_instance(const Cdn127Device&, std::uint16_t instance) noexcept { ret
 constexpr ClassAttributeDef kIdentityClass[] = {{1, 1}, {2, 1}, {6, 7}, {7, 7}};
 
 const AttributeDef kIdentityAttributes[] = {
-    {1, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u16(w, profiles::cdn127::kVendorId); }, nullptr},
-    {2, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u16(w, profiles::cdn127::kProductType); }, nullptr},
-    {3, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u16(w, profiles::cdn127::kProductCode); }, nullptr},
+    {1, Access::kGet,
+     [](const RequestContext&, ByteWriter& w) noexcept {
+       return put_u16(w, profiles::cdn127::kVendorId);
+     },
+     nullptr},
+    {2, Access::kGet,
+     [](const RequestContext&, ByteWriter& w) noexcept {
+       return put_u16(w, profiles::cdn127::kProductType);
+     },
+     nullptr},
+    {3, Access::kGet,
+     [](const RequestContext&, ByteWriter& w) noexcept {
+       return put_u16(w, profiles::cdn127::kProductCode);
+     },
+     nullptr},
     {4, Access::kGet,
      [](const RequestContext& c, ByteWriter& w) noexcept {
        w.u8(c.device.options().revision_major);
@@ -95,7 +107,11 @@ const AttributeDef kIdentityAttributes[] = {
        return kReplyOk;
      },
      nullptr},
-    {5, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u16(w, c.device.identity_status()); }, nullptr},
+    {5, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u16(w, c.device.identity_status());
+     },
+     nullptr},
     {6, Access::kGet,
      [](const RequestContext& c, ByteWriter& w) noexcept {
        // UINT per the manual's table; UDINT as an option (ODVA Identity).
@@ -108,8 +124,14 @@ const AttributeDef kIdentityAttributes[] = {
        return kReplyOk;
      },
      nullptr},
-    {7, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "CDN127"); }, nullptr},
-    {8, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.identity_state()); }, nullptr},
+    {7, Access::kGet,
+     [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "CDN127"); },
+     nullptr},
+    {8, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, c.device.identity_state());
+     },
+     nullptr},
 };
 
 // Reset type 0 (or no data): emulate a power cycle; 1: back to the
@@ -118,7 +140,8 @@ Reply identity_reset(const RequestContext& c, Bytes data, ByteWriter&) noexcept 
   if (data.size() > 1) return reply_error(GeneralStatus::kTooMuchData);
   const std::uint8_t type = data.empty() ? 0 : data[0];
   if (type > 1) return reply_error(GeneralStatus::kInvalidParameter);
-  c.device.request_action(type == 0 ? PendingAction::kRestart : PendingAction::kRestartFactoryDefaults);
+  c.device.request_action(type == 0 ? PendingAction::kRestart
+                                    : PendingAction::kRestartFactoryDefaults);
   return kReplyOk;
 }
 
@@ -128,7 +151,8 @@ Reply identity_reset(const RequestContext& c, Bytes data, ByteWriter&) noexcept 
 constexpr ClassAttributeDef kRouterClass[] = {{1, 1}, {6, 7}, {7, 2}};
 
 const AttributeDef kRouterAttributes[] = {
-    {2, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u16(w, 2); }, nullptr},
+    {2, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u16(w, 2); },
+     nullptr},
 };
 
 // ---------------------------------------------------------------------------
@@ -145,13 +169,16 @@ Reply mac_switch_attr(const RequestContext& c, ByteWriter& w, bool changed) noex
 }
 Reply baud_switch_attr(const RequestContext& c, ByteWriter& w, bool changed) noexcept {
   const Cdn127Device& d = c.device;
-  if (d.baud_switch_in_program_position()) return reply_error(GeneralStatus::kAttributeNotSupported);
+  if (d.baud_switch_in_program_position())
+    return reply_error(GeneralStatus::kAttributeNotSupported);
   return put_u8(w, changed ? static_cast<std::uint8_t>(d.baud_switch_changed()) : d.baud_switch());
 }
 
 const AttributeDef kDeviceNetAttributes[] = {
     {1, Access::kGetSet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.mac().value()); },
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, c.device.mac().value());
+     },
      [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
        std::uint8_t v = 0;
        Reply r = read_u8(data, v);
@@ -166,12 +193,16 @@ const AttributeDef kDeviceNetAttributes[] = {
        return r.ok() ? c.device.set_baud(v) : r;
      }},
     {3, Access::kGetSet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.e2().bus_off_interrupt ? 1 : 0); },
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, c.device.e2().bus_off_interrupt ? 1 : 0);
+     },
      [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
        return read_bool(data, c.device.e2().bus_off_interrupt);
      }},
     {4, Access::kGetSet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.bus_off_counter()); },
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, c.device.bus_off_counter());
+     },
      // "forced to 0 whenever set regardless of the data value provided"
      [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
        std::uint8_t ignored = 0;
@@ -186,10 +217,18 @@ const AttributeDef kDeviceNetAttributes[] = {
        return kReplyOk;
      },
      nullptr},
-    {6, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return mac_switch_attr(c, w, true); }, nullptr},
-    {7, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return baud_switch_attr(c, w, true); }, nullptr},
-    {8, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return mac_switch_attr(c, w, false); }, nullptr},
-    {9, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return baud_switch_attr(c, w, false); }, nullptr},
+    {6, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept { return mac_switch_attr(c, w, true); },
+     nullptr},
+    {7, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept { return baud_switch_attr(c, w, true); },
+     nullptr},
+    {8, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept { return mac_switch_attr(c, w, false); },
+     nullptr},
+    {9, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept { return baud_switch_attr(c, w, false); },
+     nullptr},
 };
 
 // Allocate: [choice][allocator MAC] -> [reserved:4 | body format:4].
@@ -230,7 +269,8 @@ const AttributeDef kAssemblyAttributes[] = {
        return kReplyOk;
      },
      [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
-       if (!is_consumed_assembly(c.instance)) return reply_error(GeneralStatus::kAttributeNotSettable);
+       if (!is_consumed_assembly(c.instance))
+         return reply_error(GeneralStatus::kAttributeNotSettable);
        return c.device.set_consumed_assembly(static_cast<std::uint8_t>(c.instance), data, c.now);
      }},
 };
@@ -240,7 +280,9 @@ const AttributeDef kAssemblyAttributes[] = {
 
 constexpr ClassAttributeDef kConnectionClass[] = {{1, 1}};
 
-bool connection_exists(const Cdn127Device& d, std::uint16_t i) noexcept { return d.connection_exists(i); }
+bool connection_exists(const Cdn127Device& d, std::uint16_t i) noexcept {
+  return d.connection_exists(i);
+}
 bool is_explicit(const RequestContext& c) noexcept {
   return c.instance == profiles::cdn127::connection_instance::kExplicit;
 }
@@ -288,9 +330,9 @@ Reply set_path(const RequestContext& c, Bytes data, bool produced) noexcept {
 
 std::uint16_t produced_connection_id(const RequestContext& c) noexcept {
   const auto mac = c.device.mac();
-  return static_cast<std::uint16_t>(is_explicit(c)
-                                        ? devicenet::group2_id(mac, Group2Message::kSlaveExplicitResponse)
-                                        : devicenet::group1_id(Group1Message::kSlavePollResponse, mac));
+  return static_cast<std::uint16_t>(
+      is_explicit(c) ? devicenet::group2_id(mac, Group2Message::kSlaveExplicitResponse)
+                     : devicenet::group1_id(Group1Message::kSlavePollResponse, mac));
 }
 std::uint16_t consumed_connection_id(const RequestContext& c) noexcept {
   const auto mac = c.device.mac();
@@ -304,13 +346,41 @@ const AttributeDef kConnectionAttributes[] = {
        return put_u8(w, static_cast<std::uint8_t>(c.device.connection(c.instance)->state));
      },
      nullptr},
-    {2, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, is_explicit(c) ? 0 : 1); }, nullptr},
-    {3, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, is_explicit(c) ? 0x83 : 0x82); }, nullptr},
-    {4, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u16(w, produced_connection_id(c)); }, nullptr},
-    {5, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u16(w, consumed_connection_id(c)); }, nullptr},
-    {6, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, is_explicit(c) ? 0x21 : 0x01); }, nullptr},
-    {7, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u16(w, c.device.produced_size(c.instance)); }, nullptr},
-    {8, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u16(w, c.device.consumed_size(c.instance)); }, nullptr},
+    {2, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, is_explicit(c) ? 0 : 1);
+     },
+     nullptr},
+    {3, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, is_explicit(c) ? 0x83 : 0x82);
+     },
+     nullptr},
+    {4, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u16(w, produced_connection_id(c));
+     },
+     nullptr},
+    {5, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u16(w, consumed_connection_id(c));
+     },
+     nullptr},
+    {6, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, is_explicit(c) ? 0x21 : 0x01);
+     },
+     nullptr},
+    {7, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u16(w, c.device.produced_size(c.instance));
+     },
+     nullptr},
+    {8, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u16(w, c.device.consumed_size(c.instance));
+     },
+     nullptr},
     {9, Access::kGetSet,
      [](const RequestContext& c, ByteWriter& w) noexcept {
        return put_u16(w, c.device.connection(c.instance)->expected_packet_rate_ms);
@@ -327,22 +397,32 @@ const AttributeDef kConnectionAttributes[] = {
      }},
     {12, Access::kGetSet,  // Get only on the explicit connection (manual: "fixed value")
      [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u8(w, static_cast<std::uint8_t>(c.device.connection(c.instance)->watchdog_action));
+       return put_u8(w,
+                     static_cast<std::uint8_t>(c.device.connection(c.instance)->watchdog_action));
      },
      [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
        std::uint8_t v = 0;
        Reply r = read_u8(data, v);
        return r.ok() ? c.device.set_watchdog_action(c.instance, v) : r;
      }},
-    {13, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_path_length(c, w, true); }, nullptr},
+    {13, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept { return put_path_length(c, w, true); },
+     nullptr},
     {14, Access::kGetSet,
      [](const RequestContext& c, ByteWriter& w) noexcept { return put_path(c, w, true); },
-     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept { return set_path(c, data, true); }},
-    {15, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_path_length(c, w, false); }, nullptr},
+     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
+       return set_path(c, data, true);
+     }},
+    {15, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept { return put_path_length(c, w, false); },
+     nullptr},
     {16, Access::kGetSet,
      [](const RequestContext& c, ByteWriter& w) noexcept { return put_path(c, w, false); },
-     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept { return set_path(c, data, false); }},
-    {17, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u16(w, 0); }, nullptr},
+     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
+       return set_path(c, data, false);
+     }},
+    {17, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u16(w, 0); },
+     nullptr},
 };
 
 Reply connection_reset(const RequestContext& c, Bytes data, ByteWriter&) noexcept {
@@ -371,11 +451,13 @@ const AttributeDef kDipAttributes[] = {
     {3, Access::kGet,
      [](const RequestContext& c, ByteWriter& w) noexcept {
        c.device.pump().advance(c.now);
-       const std::uint8_t bits = c.device.pump().inputs().encode(c.device.configuration().no_nc_mask);
+       const std::uint8_t bits =
+           c.device.pump().inputs().encode(c.device.configuration().no_nc_mask);
        return put_u8(w, static_cast<std::uint8_t>((bits >> (c.instance - 1)) & 1));
      },
      nullptr},
-    {4, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 0); }, nullptr},
+    {4, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 0); },
+     nullptr},
 };
 
 // ---------------------------------------------------------------------------
@@ -389,7 +471,9 @@ bool dop_exists(const Cdn127Device&, std::uint16_t i) noexcept { return i == 1 |
 bool dop_output(const PumpOutputs& o, std::uint16_t instance) noexcept {
   return instance == 1 ? o.pump_on : o.n2_ballast_on;
 }
-DopSettings& dop_settings(const RequestContext& c) noexcept { return c.device.e2().dop[c.instance - 1u]; }
+DopSettings& dop_settings(const RequestContext& c) noexcept {
+  return c.device.e2().dop[c.instance - 1u];
+}
 
 template <bool DopSettings::*Field>
 Reply get_dop_setting(const RequestContext& c, ByteWriter& w) noexcept {
@@ -414,12 +498,18 @@ const AttributeDef kDopAttributes[] = {
        return c.device.set_outputs(o, OutputCause::kExplicit, c.now);
      }},
     {4, Access::kGet,  // a short circuit is the Identity's minor recoverable fault
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.faults().minor_recoverable ? 1 : 0); },
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, c.device.faults().minor_recoverable ? 1 : 0);
+     },
      nullptr},
-    {5, Access::kGetSet, get_dop_setting<&DopSettings::fault_hold>, set_dop_setting<&DopSettings::fault_hold>},
-    {6, Access::kGetSet, get_dop_setting<&DopSettings::fault_value>, set_dop_setting<&DopSettings::fault_value>},
-    {7, Access::kGetSet, get_dop_setting<&DopSettings::idle_hold>, set_dop_setting<&DopSettings::idle_hold>},
-    {8, Access::kGetSet, get_dop_setting<&DopSettings::idle_value>, set_dop_setting<&DopSettings::idle_value>},
+    {5, Access::kGetSet, get_dop_setting<&DopSettings::fault_hold>,
+     set_dop_setting<&DopSettings::fault_hold>},
+    {6, Access::kGetSet, get_dop_setting<&DopSettings::fault_value>,
+     set_dop_setting<&DopSettings::fault_value>},
+    {7, Access::kGetSet, get_dop_setting<&DopSettings::idle_hold>,
+     set_dop_setting<&DopSettings::idle_hold>},
+    {8, Access::kGetSet, get_dop_setting<&DopSettings::idle_value>,
+     set_dop_setting<&DopSettings::idle_value>},
 };
 
 // ---------------------------------------------------------------------------
@@ -436,9 +526,12 @@ const AttributeDef kAipAttributes[] = {
        return put_u16(w, c.device.pump().analog_inputs_raw()[c.instance - 1u]);
      },
      nullptr},
-    {4, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 0); }, nullptr},
-    {7, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 2); }, nullptr},
-    {8, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 0); }, nullptr},
+    {4, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 0); },
+     nullptr},
+    {7, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 2); },
+     nullptr},
+    {8, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 0); },
+     nullptr},
 };
 
 // ---------------------------------------------------------------------------
@@ -468,19 +561,30 @@ Reply set_aop_value(const RequestContext& c, Bytes data, ByteWriter&) noexcept {
   std::uint16_t v = 0;
   Reply r = read_u16(data, v);
   if (!r.ok()) return r;
-  if (v > profiles::cdn127::kAnalogMaxRaw) return reply_error(GeneralStatus::kInvalidAttributeValue);
+  if (v > profiles::cdn127::kAnalogMaxRaw)
+    return reply_error(GeneralStatus::kInvalidAttributeValue);
   c.device.e2().aop.*Field = v;
   return kReplyOk;
 }
 
 const AttributeDef kAopAttributes[] = {
-    {3, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u16(w, c.device.pump().analog_out_raw()); }, nullptr},
-    {7, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 1); }, nullptr},
-    {8, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 0); }, nullptr},
-    {9, Access::kGetSet, get_aop_state<&AopSettings::fault_state>, set_aop_state<&AopSettings::fault_state>},
-    {10, Access::kGetSet, get_aop_state<&AopSettings::idle_state>, set_aop_state<&AopSettings::idle_state>},
-    {11, Access::kGetSet, get_aop_value<&AopSettings::fault_value>, set_aop_value<&AopSettings::fault_value>},
-    {12, Access::kGetSet, get_aop_value<&AopSettings::idle_value>, set_aop_value<&AopSettings::idle_value>},
+    {3, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u16(w, c.device.pump().analog_out_raw());
+     },
+     nullptr},
+    {7, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 1); },
+     nullptr},
+    {8, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u8(w, 0); },
+     nullptr},
+    {9, Access::kGetSet, get_aop_state<&AopSettings::fault_state>,
+     set_aop_state<&AopSettings::fault_state>},
+    {10, Access::kGetSet, get_aop_state<&AopSettings::idle_state>,
+     set_aop_state<&AopSettings::idle_state>},
+    {11, Access::kGetSet, get_aop_value<&AopSettings::fault_value>,
+     set_aop_value<&AopSettings::fault_value>},
+    {12, Access::kGetSet, get_aop_value<&AopSettings::idle_value>,
+     set_aop_value<&AopSettings::idle_value>},
 };
 
 // ---------------------------------------------------------------------------
@@ -489,21 +593,37 @@ const AttributeDef kAopAttributes[] = {
 constexpr ClassAttributeDef kSupervisorClass[] = {{1, 1}, {2, 1}, {6, 7}, {7, 16}};
 
 const AttributeDef kSupervisorAttributes[] = {
-    {3, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "ANALOG IO"); }, nullptr},
-    {4, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "E00-0000"); }, nullptr},
-    {5, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "D.I.P. Inc."); }, nullptr},
-    {6, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "CDN127"); }, nullptr},
+    {3, Access::kGet,
+     [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "ANALOG IO"); },
+     nullptr},
+    {4, Access::kGet,
+     [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "E00-0000"); },
+     nullptr},
+    {5, Access::kGet,
+     [](const RequestContext&, ByteWriter& w) noexcept {
+       return put_short_string(w, "D.I.P. Inc.");
+     },
+     nullptr},
+    {6, Access::kGet,
+     [](const RequestContext&, ByteWriter& w) noexcept { return put_short_string(w, "CDN127"); },
+     nullptr},
     {7, Access::kGet,
      [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_revision_string(w, c.device.options().revision_major, c.device.options().revision_minor);
+       return put_revision_string(w, c.device.options().revision_major,
+                                  c.device.options().revision_minor);
      },
      nullptr},
     {8, Access::kGet,
      [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_revision_string(w, c.device.options().hardware_major, c.device.options().hardware_minor);
+       return put_revision_string(w, c.device.options().hardware_major,
+                                  c.device.options().hardware_minor);
      },
      nullptr},
-    {11, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.supervisor_device_status()); }, nullptr},
+    {11, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, c.device.supervisor_device_status());
+     },
+     nullptr},
     {12, Access::kGet,
      [](const RequestContext& c, ByteWriter& w) noexcept {
        c.device.pump().advance(c.now);
@@ -520,11 +640,11 @@ const AttributeDef kSupervisorAttributes[] = {
        w.u8(0);  // DIP Status (every DIP status attribute is 0)
        w.u8(8);  // Number DOP
        w.u8(c.device.faults().minor_recoverable ? 0x03 : 0x00);  // DOP Status
-       w.u8(2);  // Number AIP
-       w.u8(0);  // AIP Status
-       w.u8(1);  // Number AOP
-       w.u8(0);  // AOP Status
-       w.u8(1);  // Man. Detail Size
+       w.u8(2);                                                  // Number AIP
+       w.u8(0);                                                  // AIP Status
+       w.u8(1);                                                  // Number AOP
+       w.u8(0);                                                  // AOP Status
+       w.u8(1);                                                  // Man. Detail Size
        w.u8(c.device.alarm_detail());
        return kReplyOk;
      },
@@ -541,11 +661,19 @@ const AttributeDef kSupervisorAttributes[] = {
      },
      nullptr},
     {15, Access::kGetSet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.e2().alarm_enable ? 1 : 0); },
-     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept { return read_bool(data, c.device.e2().alarm_enable); }},
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, c.device.e2().alarm_enable ? 1 : 0);
+     },
+     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
+       return read_bool(data, c.device.e2().alarm_enable);
+     }},
     {16, Access::kGetSet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_u8(w, c.device.e2().warning_enable ? 1 : 0); },
-     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept { return read_bool(data, c.device.e2().warning_enable); }},
+     [](const RequestContext& c, ByteWriter& w) noexcept {
+       return put_u8(w, c.device.e2().warning_enable ? 1 : 0);
+     },
+     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
+       return read_bool(data, c.device.e2().warning_enable);
+     }},
 };
 
 // ---------------------------------------------------------------------------
@@ -567,18 +695,28 @@ Reply set_config(const RequestContext& c, Bytes data, ByteWriter&) noexcept {
 Reply put_poll_size(const RequestContext& c, ByteWriter& w, bool produced) noexcept {
   auto format = profiles::cdn127::poll_format(c.device.configuration());
   if (!format.ok()) return put_u8(w, 0);
-  return put_u8(w, static_cast<std::uint8_t>(produced ? format->response.size : format->request.size));
+  return put_u8(w,
+                static_cast<std::uint8_t>(produced ? format->response.size : format->request.size));
 }
 
 const AttributeDef kConfigurationAttributes[] = {
     {1, Access::kGetSet, get_config<&IoConfiguration::mode>, set_config<&IoConfiguration::mode>},
-    {2, Access::kGetSet, get_config<&IoConfiguration::num_digital_inputs>, set_config<&IoConfiguration::num_digital_inputs>},
-    {3, Access::kGetSet, get_config<&IoConfiguration::num_digital_outputs>, set_config<&IoConfiguration::num_digital_outputs>},
-    {4, Access::kGetSet, get_config<&IoConfiguration::num_analog_inputs>, set_config<&IoConfiguration::num_analog_inputs>},
-    {5, Access::kGetSet, get_config<&IoConfiguration::num_analog_outputs>, set_config<&IoConfiguration::num_analog_outputs>},
-    {10, Access::kGetSet, get_config<&IoConfiguration::no_nc_mask>, set_config<&IoConfiguration::no_nc_mask>},
-    {16, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_poll_size(c, w, true); }, nullptr},
-    {17, Access::kGet, [](const RequestContext& c, ByteWriter& w) noexcept { return put_poll_size(c, w, false); }, nullptr},
+    {2, Access::kGetSet, get_config<&IoConfiguration::num_digital_inputs>,
+     set_config<&IoConfiguration::num_digital_inputs>},
+    {3, Access::kGetSet, get_config<&IoConfiguration::num_digital_outputs>,
+     set_config<&IoConfiguration::num_digital_outputs>},
+    {4, Access::kGetSet, get_config<&IoConfiguration::num_analog_inputs>,
+     set_config<&IoConfiguration::num_analog_inputs>},
+    {5, Access::kGetSet, get_config<&IoConfiguration::num_analog_outputs>,
+     set_config<&IoConfiguration::num_analog_outputs>},
+    {10, Access::kGetSet, get_config<&IoConfiguration::no_nc_mask>,
+     set_config<&IoConfiguration::no_nc_mask>},
+    {16, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept { return put_poll_size(c, w, true); },
+     nullptr},
+    {17, Access::kGet,
+     [](const RequestContext& c, ByteWriter& w) noexcept { return put_poll_size(c, w, false); },
+     nullptr},
 };
 
 // Reset: one byte, 0 = CDN127 preset, 1 = CDN118 preset.
@@ -684,7 +822,8 @@ Reply dispatch(Cdn127Device& device, const devicenet::RequestMessage& req, std::
       return h != nullptr ? h(ctx, req.data, w) : not_supported;
     }
     case cip::Service::kAllocateMasterSlave:
-      return (!class_level && c->allocate != nullptr) ? c->allocate(ctx, req.data, w) : not_supported;
+      return (!class_level && c->allocate != nullptr) ? c->allocate(ctx, req.data, w)
+                                                      : not_supported;
     case cip::Service::kReleaseMasterSlave:
       return (!class_level && c->release != nullptr) ? c->release(ctx, req.data, w) : not_supported;
     case cip::Service::kGetAttributesAll:

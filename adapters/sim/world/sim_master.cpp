@@ -1,4 +1,4 @@
-#include "adapters/sim/sim_master.hpp"
+#include "adapters/sim/world/sim_master.hpp"
 
 namespace dnbridge::sim {
 

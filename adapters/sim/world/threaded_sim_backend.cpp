@@ -1,4 +1,4 @@
-#include "adapters/sim/threaded_sim_backend.hpp"
+#include "adapters/sim/world/threaded_sim_backend.hpp"
 
 #include <fmt/format.h>
 #include <pthread.h>
@@ -10,7 +10,7 @@
 
 #include "adapters/port/steady_time.hpp"
 #include "adapters/port/thread_name.hpp"
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 
 namespace dnbridge::sim {
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <system_error>
 
-#include "adapters/sim/virtual_bus.hpp"
+#include "adapters/sim/bus/virtual_bus.hpp"
 #include "bridge/can/can_frame.hpp"
 #include "bridge/common/time.hpp"
 

@@ -3,7 +3,7 @@
 #include <memory>
 #include <optional>
 
-#include "adapters/sim/sim_world.hpp"
+#include "adapters/sim/world/sim_world.hpp"
 #include "bridge/devicenet/scanner.hpp"
 
 namespace dnbridge::sim {

@@ -2,8 +2,8 @@
 // A simulated CDN127 on the simulated bus.
 #include <optional>
 
-#include "adapters/sim/cdn127_slave.hpp"
-#include "adapters/sim/sim_world.hpp"
+#include "adapters/sim/cdn127/cdn127_slave.hpp"
+#include "adapters/sim/world/sim_world.hpp"
 
 namespace dnbridge::sim {
 

@@ -1,4 +1,4 @@
-#include "adapters/sim/cdn127_slave.hpp"
+#include "adapters/sim/cdn127/cdn127_slave.hpp"
 
 #include <algorithm>
 #include <array>
@@ -12,16 +12,16 @@ namespace dnbridge::sim {
 using devicenet::BodyFormat;
 using devicenet::CommFaultedLayout;
 using devicenet::CommFaultedMessage;
-using devicenet::Group4Message;
-using devicenet::OfflineOwnershipMessage;
-using devicenet::OwnershipIdentity;
 using devicenet::DuplicateMacCheck;
 using devicenet::ExplicitFragmentSender;
 using devicenet::ExplicitReassembler;
 using devicenet::Group1Message;
 using devicenet::Group2Message;
+using devicenet::Group4Message;
 using devicenet::MacId;
 using devicenet::MessageGroup;
+using devicenet::OfflineOwnershipMessage;
+using devicenet::OwnershipIdentity;
 
 namespace {
 
@@ -48,10 +48,14 @@ constexpr std::uint8_t kFragBit = 0x80;
 
 const char* to_string(Cdn127Slave::NetworkState s) noexcept {
   switch (s) {
-    case Cdn127Slave::NetworkState::kOff: return "off";
-    case Cdn127Slave::NetworkState::kDuplicateMacCheck: return "duplicate MAC check";
-    case Cdn127Slave::NetworkState::kOnline: return "online";
-    case Cdn127Slave::NetworkState::kCommunicationFault: return "communication fault";
+    case Cdn127Slave::NetworkState::kOff:
+      return "off";
+    case Cdn127Slave::NetworkState::kDuplicateMacCheck:
+      return "duplicate MAC check";
+    case Cdn127Slave::NetworkState::kOnline:
+      return "online";
+    case Cdn127Slave::NetworkState::kCommunicationFault:
+      return "communication fault";
   }
   return "?";
 }
@@ -142,9 +146,9 @@ void Cdn127Slave::on_timer(TimePoint now) noexcept {
   if (device_.explicit_connection().state != explicit_before ||
       device_.poll_connection().state != poll_before) {
     log_.debug("watchdog: explicit {} -> {}, poll {} -> {}, owner {}",
-               static_cast<int>(explicit_before), static_cast<int>(device_.explicit_connection().state),
-               static_cast<int>(poll_before), static_cast<int>(device_.poll_connection().state),
-               device_.owner());
+               static_cast<int>(explicit_before),
+               static_cast<int>(device_.explicit_connection().state), static_cast<int>(poll_before),
+               static_cast<int>(device_.poll_connection().state), device_.owner());
   }
   if (!device_.explicit_established()) {
     sender_.cancel();
@@ -259,7 +263,8 @@ void Cdn127Slave::on_unconnected(const can::CanFrame& frame, TimePoint now) noex
   } else {
     n = execute_request(device_, *request, static_cast<std::uint8_t>(header & 0x3F), now, out);
   }
-  if (n > 0 && out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
+  if (n > 0 &&
+      out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
     ++counters_.requests_refused;
   }
   respond(true, header, Bytes(out.data(), n), now);
@@ -332,7 +337,8 @@ void Cdn127Slave::on_explicit(const can::CanFrame& frame, TimePoint now) noexcep
   }
 }
 
-void Cdn127Slave::handle_explicit_message(std::uint8_t header, Bytes message, TimePoint now) noexcept {
+void Cdn127Slave::handle_explicit_message(std::uint8_t header, Bytes message,
+                                          TimePoint now) noexcept {
   if (message.empty() || (message[0] & cip::kResponseFlag) != 0) {
     ++counters_.frames_ignored;
     return;
@@ -348,7 +354,8 @@ void Cdn127Slave::handle_explicit_message(std::uint8_t header, Bytes message, Ti
                                               cip::kNoAdditionalCode, out);
     n = e.ok() ? *e : 0;
   }
-  if (n > 0 && out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
+  if (n > 0 &&
+      out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
     ++counters_.requests_refused;
   }
   respond(false, header, Bytes(out.data(), n), now);
@@ -409,7 +416,8 @@ bool Cdn127Slave::send_due(TimePoint now) noexcept {
 
 // Responses echo the request's XID and MAC (request[0] & 0x7F); longer than
 // one frame, they go out in acknowledged fragments.
-void Cdn127Slave::send_explicit_response(std::uint8_t header, Bytes message, TimePoint now) noexcept {
+void Cdn127Slave::send_explicit_response(std::uint8_t header, Bytes message,
+                                         TimePoint now) noexcept {
   const auto response_header = static_cast<std::uint8_t>(header & 0x7F);
   if (message.size() <= devicenet::kMaxUnfragmentedMessage) {
     std::array<std::uint8_t, 8> payload{};
@@ -477,8 +485,10 @@ void Cdn127Slave::send_poll_response(Bytes payload, TimePoint now) noexcept {
 // ---------------------------------------------------------------------------
 // Group 4 Offline Connection Set, in Communication Fault only (see the header).
 
-bool Cdn127Slave::names_this_node(std::uint16_t vendor_id, std::uint32_t serial_number) const noexcept {
-  return vendor_id == profiles::cdn127::kVendorId && serial_number == device_.options().serial_number;
+bool Cdn127Slave::names_this_node(std::uint16_t vendor_id,
+                                  std::uint32_t serial_number) const noexcept {
+  return vendor_id == profiles::cdn127::kVendorId &&
+         serial_number == device_.options().serial_number;
 }
 
 void Cdn127Slave::on_offline(const can::CanFrame& frame, TimePoint now) noexcept {

@@ -7,7 +7,7 @@
 #include <functional>
 #include <vector>
 
-#include "adapters/sim/virtual_bus.hpp"
+#include "adapters/sim/bus/virtual_bus.hpp"
 #include "bridge/common/time.hpp"
 
 namespace dnbridge::sim {

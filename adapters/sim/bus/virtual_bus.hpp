@@ -25,7 +25,7 @@
 #include <optional>
 #include <vector>
 
-#include "adapters/sim/fault_injection.hpp"
+#include "adapters/sim/bus/fault_injection.hpp"
 #include "bridge/can/can_frame.hpp"
 #include "bridge/can/can_timing.hpp"
 #include "bridge/can/frame_sink.hpp"

@@ -1,4 +1,4 @@
-#include "adapters/sim/sim_backend.hpp"
+#include "adapters/sim/world/sim_backend.hpp"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "adapters/port/steady_time.hpp"
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 
 namespace dnbridge::sim {
 

@@ -1,4 +1,4 @@
-#include "adapters/sim/sim_rack.hpp"
+#include "adapters/sim/world/sim_rack.hpp"
 
 #include <fmt/format.h>
 

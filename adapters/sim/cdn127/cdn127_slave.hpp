@@ -51,10 +51,10 @@
 #include <cstdint>
 #include <optional>
 
-#include "adapters/sim/cdn127_device.hpp"
-#include "adapters/sim/cdn127_objects.hpp"
-#include "adapters/sim/delay_queue.hpp"
-#include "adapters/sim/pump_model.hpp"
+#include "adapters/sim/cdn127/cdn127_device.hpp"
+#include "adapters/sim/cdn127/cdn127_objects.hpp"
+#include "adapters/sim/cdn127/delay_queue.hpp"
+#include "adapters/sim/cdn127/pump_model.hpp"
 #include "bridge/can/frame_sink.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/duplicate_mac.hpp"
@@ -65,19 +65,19 @@ namespace dnbridge::sim {
 
 struct SlaveCounters {
   std::uint32_t frames_not_addressed = 0;  // other nodes' traffic
-  std::uint32_t frames_ignored = 0;        // for us but dropped (unsupported, wrong state, malformed)
-  std::uint32_t requests_refused = 0;      // answered with an error response
-  std::uint32_t explicit_requests = 0;     // explicit requests executed (success or error)
+  std::uint32_t frames_ignored = 0;     // for us but dropped (unsupported, wrong state, malformed)
+  std::uint32_t requests_refused = 0;   // answered with an error response
+  std::uint32_t explicit_requests = 0;  // explicit requests executed (success or error)
   std::uint32_t polls_applied = 0;
   std::uint32_t polls_idle = 0;
-  std::uint32_t polls_oversize = 0;        // longer than the consumed size: ignored
+  std::uint32_t polls_oversize = 0;  // longer than the consumed size: ignored
   std::uint32_t polls_invalid = 0;
-  std::uint32_t polls_major_fault = 0;     // answered, outputs not applied: a major fault stands
-  std::uint32_t polls_ignored = 0;         // no established poll connection
+  std::uint32_t polls_major_fault = 0;  // answered, outputs not applied: a major fault stands
+  std::uint32_t polls_ignored = 0;      // no established poll connection
   std::uint32_t fragment_transfers_failed = 0;
-  std::uint32_t restarts = 0;              // power-ups, Identity Reset, MAC change
-  std::uint32_t offline_responses = 0;     // Group 4 responses sent
-  std::uint32_t responses_dropped = 0;     // delayed responses not kept: the queue was full
+  std::uint32_t restarts = 0;           // power-ups, Identity Reset, MAC change
+  std::uint32_t offline_responses = 0;  // Group 4 responses sent
+  std::uint32_t responses_dropped = 0;  // delayed responses not kept: the queue was full
 };
 
 // Responses a slow device may hold at once (SlaveOptions::*_response_delay):
@@ -89,10 +89,10 @@ inline constexpr std::size_t kMaxDelayedPolls = 16;
 class Cdn127Slave {
  public:
   enum class NetworkState : std::uint8_t {
-    kOff,                  // before power_on()
-    kDuplicateMacCheck,    // silent except for the check
+    kOff,                // before power_on()
+    kDuplicateMacCheck,  // silent except for the check
     kOnline,
-    kCommunicationFault,   // duplicate MAC detected: silent until power cycled
+    kCommunicationFault,  // duplicate MAC detected: silent until power cycled
   };
 
   Cdn127Slave(can::FrameSink& sink, SlaveOptions options = {}, Logger log = {});
