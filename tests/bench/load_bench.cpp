@@ -646,7 +646,7 @@ class Load {
             take_all(reply_reader_, reply_buffer_,
                      [&](const dnbridge_ExplicitReply& r, const dds::SampleInfo& info,
                          std::int64_t mono, dds::Timestamp) {
-                       // Invalid samples: instances the bridge let go.
+                       // Invalid samples: the bridge's writer left.
                        if (!info.valid_data() || dds::view(r.requester) != requester_) return;
                        if (r.txid == 0 || r.txid >= replied_at_.size()) return;
                        if (r.status == kStatusInProgress) return;  // the final reply follows
