@@ -229,10 +229,7 @@ void Node::on_timer(TimePoint now) {
     // poll outstanding now (none should be: any poll sent clears this) leaves
     // the changes to its response, as without the gap.
     deferred_poll_ = kNever;
-    if (outputs_dirty_ && !poll_outstanding_) {
-      last_change_poll_ = now;
-      send_poll(now);
-    }
+    if (outputs_dirty_ && !poll_outstanding_) poll_on_change(now);  // the gap is over: now
   }
   if (now >= keepalive_at_) {
     keepalive_at_ = now + explicit_epr_;
