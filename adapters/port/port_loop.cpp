@@ -109,7 +109,11 @@ bool PortLoop::drain_inbox(TimePoint now) {
   {
     std::lock_guard lock(inbox_mutex_);
     items.swap(inbox_);
-    calls.swap(calls_);
+    const std::size_t n = std::min(calls_.size(), kCallsPerPass);
+    calls.assign(std::make_move_iterator(calls_.begin()),
+                 std::make_move_iterator(calls_.begin() + static_cast<std::ptrdiff_t>(n)));
+    calls_.erase(calls_.begin(), calls_.begin() + static_cast<std::ptrdiff_t>(n));
+    calls_waiting_ = !calls_.empty();
   }
   bool keep_running = true;
   for (auto& item : items) {
@@ -184,6 +188,7 @@ void PortLoop::run() {
     for (const auto& p : published_) {
       wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
     }
+    if (calls_waiting_) wake = now;
     note_busy(pass_start);
     FrameReceiver& receiver = *this;
     backend_->wait(wake, receiver);

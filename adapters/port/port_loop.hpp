@@ -6,6 +6,7 @@
 // published from here.
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -58,6 +59,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // with "out of buffers" (on the caller's thread, through the publisher).
   void explicit_request(rack::ExplicitCall call);
   static constexpr std::size_t kMaxQueuedCalls = 256;
+  // Requests handled in one pass of the loop; the rest wait for the next
+  // pass, which comes at once, after the bus's timers and frames.
+  static constexpr std::size_t kCallsPerPass = 32;
   // Runs `fn` on the port's thread with its backend (tests and tools only).
   void post(std::function<void(CanBackend&)> fn);
 
@@ -97,9 +101,11 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // must reach the bus to mean anything.
   void start_master_when_up(TimePoint now);
   void push(Item item);
-  // Commands first, then explicit requests: a pump command never waits
-  // behind explicit traffic. False once a Stop was seen.
+  // Commands first, then at most kCallsPerPass explicit requests: a pump
+  // command never waits behind explicit traffic, nor the bus behind a flood
+  // of requests. False once a Stop was seen.
   bool drain_inbox(TimePoint now);
+  bool calls_waiting_ = false;  // requests left for the next pass
   void publish(TimePoint now, bool force);
   void publish_port(TimePoint now);
   void update_metrics(const BusCounters& bus, TimePoint now);
@@ -157,7 +163,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
 
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
-  std::vector<rack::ExplicitCall> calls_;
+  std::deque<rack::ExplicitCall> calls_;
   std::atomic<std::uint64_t> calls_refused_{0};  // kMaxQueuedCalls reached
   std::thread thread_;
   std::atomic<bool> running_{false};

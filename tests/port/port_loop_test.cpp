@@ -65,6 +65,8 @@ class RecordingPublisher final : public PortPublisher {
     return changed_.wait_for(lock, timeout, done);
   }
 
+  std::mutex& mutex() { return mutex_; }
+
   PortStatusView last_port() {
     std::lock_guard lock(mutex_);
     return port.value_or(PortStatusView{});
@@ -277,6 +279,65 @@ TEST(PortLoop, BadCommandsAreRefusedAndReported) {
   loop.command(mac(4), out, "careless");
   ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps[4].commands_refused == 1; }));
   EXPECT_NE(publisher.pumps[4].last_command_refused.find("9999"), std::string::npos);
+  loop.stop();
+  loop.join();
+}
+
+// A flood of requests is handled kCallsPerPass at a time: between two
+// batches the loop goes back to its timers and the bus, and nothing queued
+// is lost on the way.
+TEST(PortLoop, AFloodOfRequestsIsHandledAFewAtATimeBetweenPasses) {
+  RecordingPublisher publisher;
+  PortLoop loop(config_for({4}),
+                std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(4)}),
+                publisher, null_log_sink());
+  loop.start();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(4) && publisher.pumps[4].online; }));
+
+  // The loop held in a pass while the flood is queued.
+  std::promise<void> held, release;
+  loop.post([&](CanBackend&) {
+    held.set_value();
+    release.get_future().wait();
+  });
+  held.get_future().wait();
+  constexpr std::size_t kCalls = 3 * PortLoop::kCallsPerPass + 5;
+  for (std::size_t i = 0; i < kCalls; ++i) {
+    rack::ExplicitCall call;
+    call.requester = "flood-" + std::to_string(i);
+    call.txid = 1;
+    call.command = 2;  // status of a transaction it never started: answered at once
+    call.port = "A";
+    call.mac = 4;
+    loop.explicit_request(call);
+  }
+  // At the start of every pass (posted jobs run first), the replies so far.
+  std::vector<std::size_t> at_pass_start;
+  std::function<void(CanBackend&)> record = [&](CanBackend&) {
+    std::size_t replies = 0;
+    {
+      std::lock_guard lock(publisher.mutex());
+      replies = publisher.replies.size();
+    }
+    at_pass_start.push_back(replies);
+    if (replies < kCalls) loop.post(record);
+  };
+  loop.post(record);
+  release.set_value();
+  ASSERT_TRUE(publisher.wait_for([&] { return publisher.replies.size() == kCalls; }));
+  std::promise<void> recorded;
+  loop.post([&](CanBackend&) { recorded.set_value(); });
+  recorded.get_future().wait();
+
+  ASSERT_GE(at_pass_start.size(), 4u);
+  EXPECT_EQ(at_pass_start.front(), 0u);
+  for (std::size_t i = 1; i < at_pass_start.size(); ++i) {
+    EXPECT_LE(at_pass_start[i] - at_pass_start[i - 1], PortLoop::kCallsPerPass) << "pass " << i;
+  }
+  for (const auto& r : publisher.replies) {
+    EXPECT_EQ(r.status, rack::TransactionStatus::kTxidUnknown) << r.message;
+  }
   loop.stop();
   loop.join();
 }
