@@ -90,32 +90,6 @@ void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string
 
 namespace {
 
-dnbridge_SafeAction to_idl(cdn127::DiscreteAction a) {
-  switch (a) {
-    case cdn127::DiscreteAction::kOff:
-      return dnbridge_SAFE_ACTION_OFF;
-    case cdn127::DiscreteAction::kOn:
-      return dnbridge_SAFE_ACTION_ON;
-    case cdn127::DiscreteAction::kHold:
-      return dnbridge_SAFE_ACTION_HOLD;
-  }
-  return dnbridge_SAFE_ACTION_UNKNOWN;
-}
-
-dnbridge_SafeAction to_idl(const cdn127::AnalogAction& a) {
-  switch (a.kind) {
-    case cdn127::AnalogAction::Kind::kHold:
-      return dnbridge_SAFE_ACTION_HOLD;
-    case cdn127::AnalogAction::Kind::kLowLimit:
-      return dnbridge_SAFE_ACTION_OFF;
-    case cdn127::AnalogAction::Kind::kHighLimit:
-      return dnbridge_SAFE_ACTION_ON;
-    case cdn127::AnalogAction::Kind::kValue:
-      return dnbridge_SAFE_ACTION_VALUE;
-  }
-  return dnbridge_SAFE_ACTION_UNKNOWN;
-}
-
 void fill_safe_state(dnbridge_SafeState& out, const rack::PumpView& v) {
   out.known = v.safe_state.has_value();
   out.source = v.safe_state_source == cdn127::SafeStateSource::kDevice

@@ -41,6 +41,22 @@ constexpr std::array<std::pair<BusState, dnbridge_BusState>, 6> kBusStates{{
     {BusState::kDown, dnbridge_BUS_DOWN},
 }};
 
+using DiscreteAction = profiles::cdn127::DiscreteAction;
+using AnalogKind = profiles::cdn127::AnalogAction::Kind;
+
+constexpr std::array<std::pair<DiscreteAction, dnbridge_SafeAction>, 3> kDiscreteActions{{
+    {DiscreteAction::kOff, dnbridge_SAFE_ACTION_OFF},
+    {DiscreteAction::kOn, dnbridge_SAFE_ACTION_ON},
+    {DiscreteAction::kHold, dnbridge_SAFE_ACTION_HOLD},
+}};
+
+constexpr std::array<std::pair<AnalogKind, dnbridge_SafeAction>, 4> kAnalogActions{{
+    {AnalogKind::kLowLimit, dnbridge_SAFE_ACTION_OFF},
+    {AnalogKind::kHighLimit, dnbridge_SAFE_ACTION_ON},
+    {AnalogKind::kHold, dnbridge_SAFE_ACTION_HOLD},
+    {AnalogKind::kValue, dnbridge_SAFE_ACTION_VALUE},
+}};
+
 template <class Table, class Core>
 auto idl_of(const Table& table, Core core, decltype(table[0].second) otherwise) {
   const auto it = std::find_if(table.begin(), table.end(),
@@ -68,6 +84,13 @@ dnbridge_BusState to_idl(BusState state) {
   return idl_of(kBusStates, state, dnbridge_BUS_STATE_UNKNOWN);
 }
 
+dnbridge_SafeAction to_idl(DiscreteAction action) {
+  return idl_of(kDiscreteActions, action, dnbridge_SAFE_ACTION_UNKNOWN);
+}
+dnbridge_SafeAction to_idl(const profiles::cdn127::AnalogAction& action) {
+  return idl_of(kAnalogActions, action.kind, dnbridge_SAFE_ACTION_UNKNOWN);
+}
+
 std::optional<NodeState> from_idl(dnbridge_NodeLifecycle state) {
   return core_of(kNodeStates, state);
 }
@@ -87,6 +110,13 @@ std::string_view name_of(dnbridge_PortLifecycle state) {
 std::string_view name_of(dnbridge_BusState state) {
   const auto core = from_idl(state);
   return core ? port::to_string(*core) : "unknown";
+}
+
+std::string_view name_of(dnbridge_SafeAction action) {
+  if (const auto core = core_of(kDiscreteActions, action)) {
+    return profiles::cdn127::to_string(*core);
+  }
+  return action == dnbridge_SAFE_ACTION_VALUE ? "value" : "unknown";
 }
 
 }  // namespace dnbridge::dds

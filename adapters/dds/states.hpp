@@ -8,6 +8,7 @@
 #include "adapters/port/can_backend.hpp"
 #include "bridge/devicenet/node_state.hpp"
 #include "bridge/devicenet/scanner_events.hpp"
+#include "bridge/profiles/cdn127/safe_state.hpp"
 #include "dnbridge.h"
 
 namespace dnbridge::dds {
@@ -15,6 +16,10 @@ namespace dnbridge::dds {
 dnbridge_NodeLifecycle to_idl(devicenet::NodeState state);
 dnbridge_PortLifecycle to_idl(devicenet::PortState state);
 dnbridge_BusState to_idl(port::BusState state);
+// A safe state's actions: the discrete outputs' off/on/hold; the analog
+// output's low limit as OFF, high limit as ON, a value as VALUE.
+dnbridge_SafeAction to_idl(profiles::cdn127::DiscreteAction action);
+dnbridge_SafeAction to_idl(const profiles::cdn127::AnalogAction& action);
 
 // nullopt: a value this program does not know (a newer bridge's).
 std::optional<devicenet::NodeState> from_idl(dnbridge_NodeLifecycle state);
@@ -27,5 +32,7 @@ std::string_view name_of(dnbridge_NodeLifecycle state);
 std::string_view name_of(dnbridge_PortLifecycle state);
 // "error-active", "bus-off", "interface down", ...
 std::string_view name_of(dnbridge_BusState state);
+// "off", "on", "hold" (the core's), "value", "unknown".
+std::string_view name_of(dnbridge_SafeAction action);
 
 }  // namespace dnbridge::dds

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <map>
 #include <tuple>
 
@@ -69,6 +70,23 @@ std::string Table::render() const {
   return out;
 }
 
+std::string table(std::span<const std::string_view> labels, std::span<const Record> rows) {
+  std::vector<std::string> headers;
+  for (auto label : labels) {
+    std::string h(label);
+    std::transform(h.begin(), h.end(), h.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+    headers.push_back(std::move(h));
+  }
+  Table t(std::move(headers));
+  for (const auto& r : rows) {
+    std::vector<std::string> cells;
+    for (auto label : labels) cells.push_back(r.text_of(label));
+    t.add(std::move(cells));
+  }
+  return t.render();
+}
+
 namespace {
 
 const char* yes_no(bool b) { return b ? "yes" : "no"; }
@@ -81,72 +99,82 @@ using RowKey = std::tuple<std::string_view, std::string_view, unsigned>;
 
 }  // namespace
 
-std::string ports_table(std::span<const PortRow> ports) {
-  Table t({"RACK", "PORT", "BRIDGE", "STATE", "BUS", "LOAD", "FRAMES/S", "NODES", "INTERFACE",
-           "REASON"});
-  for (const auto& r : ports) {
-    const auto& p = *r.port;
-    t.add({std::string(view(p.rack)), std::string(view(p.port)), r.alive ? "live" : "gone",
-           std::string(to_text(p.state)), std::string(to_text(p.bus_state)),
-           fmt::format("{:.1f}%", p.bus_load_percent), fmt::format("{:.0f}", p.frames_per_second),
-           fmt::format("{}/{} online", p.nodes_online, p.nodes_configured),
+Record port_record(const dnbridge_PortStatus& p) {
+  Record r;
+  r.add("port", std::string(view(p.port)), "port", view(p.port))
+      .add("state", std::string(to_text(p.state)), "state", to_text(p.state))
+      .add("reason", std::string(view(p.reason)), "reason", view(p.reason))
+      .add("interface",
            fmt::format("{} {}k master {}", view(p.can_interface), p.bitrate / 1000, p.master_mac),
-           std::string(view(p.reason))});
-  }
-  return t.render();
+           {{"can_interface", view(p.can_interface)},
+            {"bitrate", p.bitrate},
+            {"master_mac", p.master_mac}})
+      .add("bus", std::string(to_text(p.bus_state)), "bus_state", to_text(p.bus_state))
+      .json("tx_error_counter", p.tx_error_counter)
+      .json("rx_error_counter", p.rx_error_counter)
+      .add("frames/s", fmt::format("{:.0f}", p.frames_per_second), "frames_per_second",
+           Decimal{p.frames_per_second, 1})
+      .add("load", fmt::format("{:.1f}%", p.bus_load_percent), "bus_load_percent",
+           Decimal{p.bus_load_percent, 1})
+      .json("scan_cycle_ms", Decimal{p.scan_cycle_ms, 1})
+      .add("nodes", fmt::format("{}/{} online", p.nodes_online, p.nodes_configured),
+           {{"nodes_online", p.nodes_online}, {"nodes_configured", p.nodes_configured}})
+      .json("explicit_outstanding", p.explicit_outstanding)
+      .json("explicit_retained", p.explicit_retained)
+      .json("explicit_refused_for_limits", p.explicit_refused_for_limits)
+      .json("replies_undelivered", p.replies_undelivered)
+      .json("loop_longest_pass_ms", Decimal{p.loop_longest_pass_ms, 2});
+  return r;
 }
 
-std::string nodes_table(std::span<const NodeRow> nodes) {
-  Table t({"RACK", "PORT", "MAC", "NAME", "STATE", "ONLINE", "PRODUCT", "REASON"});
-  for (const auto& r : nodes) {
-    const auto& n = *r.node;
-    t.add({std::string(view(n.rack)), std::string(view(n.port)), fmt::format("{}", n.mac),
-           std::string(view(n.name)), std::string(to_text(n.state)), yes_no(node_online(r)),
-           std::string(view(n.product_name)),
-           r.alive ? std::string(view(n.reason)) : "bridge gone: " + std::string(view(n.reason))});
+void port_json_members(JsonWriter& out, const dnbridge_PortStatus& p) {
+  port_record(p).write_members(out);
+}
+
+std::string ports_table(std::span<const PortRow> ports) {
+  static constexpr std::string_view kColumns[] = {
+      "rack", "port", "bridge", "state", "bus", "load", "frames/s", "nodes", "interface", "reason"};
+  std::vector<Record> rows;
+  for (const auto& r : ports) {
+    rows.push_back(port_record(*r.port)
+                       .text("rack", std::string(view(r.port->rack)))
+                       .text("bridge", r.alive ? "live" : "gone"));
   }
-  return t.render();
+  return table(kColumns, rows);
 }
 
 bool node_online(const NodeRow& r) {
   return r.alive && (r.pump ? r.pump->online : r.node->state == dnbridge_NODE_ONLINE);
 }
 
-void port_json_members(JsonWriter& out, const dnbridge_PortStatus& p) {
-  out.field("port", view(p.port))
-      .field("state", to_text(p.state))
-      .field("reason", view(p.reason))
-      .field("can_interface", view(p.can_interface))
-      .field("bitrate", p.bitrate)
-      .field("master_mac", unsigned{p.master_mac})
-      .field("bus_state", to_text(p.bus_state))
-      .field("tx_error_counter", unsigned{p.tx_error_counter})
-      .field("rx_error_counter", unsigned{p.rx_error_counter});
-  out.key("frames_per_second").number(p.frames_per_second, 1);
-  out.key("bus_load_percent").number(p.bus_load_percent, 1);
-  out.key("scan_cycle_ms").number(p.scan_cycle_ms, 1);
-  out.field("nodes_online", unsigned{p.nodes_online})
-      .field("nodes_configured", unsigned{p.nodes_configured})
-      .field("explicit_outstanding", unsigned{p.explicit_outstanding})
-      .field("explicit_retained", unsigned{p.explicit_retained})
-      .field("explicit_refused_for_limits", std::uint64_t{p.explicit_refused_for_limits})
-      .field("replies_undelivered", std::uint64_t{p.replies_undelivered});
-  out.key("loop_longest_pass_ms").number(p.loop_longest_pass_ms, 2);
-}
-
 namespace {
 
-void node_list_members(JsonWriter& out, const NodeRow& r) {
+// A node as `list` shows it.
+Record node_row_record(const NodeRow& r) {
   const auto& n = *r.node;
-  out.field("mac", unsigned{n.mac})
-      .field("name", view(n.name))
-      .field("state", to_text(n.state))
-      .field("reason", view(n.reason))
-      .field("product", view(n.product_name))
-      .field("online", node_online(r));
+  Record rec;
+  rec.text("rack", std::string(view(n.rack)))
+      .text("port", std::string(view(n.port)))
+      .add("mac", fmt::format("{}", n.mac), "mac", n.mac)
+      .add("name", std::string(view(n.name)), "name", view(n.name))
+      .add("state", std::string(to_text(n.state)), "state", to_text(n.state))
+      .add("reason",
+           r.alive ? std::string(view(n.reason)) : "bridge gone: " + std::string(view(n.reason)),
+           "reason", view(n.reason))
+      .add("product", std::string(view(n.product_name)), "product", view(n.product_name))
+      .add("online", yes_no(node_online(r)), "online", node_online(r));
+  return rec;
 }
 
 }  // namespace
+
+std::string nodes_table(std::span<const NodeRow> nodes) {
+  static constexpr std::string_view kColumns[] = {"rack",  "port",   "mac",     "name",
+                                                  "state", "online", "product", "reason"};
+  std::vector<Record> rows;
+  for (const auto& r : nodes) rows.push_back(node_row_record(r));
+  return table(kColumns, rows);
+}
 
 void list_json(JsonWriter& out, std::span<const PortRow> ports, std::span<const NodeRow> nodes) {
   // rack -> port -> (status, nodes), sorted by name.
@@ -176,11 +204,7 @@ void list_json(JsonWriter& out, std::span<const PortRow> ports, std::span<const 
       std::sort(e.nodes.begin(), e.nodes.end(),
                 [](const NodeRow* a, const NodeRow* b) { return a->node->mac < b->node->mac; });
       out.key("nodes").begin_array();
-      for (const auto* n : e.nodes) {
-        out.begin_object();
-        node_list_members(out, *n);
-        out.end_object();
-      }
+      for (const auto* n : e.nodes) node_row_record(*n).write(out);
       out.end_array().end_object();
     }
     out.end_array().end_object();
@@ -222,242 +246,217 @@ std::string pump_line(const dnbridge_PumpState& s, std::string_view time_text) {
   return l;
 }
 
-std::string pumps_table(std::span<const dnbridge_PumpState* const> pumps) {
-  Table t({"NODE", "NAME", "ONLINE", "RUNNING", "WARN", "ALARM", "N2", "INTERLOCK", "AI1", "AI2",
-           "PUMP", "BALLAST", "AOUT", "COMMANDED BY"});
-  for (const auto* p : pumps) {
-    const auto& s = *p;
-    const bool in = s.online && s.inputs_valid;
-    const auto ai = [&](unsigned i) {
-      if (!in || i >= s.analog_input_count) return std::string("-");
-      return s.analog_input_valid[i] ? fmt::format("{:.3f}V", s.analog_input_volts[i])
-                                     : fmt::format("invalid({})", s.analog_input_raw[i]);
-    };
-    const bool out = s.online && !s.outputs_idle;
-    t.add({node_name(view(s.rack), view(s.port), s.mac), std::string(view(s.name)),
-           yes_no(s.online), in ? yes_no(s.pump_running) : "-", in ? yes_no(s.warning_active) : "-",
-           in ? yes_no(s.alarm_active) : "-", in ? (s.n2_flow_ok ? "ok" : "low") : "-",
-           in ? (s.interlock_ok ? "ok" : "open") : "-", ai(0), ai(1),
-           out ? on_off(s.pump_on) : "idle", out ? on_off(s.n2_ballast_on) : "idle",
-           out ? fmt::format("{} ({:.3f}V)", s.analog_output_raw, s.analog_output_volts) : "idle",
-           out ? std::string(view(s.commanded_by)) : ""});
-  }
-  return t.render();
-}
-
-void pump_json(JsonWriter& out, const dnbridge_PumpState& s) {
-  out.begin_object()
-      .field("rack", view(s.rack))
-      .field("port", view(s.port))
-      .field("mac", unsigned{s.mac})
-      .field("name", view(s.name))
-      .field("online", static_cast<bool>(s.online))
-      .field("inputs_valid", static_cast<bool>(s.inputs_valid))
-      .field("pump_running", static_cast<bool>(s.pump_running))
-      .field("warning_active", static_cast<bool>(s.warning_active))
-      .field("alarm_active", static_cast<bool>(s.alarm_active))
-      .field("n2_flow_ok", static_cast<bool>(s.n2_flow_ok))
-      .field("interlock_ok", static_cast<bool>(s.interlock_ok))
-      .field("digital_inputs_raw", unsigned{s.digital_inputs_raw});
-  out.key("analog_inputs").begin_array();
-  for (unsigned i = 0; i < s.analog_input_count && i < 2; ++i) {
-    out.begin_object().field("raw", unsigned{s.analog_input_raw[i]});
-    out.field("valid", static_cast<bool>(s.analog_input_valid[i]));
-    if (s.analog_input_valid[i]) {
-      out.key("volts").number(s.analog_input_volts[i], 3);
-    } else {
-      out.key("volts").null();
-    }
-    out.end_object();
-  }
-  out.end_array();
-  out.field("exception_status_valid", static_cast<bool>(s.exception_status_valid))
-      .field("outputs_idle", static_cast<bool>(s.outputs_idle))
-      .field("idle_reason", view(s.idle_reason))
-      .field("pump_on", static_cast<bool>(s.pump_on))
-      .field("n2_ballast_on", static_cast<bool>(s.n2_ballast_on))
-      .field("analog_output_raw", unsigned{s.analog_output_raw});
-  out.key("analog_output_volts").number(s.analog_output_volts, 3);
-  out.field("commanded_by", view(s.commanded_by)).end_object();
-}
-
-std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive) {
-  std::string o;
-  const auto add = [&o](std::string_view label, const std::string& value) {
-    o += fmt::format("{:<26}{}\n", label, value);
-  };
-  add("node", fmt::format("{} ({})", node_name(view(n.rack), view(n.port), n.mac), view(n.name)));
-  add("state", fmt::format("{}{}", to_text(n.state), alive ? "" : " (bridge gone)"));
-  add("reason", std::string(view(n.reason)));
-  if (pump) add("online", yes_no(alive && pump->online));
-  add("product name", std::string(view(n.product_name)));
-  add("vendor", fmt::format("{} (0x{:04X})", n.vendor_id, n.vendor_id));
-  add("product type", fmt::format("{} (0x{:04X})", n.product_type, n.product_type));
-  add("product code", fmt::format("{} (0x{:04X})", n.product_code, n.product_code));
-  add("revision", fmt::format("{}.{}", n.major_revision, n.minor_revision));
-  add("serial number", fmt::format("{} (0x{:08X})", n.serial_number, n.serial_number));
-  add("device state", n.device_state_valid
-                          ? fmt::format("{} ({})", n.device_state, view(n.device_state_text))
-                      : view(n.device_state_text).empty() ? std::string("not read")
-                                                          : std::string(view(n.device_state_text)));
-  add("poll", fmt::format("every {} ms, {} byte(s) out, {} byte(s) in", n.poll_period_ms,
-                          n.consumed_size, n.produced_size));
-  add("expected packet rate", fmt::format("{} ms", n.expected_packet_rate_ms));
-  add("last error", view(n.last_error).empty()
-                        ? std::string("none")
-                        : fmt::format("{} (general status 0x{:02X}, additional 0x{:02X})",
-                                      view(n.last_error), n.last_error_general_status,
-                                      n.last_error_additional_status));
-  add("last refused command",
-      view(n.last_command_refused).empty() ? std::string("none") : std::string(view(n.last_command_refused)));
-  add("invalid inputs",
-      view(n.invalid_inputs).empty() ? std::string("none") : std::string(view(n.invalid_inputs)));
-  if (pump && !pump->outputs_idle) {
-    add("outputs", outputs_text(pump->pump_on, pump->n2_ballast_on, pump->analog_output_raw));
-    add("commanded by", std::string(view(pump->commanded_by)));
-  } else if (pump) {
-    add("outputs", view(pump->idle_reason).empty() ? std::string("idle")
-                                                   : std::string(view(pump->idle_reason)));
-  }
-  add("safe state", fmt::format("{} ({})", view(n.safe_state.text),
-                                n.safe_state.source == dnbridge_SAFE_STATE_DEVICE
-                                    ? "the device's own, kept"
-                                    : "from the configuration, read back"));
-  add("device faults",
-      view(n.device_faults).empty() ? std::string("none") : std::string(view(n.device_faults)));
-  const auto& c = n.counters;
-  o += "counters\n";
-  const auto counter = [&o](std::string_view label, std::uint64_t v) {
-    o += fmt::format("  {:<24}{}\n", label, v);
-  };
-  counter("polls", c.polls);
-  counter("idle polls", c.idle_polls);
-  counter("poll responses", c.poll_responses);
-  counter("poll timeouts", c.poll_timeouts);
-  counter("poll retries", c.poll_retries);
-  counter("poll errors", c.poll_errors);
-  counter("reconnects", c.reconnects);
-  counter("allocate attempts", c.allocate_attempts);
-  counter("idle empty responses", c.idle_empty_responses);
-  counter("settings written", c.settings_written);
-  counter("explicit requests", c.explicit_requests);
-  counter("explicit retries", c.explicit_retries);
-  counter("explicit timeouts", c.explicit_timeouts);
-  counter("explicit device errors", c.explicit_device_errors);
-  counter("last fragment unacked", c.explicit_responses_before_final_ack);
-  counter("invalid inputs", c.responses_with_invalid_inputs);
-  counter("commands accepted", c.commands_accepted);
-  counter("commands refused", c.commands_refused);
-  return o;
-}
-
 namespace {
 
-std::string_view safe_action_text(dnbridge_SafeAction a) {
-  switch (a) {
-    case dnbridge_SAFE_ACTION_UNKNOWN:
-      return "unknown";
-    case dnbridge_SAFE_ACTION_OFF:
-      return "off";
-    case dnbridge_SAFE_ACTION_ON:
-      return "on";
-    case dnbridge_SAFE_ACTION_HOLD:
-      return "hold";
-    case dnbridge_SAFE_ACTION_VALUE:
-      return "value";
+// A pump's PumpState as `watch` and `show` show it.
+Record pump_record(const dnbridge_PumpState& s) {
+  const bool in = s.online && s.inputs_valid;
+  const bool out = s.online && !s.outputs_idle;
+  const auto input = [in](bool v, const char* yes, const char* no) {
+    return std::string(in ? (v ? yes : no) : "-");
+  };
+  const auto ai = [&](unsigned i) {
+    if (!in || i >= s.analog_input_count) return std::string("-");
+    return s.analog_input_valid[i] ? fmt::format("{:.3f}V", s.analog_input_volts[i])
+                                   : fmt::format("invalid({})", s.analog_input_raw[i]);
+  };
+  std::vector<Record> analog_inputs;
+  for (unsigned i = 0; i < s.analog_input_count && i < 2; ++i) {
+    Record channel;
+    channel.json("raw", s.analog_input_raw[i])
+        .json("valid", static_cast<bool>(s.analog_input_valid[i]))
+        .json("volts",
+              s.analog_input_valid[i] ? Json(Decimal{s.analog_input_volts[i], 3}) : Json());
+    analog_inputs.push_back(std::move(channel));
   }
-  return "unknown";
-}
-
-void safe_state_json(JsonWriter& out, const dnbridge_SafeState& s) {
-  out.key("safe_state")
-      .begin_object()
-      .field("known", static_cast<bool>(s.known))
-      .field("source", s.source == dnbridge_SAFE_STATE_DEVICE ? "device" : "configured")
-      .field("pump_on_fault", safe_action_text(s.pump_on_fault))
-      .field("pump_on_idle", safe_action_text(s.pump_on_idle))
-      .field("n2_ballast_on_fault", safe_action_text(s.n2_ballast_on_fault))
-      .field("n2_ballast_on_idle", safe_action_text(s.n2_ballast_on_idle))
-      .field("analog_output_on_fault", safe_action_text(s.analog_output_on_fault))
-      .field("analog_output_fault_raw", unsigned{s.analog_output_fault_raw})
-      .field("analog_output_on_idle", safe_action_text(s.analog_output_on_idle))
-      .field("analog_output_idle_raw", unsigned{s.analog_output_idle_raw})
-      .field("text", view(s.text))
-      .end_object();
+  Record r;
+  r.add("node", node_name(view(s.rack), view(s.port), s.mac),
+        {{"rack", view(s.rack)}, {"port", view(s.port)}, {"mac", s.mac}})
+      .add("name", std::string(view(s.name)), "name", view(s.name))
+      .add("online", yes_no(s.online), "online", static_cast<bool>(s.online))
+      .json("inputs_valid", static_cast<bool>(s.inputs_valid))
+      .add("running", input(s.pump_running, "yes", "no"), "pump_running",
+           static_cast<bool>(s.pump_running))
+      .add("warn", input(s.warning_active, "yes", "no"), "warning_active",
+           static_cast<bool>(s.warning_active))
+      .add("alarm", input(s.alarm_active, "yes", "no"), "alarm_active",
+           static_cast<bool>(s.alarm_active))
+      .add("n2", input(s.n2_flow_ok, "ok", "low"), "n2_flow_ok", static_cast<bool>(s.n2_flow_ok))
+      .add("interlock", input(s.interlock_ok, "ok", "open"), "interlock_ok",
+           static_cast<bool>(s.interlock_ok))
+      .json("digital_inputs_raw", s.digital_inputs_raw)
+      .text("ai1", ai(0))
+      .text("ai2", ai(1))
+      .json("analog_inputs", Json::array(std::move(analog_inputs)))
+      .json("exception_status_valid", static_cast<bool>(s.exception_status_valid))
+      .json("outputs_idle", static_cast<bool>(s.outputs_idle))
+      .json("idle_reason", view(s.idle_reason))
+      .add("pump", out ? on_off(s.pump_on) : "idle", "pump_on", static_cast<bool>(s.pump_on))
+      .add("ballast", out ? on_off(s.n2_ballast_on) : "idle", "n2_ballast_on",
+           static_cast<bool>(s.n2_ballast_on))
+      .add("aout",
+           out ? fmt::format("{} ({:.3f}V)", s.analog_output_raw, s.analog_output_volts) : "idle",
+           {{"analog_output_raw", s.analog_output_raw},
+            {"analog_output_volts", Decimal{s.analog_output_volts, 3}}})
+      .add("commanded by", out ? std::string(view(s.commanded_by)) : "", "commanded_by",
+           view(s.commanded_by));
+  return r;
 }
 
 }  // namespace
 
+std::string pumps_table(std::span<const dnbridge_PumpState* const> pumps) {
+  static constexpr std::string_view kColumns[] = {
+      "node",      "name", "online", "running", "warn",    "alarm", "n2",
+      "interlock", "ai1",  "ai2",    "pump",    "ballast", "aout",  "commanded by"};
+  std::vector<Record> rows;
+  for (const auto* p : pumps) rows.push_back(pump_record(*p));
+  return table(kColumns, rows);
+}
+
+void pump_json(JsonWriter& out, const dnbridge_PumpState& s) { pump_record(s).write(out); }
+
+namespace {
+
+Record safe_state_record(const dnbridge_SafeState& s) {
+  Record r;
+  r.json("known", static_cast<bool>(s.known))
+      .json("source", s.source == dnbridge_SAFE_STATE_DEVICE ? "device" : "configured")
+      .json("pump_on_fault", dds::name_of(s.pump_on_fault))
+      .json("pump_on_idle", dds::name_of(s.pump_on_idle))
+      .json("n2_ballast_on_fault", dds::name_of(s.n2_ballast_on_fault))
+      .json("n2_ballast_on_idle", dds::name_of(s.n2_ballast_on_idle))
+      .json("analog_output_on_fault", dds::name_of(s.analog_output_on_fault))
+      .json("analog_output_fault_raw", s.analog_output_fault_raw)
+      .json("analog_output_on_idle", dds::name_of(s.analog_output_on_idle))
+      .json("analog_output_idle_raw", s.analog_output_idle_raw)
+      .json("text", view(s.text));
+  return r;
+}
+
+Record counters_record(const dnbridge_NodeCounters& c) {
+  Record r;
+  const auto counter = [&r](const char* label, const char* key, std::uint64_t v) {
+    r.add(label, fmt::format("{}", v), key, v);
+  };
+  counter("polls", "polls", c.polls);
+  counter("idle polls", "idle_polls", c.idle_polls);
+  counter("poll responses", "poll_responses", c.poll_responses);
+  counter("poll timeouts", "poll_timeouts", c.poll_timeouts);
+  counter("poll retries", "poll_retries", c.poll_retries);
+  counter("poll errors", "poll_errors", c.poll_errors);
+  counter("reconnects", "reconnects", c.reconnects);
+  counter("allocate attempts", "allocate_attempts", c.allocate_attempts);
+  counter("idle empty responses", "idle_empty_responses", c.idle_empty_responses);
+  counter("settings written", "settings_written", c.settings_written);
+  counter("explicit requests", "explicit_requests", c.explicit_requests);
+  counter("explicit retries", "explicit_retries", c.explicit_retries);
+  counter("explicit timeouts", "explicit_timeouts", c.explicit_timeouts);
+  counter("explicit device errors", "explicit_device_errors", c.explicit_device_errors);
+  counter("last fragment unacked", "explicit_responses_before_final_ack",
+          c.explicit_responses_before_final_ack);
+  counter("invalid inputs", "responses_with_invalid_inputs", c.responses_with_invalid_inputs);
+  counter("commands accepted", "commands_accepted", c.commands_accepted);
+  counter("commands refused", "commands_refused", c.commands_refused);
+  return r;
+}
+
+std::string none_if_empty(std::string_view s) { return s.empty() ? "none" : std::string(s); }
+
+// A node as `show` shows it: its NodeStatus, with its PumpState if seen.
+Record node_record(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive) {
+  Record identity;
+  identity
+      .add("vendor", fmt::format("{} (0x{:04X})", n.vendor_id, n.vendor_id), "vendor_id",
+           n.vendor_id)
+      .add("product type", fmt::format("{} (0x{:04X})", n.product_type, n.product_type),
+           "product_type", n.product_type)
+      .add("product code", fmt::format("{} (0x{:04X})", n.product_code, n.product_code),
+           "product_code", n.product_code)
+      .add("revision", fmt::format("{}.{}", n.major_revision, n.minor_revision),
+           {{"major_revision", n.major_revision}, {"minor_revision", n.minor_revision}})
+      .add("serial number", fmt::format("{} (0x{:08X})", n.serial_number, n.serial_number),
+           "serial_number", n.serial_number)
+      .add("product name", std::string(view(n.product_name)), "product_name", view(n.product_name));
+
+  Json device_state;
+  if (n.device_state_valid) {
+    Record d;
+    d.json("code", n.device_state).json("text", view(n.device_state_text));
+    device_state = Json::object(std::move(d));
+  }
+  std::string outputs;
+  if (pump && !pump->outputs_idle) {
+    outputs = outputs_text(pump->pump_on, pump->n2_ballast_on, pump->analog_output_raw);
+  } else if (pump) {
+    outputs = view(pump->idle_reason).empty() ? "idle" : std::string(view(pump->idle_reason));
+  }
+
+  Record r;
+  r.add("node", fmt::format("{} ({})", node_name(view(n.rack), view(n.port), n.mac), view(n.name)),
+        {{"rack", view(n.rack)}, {"port", view(n.port)}, {"mac", n.mac}, {"name", view(n.name)}})
+      .json("bridge_alive", alive)
+      .add("state", fmt::format("{}{}", to_text(n.state), alive ? "" : " (bridge gone)"), "state",
+           to_text(n.state))
+      .add("reason", std::string(view(n.reason)), "reason", view(n.reason));
+  if (pump) r.add("online", yes_no(alive && pump->online), "online", alive && pump->online);
+  r.nest("identity", std::move(identity))
+      .add("device state",
+           n.device_state_valid ? fmt::format("{} ({})", n.device_state, view(n.device_state_text))
+           : view(n.device_state_text).empty() ? std::string("not read")
+                                               : std::string(view(n.device_state_text)),
+           "device_state", std::move(device_state))
+      .add("poll",
+           fmt::format("every {} ms, {} byte(s) out, {} byte(s) in", n.poll_period_ms,
+                       n.consumed_size, n.produced_size),
+           {{"poll_period_ms", n.poll_period_ms},
+            {"produced_size", n.produced_size},
+            {"consumed_size", n.consumed_size}})
+      .add("expected packet rate", fmt::format("{} ms", n.expected_packet_rate_ms),
+           "expected_packet_rate_ms", n.expected_packet_rate_ms)
+      .add(
+          "last error",
+          view(n.last_error).empty()
+              ? std::string("none")
+              : fmt::format("{} (general status 0x{:02X}, additional 0x{:02X})", view(n.last_error),
+                            n.last_error_general_status, n.last_error_additional_status),
+          {{"last_error", view(n.last_error)},
+           {"last_error_general_status", n.last_error_general_status},
+           {"last_error_additional_status", n.last_error_additional_status}})
+      .add("last refused command", none_if_empty(view(n.last_command_refused)),
+           "last_command_refused", view(n.last_command_refused))
+      .add("invalid inputs", none_if_empty(view(n.invalid_inputs)), "invalid_inputs",
+           view(n.invalid_inputs));
+  if (pump) {
+    r.text("outputs", std::move(outputs));
+    if (!pump->outputs_idle) r.text("commanded by", std::string(view(pump->commanded_by)));
+  }
+  r.add("safe state",
+        fmt::format("{} ({})", view(n.safe_state.text),
+                    n.safe_state.source == dnbridge_SAFE_STATE_DEVICE
+                        ? "the device's own, kept"
+                        : "from the configuration, read back"),
+        "safe_state", Json::object(safe_state_record(n.safe_state)))
+      .add("device faults", none_if_empty(view(n.device_faults)), "device_faults",
+           view(n.device_faults))
+      .json("idle_reason", view(n.idle_reason))
+      .nest("counters", counters_record(n.counters), "counters");
+  if (pump) r.json("pump", Json::object(pump_record(*pump)));
+  return r;
+}
+
+// Labels are padded to this width in `show`.
+constexpr std::size_t kDetailLabelWidth = 26;
+
+}  // namespace
+
+std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive) {
+  return node_record(n, pump, alive).lines(kDetailLabelWidth);
+}
+
 void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
                bool alive) {
-  out.begin_object()
-      .field("rack", view(n.rack))
-      .field("port", view(n.port))
-      .field("mac", unsigned{n.mac})
-      .field("name", view(n.name))
-      .field("bridge_alive", alive)
-      .field("state", to_text(n.state))
-      .field("reason", view(n.reason));
-  if (pump) out.field("online", alive && pump->online);
-  out.key("identity")
-      .begin_object()
-      .field("vendor_id", unsigned{n.vendor_id})
-      .field("product_type", unsigned{n.product_type})
-      .field("product_code", unsigned{n.product_code})
-      .field("major_revision", unsigned{n.major_revision})
-      .field("minor_revision", unsigned{n.minor_revision})
-      .field("serial_number", unsigned{n.serial_number})
-      .field("product_name", view(n.product_name))
-      .end_object();
-  out.key("device_state");
-  if (n.device_state_valid) {
-    out.begin_object()
-        .field("code", unsigned{n.device_state})
-        .field("text", view(n.device_state_text))
-        .end_object();
-  } else {
-    out.null();
-  }
-  out.field("poll_period_ms", unsigned{n.poll_period_ms})
-      .field("expected_packet_rate_ms", unsigned{n.expected_packet_rate_ms})
-      .field("produced_size", unsigned{n.produced_size})
-      .field("consumed_size", unsigned{n.consumed_size})
-      .field("last_error", view(n.last_error))
-      .field("last_error_general_status", unsigned{n.last_error_general_status})
-      .field("last_error_additional_status", unsigned{n.last_error_additional_status})
-      .field("last_command_refused", view(n.last_command_refused))
-      .field("invalid_inputs", view(n.invalid_inputs))
-      .field("device_faults", view(n.device_faults))
-      .field("idle_reason", view(n.idle_reason));
-  safe_state_json(out, n.safe_state);
-  const auto& c = n.counters;
-  out.key("counters")
-      .begin_object()
-      .field("polls", std::uint64_t{c.polls})
-      .field("idle_polls", std::uint64_t{c.idle_polls})
-      .field("poll_responses", std::uint64_t{c.poll_responses})
-      .field("poll_timeouts", std::uint64_t{c.poll_timeouts})
-      .field("poll_retries", std::uint64_t{c.poll_retries})
-      .field("poll_errors", std::uint64_t{c.poll_errors})
-      .field("reconnects", std::uint64_t{c.reconnects})
-      .field("allocate_attempts", std::uint64_t{c.allocate_attempts})
-      .field("idle_empty_responses", std::uint64_t{c.idle_empty_responses})
-      .field("settings_written", std::uint64_t{c.settings_written})
-      .field("explicit_requests", std::uint64_t{c.explicit_requests})
-      .field("explicit_retries", std::uint64_t{c.explicit_retries})
-      .field("explicit_timeouts", std::uint64_t{c.explicit_timeouts})
-      .field("explicit_device_errors", std::uint64_t{c.explicit_device_errors})
-      .field("explicit_responses_before_final_ack",
-             std::uint64_t{c.explicit_responses_before_final_ack})
-      .field("responses_with_invalid_inputs", std::uint64_t{c.responses_with_invalid_inputs})
-      .field("commands_accepted", std::uint64_t{c.commands_accepted})
-      .field("commands_refused", std::uint64_t{c.commands_refused})
-      .end_object();
-  if (pump) {
-    out.key("pump");
-    pump_json(out, *pump);
-  }
-  out.end_object();
+  node_record(n, pump, alive).write(out);
 }
 
 namespace {
@@ -482,78 +481,81 @@ std::string_view decoding_name(Decoding as) {
 
 }  // namespace
 
+namespace {
+
+// A request and its reply as `get`, `set` and `service` show them: in text
+// one line per field, "label: value", the request's own line first.
+Record explicit_record(const ExplicitExchange& x, Decoding as,
+                       const std::optional<Parsed<std::string>>& decoded) {
+  Record request;
+  request.json("rack", x.rack)
+      .json("port", x.port)
+      .json("mac", x.mac)
+      .json("service", x.service)
+      .json("service_name", service_text(x.service))
+      .json("class", x.class_id)
+      .json("instance", x.instance_id)
+      .json("attribute", x.attribute ? Json(*x.attribute) : Json())
+      .json("data", hex_bytes(x.request_data));
+
+  Record r;
+  r.add(request_text(x), "", "request", Json::object(std::move(request)))
+      .add("status: ", fmt::format("{} ({})", x.status, transaction_status_text(x.status)),
+           {{"status", x.status}, {"status_text", transaction_status_text(x.status)}});
+  // The device's status exists only when the bridge completed the transaction.
+  if (x.status == 1) {
+    std::string text =
+        fmt::format("0x{:02X} ({})", x.general_status, general_status_text(x.general_status));
+    if (x.additional_status != cip::kNoAdditionalCode) {
+      text += fmt::format(", additional status 0x{:02X}", x.additional_status);
+    }
+    r.add("CIP general status: ", std::move(text),
+          {{"general_status", x.general_status},
+           {"general_status_text", general_status_text(x.general_status)},
+           {"additional_status", x.additional_status}});
+  } else {
+    r.add("", "", {{"general_status", {}}, {"general_status_text", {}}, {"additional_status", {}}});
+  }
+  r.add(x.message.empty() ? "" : "message: ", x.message, "message", x.message);
+  std::string data_label;
+  if (!x.data.empty()) {
+    data_label = fmt::format("data ({} byte{}): ", x.data.size(), x.data.size() == 1 ? "" : "s");
+  } else if (x.succeeded()) {
+    data_label = "data: ";
+  }
+  r.add(std::move(data_label), x.data.empty() ? "none" : hex_bytes(x.data), "data",
+        hex_bytes(x.data))
+      .json("succeeded", x.succeeded());
+  if (decoded) {
+    Record d;
+    d.json("as", decoding_name(as));
+    std::string text;
+    if (decoded->ok() && as == Decoding::kString) {
+      d.json("value", **decoded);
+      text = json_quote(**decoded);
+    } else if (decoded->ok()) {
+      d.json("value", Json::digits(**decoded));  // an integer decode_data wrote
+      text = **decoded;
+    } else {
+      d.json("error", decoded->error());
+      text = "cannot decode: " + decoded->error();
+    }
+    r.add(fmt::format("as {}: ", decoding_name(as)), std::move(text), "decoded",
+          Json::object(std::move(d)));
+  }
+  return r;
+}
+
+}  // namespace
+
 std::string explicit_text(const ExplicitExchange& x, Decoding as,
                           const std::optional<Parsed<std::string>>& decoded) {
-  std::string o = request_text(x) + "\n";
-  o += fmt::format("status: {} ({})\n", x.status, transaction_status_text(x.status));
-  if (x.status == 1) {
-    o += fmt::format("CIP general status: 0x{:02X} ({})", x.general_status,
-                     general_status_text(x.general_status));
-    if (x.additional_status != cip::kNoAdditionalCode) {
-      o += fmt::format(", additional status 0x{:02X}", x.additional_status);
-    }
-    o += '\n';
-  }
-  if (!x.message.empty()) o += fmt::format("message: {}\n", x.message);
-  if (!x.data.empty()) {
-    o += fmt::format("data ({} byte{}): {}\n", x.data.size(), x.data.size() == 1 ? "" : "s",
-                     hex_bytes(x.data));
-  } else if (x.succeeded()) {
-    o += "data: none\n";
-  }
-  if (decoded) {
-    if (decoded->ok()) {
-      o += fmt::format("as {}: {}\n", decoding_name(as),
-                       as == Decoding::kString ? json_quote(**decoded) : **decoded);
-    } else {
-      o += fmt::format("as {}: cannot decode: {}\n", decoding_name(as), decoded->error());
-    }
-  }
-  return o;
+  return explicit_record(x, as, decoded).lines(0);
 }
 
 void explicit_json(JsonWriter& out, const ExplicitExchange& x, Decoding as,
                    const std::optional<Parsed<std::string>>& decoded) {
-  out.begin_object().key("request").begin_object()
-      .field("rack", x.rack)
-      .field("port", x.port)
-      .field("mac", unsigned{x.mac})
-      .field("service", unsigned{x.service})
-      .field("service_name", service_text(x.service))
-      .field("class", unsigned{x.class_id})
-      .field("instance", unsigned{x.instance_id});
-  out.key("attribute");
-  if (x.attribute) {
-    out.value(unsigned{*x.attribute});
-  } else {
-    out.null();
-  }
-  out.field("data", hex_bytes(x.request_data)).end_object();
-  out.field("status", unsigned{x.status})
-      .field("status_text", transaction_status_text(x.status));
-  // The device's status exists only when the bridge completed the transaction.
-  if (x.status == 1) {
-    out.field("general_status", unsigned{x.general_status})
-        .field("general_status_text", general_status_text(x.general_status))
-        .field("additional_status", unsigned{x.additional_status});
-  } else {
-    out.key("general_status").null().key("general_status_text").null().key("additional_status").null();
-  }
-  out.field("message", x.message)
-      .field("data", hex_bytes(x.data))
-      .field("succeeded", x.succeeded());
-  if (decoded) {
-    out.key("decoded").begin_object().field("as", decoding_name(as));
-    if (decoded->ok() && as == Decoding::kString) {
-      out.field("value", **decoded);
-    } else if (decoded->ok()) {
-      out.key("value").number_text(**decoded);  // an integer decode_data wrote
-    } else {
-      out.field("error", decoded->error());
-    }
-    out.end_object();
-  }
-  out.end_object();
+  explicit_record(x, as, decoded).write(out);
 }
 
 }  // namespace dnbridge::dnbctl

@@ -1,7 +1,9 @@
 #pragma once
 // How dnbctl shows what it read: readable tables and lines for people, and
 // the same content as JSON for scripts. Pure functions of the IDL structs
-// (idl/dnbridge.idl) and plain values: no DDS entity is touched here.
+// (idl/dnbridge.idl) and plain values: no DDS entity is touched here. Each
+// record (a port, a node, a pump, an explicit exchange) is one Record
+// (record.hpp), from which its table row, its lines and its JSON are made.
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -10,6 +12,7 @@
 #include <vector>
 
 #include "adapters/dnbctl/json.hpp"
+#include "adapters/dnbctl/record.hpp"
 #include "adapters/dnbctl/values.hpp"
 #include "dnbridge.h"
 
@@ -43,6 +46,10 @@ class Table {
   std::vector<std::vector<std::string>> rows_;
 };
 
+// Records as one column per label, the headers the labels in capitals, each
+// cell the record's text_of(label).
+std::string table(std::span<const std::string_view> labels, std::span<const Record> rows);
+
 // --- list -------------------------------------------------------------------------
 // `alive`: whether the bridge that wrote the sample is still there (a state
 // instance whose writer left stays readable, NOT_ALIVE_NO_WRITERS).
@@ -59,6 +66,8 @@ struct NodeRow {
 // Whether a node is online as dnbctl shows it: its bridge is there, and it
 // is polled (PumpState's `online`, else the NodeStatus state).
 bool node_online(const NodeRow& row);
+// A port's PortStatus as every command shows it.
+Record port_record(const dnbridge_PortStatus& p);
 // The members of a port's JSON object (list, racks).
 void port_json_members(JsonWriter& out, const dnbridge_PortStatus& p);
 

@@ -169,97 +169,103 @@ std::vector<RackSummary> summarize_racks(std::span<const PortRow> ports,
   return out;
 }
 
-std::string racks_text(std::span<const RackSummary> racks) {
-  std::vector<std::string> headers{"RACK", "BRIDGE", "PORTS", "NODES"};
-  for (auto c : kClasses) {
-    std::string h(c == NodeClass::kOtherMaster ? "other master" : to_text(c));
-    std::transform(h.begin(), h.end(), h.begin(),
-                   [](unsigned char ch) { return std::toupper(ch); });
-    headers.push_back(std::move(h));
-  }
-  Table summary(std::move(headers));
-  for (const auto& r : racks) {
-    std::string bridge(to_text(r.bridge));
-    if (r.participants > 1) bridge += fmt::format(" ({} bridges!)", r.participants);
-    std::vector<std::string> row{r.rack, bridge, ports_text(r)};
-    const bool silent = r.bridge == BridgeState::kSilent;
-    row.push_back(silent ? "-" : fmt::format("{}", r.nodes.size()));
-    for (auto c : kClasses) row.push_back(silent ? "-" : fmt::format("{}", r.count(c)));
-    summary.add(std::move(row));
-  }
-  std::string text = summary.render();
+namespace {
 
-  Table ports({"RACK", "PORT", "STATE", "BUS", "REASON"});
-  bool port_problems = false;
+// A rack's line of the summary: its counts per class are table cells of
+// their own, and an object in JSON.
+Record rack_record(const RackSummary& r) {
+  const bool silent = r.bridge == BridgeState::kSilent;
+  const auto count = [silent](std::size_t n) {
+    return silent ? std::string("-") : fmt::format("{}", n);
+  };
+  Record counts;
+  counts.add("nodes", count(r.nodes.size()), "nodes", r.nodes.size());
+  for (auto c : kClasses) {
+    counts.add(c == NodeClass::kOtherMaster ? "other master" : std::string(to_text(c)),
+               count(r.count(c)), std::string(json_name(c)), r.count(c));
+  }
+  std::vector<Record> ports;
+  for (const auto* p : r.ports) {
+    Record port = port_record(*p->port);
+    port.json("bridge_alive", p->alive).json("healthy", healthy(*p));
+    ports.push_back(std::move(port));
+  }
+  std::vector<Record> nodes;
+  for (const auto* n : r.nodes) nodes.push_back(rack_node_record(*n));
+
+  std::string bridge(to_text(r.bridge));
+  if (r.participants > 1) bridge += fmt::format(" ({} bridges!)", r.participants);
+  Record rec;
+  rec.add("rack", r.rack, "rack", r.rack)
+      .add("bridge", std::move(bridge),
+           {{"bridge", to_text(r.bridge)}, {"participants", r.participants}})
+      .nest("counts", std::move(counts))
+      .add("ports", ports_text(r), "ports", Json::array(std::move(ports)))
+      .json("nodes", Json::array(std::move(nodes)));
+  return rec;
+}
+
+}  // namespace
+
+Record rack_node_record(const NodeRow& row) {
+  const auto& n = *row.node;
+  const NodeClass c = classify(row);
+  Record r;
+  r.text("rack", std::string(view(n.rack)))
+      .add("port", std::string(view(n.port)), "port", view(n.port))
+      .add("mac", fmt::format("{}", n.mac), "mac", n.mac)
+      .add("name", std::string(view(n.name)), "name", view(n.name))
+      .add("class", std::string(to_text(c)), "class", json_name(c))
+      .add("state", std::string(to_text(n.state)), "state", to_text(n.state))
+      .add("reason", class_reason(row), "reason", class_reason(row))
+      .json("state_reason", view(n.reason))
+      .json("last_error", view(n.last_error))
+      .json("allocate_attempts", n.counters.allocate_attempts)
+      .json("outputs_idle", row.pump ? Json(static_cast<bool>(row.pump->outputs_idle)) : Json())
+      .json("commanded_by", row.pump ? Json(view(row.pump->commanded_by)) : Json());
+  return r;
+}
+
+std::string racks_text(std::span<const RackSummary> racks) {
+  std::vector<std::string_view> columns{"rack", "bridge", "ports", "nodes"};
+  for (auto c : kClasses)
+    columns.push_back(c == NodeClass::kOtherMaster ? "other master" : to_text(c));
+  std::vector<Record> rows;
+  for (const auto& r : racks) rows.push_back(rack_record(r));
+  std::string text = table(columns, rows);
+
+  static constexpr std::string_view kPortColumns[] = {"rack", "port", "state", "bus", "reason"};
+  std::vector<Record> problem_ports;
   for (const auto& r : racks) {
     for (const auto* p : r.ports) {
       if (healthy(*p)) continue;
-      port_problems = true;
-      ports.add({r.rack, std::string(view(p->port->port)),
-                 p->alive ? std::string(to_text(p->port->state)) : "bridge gone",
-                 std::string(to_text(p->port->bus_state)), std::string(view(p->port->reason))});
+      Record port = port_record(*p->port);
+      port.text("rack", r.rack);
+      if (!p->alive) port.retext("state", "bridge gone");
+      problem_ports.push_back(std::move(port));
     }
   }
-  if (port_problems) text += "\n" + ports.render();
+  if (!problem_ports.empty()) text += "\n" + table(kPortColumns, problem_ports);
 
-  Table nodes({"RACK", "PORT", "MAC", "NAME", "CLASS", "STATE", "REASON"});
-  bool not_online = false;
+  static constexpr std::string_view kNodeColumns[] = {"rack",  "port",  "mac",   "name",
+                                                      "class", "state", "reason"};
+  std::vector<Record> not_online;
   for (const auto& r : racks) {
     for (const auto* n : r.nodes) {
-      const NodeClass c = classify(*n);
-      if (c == NodeClass::kOnline) continue;
-      not_online = true;
-      nodes.add({r.rack, std::string(view(n->node->port)), fmt::format("{}", n->node->mac),
-                 std::string(view(n->node->name)), std::string(to_text(c)),
-                 std::string(to_text(n->node->state)), class_reason(*n)});
+      if (classify(*n) != NodeClass::kOnline) not_online.push_back(rack_node_record(*n));
     }
   }
   text += "\n";
-  text += not_online ? nodes.render() : "every node reported is online\n";
+  text += not_online.empty() ? "every node reported is online\n" : table(kNodeColumns, not_online);
   return text;
 }
 
 void racks_json(JsonWriter& out, std::span<const RackSummary> racks) {
-  out.begin_object().key("racks").begin_array();
-  for (const auto& r : racks) {
-    out.begin_object()
-        .field("rack", r.rack)
-        .field("bridge", to_text(r.bridge))
-        .field("participants", r.participants);
-    out.key("counts").begin_object().field("nodes", r.nodes.size());
-    for (auto c : kClasses) out.field(json_name(c), r.count(c));
-    out.end_object();
-    out.key("ports").begin_array();
-    for (const auto* p : r.ports) {
-      out.begin_object();
-      port_json_members(out, *p->port);
-      out.field("bridge_alive", p->alive).field("healthy", healthy(*p)).end_object();
-    }
-    out.end_array();
-    out.key("nodes").begin_array();
-    for (const auto* n : r.nodes) {
-      const auto& s = *n->node;
-      out.begin_object()
-          .field("port", view(s.port))
-          .field("mac", unsigned{s.mac})
-          .field("name", view(s.name))
-          .field("class", json_name(classify(*n)))
-          .field("state", to_text(s.state))
-          .field("reason", class_reason(*n))
-          .field("state_reason", view(s.reason))
-          .field("last_error", view(s.last_error))
-          .field("allocate_attempts", s.counters.allocate_attempts);
-      if (n->pump) {
-        out.field("outputs_idle", static_cast<bool>(n->pump->outputs_idle))
-            .field("commanded_by", view(n->pump->commanded_by));
-      } else {
-        out.key("outputs_idle").null().key("commanded_by").null();
-      }
-      out.end_object();
-    }
-    out.end_array().end_object();
-  }
-  out.end_array().end_object();
+  std::vector<Record> items;
+  for (const auto& r : racks) items.push_back(rack_record(r));
+  Record doc;
+  doc.json("racks", Json::array(std::move(items)));
+  doc.write(out);
 }
 
 }  // namespace dnbridge::dnbctl

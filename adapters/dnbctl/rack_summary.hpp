@@ -38,6 +38,8 @@ NodeClass classify(const NodeRow& row);
 // with what helps an operator act (idle: no commander; absent: Allocate
 // attempts and the last error; unknown: the last state reported).
 std::string class_reason(const NodeRow& row);
+// A node as `racks` shows it: its class and why.
+Record rack_node_record(const NodeRow& row);
 
 enum class BridgeState : std::uint8_t {
   kLive,    // its participant is on the domain, or its instances are alive

@@ -50,5 +50,20 @@ TEST(States, EveryBusStateHasItsOwnIdlValueAndComesBack) {
   EXPECT_EQ(name_of(static_cast<dnbridge_BusState>(7)), "unknown");
 }
 
+TEST(States, SafeActionsHaveTheCoresNames) {
+  namespace cdn127 = profiles::cdn127;
+  for (auto a :
+       {cdn127::DiscreteAction::kOff, cdn127::DiscreteAction::kOn, cdn127::DiscreteAction::kHold}) {
+    EXPECT_EQ(name_of(to_idl(a)), cdn127::to_string(a));
+  }
+  using Kind = cdn127::AnalogAction::Kind;
+  EXPECT_EQ(to_idl(cdn127::AnalogAction{Kind::kLowLimit, 0}), dnbridge_SAFE_ACTION_OFF);
+  EXPECT_EQ(to_idl(cdn127::AnalogAction{Kind::kHighLimit, 0}), dnbridge_SAFE_ACTION_ON);
+  EXPECT_EQ(to_idl(cdn127::AnalogAction{Kind::kHold, 0}), dnbridge_SAFE_ACTION_HOLD);
+  EXPECT_EQ(to_idl(cdn127::AnalogAction{Kind::kValue, 2048}), dnbridge_SAFE_ACTION_VALUE);
+  EXPECT_EQ(name_of(dnbridge_SAFE_ACTION_VALUE), "value");
+  EXPECT_EQ(name_of(dnbridge_SAFE_ACTION_UNKNOWN), "unknown");
+}
+
 }  // namespace
 }  // namespace dnbridge::dds
