@@ -181,7 +181,8 @@ void PortLoop::run() {
       port_event_time_ = now;
     }
     publish(now, false);
-    if (stopping && (scanner_->stopped() || now >= stop_deadline)) break;
+    // Requests still queued are handled first: each gets its one reply.
+    if (stopping && !calls_waiting_ && (scanner_->stopped() || now >= stop_deadline)) break;
 
     TimePoint wake = std::min({scanner_->next_deadline(), stop_deadline,
                                port_status_time_ + config_.status_period, gateway_->next_expiry()});

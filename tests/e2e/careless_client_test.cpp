@@ -34,13 +34,14 @@ namespace {
 bool thread_to_fifo(pid_t pid, const std::string& name) {
   const std::filesystem::path tasks = "/proc/" + std::to_string(pid) + "/task";
   std::error_code ec;
-  for (const auto& task : std::filesystem::directory_iterator(tasks, ec)) {
-    std::ifstream comm(task.path() / "comm");
+  for (std::filesystem::directory_iterator it(tasks, ec), end; !ec && it != end; it.increment(ec)) {
+    std::ifstream comm(it->path() / "comm");
     std::string line;
-    if (!std::getline(comm, line) || line != name) continue;
+    // The kernel keeps 15 characters of a thread's name.
+    if (!std::getline(comm, line) || line != name.substr(0, 15)) continue;
     sched_param priority{};
     priority.sched_priority = 1;
-    const auto tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
+    const auto tid = static_cast<pid_t>(std::stol(it->path().filename().string()));
     return sched_setscheduler(tid, SCHED_FIFO, &priority) == 0;
   }
   return false;

@@ -283,11 +283,29 @@ TEST(PortLoop, BadCommandsAreRefusedAndReported) {
   loop.join();
 }
 
+// `count` requests for the status of transactions never started: each is
+// answered at once, by the port loop, with "txid unknown".
+void queue_status_requests(PortLoop& loop, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i) {
+    rack::ExplicitCall call;
+    call.requester = "flood-" + std::to_string(i);
+    call.txid = 1;
+    call.command = 2;
+    call.port = "A";
+    call.mac = 4;
+    loop.explicit_request(call);
+  }
+}
+
 // A flood of requests is handled kCallsPerPass at a time: between two
 // batches the loop goes back to its timers and the bus, and nothing queued
 // is lost on the way.
 TEST(PortLoop, AFloodOfRequestsIsHandledAFewAtATimeBetweenPasses) {
+  constexpr std::size_t kCalls = 3 * PortLoop::kCallsPerPass + 5;
   RecordingPublisher publisher;
+  // At the start of every pass (posted jobs run first), the replies so far.
+  std::vector<std::size_t> at_pass_start;
+  std::function<void(CanBackend&)> record;
   PortLoop loop(config_for({4}),
                 std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(4)}),
                 publisher, null_log_sink());
@@ -302,19 +320,8 @@ TEST(PortLoop, AFloodOfRequestsIsHandledAFewAtATimeBetweenPasses) {
     release.get_future().wait();
   });
   held.get_future().wait();
-  constexpr std::size_t kCalls = 3 * PortLoop::kCallsPerPass + 5;
-  for (std::size_t i = 0; i < kCalls; ++i) {
-    rack::ExplicitCall call;
-    call.requester = "flood-" + std::to_string(i);
-    call.txid = 1;
-    call.command = 2;  // status of a transaction it never started: answered at once
-    call.port = "A";
-    call.mac = 4;
-    loop.explicit_request(call);
-  }
-  // At the start of every pass (posted jobs run first), the replies so far.
-  std::vector<std::size_t> at_pass_start;
-  std::function<void(CanBackend&)> record = [&](CanBackend&) {
+  queue_status_requests(loop, kCalls);
+  record = [&](CanBackend&) {
     std::size_t replies = 0;
     {
       std::lock_guard lock(publisher.mutex());
@@ -340,6 +347,28 @@ TEST(PortLoop, AFloodOfRequestsIsHandledAFewAtATimeBetweenPasses) {
   }
   loop.stop();
   loop.join();
+}
+
+// Requests queued when the port stops are answered before its loop ends,
+// even when the master has nothing to release (no node ever answered).
+TEST(PortLoop, RequestsQueuedAtStopAreAllAnswered) {
+  constexpr std::size_t kCalls = 3 * PortLoop::kCallsPerPass + 5;
+  RecordingPublisher publisher;
+  PortLoop loop(config_for({4}),
+                std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{}),
+                publisher, null_log_sink());
+  loop.start();
+  std::promise<void> held, release;
+  loop.post([&](CanBackend&) {
+    held.set_value();
+    release.get_future().wait();
+  });
+  held.get_future().wait();
+  queue_status_requests(loop, kCalls);
+  loop.stop();
+  release.set_value();
+  loop.join();
+  EXPECT_EQ(publisher.replies.size(), kCalls);
 }
 
 // The world on a thread of its own (what the benchmark measures the bridge
