@@ -16,32 +16,17 @@
 #include <utility>
 
 #include "adapters/sim/world/sim_rack.hpp"
-#include "adapters/toml/problems.hpp"
+#include "adapters/toml/reader.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
 namespace dnbridge::cdn127_sim {
 namespace {
 
 using devicenet::MacId;
-using toml_config::Problem;
 using toml_config::type_name;
 
-constexpr std::string_view kTopKeys[] = {"defaults", "device"};
-// Every key of a [[device]] table; [defaults] takes all but its MAC.
-constexpr std::string_view kDeviceKeys[] = {
-    "mac",
-    "configuration_locked_while_poll_allocated",
-    "poll_paths_fixed",
-    "idle_poll_answered_empty",
-    "no_ack_of_last_request_fragment",
-    "explicit_response_delay_ms",
-    "poll_response_delay_ms",
-    "serial_number_bytes",
-    "identity_state_supported",
-    "epr_resolution_ms",
-    "unsafe_factory_output_actions",
-};
-constexpr std::span<const std::string_view> kSettingKeys = std::span(kDeviceKeys).subspan(1);
+using toml_config::Problems;
+using toml_config::TableReader;
 
 // A delay longer than any master's timeout is still a reading worth trying;
 // a minute bounds typing mistakes.
@@ -51,136 +36,71 @@ constexpr std::int64_t kMaxResolutionMs = 0xFFFF;
 
 constexpr sim::ClassAttribute kIdentityState{profiles::cdn127::class_id::kIdentity, 8};
 
-class Reader {
- public:
-  void error(const toml::source_region& at, std::string text) {
-    problems_.push_back({at, std::move(text)});
-  }
-  bool ok() const noexcept { return problems_.empty(); }
-
-  // Every problem, "FILE:LINE:COLUMN: text", in the file's order.
-  std::vector<std::string> messages(std::string_view source) {
-    std::stable_sort(problems_.begin(), problems_.end(), [](const Problem& a, const Problem& b) {
-      return std::tie(a.at.begin.line, a.at.begin.column) <
-             std::tie(b.at.begin.line, b.at.begin.column);
-    });
-    std::vector<std::string> out;
-    for (const auto& p : problems_) out.push_back(toml_config::format(source, p));
-    return out;
-  }
-
-  std::optional<bool> boolean(const toml::node& n, std::string_view key) {
-    if (const auto* v = n.as_boolean()) return v->get();
-    error(n.source(), fmt::format("{} must be true or false, not {}", key, type_name(n.type())));
-    return std::nullopt;
-  }
-
-  std::optional<std::int64_t> integer(const toml::node& n, std::string_view key, std::int64_t min,
-                                      std::int64_t max, std::string_view unit = {}) {
-    const auto* v = n.as_integer();
-    if (v == nullptr) {
-      error(n.source(), fmt::format("{} must be an integer, not {}", key, type_name(n.type())));
-      return std::nullopt;
-    }
-    if (v->get() < min || v->get() > max) {
-      error(n.source(),
-            fmt::format("{} = {} is out of range ({}..{}{})", key, v->get(), min, max, unit));
-      return std::nullopt;
-    }
-    return v->get();
-  }
-
-  std::optional<Duration> ms(const toml::node& n, std::string_view key, std::int64_t min,
-                             std::int64_t max) {
-    auto v = integer(n, key, min, max, " ms");
-    if (!v) return std::nullopt;
-    return milliseconds(*v);
-  }
-
-  // The settings keys of `t` (unknown keys are checked by the caller).
-  DeviceSettings settings(const toml::table& t) {
-    DeviceSettings s;
-    auto flag = [&](std::string_view key, std::optional<bool>& out) {
-      if (const toml::node* n = t.get(key)) out = boolean(*n, key);
-    };
-    flag("configuration_locked_while_poll_allocated", s.configuration_locked_while_poll_allocated);
-    flag("poll_paths_fixed", s.poll_paths_fixed);
-    flag("idle_poll_answered_empty", s.idle_poll_answered_empty);
-    flag("no_ack_of_last_request_fragment", s.no_ack_of_last_request_fragment);
-    flag("identity_state_supported", s.identity_state_supported);
-    flag("unsafe_factory_output_actions", s.unsafe_factory_output_actions);
-    if (const toml::node* n = t.get("explicit_response_delay_ms")) {
-      s.explicit_response_delay = ms(*n, "explicit_response_delay_ms", 0, kMaxDelayMs);
-    }
-    if (const toml::node* n = t.get("poll_response_delay_ms")) {
-      s.poll_response_delay = ms(*n, "poll_response_delay_ms", 0, kMaxDelayMs);
-    }
-    if (const toml::node* n = t.get("epr_resolution_ms")) {
-      s.epr_resolution = ms(*n, "epr_resolution_ms", 1, kMaxResolutionMs);
-    }
-    if (const toml::node* n = t.get("serial_number_bytes")) {
-      constexpr auto kAny = std::numeric_limits<std::int64_t>::max();
-      if (auto v = integer(*n, "serial_number_bytes", -kAny, kAny)) {
-        if (*v == 2 || *v == 4) {
-          s.serial_number_udint = *v == 4;
-        } else {
-          error(n->source(), fmt::format("serial_number_bytes = {}: 2 (UINT, as the manual's "
+// The settings a [[device]] and [defaults] both hold.
+DeviceSettings read_settings(TableReader& t) {
+  Problems& p = t.problems();
+  DeviceSettings s;
+  auto flag = [&](std::string_view key, std::optional<bool>& out) {
+    if (const toml::node* n = t.get(key)) out = toml_config::read_bool(*n, key, p);
+  };
+  auto ms = [&](std::string_view key, std::int64_t min, std::int64_t max,
+                std::optional<Duration>& out) {
+    if (const toml::node* n = t.get(key)) out = toml_config::read_ms(*n, key, min, max, p);
+  };
+  flag("configuration_locked_while_poll_allocated", s.configuration_locked_while_poll_allocated);
+  flag("poll_paths_fixed", s.poll_paths_fixed);
+  flag("idle_poll_answered_empty", s.idle_poll_answered_empty);
+  flag("no_ack_of_last_request_fragment", s.no_ack_of_last_request_fragment);
+  flag("identity_state_supported", s.identity_state_supported);
+  flag("unsafe_factory_output_actions", s.unsafe_factory_output_actions);
+  ms("explicit_response_delay_ms", 0, kMaxDelayMs, s.explicit_response_delay);
+  ms("poll_response_delay_ms", 0, kMaxDelayMs, s.poll_response_delay);
+  ms("epr_resolution_ms", 1, kMaxResolutionMs, s.epr_resolution);
+  if (const toml::node* n = t.get("serial_number_bytes")) {
+    constexpr auto kAny = std::numeric_limits<std::int64_t>::max();
+    if (auto v = toml_config::read_integer(*n, "serial_number_bytes", {-kAny, kAny}, p)) {
+      if (*v == 2 || *v == 4) {
+        s.serial_number_udint = *v == 4;
+      } else {
+        p.error(n->source(), fmt::format("serial_number_bytes = {}: 2 (UINT, as the manual's "
                                          "table types it) or 4 (UDINT, as ODVA's Identity)",
                                          *v));
-        }
       }
     }
-    return s;
   }
+  return s;
+}
 
-  void unknown_keys(const toml::table& t, std::string_view where,
-                    std::span<const std::string_view> known) {
-    for (auto& p : toml_config::unknown_keys(t, where, known)) {
-      problems_.push_back(std::move(p));
-    }
-  }
-
- private:
-  std::vector<Problem> problems_;
-};
-
-DeviceConfig read(const toml::table& root, Reader& r) {
+DeviceConfig read(const toml::table& table, Problems& p) {
   DeviceConfig config;
-  r.unknown_keys(root, "the device configuration", kTopKeys);
+  TableReader root(table, "the device configuration", p);
   if (const toml::node* n = root.get("defaults")) {
-    if (const auto* t = n->as_table()) {
-      r.unknown_keys(*t, "[defaults]", kSettingKeys);
-      config.defaults = r.settings(*t);
-    } else {
-      r.error(n->source(),
-              fmt::format("defaults must be a table ([defaults]), not {}", type_name(n->type())));
+    if (const toml::table* t = toml_config::as_table(*n, "defaults", "[defaults]", p)) {
+      TableReader defaults(*t, "[defaults]", p);
+      config.defaults = read_settings(defaults);
     }
   }
   const toml::node* devices = root.get("device");
   if (devices == nullptr) return config;
   const auto* list = devices->as_array();
   if (list == nullptr || !list->is_array_of_tables()) {
-    r.error(devices->source(), fmt::format("device must be an array of tables ([[device]]), not {}",
+    p.error(devices->source(), fmt::format("device must be an array of tables ([[device]]), not {}",
                                            type_name(devices->type())));
     return config;
   }
   std::map<unsigned, std::uint32_t> first_line;  // MAC -> line of its [[device]]
   for (const toml::node& n : *list) {
-    const toml::table& t = *n.as_table();
-    r.unknown_keys(t, "[[device]]", kDeviceKeys);
+    TableReader t(*n.as_table(), "[[device]]", p);
     DeviceEntry entry;
-    entry.settings = r.settings(t);
-    const toml::node* mac = t.get("mac");
-    if (mac == nullptr) {
-      r.error(t.source(), "missing required key 'mac' in [[device]]");
-      continue;
-    }
-    auto v = r.integer(*mac, "mac", 0, devicenet::MacId::kMax);
+    entry.settings = read_settings(t);
+    const toml::node* mac = t.require("mac");
+    if (mac == nullptr) continue;
+    auto v = toml_config::read_integer(*mac, "mac", {0, devicenet::MacId::kMax}, p);
     if (!v) continue;
     entry.mac = MacId::from_bits(static_cast<std::uint8_t>(*v));
     const auto [it, added] = first_line.try_emplace(entry.mac.value(), mac->source().begin.line);
     if (!added) {
-      r.error(mac->source(),
+      p.error(mac->source(),
               fmt::format("mac = {} is given twice (first on line {})", *v, it->second));
       continue;
     }
@@ -220,16 +140,11 @@ DeviceConfigError::DeviceConfigError(std::vector<std::string> problems)
     : std::runtime_error(toml_config::join_lines(problems)), problems_(std::move(problems)) {}
 
 DeviceConfig parse_device_config(std::string_view text, std::string_view source_name) {
-  toml::table root;
-  try {
-    root = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    throw DeviceConfigError(
-        {toml_config::format(source_name, Problem{e.source(), std::string(e.description())})});
-  }
-  Reader r;
-  DeviceConfig config = read(root, r);
-  if (!r.ok()) throw DeviceConfigError(r.messages(source_name));
+  Problems problems{std::string(source_name)};
+  const auto root = toml_config::parse(text, problems);
+  if (!root) throw DeviceConfigError(problems.errors());
+  DeviceConfig config = read(*root, problems);
+  if (problems.has_errors()) throw DeviceConfigError(problems.errors());
   return config;
 }
 

@@ -20,7 +20,7 @@
 
 #include "adapters/daemon/host_identity.hpp"
 #include "adapters/security/toml_settings.hpp"
-#include "adapters/toml/problems.hpp"
+#include "adapters/toml/reader.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
 namespace dnbridge::daemon {
@@ -31,160 +31,24 @@ using toml_config::type_name;
 
 namespace {
 
-// ---------------------------------------------------------------------------
-// Problems, collected with their position so that all of them are reported
-// at once, in the order of the file.
+using toml_config::IntRange;
+using toml_config::Problems;
+using toml_config::read_bool;
+using toml_config::read_int_as;
+using toml_config::read_integer;
+using toml_config::read_ms;
+using toml_config::read_name;
+using toml_config::read_number;
+using toml_config::read_string;
+using toml_config::TableReader;
 
-struct Position {
-  std::uint32_t line = 1;
-  std::uint32_t column = 1;
-};
-
-Position at(const toml::source_region& region) {
-  // An empty document has no position; its problems are at its start.
-  return {std::max<std::uint32_t>(region.begin.line, 1),
-          std::max<std::uint32_t>(region.begin.column, 1)};
-}
-
-class Reporter {
- public:
-  explicit Reporter(std::string_view source) : source_(source) {}
-
-  void error(Position p, std::string text) { add(errors_, p, std::move(text)); }
-  void warning(Position p, std::string text) { add(warnings_, p, std::move(text)); }
-  bool has_errors() const noexcept { return !errors_.empty(); }
-  std::vector<std::string> errors() const { return format(errors_); }
-  std::vector<std::string> warnings() const { return format(warnings_); }
-
- private:
-  struct Entry {
-    Position at;
-    std::string text;
-  };
-  // Settings of [defaults] are read again for every node that inherits them:
-  // a problem in one is reported once.
-  void add(std::vector<Entry>& list, Position p, std::string text) {
-    if (seen_.emplace(p.line, p.column, text).second) list.push_back({p, std::move(text)});
-  }
-  std::vector<std::string> format(std::vector<Entry> list) const {
-    std::stable_sort(list.begin(), list.end(), [](const Entry& a, const Entry& b) {
-      return std::tie(a.at.line, a.at.column) < std::tie(b.at.line, b.at.column);
-    });
-    std::vector<std::string> out;
-    out.reserve(list.size());
-    for (const auto& e : list) {
-      out.push_back(fmt::format("{}:{}:{}: {}", source_, e.at.line, e.at.column, e.text));
-    }
-    return out;
-  }
-
-  std::string source_;
-  std::vector<Entry> errors_;
-  std::vector<Entry> warnings_;
-  std::set<std::tuple<std::uint32_t, std::uint32_t, std::string>> seen_;
-};
-
-// ---------------------------------------------------------------------------
-// Keys and typed values.
-
-using KeyList = std::span<const std::string_view>;
-
-// A misspelt key must not fall back silently to a default: every key a table
-// holds must be one it may hold.
-void check_keys(const toml::table& table, std::string_view where, KeyList known, Reporter& r) {
-  for (auto& p : toml_config::unknown_keys(table, where, known)) {
-    r.error(at(p.at), std::move(p.text));
-  }
-}
-
-const toml::node* require(const toml::table& table, std::string_view key, std::string_view where,
-                          Reporter& r) {
-  const toml::node* n = table.get(key);
-  if (!n) r.error(at(table.source()), fmt::format("missing required key '{}' in {}", key, where));
-  return n;
-}
-
-struct IntRange {
-  std::int64_t min;
-  std::int64_t max;
-  std::string_view unit = {};  // " ms"
-  std::string_view note = {};  // replaces "(min..max unit)" in the message
-};
-
-std::optional<std::int64_t> read_integer(const toml::node& n, std::string_view key, IntRange range,
-                                         Reporter& r) {
-  const auto* v = n.as_integer();
-  if (!v) {
-    r.error(at(n.source()), fmt::format("{} must be an integer, not {}", key, type_name(n.type())));
-    return std::nullopt;
-  }
-  const std::int64_t value = v->get();
-  if (value < range.min || value > range.max) {
-    if (range.note.empty()) {
-      r.error(at(n.source()), fmt::format("{} = {} is out of range ({}..{}{})", key, value,
-                                          range.min, range.max, range.unit));
-    } else {
-      r.error(at(n.source()), fmt::format("{} = {} is out of range: {}", key, value, range.note));
-    }
-    return std::nullopt;
-  }
-  return value;
-}
-
-template <class T>
-std::optional<T> read_int_as(const toml::node& n, std::string_view key, IntRange range,
-                             Reporter& r) {
-  auto v = read_integer(n, key, range, r);
-  if (!v) return std::nullopt;
-  return static_cast<T>(*v);
-}
-
-std::optional<Duration> read_ms(const toml::node& n, std::string_view key, std::int64_t min,
-                                std::int64_t max, Reporter& r) {
-  auto v = read_integer(n, key, {min, max, " ms"}, r);
-  if (!v) return std::nullopt;
-  return milliseconds(*v);
-}
-
-std::optional<std::string> read_string(const toml::node& n, std::string_view key, Reporter& r) {
-  const auto* v = n.as_string();
-  if (!v) {
-    r.error(at(n.source()), fmt::format("{} must be a string, not {}", key, type_name(n.type())));
-    return std::nullopt;
-  }
-  return v->get();
-}
-
-// A name is a DDS key and what operators read: never empty.
-std::optional<std::string> read_name(const toml::node& n, std::string_view key, Reporter& r) {
-  auto v = read_string(n, key, r);
-  if (v && v->empty()) {
-    r.error(at(n.source()), fmt::format("{} must not be empty", key));
-    return std::nullopt;
-  }
-  return v;
-}
-
-std::optional<bool> read_bool(const toml::node& n, std::string_view key, Reporter& r) {
-  const auto* v = n.as_boolean();
-  if (!v) {
-    r.error(at(n.source()),
-            fmt::format("{} must be true or false, not {}", key, type_name(n.type())));
-    return std::nullopt;
-  }
-  return v->get();
-}
-
-std::optional<double> read_number(const toml::node& n, std::string_view key, Reporter& r) {
-  if (const auto* i = n.as_integer()) return static_cast<double>(i->get());
-  if (const auto* f = n.as_floating_point()) return f->get();
-  r.error(at(n.source()), fmt::format("{} must be a number, not {}", key, type_name(n.type())));
-  return std::nullopt;
+std::uint32_t line_of(const toml::source_region& at) {
+  return std::max<std::uint32_t>(at.begin.line, 1);
 }
 
 const IntRange kMacRange{0, MacId::kMax, {}, "a DeviceNet MAC ID is 0..63"};
 
-std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Reporter& r) {
+std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Problems& r) {
   auto v = read_integer(n, key, kMacRange, r);
   if (!v) return std::nullopt;
   return MacId::from(static_cast<unsigned>(*v));
@@ -195,57 +59,6 @@ std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Reporte
 
 constexpr std::string_view kProfileCdn127 = "cdn127";
 
-// Every key of a node; [defaults] takes all but mac and name.
-constexpr std::array<std::string_view, 24> kNodeKeys{"mac",
-                                                     "name",
-                                                     "serial",
-                                                     "profile",
-                                                     "io",
-                                                     "identity",
-                                                     "poll_period_ms",
-                                                     "expected_packet_rate_ms",
-                                                     "explicit_packet_rate_ms",
-                                                     "immediate_poll",
-                                                     "immediate_poll_min_gap_ms",
-                                                     "publish_max_period_ms",
-                                                     "analog_deadband_volts",
-                                                     "no_commander",
-                                                     "explicit_response_timeout_ms",
-                                                     "poll_response_timeout_ms",
-                                                     "safe_state",
-                                                     "pump_on_fault",
-                                                     "pump_on_idle",
-                                                     "n2_ballast_on_fault",
-                                                     "n2_ballast_on_idle",
-                                                     "analog_output_on_fault",
-                                                     "analog_output_on_idle",
-                                                     "resume"};
-// [defaults] takes every key of a node but its MAC, name and serial number.
-constexpr KeyList kDefaultsKeys = KeyList(kNodeKeys).subspan(3);
-
-constexpr std::array<std::string_view, 7> kIoKeys{
-    "preset",        "mode",           "digital_inputs", "digital_outputs",
-    "analog_inputs", "analog_outputs", "no_nc_mask"};
-constexpr std::array<std::string_view, 3> kIdentityKeys{"vendor_id", "product_type",
-                                                        "product_code"};
-constexpr std::array<std::string_view, 15> kPortKeys{"name",
-                                                     "interface",
-                                                     "bitrate",
-                                                     "bus_off_recovery",
-                                                     "master_mac",
-                                                     "master_vendor_id",
-                                                     "master_serial_number",
-                                                     "allocate_retry_min_ms",
-                                                     "allocate_retry_max_ms",
-                                                     "fault_recheck_ms",
-                                                     "poll_response_timeout_ms",
-                                                     "poll_batch_ms",
-                                                     "explicit_response_timeout_ms",
-                                                     "max_consecutive_errors",
-                                                     "node"};
-constexpr std::array<std::string_view, 8> kRootKeys{
-    "rack", "domain", "master_mac", "log_level", "defaults", "port", "security", "explicit_policy"};
-
 enum class Level { kBuiltIn, kDefaults, kNode };
 
 struct Found {
@@ -253,17 +66,18 @@ struct Found {
   Level level = Level::kBuiltIn;
 };
 
+// A key is declared in both tables when looked for, found or not: [defaults]
+// may hold every key a node's settings are read from.
 struct Layers {
-  const toml::table* node = nullptr;  // null when [defaults] is read alone
-  const toml::table* defaults = nullptr;
+  TableReader* node = nullptr;  // null when [defaults] is read alone
+  TableReader* defaults = nullptr;
 
+  bool per_node() const noexcept { return node != nullptr; }
   Found find(std::string_view key) const {
-    if (node) {
-      if (const toml::node* v = node->get(key)) return {v, Level::kNode};
-    }
-    if (defaults) {
-      if (const toml::node* v = defaults->get(key)) return {v, Level::kDefaults};
-    }
+    const toml::node* own = node ? node->get(key) : nullptr;
+    const toml::node* inherited = defaults ? defaults->get(key) : nullptr;
+    if (own) return {own, Level::kNode};
+    if (inherited) return {inherited, Level::kDefaults};
     return {};
   }
 };
@@ -274,7 +88,7 @@ std::string origin(const Found& f) {
     case Level::kNode:
       return {};
     case Level::kDefaults:
-      return fmt::format(" (from [defaults], line {})", at(f.value->source()).line);
+      return fmt::format(" (from [defaults], line {})", line_of(f.value->source()));
     case Level::kBuiltIn:
       return " (the default)";
   }
@@ -305,12 +119,12 @@ std::optional<cdn127::IoConfiguration> preset_named(std::string_view name) {
 }
 
 std::optional<cdn127::IoConfiguration> read_preset(const toml::node& n, std::string_view key,
-                                                   Reporter& r) {
+                                                   Problems& r) {
   auto name = read_string(n, key, r);
   if (!name) return std::nullopt;
   auto io = preset_named(*name);
   if (!io) {
-    r.error(at(n.source()),
+    r.error(n.source(),
             fmt::format("{} = \"{}\" is not a preset: use \"cdn127\" or \"cdn118\"{}", key, *name,
                         key == "io" ? ", or a table of Configuration object values" : ""));
   }
@@ -319,32 +133,32 @@ std::optional<cdn127::IoConfiguration> read_preset(const toml::node& n, std::str
 
 // `io` is a preset name, or a table of Configuration object values over a
 // preset (the CDN127's unless `preset` names another).
-std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Reporter& r) {
+std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Problems& r) {
   if (n.is_string()) return read_preset(n, "io", r);
   const toml::table* t = n.as_table();
   if (!t) {
-    r.error(at(n.source()),
+    r.error(n.source(),
             fmt::format("io must be a preset name (\"cdn127\", \"cdn118\") or a table, not {}",
                         type_name(n.type())));
     return std::nullopt;
   }
-  check_keys(*t, "io", kIoKeys, r);
+  TableReader table(*t, "io", r);
   bool ok = true;
   auto io = cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
-  if (const toml::node* p = t->get("preset")) {
+  if (const toml::node* p = table.get("preset")) {
     if (auto base = read_preset(*p, "io.preset", r)) {
       io = *base;
     } else {
       ok = false;
     }
   }
-  if (const toml::node* m = t->get("mode")) {
+  if (const toml::node* m = table.get("mode")) {
     if (auto v = read_int_as<std::uint8_t>(*m, "io.mode", {0, 0xFF}, r)) {
       io.mode = *v;
       // CDN127 manual, Configuration object, Mode: "Bits 3..5 should be set
       // to 0"; bit 6 is not described. Loaded as given, but said.
       if (*v & 0x78) {
-        r.warning(at(m->source()),
+        r.warning(m->source(),
                   fmt::format("io.mode = 0x{:02X} sets bits 3..6, which the CDN127 manual leaves "
                               "reserved",
                               *v));
@@ -353,7 +167,7 @@ std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Reporter& r)
       ok = false;
     }
   }
-  if (const toml::node* m = t->get("no_nc_mask")) {
+  if (const toml::node* m = table.get("no_nc_mask")) {
     if (auto v = read_int_as<std::uint8_t>(*m, "io.no_nc_mask", {0, 0xFF}, r)) {
       io.no_nc_mask = *v;
     } else {
@@ -368,7 +182,7 @@ std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Reporter& r)
                          Count{"digital_outputs", &cdn127::IoConfiguration::num_digital_outputs},
                          Count{"analog_inputs", &cdn127::IoConfiguration::num_analog_inputs},
                          Count{"analog_outputs", &cdn127::IoConfiguration::num_analog_outputs}}) {
-    const toml::node* v = t->get(c.key);
+    const toml::node* v = table.get(c.key);
     if (!v) continue;
     const std::string key = fmt::format("io.{}", c.key);
     auto count = read_integer(*v, key, {0, 0xFF}, r);
@@ -378,7 +192,7 @@ std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Reporter& r)
     }
     const std::uint8_t max = device_maximum(c.field);
     if (*count > max) {
-      r.error(at(v->source()),
+      r.error(v->source(),
               fmt::format("{} = {} is more than a CDN127 has (at most {})", key, *count, max));
       ok = false;
       continue;
@@ -388,26 +202,26 @@ std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Reporter& r)
   if (!ok) return std::nullopt;
   // Whatever the checks above let through, the poll formats must exist.
   if (!cdn127::validate(io) || !cdn127::poll_format(io)) {
-    r.error(at(n.source()), "io is not a configuration a CDN127 accepts");
+    r.error(n.source(), "io is not a configuration a CDN127 accepts");
     return std::nullopt;
   }
   return io;
 }
 
-std::optional<devicenet::ExpectedIdentity> read_identity(const toml::node& n, Reporter& r) {
+std::optional<devicenet::ExpectedIdentity> read_identity(const toml::node& n, Problems& r) {
   const toml::table* t = n.as_table();
   if (!t) {
-    r.error(at(n.source()),
+    r.error(n.source(),
             fmt::format("identity must be a table {{ vendor_id, product_type, product_code }}, "
                         "not {}",
                         type_name(n.type())));
     return std::nullopt;
   }
-  check_keys(*t, "identity", kIdentityKeys, r);
+  TableReader table(*t, "identity", r);
   devicenet::ExpectedIdentity id;
   bool ok = true;
   auto field = [&](std::string_view key, std::uint16_t& out) {
-    const toml::node* v = require(*t, key, "identity", r);
+    const toml::node* v = table.require(key);
     auto value = v ? read_int_as<std::uint16_t>(*v, fmt::format("identity.{}", key), {0, 0xFFFF}, r)
                    : std::nullopt;
     if (value) {
@@ -449,30 +263,29 @@ constexpr std::array<SafeStateKey, 6> kSafeStateKeys{{
 
 // "off", "on" or "hold".
 std::optional<cdn127::DiscreteAction> read_discrete_action(const toml::node& n,
-                                                           std::string_view key, Reporter& r) {
+                                                           std::string_view key, Problems& r) {
   auto v = read_string(n, key, r);
   if (!v) return std::nullopt;
   for (auto a : {cdn127::DiscreteAction::kOff, cdn127::DiscreteAction::kOn,
                  cdn127::DiscreteAction::kHold}) {
     if (*v == cdn127::to_string(a)) return a;
   }
-  r.error(at(n.source()),
-          fmt::format("{} = \"{}\" is not an output action: use \"off\", \"on\" or \"hold\"",
-                      key, *v));
+  r.error(
+      n.source(),
+      fmt::format("{} = \"{}\" is not an output action: use \"off\", \"on\" or \"hold\"", key, *v));
   return std::nullopt;
 }
 
 // A voltage, 0..10, or "hold".
 std::optional<cdn127::AnalogAction> read_analog_action(const toml::node& n, std::string_view key,
-                                                       Reporter& r) {
+                                                       Problems& r) {
   if (n.is_string()) {
     auto v = read_string(n, key, r);
     if (v && *v == "hold") return cdn127::AnalogAction{cdn127::AnalogAction::Kind::kHold, 0};
     if (v) {
-      r.error(at(n.source()),
-              fmt::format("{} = \"{}\" is not an analog output action: use a voltage "
-                          "(0..10, e.g. 0.0) or \"hold\"",
-                          key, *v));
+      r.error(n.source(), fmt::format("{} = \"{}\" is not an analog output action: use a voltage "
+                                      "(0..10, e.g. 0.0) or \"hold\"",
+                                      key, *v));
     }
     return std::nullopt;
   }
@@ -480,13 +293,13 @@ std::optional<cdn127::AnalogAction> read_analog_action(const toml::node& n, std:
   if (!volts) return std::nullopt;
   auto raw = cdn127::volts_to_raw(*volts);
   if (!raw) {
-    r.error(at(n.source()), fmt::format("{} = {} V is out of range (0..10 V)", key, *volts));
+    r.error(n.source(), fmt::format("{} = {} V is out of range (0..10 V)", key, *volts));
     return std::nullopt;
   }
   return cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, *raw};
 }
 
-void read_safe_state(const Layers& layers, NodeSettings& s, Reporter& r) {
+void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
   if (Found f = layers.find("safe_state"); f.value) {
     if (auto v = read_string(*f.value, "safe_state", r)) {
       if (*v == "configured") {
@@ -494,7 +307,7 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Reporter& r) {
       } else if (*v == "device") {
         s.safe_state.source = cdn127::SafeStateSource::kDevice;
       } else {
-        r.error(at(f.value->source()),
+        r.error(f.value->source(),
                 fmt::format("safe_state = \"{}\" is not a choice: use \"configured\" (the "
                             "default: the keys pump_on_fault ... are downloaded) or \"device\"",
                             *v));
@@ -508,7 +321,7 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Reporter& r) {
     // A node that keeps the device's values and gives values of its own
     // says two things; [defaults] may give values other nodes use.
     if (keep_device && f.level == Level::kNode) {
-      r.error(at(f.value->source()),
+      r.error(f.value->source(),
               fmt::format("{} has no effect with safe_state = \"device\": the device's own "
                           "fault and idle actions are kept",
                           k.key));
@@ -527,7 +340,7 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Reporter& r) {
       } else if (*v == "last-command") {
         s.resume = rack::ResumePolicy::kLastCommand;
       } else {
-        r.error(at(f.value->source()),
+        r.error(f.value->source(),
                 fmt::format("resume = \"{}\" is not a policy: use \"new-command\" (the "
                             "default) or \"last-command\"",
                             *v));
@@ -535,16 +348,16 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Reporter& r) {
     }
   }
   // Opt-ins that give up a guarantee: said in the log at every start.
-  if (layers.node != nullptr && keep_device) {
+  if (layers.per_node() && keep_device) {
     const Found f = layers.find("safe_state");
-    r.warning(at(f.value->source()),
+    r.warning(f.value->source(),
               fmt::format("node {} keeps the device's own fault and idle actions "
                           "(safe_state = \"device\"): read and shown, never written",
                           s.mac.value()));
   }
-  if (layers.node != nullptr && s.resume == rack::ResumePolicy::kLastCommand) {
+  if (layers.per_node() && s.resume == rack::ResumePolicy::kLastCommand) {
     const Found f = layers.find("resume");
-    r.warning(at(f.value->source()),
+    r.warning(f.value->source(),
               fmt::format("node {} drives its last outputs again after a loss without a new "
                           "command (resume = \"last-command\"): a pump may start on its own "
                           "after a power cycle",
@@ -554,13 +367,13 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Reporter& r) {
 
 // Reads every setting a node and [defaults] share into `s`, which holds the
 // built-in values to start with.
-void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
+void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
   if (Found f = layers.find("profile"); f.value) {
     if (auto v = read_string(*f.value, "profile", r)) {
       if (*v == kProfileCdn127) {
         s.profile = *v;
       } else {
-        r.error(at(f.value->source()),
+        r.error(f.value->source(),
                 fmt::format("profile \"{}\" is not supported: the only profile is \"cdn127\"", *v));
       }
     }
@@ -586,12 +399,12 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
     if (v) s.expected_packet_rate = *v;
   }
   // Compared per node only: [defaults] alone may rely on what nodes add.
-  const bool per_node = layers.node != nullptr;
+  const bool per_node = layers.per_node();
   if (per_node && poll_ok && epr_ok && s.expected_packet_rate < s.poll_period) {
     // Reported where the more specific of the two is written.
     const bool at_epr = epr.level >= poll.level;
     const Found& here = at_epr ? epr : poll;
-    r.error(at(here.value->source()),
+    r.error(here.value->source(),
             fmt::format("expected_packet_rate_ms = {}{} is shorter than poll_period_ms = {}{}: the "
                         "node expects a poll at least once per expected packet rate",
                         std::chrono::duration_cast<milliseconds>(s.expected_packet_rate).count(),
@@ -615,7 +428,7 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
       if (per_node && poll_ok && *v > s.poll_period) {
         const bool at_gap = gap.level >= poll.level;
         const Found& here = at_gap ? gap : poll;
-        r.error(at(here.value->source()),
+        r.error(here.value->source(),
                 fmt::format("immediate_poll_min_gap_ms = {}{} is longer than poll_period_ms = "
                             "{}{}: polls for changed outputs may be held back at most a poll "
                             "period",
@@ -633,7 +446,7 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
     if (auto v = read_ms(*f.value, "publish_max_period_ms", 1, kMaxPublishPeriodMs, r)) {
       s.publish.max_period = *v;
       if (per_node && poll_ok && *v < s.poll_period) {
-        r.warning(at(f.value->source()),
+        r.warning(f.value->source(),
                   fmt::format("publish_max_period_ms = {} is shorter than poll_period_ms = {}{}: "
                               "samples in between repeat the last poll",
                               std::chrono::duration_cast<milliseconds>(*v).count(),
@@ -645,7 +458,7 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
   if (Found f = layers.find("analog_deadband_volts"); f.value) {
     if (auto v = read_number(*f.value, "analog_deadband_volts", r)) {
       if (*v < 0 || *v > kAnalogFullScaleVolts) {
-        r.error(at(f.value->source()),
+        r.error(f.value->source(),
                 fmt::format("analog_deadband_volts = {} is out of range (0..10 V)", *v));
       } else {
         s.publish.analog_deadband_volts = *v;
@@ -669,7 +482,7 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Reporter& r) {
       } else if (*v == "hold") {
         s.no_commander = NoCommanderPolicy::kHoldLastOutputs;
       } else {
-        r.error(at(f.value->source()),
+        r.error(f.value->source(),
                 fmt::format("no_commander = \"{}\" is not a policy: use \"idle\" or \"hold\"", *v));
       }
     }
@@ -694,28 +507,27 @@ struct NodeSeen {
   std::uint32_t line;
 };
 
-PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml::table* defaults,
-                     Reporter& r) {
-  constexpr std::string_view kWhere = "[[port]]";
-  check_keys(t, kWhere, kPortKeys, r);
+PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableReader* defaults,
+                     Problems& r) {
+  TableReader t(table, "[[port]]", r);
   PortConfig port;
   port.master_mac = rack.master_mac;
-  if (const toml::node* n = require(t, "name", kWhere, r)) {
+  if (const toml::node* n = t.require("name")) {
     if (auto v = read_name(*n, "name", r)) port.name = *v;
   }
-  if (const toml::node* n = require(t, "interface", kWhere, r)) {
+  if (const toml::node* n = t.require("interface")) {
     if (auto v = read_string(*n, "interface", r)) {
       if (*v == kSimulatedInterface || valid_interface_name(*v)) {
         port.interface = *v;
       } else {
-        r.error(at(n->source()),
+        r.error(n->source(),
                 fmt::format("interface = \"{}\" is not a CAN interface name: use \"simulated\" or "
                             "a SocketCAN interface such as \"can0\" (at most 15 characters)",
                             *v));
       }
     }
   }
-  if (const toml::node* n = require(t, "bitrate", kWhere, r)) {
+  if (const toml::node* n = t.require("bitrate")) {
     if (auto v = read_integer(
             *n, "bitrate",
             {std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()},
@@ -723,7 +535,7 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
       if (*v == 125000 || *v == 250000 || *v == 500000) {
         port.bitrate = static_cast<std::uint32_t>(*v);
       } else {
-        r.error(at(n->source()),
+        r.error(n->source(),
                 fmt::format(
                     "bitrate = {} is not a DeviceNet bit rate: use 125000, 250000 or 500000", *v));
       }
@@ -738,7 +550,7 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
       } else if (*v == "report") {
         port.bus_off_recovery = BusOffRecovery::kReport;
       } else {
-        r.error(at(n->source()),
+        r.error(n->source(),
                 fmt::format("bus_off_recovery = \"{}\" is not a policy: use \"interface\", "
                             "\"restart\" or \"report\"",
                             *v));
@@ -782,20 +594,19 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
   if (tm.allocate_retry_max < tm.allocate_retry_min) {
     const toml::node* n = t.get("allocate_retry_max_ms");
     if (!n) n = t.get("allocate_retry_min_ms");
-    r.error(at(n ? n->source() : t.source()),
+    r.error(n ? n->source() : table.source(),
             "allocate_retry_max_ms is shorter than allocate_retry_min_ms");
   }
 
   const toml::node* nodes = t.get("node");
   const toml::array* list = nodes ? nodes->as_array() : nullptr;
   if (nodes && (!list || !list->is_array_of_tables())) {
-    r.error(at(nodes->source()),
-            fmt::format("node must be an array of tables ([[port.node]]), not {}",
-                        type_name(nodes->type())));
+    r.error(nodes->source(), fmt::format("node must be an array of tables ([[port.node]]), not {}",
+                                         type_name(nodes->type())));
     return port;
   }
   if (!list || list->empty()) {
-    r.warning(at(t.source()), fmt::format("port \"{}\" has no [[port.node]]: its master scans "
+    r.warning(table.source(), fmt::format("port \"{}\" has no [[port.node]]: its master scans "
                                           "nothing",
                                           port.name));
     return port;
@@ -804,30 +615,28 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
   std::map<std::uint8_t, NodeSeen> macs;
   std::map<std::string, std::uint32_t> names;
   for (const toml::node& element : *list) {
-    const toml::table& nt = *element.as_table();
-    constexpr std::string_view kNodeWhere = "[[port.node]]";
-    check_keys(nt, kNodeWhere, kNodeKeys, r);
+    TableReader nt(*element.as_table(), "[[port.node]]", r);
     NodeSettings s;
     bool ok = true;
-    const toml::node* mac_node = require(nt, "mac", kNodeWhere, r);
-    const toml::node* name_node = require(nt, "name", kNodeWhere, r);
+    const toml::node* mac_node = nt.require("mac");
+    const toml::node* name_node = nt.require("name");
     std::optional<MacId> mac = mac_node ? read_mac(*mac_node, "mac", r) : std::nullopt;
     std::optional<std::string> name = name_node ? read_name(*name_node, "name", r) : std::nullopt;
     if (mac) {
       s.mac = *mac;
       if (*mac == port.master_mac) {
-        r.error(at(mac_node->source()),
+        r.error(mac_node->source(),
                 fmt::format(
                     "mac = {} is the master's own MAC on port \"{}\"{}", mac->value(), port.name,
                     master_mac_node
-                        ? fmt::format(" (master_mac, line {})", at(master_mac_node->source()).line)
+                        ? fmt::format(" (master_mac, line {})", line_of(master_mac_node->source()))
                         : std::string(" (the rack's master_mac)")));
         ok = false;
       }
-      const std::uint32_t line = at(mac_node->source()).line;
+      const std::uint32_t line = line_of(mac_node->source());
       auto [it, added] = macs.try_emplace(mac->value(), NodeSeen{name.value_or(""), line});
       if (!added) {
-        r.error(at(mac_node->source()),
+        r.error(mac_node->source(),
                 fmt::format("mac = {} is already used on port \"{}\" by node \"{}\" (line {})",
                             mac->value(), port.name, it->second.name, it->second.line));
         ok = false;
@@ -844,10 +653,10 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
     }
     if (name) {
       s.name = *name;
-      const std::uint32_t line = at(name_node->source()).line;
+      const std::uint32_t line = line_of(name_node->source());
       auto [it, added] = names.try_emplace(*name, line);
       if (!added) {
-        r.error(at(name_node->source()),
+        r.error(name_node->source(),
                 fmt::format("name \"{}\" is already used on port \"{}\" (line {})", *name,
                             port.name, it->second));
         ok = false;
@@ -863,22 +672,21 @@ PortConfig read_port(const toml::table& t, const DaemonConfig& rack, const toml:
 
 // [explicit_policy]: one true/false key per class of guarded request, named
 // by the policy itself.
-rack::ExplicitPolicy read_explicit_policy(const toml::node& n, Reporter& r) {
+rack::ExplicitPolicy read_explicit_policy(const toml::node& n, Problems& r) {
   rack::ExplicitPolicy policy;
   const toml::table* t = n.as_table();
   if (!t) {
-    r.error(at(n.source()),
-            fmt::format("explicit_policy must be a table ([explicit_policy]), not {}",
-                        type_name(n.type())));
+    r.error(n.source(), fmt::format("explicit_policy must be a table ([explicit_policy]), not {}",
+                                    type_name(n.type())));
     return policy;
   }
   std::array<std::string_view, rack::kGuardedRequestKinds> keys{};
   for (std::size_t i = 0; i < keys.size(); ++i) {
     keys[i] = rack::policy_key(static_cast<rack::GuardedRequest>(i));
   }
-  check_keys(*t, "[explicit_policy]", keys, r);
+  TableReader table(*t, "[explicit_policy]", r);
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    if (const toml::node* v = t->get(keys[i])) {
+    if (const toml::node* v = table.get(keys[i])) {
       if (auto allowed = read_bool(*v, keys[i], r)) {
         policy.allow(static_cast<rack::GuardedRequest>(i), *allowed);
       }
@@ -899,12 +707,11 @@ std::optional<LogLevel> log_level_named(std::string_view name) {
 // highest that fits is 232.
 constexpr std::int64_t kMaxDomainId = 232;
 
-DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporter& r) {
-  constexpr std::string_view kWhere = "the top level";
-  check_keys(root, kWhere, kRootKeys, r);
+DaemonConfig read_rack(const toml::table& table, std::string_view source, Problems& r) {
+  TableReader root(table, "the top level", r);
   DaemonConfig config;
   config.source = std::string(source);
-  if (const toml::node* n = require(root, "rack", kWhere, r)) {
+  if (const toml::node* n = root.require("rack")) {
     if (auto v = read_name(*n, "rack", r)) config.rack = *v;
   }
   if (const toml::node* n = root.get("domain")) {
@@ -922,7 +729,7 @@ DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporte
         config.log_level = *l;
       } else {
         r.error(
-            at(n->source()),
+            n->source(),
             fmt::format("log_level = \"{}\" is not a level: use \"trace\", \"debug\", \"info\", "
                         "\"warn\" or \"error\"",
                         *v));
@@ -935,52 +742,47 @@ DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporte
   }
 
   if (const toml::node* n = root.get("security")) {
-    std::vector<toml_config::Problem> problems;
-    config.security = security::read_table(*n, problems);
-    for (auto& p : problems) r.error(at(p.at), std::move(p.text));
+    config.security = security::read_table(*n, r);
   }
 
-  const toml::table* defaults = nullptr;
+  std::optional<TableReader> defaults;
   if (const toml::node* n = root.get("defaults")) {
-    defaults = n->as_table();
-    if (!defaults) {
-      r.error(at(n->source()),
-              fmt::format("defaults must be a table ([defaults]), not {}", type_name(n->type())));
-    } else {
-      check_keys(*defaults, "[defaults]", kDefaultsKeys, r);
+    if (const toml::table* t = toml_config::as_table(*n, "defaults", "[defaults]", r)) {
+      defaults.emplace(*t, "[defaults]", r);
       // Read once on their own, so that their problems are reported even
       // when no node inherits them.
       NodeSettings ignored;
-      read_node_settings(Layers{nullptr, defaults}, ignored, r);
+      read_node_settings(Layers{nullptr, &*defaults}, ignored, r);
+      // Every key [defaults] may hold is declared by now.
+      defaults->finish();
     }
   }
 
   const toml::node* ports = root.get("port");
   if (!ports) {
-    r.error(at(root.source()), "no [[port]]: a rack has at least one DeviceNet port");
+    r.error(table.source(), "no [[port]]: a rack has at least one DeviceNet port");
     return config;
   }
   const toml::array* list = ports->as_array();
   if (list && list->empty()) {
-    r.error(at(ports->source()), "port is empty: a rack has at least one DeviceNet port");
+    r.error(ports->source(), "port is empty: a rack has at least one DeviceNet port");
     return config;
   }
   if (!list || !list->is_array_of_tables()) {
-    r.error(at(ports->source()),
-            fmt::format("port must be an array of tables: write [[port]], not {}",
-                        ports->is_table() ? "[port]" : type_name(ports->type())));
+    r.error(ports->source(), fmt::format("port must be an array of tables: write [[port]], not {}",
+                                         ports->is_table() ? "[port]" : type_name(ports->type())));
     return config;
   }
   std::map<std::string, std::uint32_t> names;
   std::map<std::string, std::string> interfaces;
   for (const toml::node& element : *list) {
     const toml::table& pt = *element.as_table();
-    PortConfig port = read_port(pt, config, defaults, r);
+    PortConfig port = read_port(pt, config, defaults ? &*defaults : nullptr, r);
     if (!port.name.empty()) {
       const toml::node* name_node = pt.get("name");
-      auto [it, added] = names.try_emplace(port.name, at(name_node->source()).line);
+      auto [it, added] = names.try_emplace(port.name, line_of(name_node->source()));
       if (!added) {
-        r.error(at(name_node->source()),
+        r.error(name_node->source(),
                 fmt::format("port name \"{}\" is already used by the port at line {}", port.name,
                             it->second));
       }
@@ -988,7 +790,7 @@ DaemonConfig read_rack(const toml::table& root, std::string_view source, Reporte
     if (!port.interface.empty() && port.interface != kSimulatedInterface) {
       auto [it, added] = interfaces.try_emplace(port.interface, port.name);
       if (!added) {
-        r.error(at(pt.get("interface")->source()),
+        r.error(pt.get("interface")->source(),
                 fmt::format("interface \"{}\" is already used by port \"{}\"", port.interface,
                             it->second));
       }
@@ -1014,16 +816,10 @@ std::string_view to_string(NoCommanderPolicy policy) noexcept {
 }
 
 DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
-  toml::table root;
-  try {
-    root = toml::parse(text);
-  } catch (const toml::parse_error& e) {
-    const Position p = at(e.source());
-    throw ConfigError(
-        {fmt::format("{}:{}:{}: {}", source_name, p.line, p.column, e.description())});
-  }
-  Reporter r(source_name);
-  DaemonConfig config = read_rack(root, source_name, r);
+  Problems r{std::string(source_name)};
+  const auto root = toml_config::parse(text, r);
+  if (!root) throw ConfigError(r.errors());
+  DaemonConfig config = read_rack(*root, source_name, r);
   if (r.has_errors()) throw ConfigError(r.errors());
   config.warnings = r.warnings();
   return config;

@@ -22,15 +22,14 @@
 #include <vector>
 
 #include "adapters/security/settings.hpp"
-#include "adapters/toml/problems.hpp"
+#include "adapters/toml/reader.hpp"
 
 namespace dnbridge::security {
 
 // Reads the value of a `security` key. Paths are kept as written:
 // Settings::resolve_relative_to takes them from the file's directory. Adds
 // what is wrong to `problems`; nullopt when anything is.
-std::optional<Settings> read_table(const toml::node& node,
-                                   std::vector<toml_config::Problem>& problems);
+std::optional<Settings> read_table(const toml::node& node, toml_config::Problems& problems);
 
 // A file whose [security] table is wrong, or absent: every problem,
 // "FILE:LINE:COLUMN: text", one per line.
