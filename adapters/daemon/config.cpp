@@ -303,9 +303,9 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
   if (Found f = layers.find("safe_state"); f.value) {
     if (auto v = read_string(*f.value, "safe_state", r)) {
       if (*v == "configured") {
-        s.safe_state.source = cdn127::SafeStateSource::kConfiguration;
+        s.pump.safe_state.source = cdn127::SafeStateSource::kConfiguration;
       } else if (*v == "device") {
-        s.safe_state.source = cdn127::SafeStateSource::kDevice;
+        s.pump.safe_state.source = cdn127::SafeStateSource::kDevice;
       } else {
         r.error(f.value->source(),
                 fmt::format("safe_state = \"{}\" is not a choice: use \"configured\" (the "
@@ -314,7 +314,7 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
       }
     }
   }
-  const bool keep_device = s.safe_state.source == cdn127::SafeStateSource::kDevice;
+  const bool keep_device = s.pump.safe_state.source == cdn127::SafeStateSource::kDevice;
   for (const auto& k : kSafeStateKeys) {
     const Found f = layers.find(k.key);
     if (!f.value) continue;
@@ -328,17 +328,18 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
       continue;
     }
     if (k.discrete) {
-      if (auto v = read_discrete_action(*f.value, k.key, r)) s.safe_state.values.*k.discrete = *v;
+      if (auto v = read_discrete_action(*f.value, k.key, r))
+        s.pump.safe_state.values.*k.discrete = *v;
     } else if (auto v = read_analog_action(*f.value, k.key, r)) {
-      s.safe_state.values.*k.analog = *v;
+      s.pump.safe_state.values.*k.analog = *v;
     }
   }
   if (Found f = layers.find("resume"); f.value) {
     if (auto v = read_string(*f.value, "resume", r)) {
       if (*v == "new-command") {
-        s.resume = rack::ResumePolicy::kFreshCommand;
+        s.pump.resume = rack::ResumePolicy::kFreshCommand;
       } else if (*v == "last-command") {
-        s.resume = rack::ResumePolicy::kLastCommand;
+        s.pump.resume = rack::ResumePolicy::kLastCommand;
       } else {
         r.error(f.value->source(),
                 fmt::format("resume = \"{}\" is not a policy: use \"new-command\" (the "
@@ -353,15 +354,15 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
     r.warning(f.value->source(),
               fmt::format("node {} keeps the device's own fault and idle actions "
                           "(safe_state = \"device\"): read and shown, never written",
-                          s.mac.value()));
+                          s.pump.node.mac.value()));
   }
-  if (layers.per_node() && s.resume == rack::ResumePolicy::kLastCommand) {
+  if (layers.per_node() && s.pump.resume == rack::ResumePolicy::kLastCommand) {
     const Found f = layers.find("resume");
     r.warning(f.value->source(),
               fmt::format("node {} drives its last outputs again after a loss without a new "
                           "command (resume = \"last-command\"): a pump may start on its own "
                           "after a power cycle",
-                          s.mac.value()));
+                          s.pump.node.mac.value()));
   }
 }
 
@@ -379,10 +380,10 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
     }
   }
   if (Found f = layers.find("io"); f.value) {
-    if (auto v = read_io(*f.value, r)) s.io = *v;
+    if (auto v = read_io(*f.value, r)) s.pump.io = *v;
   }
   if (Found f = layers.find("identity"); f.value) {
-    if (auto v = read_identity(*f.value, r)) s.identity = *v;
+    if (auto v = read_identity(*f.value, r)) s.pump.identity = *v;
   }
 
   const Found poll = layers.find("poll_period_ms");
@@ -391,67 +392,72 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
   if (poll.value) {
     auto v = read_ms(*poll.value, "poll_period_ms", 1, kMaxPacketRateMs, r);
     poll_ok = v.has_value();
-    if (v) s.poll_period = *v;
+    if (v) s.pump.node.poll_period = *v;
   }
   if (epr.value) {
     auto v = read_ms(*epr.value, "expected_packet_rate_ms", 1, kMaxPacketRateMs, r);
     epr_ok = v.has_value();
-    if (v) s.expected_packet_rate = *v;
+    if (v) s.pump.node.expected_packet_rate = *v;
   }
   // Compared per node only: [defaults] alone may rely on what nodes add.
   const bool per_node = layers.per_node();
-  if (per_node && poll_ok && epr_ok && s.expected_packet_rate < s.poll_period) {
+  if (per_node && poll_ok && epr_ok && s.pump.node.expected_packet_rate < s.pump.node.poll_period) {
     // Reported where the more specific of the two is written.
     const bool at_epr = epr.level >= poll.level;
     const Found& here = at_epr ? epr : poll;
     r.error(here.value->source(),
-            fmt::format("expected_packet_rate_ms = {}{} is shorter than poll_period_ms = {}{}: the "
-                        "node expects a poll at least once per expected packet rate",
-                        std::chrono::duration_cast<milliseconds>(s.expected_packet_rate).count(),
-                        at_epr ? std::string() : origin(epr),
-                        std::chrono::duration_cast<milliseconds>(s.poll_period).count(),
-                        at_epr ? origin(poll) : std::string()));
+            fmt::format(
+                "expected_packet_rate_ms = {}{} is shorter than poll_period_ms = {}{}: the "
+                "node expects a poll at least once per expected packet rate",
+                std::chrono::duration_cast<milliseconds>(s.pump.node.expected_packet_rate).count(),
+                at_epr ? std::string() : origin(epr),
+                std::chrono::duration_cast<milliseconds>(s.pump.node.poll_period).count(),
+                at_epr ? origin(poll) : std::string()));
   }
   if (Found f = layers.find("explicit_packet_rate_ms"); f.value) {
     if (auto v = read_ms(*f.value, "explicit_packet_rate_ms", 1, kMaxPacketRateMs, r)) {
-      s.explicit_packet_rate = *v;
+      s.pump.node.explicit_packet_rate = *v;
     }
   }
   if (Found f = layers.find("immediate_poll"); f.value) {
-    if (auto v = read_bool(*f.value, "immediate_poll", r)) s.immediate_poll_on_change = *v;
+    if (auto v = read_bool(*f.value, "immediate_poll", r))
+      s.pump.node.immediate_poll_on_change = *v;
   }
   if (const Found gap = layers.find("immediate_poll_min_gap_ms"); gap.value) {
     if (auto v = read_ms(*gap.value, "immediate_poll_min_gap_ms", 0, kMaxPacketRateMs, r)) {
-      s.immediate_poll_min_gap = *v;
+      s.pump.node.immediate_poll_min_gap = *v;
       // Longer than the poll period it would only hold back changes the
       // node's next slot carries anyway: a mistake, not a setting.
-      if (per_node && poll_ok && *v > s.poll_period) {
+      if (per_node && poll_ok && *v > s.pump.node.poll_period) {
         const bool at_gap = gap.level >= poll.level;
         const Found& here = at_gap ? gap : poll;
-        r.error(here.value->source(),
-                fmt::format("immediate_poll_min_gap_ms = {}{} is longer than poll_period_ms = "
-                            "{}{}: polls for changed outputs may be held back at most a poll "
-                            "period",
-                            std::chrono::duration_cast<milliseconds>(*v).count(),
-                            at_gap ? std::string() : origin(gap),
-                            std::chrono::duration_cast<milliseconds>(s.poll_period).count(),
-                            at_gap ? origin(poll) : std::string()));
+        r.error(
+            here.value->source(),
+            fmt::format("immediate_poll_min_gap_ms = {}{} is longer than poll_period_ms = "
+                        "{}{}: polls for changed outputs may be held back at most a poll "
+                        "period",
+                        std::chrono::duration_cast<milliseconds>(*v).count(),
+                        at_gap ? std::string() : origin(gap),
+                        std::chrono::duration_cast<milliseconds>(s.pump.node.poll_period).count(),
+                        at_gap ? origin(poll) : std::string()));
       }
     }
   } else if (per_node && poll_ok) {
     // The built-in gap, for a node polled faster than it: the poll period.
-    s.immediate_poll_min_gap = std::min(s.immediate_poll_min_gap, s.poll_period);
+    s.pump.node.immediate_poll_min_gap =
+        std::min(s.pump.node.immediate_poll_min_gap, s.pump.node.poll_period);
   }
   if (Found f = layers.find("publish_max_period_ms"); f.value) {
     if (auto v = read_ms(*f.value, "publish_max_period_ms", 1, kMaxPublishPeriodMs, r)) {
       s.publish.max_period = *v;
-      if (per_node && poll_ok && *v < s.poll_period) {
-        r.warning(f.value->source(),
-                  fmt::format("publish_max_period_ms = {} is shorter than poll_period_ms = {}{}: "
-                              "samples in between repeat the last poll",
-                              std::chrono::duration_cast<milliseconds>(*v).count(),
-                              std::chrono::duration_cast<milliseconds>(s.poll_period).count(),
-                              f.level == poll.level ? std::string() : origin(poll)));
+      if (per_node && poll_ok && *v < s.pump.node.poll_period) {
+        r.warning(
+            f.value->source(),
+            fmt::format("publish_max_period_ms = {} is shorter than poll_period_ms = {}{}: "
+                        "samples in between repeat the last poll",
+                        std::chrono::duration_cast<milliseconds>(*v).count(),
+                        std::chrono::duration_cast<milliseconds>(s.pump.node.poll_period).count(),
+                        f.level == poll.level ? std::string() : origin(poll)));
       }
     }
   }
@@ -467,20 +473,20 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
   }
   if (Found f = layers.find("explicit_response_timeout_ms"); f.value) {
     if (auto v = read_ms(*f.value, "explicit_response_timeout_ms", 1, kMaxResponseTimeoutMs, r)) {
-      s.explicit_response_timeout = *v;
+      s.pump.node.explicit_response_timeout = *v;
     }
   }
   if (Found f = layers.find("poll_response_timeout_ms"); f.value) {
     if (auto v = read_ms(*f.value, "poll_response_timeout_ms", 1, kMaxResponseTimeoutMs, r)) {
-      s.poll_response_timeout = *v;
+      s.pump.node.poll_response_timeout = *v;
     }
   }
   if (Found f = layers.find("no_commander"); f.value) {
     if (auto v = read_string(*f.value, "no_commander", r)) {
       if (*v == "idle") {
-        s.no_commander = NoCommanderPolicy::kIdle;
+        s.pump.no_commander = NoCommanderPolicy::kIdle;
       } else if (*v == "hold") {
-        s.no_commander = NoCommanderPolicy::kHoldLastOutputs;
+        s.pump.no_commander = NoCommanderPolicy::kHoldLastOutputs;
       } else {
         r.error(f.value->source(),
                 fmt::format("no_commander = \"{}\" is not a policy: use \"idle\" or \"hold\"", *v));
@@ -511,7 +517,7 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
                      Problems& r) {
   TableReader t(table, "[[port]]", r);
   PortConfig port;
-  port.master_mac = rack.master_mac;
+  port.master.master_mac = rack.master_mac;
   if (const toml::node* n = t.require("name")) {
     if (auto v = read_name(*n, "name", r)) port.name = *v;
   }
@@ -559,11 +565,11 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
   }
   const toml::node* master_mac_node = t.get("master_mac");
   if (master_mac_node) {
-    if (auto v = read_mac(*master_mac_node, "master_mac", r)) port.master_mac = *v;
+    if (auto v = read_mac(*master_mac_node, "master_mac", r)) port.master.master_mac = *v;
   }
   if (const toml::node* n = t.get("master_vendor_id")) {
     if (auto v = read_int_as<std::uint16_t>(*n, "master_vendor_id", {0, 0xFFFF}, r)) {
-      port.master_vendor_id = *v;
+      port.master.vendor_id = *v;
     }
   }
   if (const toml::node* n = t.get("master_serial_number")) {
@@ -577,12 +583,12 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
       if (auto v = read_ms(*n, key, 1, kMaxPublishPeriodMs, r)) out = *v;
     }
   };
-  ScannerTimings& tm = port.timings;
+  devicenet::ScannerConfig& tm = port.master;
   timing("allocate_retry_min_ms", tm.allocate_retry_min);
   timing("allocate_retry_max_ms", tm.allocate_retry_max);
   timing("fault_recheck_ms", tm.fault_recheck);
   timing("poll_response_timeout_ms", tm.poll_response_timeout);
-  timing("explicit_response_timeout_ms", tm.explicit_response_timeout);
+  timing("explicit_response_timeout_ms", tm.explicit_messaging.response_timeout);
   if (const toml::node* n = t.get("poll_batch_ms")) {
     if (auto v = read_ms(*n, "poll_batch_ms", 0, kMaxPollBatchMs, r)) tm.poll_batch_window = *v;
   }
@@ -623,8 +629,8 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
     std::optional<MacId> mac = mac_node ? read_mac(*mac_node, "mac", r) : std::nullopt;
     std::optional<std::string> name = name_node ? read_name(*name_node, "name", r) : std::nullopt;
     if (mac) {
-      s.mac = *mac;
-      if (*mac == port.master_mac) {
+      s.pump.node.mac = *mac;
+      if (*mac == port.master.master_mac) {
         r.error(mac_node->source(),
                 fmt::format(
                     "mac = {} is the master's own MAC on port \"{}\"{}", mac->value(), port.name,
@@ -646,13 +652,13 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
     }
     if (const toml::node* serial = nt.get("serial")) {
       if (auto v = read_int_as<std::uint32_t>(*serial, "serial", {0, 0xFFFF'FFFF}, r)) {
-        s.serial_number = *v;
+        s.pump.node.serial_number = *v;
       } else {
         ok = false;
       }
     }
     if (name) {
-      s.name = *name;
+      s.pump.node.name = *name;
       const std::uint32_t line = line_of(name_node->source());
       auto [it, added] = names.try_emplace(*name, line);
       if (!added) {
@@ -851,45 +857,22 @@ DaemonConfig embedded_default_config() {
   return parse_config(embedded_default_config_text(), "embedded default");
 }
 
-rack::PumpConfig to_pump_config(const NodeSettings& node) {
+rack::PumpConfig NodeSettings::cdn127_pump() {
   rack::PumpConfig p;
-  p.node.mac = node.mac;
-  p.node.name = node.name;
-  p.node.poll_period = node.poll_period;
-  p.node.expected_packet_rate = node.expected_packet_rate;
-  p.node.explicit_packet_rate = node.explicit_packet_rate;
-  p.node.immediate_poll_on_change = node.immediate_poll_on_change;
-  p.node.immediate_poll_min_gap = node.immediate_poll_min_gap;
-  p.node.serial_number = node.serial_number;
-  p.node.explicit_response_timeout = node.explicit_response_timeout;
-  p.node.poll_response_timeout = node.poll_response_timeout;
-  p.io = node.io;
-  p.identity = node.identity;
-  p.no_commander = node.no_commander;
-  p.resume = node.resume;
-  p.safe_state = node.safe_state;
+  p.io = cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
   return p;
 }
 
 std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port) {
   std::vector<rack::PumpConfig> out;
   out.reserve(port.nodes.size());
-  for (const auto& n : port.nodes) out.push_back(to_pump_config(n));
+  for (const auto& n : port.nodes) out.push_back(n.pump);
   return out;
 }
 
 devicenet::ScannerConfig to_scanner_config(const PortConfig& port, std::string_view host_id) {
-  devicenet::ScannerConfig c;
-  c.master_mac = port.master_mac;
-  c.vendor_id = port.master_vendor_id;
+  devicenet::ScannerConfig c = port.master;
   c.serial_number = port.master_serial_number.value_or(derived_master_serial(host_id, port.name));
-  c.explicit_messaging.response_timeout = port.timings.explicit_response_timeout;
-  c.allocate_retry_min = port.timings.allocate_retry_min;
-  c.allocate_retry_max = port.timings.allocate_retry_max;
-  c.fault_recheck = port.timings.fault_recheck;
-  c.max_consecutive_errors = port.timings.max_consecutive_errors;
-  c.poll_response_timeout = port.timings.poll_response_timeout;
-  c.poll_batch_window = port.timings.poll_batch_window;
   return c;
 }
 

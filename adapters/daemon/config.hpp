@@ -32,47 +32,17 @@ using NoCommanderPolicy = rack::NoCommanderPolicy;
 
 std::string_view to_string(NoCommanderPolicy policy) noexcept;  // "idle", "hold"
 
+// A node of the scan list as the configuration gives it: the rack model's
+// own PumpConfig (its node's MAC, name and timings, its I/O configuration,
+// identity, no-commander and resume policies, safe state), filled by the
+// loader with every default resolved, and how its samples are published.
 struct NodeSettings {
-  devicenet::MacId mac;
-  std::string name;
-  std::string profile = "cdn127";  // the only device profile there is
-  profiles::cdn127::IoConfiguration io =
-      profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127);
-  // The identity the device must show; the CDN127's when not given.
-  std::optional<devicenet::ExpectedIdentity> identity;
-  Duration poll_period = devicenet::NodeConfig{}.poll_period;
-  Duration expected_packet_rate = devicenet::NodeConfig{}.expected_packet_rate;
-  Duration explicit_packet_rate = devicenet::NodeConfig{}.explicit_packet_rate;
-  bool immediate_poll_on_change = devicenet::NodeConfig{}.immediate_poll_on_change;
-  // At most the poll period; the built-in value is cut to a shorter one.
-  Duration immediate_poll_min_gap = devicenet::NodeConfig{}.immediate_poll_min_gap;
+  rack::PumpConfig pump = cdn127_pump();
   PublishPolicy publish;
-  NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
-  // The outputs' fault and idle actions downloaded at start-up (off, 0 V), or
-  // the device's own kept (safe_state = "device").
-  profiles::cdn127::SafeStateConfig safe_state;
-  // After a loss: idle until a new command (the default), or the last
-  // command again (resume = "last-command").
-  rack::ResumePolicy resume = rack::ResumePolicy::kFreshCommand;
-  // The serial number the device must have (a swapped module or a misset
-  // MAC switch is then a wrong device); without it the first one seen is
-  // recorded and a change warned of.
-  std::optional<std::uint32_t> serial_number;
-  // For a slow device: its own timeouts, else the port's.
-  std::optional<Duration> explicit_response_timeout;
-  std::optional<Duration> poll_response_timeout;
-};
+  std::string profile = "cdn127";  // the only device profile there is
 
-// The master's timings on one port; defaults are devicenet::ScannerConfig's.
-struct ScannerTimings {
-  Duration allocate_retry_min = devicenet::ScannerConfig{}.allocate_retry_min;
-  Duration allocate_retry_max = devicenet::ScannerConfig{}.allocate_retry_max;
-  Duration fault_recheck = devicenet::ScannerConfig{}.fault_recheck;
-  Duration poll_response_timeout = devicenet::ScannerConfig{}.poll_response_timeout;
-  Duration explicit_response_timeout =
-      devicenet::ScannerConfig{}.explicit_messaging.response_timeout;
-  unsigned max_consecutive_errors = devicenet::ScannerConfig{}.max_consecutive_errors;
-  Duration poll_batch_window = devicenet::ScannerConfig{}.poll_batch_window;
+  // A CDN127 with the rack model's defaults.
+  static rack::PumpConfig cdn127_pump();
 };
 
 // The interface name of the in-process simulated bus.
@@ -86,15 +56,15 @@ struct PortConfig {
   std::string interface;           // kSimulatedInterface, or a SocketCAN interface (can0, ...)
   std::uint32_t bitrate = 500000;  // 125000, 250000 or 500000
   BusOffRecovery bus_off_recovery = BusOffRecovery::kInterface;  // SocketCAN only
-  devicenet::MacId master_mac;  // the rack's unless the port gives its own
-  // Sent in the duplicate MAC ID check of the master's MAC. dnbridge has no
-  // ODVA vendor ID of its own, so the vendor defaults to 0; a site may set
-  // its integrator's.
-  std::uint16_t master_vendor_id = 0;
+  // The port's master as the core takes it: its MAC (the rack's unless the
+  // port gives its own), the vendor ID of its duplicate MAC ID check (0 by
+  // default: dnbridge has no ODVA vendor ID of its own; a site may set its
+  // integrator's) and its timings. The scan list and the serial number are
+  // left to to_scanner_config.
+  devicenet::ScannerConfig master;
   // Unset: derived from the host's identifier and the port's name
   // (host_identity.hpp), so that bridges on one bus differ.
   std::optional<std::uint32_t> master_serial_number;
-  ScannerTimings timings;
   std::vector<NodeSettings> nodes;
 };
 
@@ -140,9 +110,9 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name);
 std::string_view embedded_default_config_text() noexcept;
 DaemonConfig embedded_default_config();
 
-// The scan-list entry of a node and the I/O configuration its data is decoded
-// with; the node's profile is filled by rack::PumpRack::scanner_config.
-rack::PumpConfig to_pump_config(const NodeSettings& node);
+// The scan-list entries of the port's nodes and the I/O configurations their
+// data is decoded with; each node's profile is filled by
+// rack::PumpRack::scanner_config.
 std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port);
 
 // The port's master: MAC, duplicate MAC identity and timings. The nodes are

@@ -11,7 +11,7 @@ BackendFactory simulated_backend_factory(LogSink& log) {
              const PortConfig& p) -> std::unique_ptr<port::CanBackend> {
     if (p.interface != kSimulatedInterface) return others(p);
     std::vector<devicenet::MacId> macs;
-    for (const auto& n : p.nodes) macs.push_back(n.mac);
+    for (const auto& n : p.nodes) macs.push_back(n.pump.node.mac);
     return std::make_unique<sim::SimBackend>(p.bitrate, macs, &log);
   };
 }

@@ -779,12 +779,12 @@ class Bridge {
       p.name = name;
       p.interface = std::string(daemon::kSimulatedInterface);
       p.bitrate = s.bitrate;
-      p.master_mac = c.master_mac;
+      p.master.master_mac = c.master_mac;
       for (unsigned m = 1; m <= s.nodes; ++m) {
         daemon::NodeSettings n;
-        n.mac = MacId::from(m).value();
-        n.name = fmt::format("pump-{}-{}", name, m);
-        n.poll_period = s.poll_period;
+        n.pump.node.mac = MacId::from(m).value();
+        n.pump.node.name = fmt::format("pump-{}-{}", name, m);
+        n.pump.node.poll_period = s.poll_period;
         n.publish = s.publish;
         p.nodes.push_back(n);
       }
@@ -798,7 +798,7 @@ class Bridge {
     auto factory = [this, &s, &log,
                     layout](const daemon::PortConfig& p) -> std::unique_ptr<port::CanBackend> {
       std::vector<MacId> macs;
-      for (const auto& n : p.nodes) macs.push_back(n.mac);
+      for (const auto& n : p.nodes) macs.push_back(n.pump.node.mac);
       auto backend = std::make_unique<sim::ThreadedSimBackend>(p.bitrate, macs, &log);
       auto wire = std::make_unique<PortWire>();
       wire->backend = backend.get();

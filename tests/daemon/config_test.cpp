@@ -62,42 +62,43 @@ TEST(ConfigFile, ExampleLoadsWithEveryValueWhereItWasWritten) {
   EXPECT_EQ(a.name, "A");
   EXPECT_EQ(a.interface, "can0");
   EXPECT_EQ(a.bitrate, 500000u);
-  EXPECT_EQ(a.master_mac, mac(0));
-  EXPECT_EQ(a.master_vendor_id, 0u);
+  EXPECT_EQ(a.master.master_mac, mac(0));
+  EXPECT_EQ(a.master.vendor_id, 0u);
   EXPECT_EQ(a.master_serial_number, std::nullopt);  // derived from the host
   ASSERT_EQ(a.nodes.size(), 3u);
-  EXPECT_EQ(a.nodes[0].mac, mac(1));
-  EXPECT_EQ(a.nodes[0].name, "chamber-1-dry-pump");
+  EXPECT_EQ(a.nodes[0].pump.node.mac, mac(1));
+  EXPECT_EQ(a.nodes[0].pump.node.name, "chamber-1-dry-pump");
   EXPECT_EQ(a.nodes[0].profile, "cdn127");
-  EXPECT_EQ(a.nodes[0].io, kCdn127);
-  EXPECT_EQ(a.nodes[0].poll_period, milliseconds(100));           // [defaults]
-  EXPECT_EQ(a.nodes[0].expected_packet_rate, milliseconds(500));  // [defaults]
-  EXPECT_EQ(a.nodes[0].no_commander, NoCommanderPolicy::kIdle);
-  EXPECT_FALSE(a.nodes[0].identity.has_value());
-  EXPECT_EQ(a.nodes[1].io, kCdn118);
-  EXPECT_EQ(a.nodes[2].name, "loadlock-pump");
-  EXPECT_EQ(a.nodes[2].io, (cdn127::IoConfiguration{.mode = 0x86,
-                                                    .num_digital_inputs = 8,
-                                                    .num_digital_outputs = 3,
-                                                    .num_analog_inputs = 1,
-                                                    .num_analog_outputs = 0,
-                                                    .no_nc_mask = 0}));
-  EXPECT_EQ(a.nodes[2].no_commander, NoCommanderPolicy::kHoldLastOutputs);
+  EXPECT_EQ(a.nodes[0].pump.io, kCdn127);
+  EXPECT_EQ(a.nodes[0].pump.node.poll_period, milliseconds(100));           // [defaults]
+  EXPECT_EQ(a.nodes[0].pump.node.expected_packet_rate, milliseconds(500));  // [defaults]
+  EXPECT_EQ(a.nodes[0].pump.no_commander, NoCommanderPolicy::kIdle);
+  EXPECT_FALSE(a.nodes[0].pump.identity.has_value());
+  EXPECT_EQ(a.nodes[1].pump.io, kCdn118);
+  EXPECT_EQ(a.nodes[2].pump.node.name, "loadlock-pump");
+  EXPECT_EQ(a.nodes[2].pump.io, (cdn127::IoConfiguration{.mode = 0x86,
+                                                         .num_digital_inputs = 8,
+                                                         .num_digital_outputs = 3,
+                                                         .num_analog_inputs = 1,
+                                                         .num_analog_outputs = 0,
+                                                         .no_nc_mask = 0}));
+  EXPECT_EQ(a.nodes[2].pump.no_commander, NoCommanderPolicy::kHoldLastOutputs);
 
   const PortConfig& b = c.ports[1];
   EXPECT_EQ(b.name, "B");
   EXPECT_EQ(b.interface, "can1");
   EXPECT_EQ(b.bitrate, 250000u);
-  EXPECT_EQ(b.master_mac, mac(62));
+  EXPECT_EQ(b.master.master_mac, mac(62));
   ASSERT_EQ(b.nodes.size(), 2u);
-  EXPECT_EQ(b.nodes[0].mac, mac(10));
-  EXPECT_EQ(b.nodes[0].poll_period, milliseconds(200));
-  EXPECT_EQ(b.nodes[0].expected_packet_rate, milliseconds(1000));
+  EXPECT_EQ(b.nodes[0].pump.node.mac, mac(10));
+  EXPECT_EQ(b.nodes[0].pump.node.poll_period, milliseconds(200));
+  EXPECT_EQ(b.nodes[0].pump.node.expected_packet_rate, milliseconds(1000));
   EXPECT_DOUBLE_EQ(b.nodes[0].publish.analog_deadband_volts, 0.1);
   EXPECT_DOUBLE_EQ(b.nodes[1].publish.analog_deadband_volts, 0.05);  // [defaults]
-  EXPECT_EQ(b.nodes[1].io, kCdn118);
-  EXPECT_EQ(b.nodes[1].identity, (devicenet::ExpectedIdentity{
-                                     .vendor_id = 59, .product_type = 27, .product_code = 1888}));
+  EXPECT_EQ(b.nodes[1].pump.io, kCdn118);
+  EXPECT_EQ(
+      b.nodes[1].pump.identity,
+      (devicenet::ExpectedIdentity{.vendor_id = 59, .product_type = 27, .product_code = 1888}));
 }
 
 TEST(ConfigFile, EmbeddedDefaultIsTheShippedFile) {
@@ -121,16 +122,16 @@ TEST(ConfigFile, EmbeddedDefaultIsTheSimulatedRack) {
   EXPECT_EQ(p.name, "A");
   EXPECT_EQ(p.interface, kSimulatedInterface);
   EXPECT_EQ(p.bitrate, 500000u);
-  EXPECT_EQ(p.master_mac, mac(0));
+  EXPECT_EQ(p.master.master_mac, mac(0));
   ASSERT_EQ(p.nodes.size(), 8u);
   for (unsigned i = 0; i < 8; ++i) {
     SCOPED_TRACE(i);
     const NodeSettings& n = p.nodes[i];
-    EXPECT_EQ(n.mac, mac(i + 1));
-    EXPECT_EQ(n.name, "pump-" + std::to_string(i + 1));
-    EXPECT_EQ(n.io, i == 7 ? kCdn118 : kCdn127);
-    EXPECT_EQ(n.poll_period, milliseconds(100));
-    EXPECT_EQ(n.expected_packet_rate, milliseconds(500));
+    EXPECT_EQ(n.pump.node.mac, mac(i + 1));
+    EXPECT_EQ(n.pump.node.name, "pump-" + std::to_string(i + 1));
+    EXPECT_EQ(n.pump.io, i == 7 ? kCdn118 : kCdn127);
+    EXPECT_EQ(n.pump.node.poll_period, milliseconds(100));
+    EXPECT_EQ(n.pump.node.expected_packet_rate, milliseconds(500));
   }
 }
 
@@ -140,8 +141,8 @@ TEST(ConfigFile, EmbeddedDefaultTextIsWhatItRuns) {
   ASSERT_EQ(printed.ports.size(), embedded.ports.size());
   ASSERT_EQ(printed.ports[0].nodes.size(), embedded.ports[0].nodes.size());
   for (std::size_t i = 0; i < printed.ports[0].nodes.size(); ++i) {
-    EXPECT_EQ(printed.ports[0].nodes[i].mac, embedded.ports[0].nodes[i].mac);
-    EXPECT_EQ(printed.ports[0].nodes[i].io, embedded.ports[0].nodes[i].io);
+    EXPECT_EQ(printed.ports[0].nodes[i].pump.node.mac, embedded.ports[0].nodes[i].pump.node.mac);
+    EXPECT_EQ(printed.ports[0].nodes[i].pump.io, embedded.ports[0].nodes[i].pump.io);
   }
 }
 
@@ -156,20 +157,21 @@ TEST(ConfigFile, MinimalFileTakesTheBuiltInDefaults) {
   const NodeSettings& n = c.ports.at(0).nodes.at(0);
   const devicenet::NodeConfig scan_list_defaults;
   EXPECT_EQ(n.profile, "cdn127");
-  EXPECT_EQ(n.io, kCdn127);
-  EXPECT_EQ(n.poll_period, scan_list_defaults.poll_period);
-  EXPECT_EQ(n.expected_packet_rate, scan_list_defaults.expected_packet_rate);
-  EXPECT_EQ(n.explicit_packet_rate, scan_list_defaults.explicit_packet_rate);
-  EXPECT_EQ(n.immediate_poll_on_change, scan_list_defaults.immediate_poll_on_change);
+  EXPECT_EQ(n.pump.io, kCdn127);
+  EXPECT_EQ(n.pump.node.poll_period, scan_list_defaults.poll_period);
+  EXPECT_EQ(n.pump.node.expected_packet_rate, scan_list_defaults.expected_packet_rate);
+  EXPECT_EQ(n.pump.node.explicit_packet_rate, scan_list_defaults.explicit_packet_rate);
+  EXPECT_EQ(n.pump.node.immediate_poll_on_change, scan_list_defaults.immediate_poll_on_change);
   EXPECT_EQ(n.publish, PublishPolicy{});
-  EXPECT_EQ(n.no_commander, NoCommanderPolicy::kIdle);
+  EXPECT_EQ(n.pump.no_commander, NoCommanderPolicy::kIdle);
   const devicenet::ScannerConfig scanner_defaults;
-  const ScannerTimings& t = c.ports[0].timings;
+  const devicenet::ScannerConfig& t = c.ports[0].master;
   EXPECT_EQ(t.allocate_retry_min, scanner_defaults.allocate_retry_min);
   EXPECT_EQ(t.allocate_retry_max, scanner_defaults.allocate_retry_max);
   EXPECT_EQ(t.fault_recheck, scanner_defaults.fault_recheck);
   EXPECT_EQ(t.poll_response_timeout, scanner_defaults.poll_response_timeout);
-  EXPECT_EQ(t.explicit_response_timeout, scanner_defaults.explicit_messaging.response_timeout);
+  EXPECT_EQ(t.explicit_messaging.response_timeout,
+            scanner_defaults.explicit_messaging.response_timeout);
   EXPECT_EQ(t.max_consecutive_errors, scanner_defaults.max_consecutive_errors);
   EXPECT_EQ(t.poll_batch_window, scanner_defaults.poll_batch_window);
 }
@@ -220,35 +222,35 @@ TEST(ConfigFile, NodeSettingsOverrideDefaults) {
   EXPECT_EQ(c.domain_id, 7u);
   const PortConfig& p = c.ports.at(0);
   EXPECT_EQ(p.bitrate, 125000u);
-  EXPECT_EQ(p.master_vendor_id, 1234u);
+  EXPECT_EQ(p.master.vendor_id, 1234u);
   EXPECT_EQ(p.master_serial_number, 0xDB000001u);
-  EXPECT_EQ(p.timings.allocate_retry_min, milliseconds(100));
-  EXPECT_EQ(p.timings.allocate_retry_max, milliseconds(800));
-  EXPECT_EQ(p.timings.fault_recheck, milliseconds(3000));
-  EXPECT_EQ(p.timings.poll_response_timeout, milliseconds(20));
-  EXPECT_EQ(p.timings.poll_batch_window, Duration::zero());
-  EXPECT_EQ(p.timings.explicit_response_timeout, milliseconds(1500));
-  EXPECT_EQ(p.timings.max_consecutive_errors, 4u);
+  EXPECT_EQ(p.master.allocate_retry_min, milliseconds(100));
+  EXPECT_EQ(p.master.allocate_retry_max, milliseconds(800));
+  EXPECT_EQ(p.master.fault_recheck, milliseconds(3000));
+  EXPECT_EQ(p.master.poll_response_timeout, milliseconds(20));
+  EXPECT_EQ(p.master.poll_batch_window, Duration::zero());
+  EXPECT_EQ(p.master.explicit_messaging.response_timeout, milliseconds(1500));
+  EXPECT_EQ(p.master.max_consecutive_errors, 4u);
 
   const NodeSettings& a = p.nodes.at(0);
-  EXPECT_EQ(a.poll_period, milliseconds(50));
-  EXPECT_EQ(a.expected_packet_rate, milliseconds(400));
-  EXPECT_EQ(a.explicit_packet_rate, milliseconds(3000));
-  EXPECT_FALSE(a.immediate_poll_on_change);
+  EXPECT_EQ(a.pump.node.poll_period, milliseconds(50));
+  EXPECT_EQ(a.pump.node.expected_packet_rate, milliseconds(400));
+  EXPECT_EQ(a.pump.node.explicit_packet_rate, milliseconds(3000));
+  EXPECT_FALSE(a.pump.node.immediate_poll_on_change);
   EXPECT_EQ(a.publish.max_period, milliseconds(2000));
   EXPECT_DOUBLE_EQ(a.publish.analog_deadband_volts, 1.0);
-  EXPECT_EQ(a.no_commander, NoCommanderPolicy::kHoldLastOutputs);
-  EXPECT_EQ(a.io, kCdn118);
+  EXPECT_EQ(a.pump.no_commander, NoCommanderPolicy::kHoldLastOutputs);
+  EXPECT_EQ(a.pump.io, kCdn118);
 
   const NodeSettings& b = p.nodes.at(1);
-  EXPECT_EQ(b.poll_period, milliseconds(25));
-  EXPECT_EQ(b.expected_packet_rate, milliseconds(100));
-  EXPECT_EQ(b.explicit_packet_rate, milliseconds(1000));
-  EXPECT_TRUE(b.immediate_poll_on_change);
+  EXPECT_EQ(b.pump.node.poll_period, milliseconds(25));
+  EXPECT_EQ(b.pump.node.expected_packet_rate, milliseconds(100));
+  EXPECT_EQ(b.pump.node.explicit_packet_rate, milliseconds(1000));
+  EXPECT_TRUE(b.pump.node.immediate_poll_on_change);
   EXPECT_EQ(b.publish.max_period, milliseconds(500));
   EXPECT_DOUBLE_EQ(b.publish.analog_deadband_volts, 0.25);
-  EXPECT_EQ(b.no_commander, NoCommanderPolicy::kIdle);
-  EXPECT_EQ(b.io, kCdn127);
+  EXPECT_EQ(b.pump.no_commander, NoCommanderPolicy::kIdle);
+  EXPECT_EQ(b.pump.io, kCdn127);
 }
 
 TEST(ConfigFile, MissingFileIsReportedWithItsName) {
@@ -267,7 +269,7 @@ TEST(ConfigFile, MissingFileIsReportedWithItsName) {
 cdn127::IoConfiguration io_of(std::string_view io_value) {
   const std::string text = std::string(ONE_PORT "[[port.node]]\nmac = 1\nname = \"p\"\nio = ") +
                            std::string(io_value) + "\n";
-  return parse_config(text, "t.toml").ports.at(0).nodes.at(0).io;
+  return parse_config(text, "t.toml").ports.at(0).nodes.at(0).pump.io;
 }
 
 TEST(ConfigIo, PresetNamesAreTheDevicePresets) {
@@ -344,7 +346,7 @@ TEST(ConfigIo, ReservedModeBitsLoadWithAWarning) {
                                       "name = \"p\"\n"
                                       "io = { mode = 0x88 }\n",
                                       "t.toml");
-  EXPECT_EQ(c.ports.at(0).nodes.at(0).io.mode, 0x88);
+  EXPECT_EQ(c.ports.at(0).nodes.at(0).pump.io.mode, 0x88);
   EXPECT_THAT(c.warnings, ElementsAre("t.toml:9:15: io.mode = 0x88 sets bits 3..6, which the "
                                       "CDN127 manual leaves reserved"));
 }
@@ -426,15 +428,15 @@ TEST(ConfigFile, SerialAndTimeoutsOfASlowDevice) {
                                       "t.toml");
   const auto& nodes = c.ports.at(0).nodes;
   ASSERT_EQ(nodes.size(), 2u);
-  EXPECT_EQ(nodes[0].serial_number, 0x1234u);
-  EXPECT_EQ(nodes[0].explicit_response_timeout, milliseconds(2500));
-  EXPECT_EQ(nodes[0].poll_response_timeout, milliseconds(30));
-  EXPECT_EQ(nodes[1].serial_number, std::nullopt);
+  EXPECT_EQ(nodes[0].pump.node.serial_number, 0x1234u);
+  EXPECT_EQ(nodes[0].pump.node.explicit_response_timeout, milliseconds(2500));
+  EXPECT_EQ(nodes[0].pump.node.poll_response_timeout, milliseconds(30));
+  EXPECT_EQ(nodes[1].pump.node.serial_number, std::nullopt);
   // Node 2 keeps the port's explicit timeout (no override of its own).
-  EXPECT_EQ(nodes[1].explicit_response_timeout, std::nullopt);
-  EXPECT_EQ(nodes[1].poll_response_timeout, milliseconds(30));
-  EXPECT_EQ(c.ports.at(0).timings.explicit_response_timeout, milliseconds(1500));
-  const rack::PumpConfig p = to_pump_config(nodes[0]);
+  EXPECT_EQ(nodes[1].pump.node.explicit_response_timeout, std::nullopt);
+  EXPECT_EQ(nodes[1].pump.node.poll_response_timeout, milliseconds(30));
+  EXPECT_EQ(c.ports.at(0).master.explicit_messaging.response_timeout, milliseconds(1500));
+  const rack::PumpConfig p = to_pump_configs(c.ports.at(0)).at(0);
   EXPECT_EQ(p.node.serial_number, 0x1234u);
   EXPECT_EQ(p.node.explicit_response_timeout, milliseconds(2500));
   EXPECT_EQ(p.node.poll_response_timeout, milliseconds(30));
@@ -562,10 +564,10 @@ TEST(ConfigFile, ImmediatePollMinGapFromDefaultsNodesAndTheBuiltInValue) {
       "t.toml");
   const auto& nodes = c.ports.at(0).nodes;
   ASSERT_EQ(nodes.size(), 3u);
-  EXPECT_EQ(nodes[0].immediate_poll_min_gap, milliseconds(20));
-  EXPECT_EQ(nodes[1].immediate_poll_min_gap, Duration::zero());
-  EXPECT_EQ(nodes[2].immediate_poll_min_gap, milliseconds(50));
-  EXPECT_EQ(to_pump_config(nodes[0]).node.immediate_poll_min_gap, milliseconds(20));
+  EXPECT_EQ(nodes[0].pump.node.immediate_poll_min_gap, milliseconds(20));
+  EXPECT_EQ(nodes[1].pump.node.immediate_poll_min_gap, Duration::zero());
+  EXPECT_EQ(nodes[2].pump.node.immediate_poll_min_gap, milliseconds(50));
+  EXPECT_EQ(to_pump_configs(c.ports.at(0)).at(0).node.immediate_poll_min_gap, milliseconds(20));
 
   // Not given: the built-in 10 ms, or the poll period where that is shorter.
   const DaemonConfig d = parse_config(ONE_PORT
@@ -577,10 +579,10 @@ TEST(ConfigFile, ImmediatePollMinGapFromDefaultsNodesAndTheBuiltInValue) {
                                       "name = \"q\"\n"
                                       "poll_period_ms = 4\n",
                                       "t.toml");
-  EXPECT_EQ(d.ports.at(0).nodes.at(0).immediate_poll_min_gap,
+  EXPECT_EQ(d.ports.at(0).nodes.at(0).pump.node.immediate_poll_min_gap,
             devicenet::NodeConfig{}.immediate_poll_min_gap);
   EXPECT_EQ(devicenet::NodeConfig{}.immediate_poll_min_gap, milliseconds(10));
-  EXPECT_EQ(d.ports.at(0).nodes.at(1).immediate_poll_min_gap, milliseconds(4));
+  EXPECT_EQ(d.ports.at(0).nodes.at(1).pump.node.immediate_poll_min_gap, milliseconds(4));
 }
 
 TEST(ConfigErrors, ImmediatePollMinGapNegativeOrLongerThanThePollPeriod) {
@@ -848,25 +850,26 @@ TEST(ConfigWarnings, PublishFasterThanPollAndEmptyPort) {
 // ---------------------------------------------------------------------------
 // What the master is given.
 
-TEST(ConfigToMaster, PumpConfigCarriesTheNodeSettings) {
-  NodeSettings n;
-  n.mac = mac(9);
-  n.name = "pump-9";
-  n.io = kCdn118;
-  n.identity = devicenet::ExpectedIdentity{.vendor_id = 1, .product_type = 2, .product_code = 3};
-  n.poll_period = milliseconds(40);
-  n.expected_packet_rate = milliseconds(160);
-  n.explicit_packet_rate = milliseconds(5000);
-  n.immediate_poll_on_change = false;
-  const rack::PumpConfig p = to_pump_config(n);
-  EXPECT_EQ(p.node.mac, mac(9));
-  EXPECT_EQ(p.node.name, "pump-9");
-  EXPECT_EQ(p.node.poll_period, milliseconds(40));
-  EXPECT_EQ(p.node.expected_packet_rate, milliseconds(160));
-  EXPECT_EQ(p.node.explicit_packet_rate, milliseconds(5000));
-  EXPECT_FALSE(p.node.immediate_poll_on_change);
-  EXPECT_EQ(p.io, kCdn118);
-  EXPECT_EQ(p.identity, n.identity);
+TEST(ConfigToMaster, TheScanListIsEachNodesPumpConfigInOrder) {
+  PortConfig port;
+  for (unsigned m : {9u, 4u}) {
+    NodeSettings n;
+    n.pump.node.mac = mac(m);
+    n.pump.node.name = "pump-" + std::to_string(m);
+    n.pump.io = kCdn118;
+    n.pump.identity =
+        devicenet::ExpectedIdentity{.vendor_id = 1, .product_type = 2, .product_code = 3};
+    n.pump.node.poll_period = milliseconds(40);
+    port.nodes.push_back(n);
+  }
+  const auto pumps = to_pump_configs(port);
+  ASSERT_EQ(pumps.size(), 2u);
+  EXPECT_EQ(pumps[0].node.mac, mac(9));
+  EXPECT_EQ(pumps[1].node.mac, mac(4));
+  EXPECT_EQ(pumps[0].node.name, "pump-9");
+  EXPECT_EQ(pumps[0].node.poll_period, milliseconds(40));
+  EXPECT_EQ(pumps[0].io, kCdn118);
+  EXPECT_EQ(pumps[0].identity, port.nodes[0].pump.identity);
 }
 
 TEST(ConfigToMaster, ScannerConfigCarriesThePortsMasterAndTimings) {
@@ -925,28 +928,28 @@ TEST(ConfigToMaster, ScanListOfTheExampleFileIsWhatTheRackBuilds) {
     const auto pumps = to_pump_configs(port);
     const devicenet::ScannerConfig scan =
         rack::PumpRack::scanner_config(to_scanner_config(port, "host-1"), pumps);
-    EXPECT_EQ(scan.master_mac, port.master_mac);
+    EXPECT_EQ(scan.master_mac, port.master.master_mac);
     ASSERT_EQ(scan.nodes.size(), port.nodes.size());
     for (std::size_t i = 0; i < port.nodes.size(); ++i) {
       const NodeSettings& n = port.nodes[i];
       const devicenet::NodeConfig& node = scan.nodes[i];
-      SCOPED_TRACE(n.name);
-      EXPECT_EQ(node.mac, n.mac);
-      EXPECT_EQ(node.name, n.name);
-      EXPECT_EQ(node.poll_period, n.poll_period);
-      EXPECT_EQ(node.expected_packet_rate, n.expected_packet_rate);
-      const auto format = cdn127::poll_format(n.io);
+      SCOPED_TRACE(n.pump.node.name);
+      EXPECT_EQ(node.mac, n.pump.node.mac);
+      EXPECT_EQ(node.name, n.pump.node.name);
+      EXPECT_EQ(node.poll_period, n.pump.node.poll_period);
+      EXPECT_EQ(node.expected_packet_rate, n.pump.node.expected_packet_rate);
+      const auto format = cdn127::poll_format(n.pump.io);
       ASSERT_TRUE(format.ok());
       EXPECT_EQ(node.profile.consumed_size, format->request.size);
       EXPECT_EQ(node.profile.produced_size, format->response.size);
       const devicenet::ExpectedIdentity cdn127_identity{.vendor_id = cdn127::kVendorId,
                                                         .product_type = cdn127::kProductType,
                                                         .product_code = cdn127::kProductCode};
-      EXPECT_EQ(node.profile.identity, n.identity.value_or(cdn127_identity));
+      EXPECT_EQ(node.profile.identity, n.pump.identity.value_or(cdn127_identity));
     }
   }
   // The custom I/O node polls with its own sizes: 1 output byte, no analog out.
-  const auto custom = cdn127::poll_format(c.ports.at(0).nodes.at(2).io);
+  const auto custom = cdn127::poll_format(c.ports.at(0).nodes.at(2).pump.io);
   ASSERT_TRUE(custom.ok());
   EXPECT_EQ(custom->request.size, 1u);
 }
@@ -1055,16 +1058,16 @@ TEST(ConfigSafeState, DefaultIsEveryOutputOffOnFaultAndIdleDownloaded) {
                                       "name = \"p\"\n",
                                       "t.toml");
   const NodeSettings& n = c.ports.at(0).nodes.at(0);
-  EXPECT_EQ(n.safe_state.source, cdn127::SafeStateSource::kConfiguration);
-  EXPECT_EQ(n.safe_state.values, cdn127::SafeState{});
-  EXPECT_EQ(n.safe_state.values.pump_fault, cdn127::DiscreteAction::kOff);
-  EXPECT_EQ(n.safe_state.values.analog_idle,
+  EXPECT_EQ(n.pump.safe_state.source, cdn127::SafeStateSource::kConfiguration);
+  EXPECT_EQ(n.pump.safe_state.values, cdn127::SafeState{});
+  EXPECT_EQ(n.pump.safe_state.values.pump_fault, cdn127::DiscreteAction::kOff);
+  EXPECT_EQ(n.pump.safe_state.values.analog_idle,
             (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, 0}));
-  EXPECT_EQ(n.resume, rack::ResumePolicy::kFreshCommand);
+  EXPECT_EQ(n.pump.resume, rack::ResumePolicy::kFreshCommand);
   EXPECT_TRUE(c.warnings.empty());
   // And the rack's scan list asks for them: DOP 1 and 2, AOP 1.
-  const rack::PumpConfig p = to_pump_config(n);
-  EXPECT_EQ(p.safe_state.values, n.safe_state.values);
+  const rack::PumpConfig p = to_pump_configs(c.ports.at(0)).at(0);
+  EXPECT_EQ(p.safe_state.values, n.pump.safe_state.values);
   auto profile = cdn127::make_node_profile(p.io, p.safe_state);
   ASSERT_TRUE(profile.ok());
   unsigned dop = 0, aop = 0;
@@ -1099,14 +1102,14 @@ TEST(ConfigSafeState, WordsAndVoltsFromDefaultsAndNodes) {
                                       "pump_on_idle = \"off\"\n"
                                       "analog_output_on_fault = 10\n",
                                       "t.toml");
-  const auto& p = c.ports.at(0).nodes.at(0).safe_state.values;
+  const auto& p = c.ports.at(0).nodes.at(0).pump.safe_state.values;
   EXPECT_EQ(p.pump_fault, cdn127::DiscreteAction::kOff);
   EXPECT_EQ(p.pump_idle, cdn127::DiscreteAction::kHold);  // from [defaults]
   EXPECT_EQ(p.n2_ballast_fault, cdn127::DiscreteAction::kOn);
   EXPECT_EQ(p.n2_ballast_idle, cdn127::DiscreteAction::kHold);
   EXPECT_EQ(p.analog_fault, (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, 1024}));
   EXPECT_EQ(p.analog_idle, (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kHold, 0}));
-  const auto& q = c.ports.at(0).nodes.at(1).safe_state.values;
+  const auto& q = c.ports.at(0).nodes.at(1).pump.safe_state.values;
   EXPECT_EQ(q.pump_idle, cdn127::DiscreteAction::kOff);  // its own over [defaults]
   EXPECT_EQ(q.analog_fault, (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, 4095}));
   EXPECT_EQ(q.analog_idle, (cdn127::AnalogAction{cdn127::AnalogAction::Kind::kValue, 0}));
@@ -1121,8 +1124,8 @@ TEST(ConfigSafeState, OptInsAreReadAndWarnedOf) {
                                       "resume = \"last-command\"\n",
                                       "t.toml");
   const NodeSettings& n = c.ports.at(0).nodes.at(0);
-  EXPECT_EQ(n.safe_state.source, cdn127::SafeStateSource::kDevice);
-  EXPECT_EQ(n.resume, rack::ResumePolicy::kLastCommand);
+  EXPECT_EQ(n.pump.safe_state.source, cdn127::SafeStateSource::kDevice);
+  EXPECT_EQ(n.pump.resume, rack::ResumePolicy::kLastCommand);
   EXPECT_THAT(c.warnings,
               ElementsAre("t.toml:9:14: node 1 keeps the device's own fault and idle actions "
                           "(safe_state = \"device\"): read and shown, never written",
@@ -1130,7 +1133,7 @@ TEST(ConfigSafeState, OptInsAreReadAndWarnedOf) {
                           "without a new command (resume = \"last-command\"): a pump may start on "
                           "its own after a power cycle"));
   // The device's values are read, none written.
-  const rack::PumpConfig p = to_pump_config(n);
+  const rack::PumpConfig p = to_pump_configs(c.ports.at(0)).at(0);
   EXPECT_EQ(p.resume, rack::ResumePolicy::kLastCommand);
   auto profile = cdn127::make_node_profile(p.io, p.safe_state);
   ASSERT_TRUE(profile.ok());

@@ -46,7 +46,9 @@ class DnbctlEndToEnd : public ::testing::Test {
     daemon::DaemonConfig config = daemon::embedded_default_config();
     config.domain_id = test_domain();
     for (auto& node : config.ports.at(0).nodes) {
-      if (node.mac.value() == 3) node.no_commander = daemon::NoCommanderPolicy::kHoldLastOutputs;
+      if (node.pump.node.mac.value() == 3) {
+        node.pump.no_commander = daemon::NoCommanderPolicy::kHoldLastOutputs;
+      }
     }
     bridge_ = std::make_unique<daemon::Daemon>(std::move(config), *log_,
                                                daemon::simulated_backend_factory(*log_));

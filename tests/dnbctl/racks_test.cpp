@@ -85,7 +85,7 @@ class BusWithAnotherMaster final : public port::CanBackend {
     c.allocate_retry_max = milliseconds(50);
     std::vector<rack::PumpConfig> pumps;
     for (const auto& n : port.nodes) {
-      if (n.mac == held) pumps.push_back(daemon::to_pump_config(n));
+      if (n.pump.node.mac == held) pumps.push_back(n.pump);
     }
     return rack::PumpRack::scanner_config(c, pumps);
   }

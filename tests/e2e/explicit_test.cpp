@@ -175,7 +175,7 @@ TEST_F(ExplicitTest, RepeatedRequestGetsTheSameReplyAndIsNotExecutedTwice) {
 TEST_F(ExplicitTest, RefusalsHaveTheirStatusCodes) {
   auto config = rack_config();
   // Node 7 is configured for another product: the master will not connect.
-  config.ports[0].nodes[6].identity = devicenet::ExpectedIdentity{59, 27, 9999};
+  config.ports[0].nodes[6].pump.identity = devicenet::ExpectedIdentity{59, 27, 9999};
   ASSERT_NO_FATAL_FAILURE(make_bridge(config));
 
   // 5: sent before the port runs (it checks its own MAC for 2 s first).
