@@ -72,7 +72,7 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
                 rack::policy_key(kind), rack::name_of(kind), rack::risk_of(kind));
     }
   }
-  std::map<std::string, port::PortLoop*> by_name;
+  std::map<std::string, port::PortLoop*, std::less<>> by_name;
   const std::string host_id = read_host_id();
   for (const auto& p : config_.ports) {
     const devicenet::ScannerConfig scanner = to_scanner_config(p, host_id);

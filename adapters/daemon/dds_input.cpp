@@ -51,7 +51,7 @@ bool take_batches(Take take, std::size_t capacity, std::size_t batches, Logger& 
 }  // namespace
 
 DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
-                   std::map<std::string, port::PortLoop*> ports, Logger log)
+                   std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log)
     : rack_(std::move(rack)),
       publisher_(publisher),
       ports_(std::move(ports)),
@@ -91,7 +91,7 @@ void DdsInput::stop() {
 }
 
 port::PortLoop* DdsInput::port_of(std::string_view name) {
-  auto it = ports_.find(std::string(name));
+  auto it = ports_.find(name);
   return it == ports_.end() ? nullptr : it->second;
 }
 

@@ -3,6 +3,7 @@
 // this rack. A waitset on a thread of its own takes them and hands each to
 // its port's loop through the loop's inbox; no DDS callback touches master
 // state. Requests for other racks are left to their bridges.
+#include <functional>
 #include <map>
 #include <span>
 #include <string>
@@ -20,7 +21,7 @@ namespace dnbridge::daemon {
 class DdsInput {
  public:
   DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
-           std::map<std::string, port::PortLoop*> ports, Logger log);
+           std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log);
   ~DdsInput();
   DdsInput(const DdsInput&) = delete;
   DdsInput& operator=(const DdsInput&) = delete;
@@ -39,7 +40,7 @@ class DdsInput {
 
   std::string rack_;
   DdsPublisher& publisher_;
-  std::map<std::string, port::PortLoop*> ports_;
+  std::map<std::string, port::PortLoop*, std::less<>> ports_;
   Logger log_;
   dds::Reader<dnbridge_PumpCommand> commands_;
   dds::Reader<dnbridge_ExplicitRequest> requests_;

@@ -38,6 +38,7 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
     published_.push_back(Published{rack::PumpStateGate(policy)});
   }
   last_polls_.assign(config_.pumps.size(), 0);
+  for (const auto& p : config_.pumps) scan_list_.set(p.node.mac.value());
 }
 
 PortLoop::~PortLoop() {
@@ -64,10 +65,7 @@ std::string PortLoop::problem() const {
   return problem_;
 }
 
-bool PortLoop::has_node(MacId mac) const {
-  return std::any_of(config_.pumps.begin(), config_.pumps.end(),
-                     [&](const rack::PumpConfig& p) { return p.node.mac == mac; });
-}
+bool PortLoop::has_node(MacId mac) const { return scan_list_.test(mac.value()); }
 
 void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs,
                        std::string issuer) {
@@ -118,13 +116,14 @@ bool PortLoop::drain_inbox(TimePoint now) {
   bool keep_running = true;
   for (auto& item : items) {
     if (auto* c = std::get_if<Command>(&item)) {
+      // The MAC was checked against the scan list where the command came
+      // in (has_node); here the rack finds its pump by it at once.
       if (auto s = rack_.command(c->mac, c->outputs, c->issuer, now); !s) {
-        if (!has_node(c->mac)) {
-          log_.warn("command from {} for MAC {} refused: not in this port's scan list", c->issuer,
-                    c->mac.value());
-        } else {
-          log_.warn("command refused: {}", rack_.pump(c->mac)->last_command_refused);
-        }
+        const rack::PumpView* pump = rack_.pump(c->mac);
+        log_.warn("command refused: {}",
+                  pump ? pump->last_command_refused
+                       : fmt::format("from {}: MAC {} is not in this port's scan list", c->issuer,
+                                     c->mac.value()));
       }
     } else if (auto* r = std::get_if<Release>(&item)) {
       if (rack_.release_command(r->mac, now)) {

@@ -5,6 +5,7 @@
 // (the DDS input) talk to it through its inbox, which wakes it. State is
 // published from here.
 #include <atomic>
+#include <bitset>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -66,6 +67,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void post(std::function<void(CanBackend&)> fn);
 
   const std::string& name() const { return config_.port; }
+  // Whether `mac` is in the port's scan list (any thread).
   bool has_node(devicenet::MacId mac) const;
 
   // For a service manager, from any thread. The port has finished its
@@ -161,6 +163,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void note_busy(std::chrono::steady_clock::time_point since);
   Duration longest_pass_{};
 
+  std::bitset<64> scan_list_;  // by MAC; set at construction, read from any thread
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
   std::deque<rack::ExplicitCall> calls_;

@@ -279,6 +279,16 @@ TEST(PortLoop, BadCommandsAreRefusedAndReported) {
   loop.command(mac(4), out, "careless");
   ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps[4].commands_refused == 1; }));
   EXPECT_NE(publisher.pumps[4].last_command_refused.find("9999"), std::string::npos);
+  // Only the scan list's MACs are commanded; another one is refused where it
+  // comes in (DdsInput asks has_node), and the loop refuses it too.
+  EXPECT_TRUE(loop.has_node(mac(4)));
+  EXPECT_FALSE(loop.has_node(mac(5)));
+  EXPECT_FALSE(loop.has_node(mac(63)));
+  loop.command(mac(5), profiles::cdn127::PumpOutputs{}, "careless");
+  std::promise<void> handled;
+  loop.post([&](CanBackend&) { handled.set_value(); });
+  handled.get_future().wait();
+  EXPECT_EQ(publisher.pumps.count(5), 0u);
   loop.stop();
   loop.join();
 }
