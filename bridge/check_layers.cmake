@@ -1,23 +1,29 @@
 # Fails when a file of the core includes a layer that is not below its own:
-#   common  <  can, cip  <  devicenet  <  profiles  <  rack
-# (can and cip are side by side: neither includes the other).
+#   common  <  can, cip  <  devicenet/wire  <  devicenet/master  <  profiles  <  rack
+# (can and cip are side by side: neither includes the other). A layer is the
+# first directory under bridge/, or the second under bridge/devicenet/.
 #   cmake -DROOT=path/to/bridge -P check_layers.cmake
 set(allowed_common common)
 set(allowed_can can common)
 set(allowed_cip cip common)
-set(allowed_devicenet devicenet can cip common)
-set(allowed_profiles profiles devicenet can cip common)
-set(allowed_rack rack profiles devicenet can cip common)
+set(allowed_devicenet/wire devicenet/wire can cip common)
+set(allowed_devicenet/master devicenet/master devicenet/wire can cip common)
+set(allowed_profiles profiles devicenet/master devicenet/wire can cip common)
+set(allowed_rack rack profiles devicenet/master devicenet/wire can cip common)
 
 set(violations "")
 set(count 0)
-foreach(layer common can cip devicenet profiles rack)
+foreach(layer common can cip devicenet/wire devicenet/master profiles rack)
   file(GLOB_RECURSE files ${ROOT}/${layer}/*.hpp ${ROOT}/${layer}/*.cpp)
   foreach(f ${files})
     math(EXPR count "${count} + 1")
     file(STRINGS ${f} includes REGEX "^#include \"bridge/")
     foreach(line ${includes})
-      string(REGEX REPLACE "^#include \"bridge/([a-z0-9_]+)/.*" "\\1" target "${line}")
+      if(line MATCHES "^#include \"bridge/devicenet/")
+        string(REGEX REPLACE "^#include \"bridge/(devicenet/[a-z0-9_]+)/.*" "\\1" target "${line}")
+      else()
+        string(REGEX REPLACE "^#include \"bridge/([a-z0-9_]+)/.*" "\\1" target "${line}")
+      endif()
       list(FIND allowed_${layer} ${target} at)
       if(at EQUAL -1)
         file(RELATIVE_PATH rel ${ROOT} ${f})

@@ -41,7 +41,7 @@
 
 #include "adapters/sim/cdn127/cdn127_device.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::cdn127_sim {
 

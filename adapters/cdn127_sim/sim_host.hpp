@@ -16,7 +16,7 @@
 #include "adapters/sim/cdn127/cdn127_slave.hpp"
 #include "adapters/socketcan/can_socket.hpp"
 #include "bridge/common/log.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::cdn127_sim {
 

@@ -6,8 +6,8 @@
 #include <string_view>
 
 #include "adapters/port/can_backend.hpp"
-#include "bridge/devicenet/node_state.hpp"
-#include "bridge/devicenet/scanner_events.hpp"
+#include "bridge/devicenet/master/node_state.hpp"
+#include "bridge/devicenet/master/scanner_events.hpp"
 #include "bridge/profiles/cdn127/safe_state.hpp"
 #include "dnbridge.h"
 

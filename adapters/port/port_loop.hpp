@@ -20,7 +20,7 @@
 #include "adapters/port/can_backend.hpp"
 #include "adapters/port/port_publisher.hpp"
 #include "bridge/common/log.hpp"
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
 #include "bridge/rack/publish_gate.hpp"
 #include "bridge/rack/pump_rack.hpp"

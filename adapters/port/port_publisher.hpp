@@ -7,8 +7,8 @@
 #include <string>
 
 #include "adapters/port/can_backend.hpp"
-#include "bridge/devicenet/node.hpp"
-#include "bridge/devicenet/scanner_events.hpp"
+#include "bridge/devicenet/master/node.hpp"
+#include "bridge/devicenet/master/scanner_events.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
 #include "bridge/rack/pump_rack.hpp"
 

@@ -13,7 +13,7 @@
 #include <system_error>
 
 #include "bridge/can/can_timing.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::socketcan {
 namespace {

@@ -36,7 +36,7 @@
 #include "adapters/socketcan/can_socket.hpp"
 #include "adapters/socketcan/error_frame.hpp"
 #include "bridge/common/log.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::socketcan {
 

@@ -25,7 +25,7 @@
 
 #include "bridge/common/log.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
 #include "bridge/rack/explicit_policy.hpp"
 
 namespace dnbridge::rack {

@@ -17,8 +17,8 @@
 #include <string_view>
 #include <vector>
 
-#include "bridge/devicenet/explicit_message.hpp"
-#include "bridge/devicenet/scan_list.hpp"
+#include "bridge/devicenet/master/scan_list.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
 
 namespace dnbridge::rack {
 

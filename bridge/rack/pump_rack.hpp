@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "bridge/profiles/cdn127/node_profile.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"

@@ -82,7 +82,7 @@
 #include "adapters/dds/writer.hpp"
 #include "adapters/sim/world/threaded_sim_backend.hpp"
 #include "bridge/can/can_timing.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 #include "figures.hpp"

@@ -12,7 +12,7 @@
 #include <memory>
 #include <vector>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 #include "bridge_fixture.hpp"
 

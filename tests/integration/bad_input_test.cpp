@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "rack_fixture.hpp"
 
 namespace dnbridge::test {

@@ -8,7 +8,7 @@
 
 #include <functional>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 #include "rack_fixture.hpp"
 

@@ -7,7 +7,7 @@
 #include <array>
 
 #include "bridge/cip/data_types.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "bridge/profiles/cdn127/device_info.hpp"
 #include "bridge/profiles/cdn127/node_profile.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"

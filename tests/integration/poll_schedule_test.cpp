@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "adapters/sim/world/sim_rack.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "integration/rack_fixture.hpp"
 
 namespace dnbridge::test {

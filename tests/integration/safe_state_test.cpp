@@ -11,7 +11,7 @@
 #include <functional>
 #include <vector>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 #include "rack_fixture.hpp"
 

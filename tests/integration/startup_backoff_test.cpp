@@ -12,7 +12,7 @@
 #include <string>
 
 #include "bridge/cip/general_status.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "rack_fixture.hpp"
 
 namespace dnbridge::test {

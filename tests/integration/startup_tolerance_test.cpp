@@ -11,7 +11,7 @@
 #include <string>
 
 #include "bridge/cip/epath.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "rack_fixture.hpp"
 
 namespace dnbridge::test {

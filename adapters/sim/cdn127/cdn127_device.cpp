@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "bridge/devicenet/explicit_message.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
 
 namespace dnbridge::sim {
 

@@ -13,8 +13,8 @@
 #include "bridge/cip/general_status.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/mac_id.hpp"
-#include "bridge/devicenet/offline_connection.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
+#include "bridge/devicenet/wire/offline_connection.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
@@ -54,7 +54,7 @@ constexpr Reply reply_error(cip::GeneralStatus s,
 }
 
 // The Group 4 Offline Connection Set (bridge/PROTOCOL.md §9, UNVERIFIED; layouts
-// and sources in bridge/devicenet/offline_connection.hpp). Where the sources
+// and sources in bridge/devicenet/wire/offline_connection.hpp). Where the sources
 // disagree or are silent, the choice is here.
 struct OfflineOptions {
   // The manual ("DeviceNet Message Types") lists the set as supported.

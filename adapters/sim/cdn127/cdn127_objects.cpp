@@ -7,7 +7,7 @@
 #include "bridge/cip/data_types.hpp"
 #include "bridge/cip/epath.hpp"
 #include "bridge/cip/service.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
 namespace dnbridge::sim {

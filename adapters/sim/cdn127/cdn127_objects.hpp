@@ -13,7 +13,7 @@
 #include "adapters/sim/cdn127/cdn127_device.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/explicit_message.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
 
 namespace dnbridge::sim {
 

@@ -4,8 +4,8 @@
 #include <array>
 #include <utility>
 
-#include "bridge/devicenet/explicit_message.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::sim {
 

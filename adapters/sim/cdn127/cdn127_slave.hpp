@@ -14,7 +14,7 @@
 // Group 1/3, bit strobe) is ignored and counted.
 //
 // In Communication Fault it listens to the Group 4 Offline Connection Set
-// only (bridge/devicenet/offline_connection.hpp has the layouts, their
+// only (bridge/devicenet/wire/offline_connection.hpp has the layouts, their
 // sources and what is assumed; SlaveOptions::offline the choices):
 // - Offline Ownership Request (0x7EF): allocate 1 takes ownership for the
 //   client MAC, 0 gives it up; answered on 0x7EE with the request echoed, R/R
@@ -57,9 +57,9 @@
 #include "adapters/sim/cdn127/pump_model.hpp"
 #include "bridge/can/frame_sink.hpp"
 #include "bridge/common/log.hpp"
-#include "bridge/devicenet/duplicate_mac.hpp"
-#include "bridge/devicenet/fragmentation.hpp"
-#include "bridge/devicenet/offline_connection.hpp"
+#include "bridge/devicenet/wire/duplicate_mac.hpp"
+#include "bridge/devicenet/wire/fragmentation.hpp"
+#include "bridge/devicenet/wire/offline_connection.hpp"
 
 namespace dnbridge::sim {
 

@@ -4,7 +4,7 @@
 #include <optional>
 
 #include "adapters/sim/world/sim_world.hpp"
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
 
 namespace dnbridge::sim {
 

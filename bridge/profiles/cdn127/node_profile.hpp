@@ -3,7 +3,7 @@
 // Configuration object values, its outputs' safe state, the poll
 // connection's paths and sizes.
 #include "bridge/common/result.hpp"
-#include "bridge/devicenet/scan_list.hpp"
+#include "bridge/devicenet/master/scan_list.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 #include "bridge/profiles/cdn127/safe_state.hpp"
 

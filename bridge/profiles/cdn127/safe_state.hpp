@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "bridge/devicenet/scan_list.hpp"
+#include "bridge/devicenet/master/scan_list.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 
 namespace dnbridge::profiles::cdn127 {

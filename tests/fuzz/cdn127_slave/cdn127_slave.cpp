@@ -10,7 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 #include "tests/fuzz/support/session_records.hpp"
 

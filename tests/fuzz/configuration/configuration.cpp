@@ -16,7 +16,7 @@
 #include "adapters/cdn127_sim/device_config.hpp"
 #include "adapters/daemon/config.hpp"
 #include "adapters/security/toml_settings.hpp"
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
 #include "bridge/rack/pump_rack.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 

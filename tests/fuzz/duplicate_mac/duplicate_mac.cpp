@@ -3,11 +3,12 @@
 // to the same 7 bytes; any other size is refused; the check fed the decoded
 // message (and timers) never answers a response, never sends before it
 // started and never leaves the duplicate state.
+#include "bridge/devicenet/wire/duplicate_mac.hpp"
+
 #include <cstddef>
 #include <cstdint>
 
-#include "bridge/devicenet/duplicate_mac.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;

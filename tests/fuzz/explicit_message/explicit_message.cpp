@@ -4,11 +4,12 @@
 // Properties: whatever decodes re-encodes to the very same bytes and decodes
 // again to the same fields; the decoded service data points into the input;
 // encoders refuse outputs one byte too small.
+#include "bridge/devicenet/wire/explicit_message.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
 
-#include "bridge/devicenet/explicit_message.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;

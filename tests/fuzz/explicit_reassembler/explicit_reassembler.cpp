@@ -10,7 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "bridge/devicenet/fragmentation.hpp"
+#include "bridge/devicenet/wire/fragmentation.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;

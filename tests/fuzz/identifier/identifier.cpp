@@ -4,12 +4,13 @@
 // Properties: an identifier that decodes encodes back to itself; one that
 // does not decode is outside 0..0x7EF; the header and fragment byte codecs
 // are bijections on their byte.
+#include "bridge/devicenet/wire/identifier.hpp"
+
 #include <cstddef>
 #include <cstdint>
 
-#include "bridge/devicenet/explicit_message.hpp"
-#include "bridge/devicenet/fragmentation.hpp"
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
+#include "bridge/devicenet/wire/fragmentation.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;

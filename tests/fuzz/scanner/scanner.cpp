@@ -5,11 +5,12 @@
 // deadline is after now (an event loop would otherwise spin); every frame sent
 // is a valid CAN 2.0A frame; events are consistent with the scan list and
 // with each other.
+#include "bridge/devicenet/master/scanner.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
 
-#include "bridge/devicenet/scanner.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 #include "tests/fuzz/support/session_records.hpp"
 

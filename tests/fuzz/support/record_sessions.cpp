@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "adapters/sim/cdn127/cdn127_slave.hpp"
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
 #include "tests/fuzz/support/session_records.hpp"
 
 namespace {

@@ -19,7 +19,7 @@
 #include "adapters/sim/world/sim_rack.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/scan_list.hpp"
+#include "bridge/devicenet/master/scan_list.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 #include "bridge/rack/pump_rack.hpp"
 

@@ -1,4 +1,4 @@
-#include "bridge/devicenet/duplicate_mac.hpp"
+#include "bridge/devicenet/wire/duplicate_mac.hpp"
 
 #include <gtest/gtest.h>
 

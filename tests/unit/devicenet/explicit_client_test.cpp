@@ -1,4 +1,4 @@
-#include "bridge/devicenet/explicit_client.hpp"
+#include "bridge/devicenet/master/explicit_client.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "support/bytes.hpp"
 
 namespace dnbridge::devicenet {

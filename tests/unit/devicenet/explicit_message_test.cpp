@@ -1,11 +1,11 @@
-#include "bridge/devicenet/explicit_message.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
 
 #include <gtest/gtest.h>
 
 #include <array>
 #include <random>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "support/bytes.hpp"
 
 namespace dnbridge::devicenet {

@@ -1,4 +1,4 @@
-#include "bridge/devicenet/fragmentation.hpp"
+#include "bridge/devicenet/wire/fragmentation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "support/bytes.hpp"
 
 namespace dnbridge::devicenet {

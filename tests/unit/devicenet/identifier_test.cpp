@@ -1,4 +1,4 @@
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 #include <gtest/gtest.h>
 

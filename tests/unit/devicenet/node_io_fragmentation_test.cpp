@@ -6,10 +6,10 @@
 
 #include <deque>
 
-#include "bridge/devicenet/explicit_message.hpp"
-#include "bridge/devicenet/fragmentation.hpp"
-#include "bridge/devicenet/identifier.hpp"
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
+#include "bridge/devicenet/wire/fragmentation.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::devicenet {
 namespace {

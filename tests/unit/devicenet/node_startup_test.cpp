@@ -21,7 +21,7 @@
 #include <sstream>
 #include <string>
 
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
 #include "bridge/profiles/cdn127/node_profile.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 

@@ -1,4 +1,4 @@
-#include "bridge/devicenet/offline_connection.hpp"
+#include "bridge/devicenet/wire/offline_connection.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "bridge/devicenet/scanner.hpp"
+#include "bridge/devicenet/master/scanner.hpp"
 
 #include <gtest/gtest.h>
 

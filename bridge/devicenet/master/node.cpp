@@ -1,12 +1,12 @@
 // Node: its state, its timers and frames, losing it, faults and shutdown.
-#include "bridge/devicenet/node.hpp"
+#include "bridge/devicenet/master/node.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <array>
 
-#include "bridge/devicenet/node_internal.hpp"
+#include "bridge/devicenet/master/node_internal.hpp"
 
 namespace dnbridge::devicenet {
 

@@ -1,8 +1,8 @@
-#include "bridge/devicenet/explicit_client.hpp"
+#include "bridge/devicenet/master/explicit_client.hpp"
 
 #include <algorithm>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::devicenet {
 

@@ -1,4 +1,4 @@
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::devicenet {
 

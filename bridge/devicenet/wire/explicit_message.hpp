@@ -21,7 +21,7 @@
 #include "bridge/cip/service.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/result.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::devicenet {
 

@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <array>
 
-#include "bridge/devicenet/identifier.hpp"
-#include "bridge/devicenet/node.hpp"
-#include "bridge/devicenet/node_internal.hpp"
+#include "bridge/devicenet/master/node.hpp"
+#include "bridge/devicenet/master/node_internal.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::devicenet {
 

@@ -1,6 +1,6 @@
-#include "bridge/devicenet/duplicate_mac.hpp"
+#include "bridge/devicenet/wire/duplicate_mac.hpp"
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::devicenet {
 namespace {

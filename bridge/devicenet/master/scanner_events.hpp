@@ -9,9 +9,9 @@
 
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/explicit_client.hpp"
-#include "bridge/devicenet/mac_id.hpp"
-#include "bridge/devicenet/node_state.hpp"
+#include "bridge/devicenet/master/explicit_client.hpp"
+#include "bridge/devicenet/master/node_state.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::devicenet {
 

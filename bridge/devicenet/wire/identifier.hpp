@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "bridge/common/result.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::devicenet {
 

@@ -22,7 +22,8 @@
 //   7  kPortVendorSerial  [physical port][vendor LE:2][serial LE:4]; a response only
 //                         (ICP DAS: response "00 23 03 01 00 00 00"; Wireshark
 //                         shows nothing for this length)
-//   8  kLong              [rsv b7 | match b6 | value b5..0][R/R | service][vendor LE:2][serial LE:4]
+//   8  kLong              [rsv b7 | match b6 | value b5..0][R/R | service][vendor LE:2][serial
+//   LE:4]
 //                         (Wireshark, which names only bit 7 of the first byte
 //                         "reserved" and leaves bits 6..0 unparsed; this codec
 //                         reads them as in the short form, and a Set MAC
@@ -45,7 +46,7 @@
 #include "bridge/can/can_frame.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/result.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::devicenet {
 
@@ -64,13 +65,13 @@ struct CommFaultedMessage {
   CommFaultedLayout layout = CommFaultedLayout::kShort;
   // R/R bit. The 7-byte layout has none and is always a response.
   bool response = false;
-  bool match = false;              // short and long layouts
-  std::uint8_t value = 0;          // 0..63; short and long layouts
-  std::uint8_t service = 0;        // 0..127; all but the 7-byte layout
+  bool match = false;                  // short and long layouts
+  std::uint8_t value = 0;              // 0..63; short and long layouts
+  std::uint8_t service = 0;            // 0..127; all but the 7-byte layout
   std::uint8_t delay_byte_offset = 0;  // kShortWithDelay only
-  std::uint8_t physical_port = 0;  // 0..127; kPortVendorSerial only
-  std::uint16_t vendor_id = 0;     // 7- and 8-byte layouts
-  std::uint32_t serial_number = 0; // 7- and 8-byte layouts
+  std::uint8_t physical_port = 0;      // 0..127; kPortVendorSerial only
+  std::uint16_t vendor_id = 0;         // 7- and 8-byte layouts
+  std::uint32_t serial_number = 0;     // 7- and 8-byte layouts
 
   friend bool operator==(const CommFaultedMessage&, const CommFaultedMessage&) = default;
 };

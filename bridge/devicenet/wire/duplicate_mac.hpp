@@ -17,7 +17,7 @@
 #include "bridge/can/can_frame.hpp"
 #include "bridge/common/result.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::devicenet {
 
@@ -40,10 +40,10 @@ Result<DuplicateMacMessage> decode_duplicate_mac(Bytes payload) noexcept;
 class DuplicateMacCheck {
  public:
   enum class State : std::uint8_t {
-    kIdle,        // not started
-    kChecking,    // requests sent, listening (two windows)
-    kOnline,      // no duplicate seen; defending the MAC
-    kDuplicate,   // another node has this MAC: stop (Communication Fault)
+    kIdle,       // not started
+    kChecking,   // requests sent, listening (two windows)
+    kOnline,     // no duplicate seen; defending the MAC
+    kDuplicate,  // another node has this MAC: stop (Communication Fault)
   };
 
   struct Config {

@@ -21,7 +21,7 @@
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/result.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/explicit_message.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
 
 namespace dnbridge::devicenet {
 
@@ -130,14 +130,14 @@ class ExplicitFragmentSender {
 class ExplicitReassembler {
  public:
   enum class Outcome : std::uint8_t {
-    kDropped,   // not acceptable (first with count != 0, middle/last with no
-                // transfer in progress, unparsable): no ack
-    kAccepted,  // appended; send ack()
-    kRepeated,  // a repeat of the previous fragment: send ack() again, nothing appended
-    kComplete,  // last fragment appended; send ack(), then read message()
-    kOverflow,  // the message would exceed the buffer: send ack() (status error); reset
-    kRestarted, // a count out of sequence: the transfer in progress was discarded
-                // (a first fragment with count 0 starts a new one: see in_progress())
+    kDropped,    // not acceptable (first with count != 0, middle/last with no
+                 // transfer in progress, unparsable): no ack
+    kAccepted,   // appended; send ack()
+    kRepeated,   // a repeat of the previous fragment: send ack() again, nothing appended
+    kComplete,   // last fragment appended; send ack(), then read message()
+    kOverflow,   // the message would exceed the buffer: send ack() (status error); reset
+    kRestarted,  // a count out of sequence: the transfer in progress was discarded
+                 // (a first fragment with count 0 starts a new one: see in_progress())
   };
 
   explicit ExplicitReassembler(std::size_t max_size = kMaxExplicitMessage) noexcept;

@@ -1,4 +1,4 @@
-#include "bridge/devicenet/fragmentation.hpp"
+#include "bridge/devicenet/wire/fragmentation.hpp"
 
 #include <algorithm>
 

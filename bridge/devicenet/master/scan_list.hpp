@@ -8,8 +8,8 @@
 
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/explicit_client.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/master/explicit_client.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::devicenet {
 
@@ -46,7 +46,7 @@ struct SizeSource {
   std::uint16_t instance_id = 0;
   std::uint8_t produced_attribute = 0;
   std::uint8_t consumed_attribute = 0;
-  bool one_byte = false;  // USINT rather than UINT
+  bool one_byte = false;    // USINT rather than UINT
   std::string object_name;  // for reasons: "Configuration"
 };
 

@@ -19,10 +19,10 @@
 #include "bridge/common/log.hpp"
 #include "bridge/common/result.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/duplicate_mac.hpp"
-#include "bridge/devicenet/node.hpp"
-#include "bridge/devicenet/scan_list.hpp"
-#include "bridge/devicenet/scanner_events.hpp"
+#include "bridge/devicenet/master/node.hpp"
+#include "bridge/devicenet/master/scan_list.hpp"
+#include "bridge/devicenet/master/scanner_events.hpp"
+#include "bridge/devicenet/wire/duplicate_mac.hpp"
 
 namespace dnbridge::devicenet {
 

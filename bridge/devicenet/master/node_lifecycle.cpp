@@ -16,8 +16,8 @@
 
 #include "bridge/cip/data_types.hpp"
 #include "bridge/cip/identity_health.hpp"
-#include "bridge/devicenet/node.hpp"
-#include "bridge/devicenet/node_internal.hpp"
+#include "bridge/devicenet/master/node.hpp"
+#include "bridge/devicenet/master/node_internal.hpp"
 
 namespace dnbridge::devicenet {
 

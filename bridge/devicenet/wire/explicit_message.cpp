@@ -1,6 +1,6 @@
-#include "bridge/devicenet/explicit_message.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::devicenet {
 namespace {

@@ -18,7 +18,9 @@ class MacId {
     return MacId(static_cast<std::uint8_t>(v));
   }
   // For values already known to be valid (taken from a 6-bit field).
-  static constexpr MacId from_bits(unsigned v) noexcept { return MacId(static_cast<std::uint8_t>(v & 0x3F)); }
+  static constexpr MacId from_bits(unsigned v) noexcept {
+    return MacId(static_cast<std::uint8_t>(v & 0x3F));
+  }
 
   constexpr std::uint8_t value() const noexcept { return v_; }
   friend constexpr auto operator<=>(MacId, MacId) noexcept = default;

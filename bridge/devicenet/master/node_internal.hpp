@@ -11,7 +11,7 @@
 #include "bridge/cip/general_status.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/explicit_client.hpp"
+#include "bridge/devicenet/master/explicit_client.hpp"
 
 namespace dnbridge::devicenet::node_detail {
 

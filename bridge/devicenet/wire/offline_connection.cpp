@@ -1,8 +1,8 @@
-#include "bridge/devicenet/offline_connection.hpp"
+#include "bridge/devicenet/wire/offline_connection.hpp"
 
 #include <array>
 
-#include "bridge/devicenet/identifier.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
 
 namespace dnbridge::devicenet {
 namespace {
@@ -21,10 +21,14 @@ std::uint8_t rr_service(bool response, std::uint8_t service) noexcept {
 
 std::size_t comm_faulted_size(CommFaultedLayout layout) noexcept {
   switch (layout) {
-    case CommFaultedLayout::kShort: return 2;
-    case CommFaultedLayout::kShortWithDelay: return 3;
-    case CommFaultedLayout::kPortVendorSerial: return 7;
-    case CommFaultedLayout::kLong: return 8;
+    case CommFaultedLayout::kShort:
+      return 2;
+    case CommFaultedLayout::kShortWithDelay:
+      return 3;
+    case CommFaultedLayout::kPortVendorSerial:
+      return 7;
+    case CommFaultedLayout::kLong:
+      return 8;
   }
   return 0;
 }
@@ -69,10 +73,18 @@ Result<can::CanFrame> encode_comm_faulted(const CommFaultedMessage& m) noexcept 
 Result<CommFaultedMessage> decode_comm_faulted(Bytes payload) noexcept {
   CommFaultedMessage m;
   switch (payload.size()) {
-    case 2: m.layout = CommFaultedLayout::kShort; break;
-    case 3: m.layout = CommFaultedLayout::kShortWithDelay; break;
-    case 7: m.layout = CommFaultedLayout::kPortVendorSerial; break;
-    case 8: m.layout = CommFaultedLayout::kLong; break;
+    case 2:
+      m.layout = CommFaultedLayout::kShort;
+      break;
+    case 3:
+      m.layout = CommFaultedLayout::kShortWithDelay;
+      break;
+    case 7:
+      m.layout = CommFaultedLayout::kPortVendorSerial;
+      break;
+    case 8:
+      m.layout = CommFaultedLayout::kLong;
+      break;
     default:
       return payload.size() > 8 ? Errc::kMalformed : Errc::kTruncated;
   }

@@ -1,4 +1,4 @@
-#include "bridge/devicenet/node_state.hpp"
+#include "bridge/devicenet/master/node_state.hpp"
 
 #include <fmt/format.h>
 

@@ -16,11 +16,11 @@
 #include "bridge/common/log.hpp"
 #include "bridge/common/result.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/explicit_client.hpp"
-#include "bridge/devicenet/fragmentation.hpp"
-#include "bridge/devicenet/node_state.hpp"
-#include "bridge/devicenet/scan_list.hpp"
-#include "bridge/devicenet/scanner_events.hpp"
+#include "bridge/devicenet/master/explicit_client.hpp"
+#include "bridge/devicenet/master/node_state.hpp"
+#include "bridge/devicenet/master/scan_list.hpp"
+#include "bridge/devicenet/master/scanner_events.hpp"
+#include "bridge/devicenet/wire/fragmentation.hpp"
 
 namespace dnbridge::devicenet {
 
@@ -257,7 +257,7 @@ class Node final : private ExplicitClient::Listener {
   bool setting_retried_ = false;     // a refused Set retried once after releasing the poll
   bool poll_release_tried_ = false;  // the poll Allocate retried once after a Release
   InlineBytes<16> setting_found_;    // what the device had before the Set
-  unsigned step_timeouts_ = 0;  // consecutive timeouts of the current life-cycle step
+  unsigned step_timeouts_ = 0;       // consecutive timeouts of the current life-cycle step
   Step last_step_ = Step::kNone;
   RequestMessage last_request_;
   InlineBytes<64> last_request_data_;

@@ -16,9 +16,9 @@
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/result.hpp"
 #include "bridge/common/time.hpp"
-#include "bridge/devicenet/explicit_message.hpp"
-#include "bridge/devicenet/fragmentation.hpp"
-#include "bridge/devicenet/mac_id.hpp"
+#include "bridge/devicenet/wire/explicit_message.hpp"
+#include "bridge/devicenet/wire/fragmentation.hpp"
+#include "bridge/devicenet/wire/mac_id.hpp"
 
 namespace dnbridge::devicenet {
 
