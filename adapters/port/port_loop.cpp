@@ -22,15 +22,12 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
     : config_(std::move(config)),
       backend_(std::move(backend)),
       publisher_(publisher),
-      log_(log, fmt::format("port {}", config_.port)),
-      rack_(config_.pumps) {
+      log_(log, fmt::format("port {}", config_.port)) {
   // The master's events reach the rack model first, then this loop.
-  observers_.add(rack_);
-  observers_.add(static_cast<devicenet::ScannerObserver&>(*this));
-  scanner_.emplace(rack::PumpRack::scanner_config(config_.scanner, config_.pumps), backend_->sink(),
-                   observers_, Logger(log, fmt::format("port {}", config_.port)));
-  rack_.attach(*scanner_);
-  gateway_.emplace(*scanner_, rack::ExplicitGateway::Limits{}, config_.explicit_policy,
+  port_.emplace(config_.scanner, config_.pumps, backend_->sink(),
+                Logger(log, fmt::format("port {}", config_.port)));
+  port_->observe(static_cast<devicenet::ScannerObserver&>(*this));
+  gateway_.emplace(scanner(), rack::ExplicitGateway::Limits{}, config_.explicit_policy,
                    Logger(log, fmt::format("port {}", config_.port)));
   for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
     const rack::PublishPolicy policy =
@@ -118,15 +115,15 @@ bool PortLoop::drain_inbox(TimePoint now) {
     if (auto* c = std::get_if<Command>(&item)) {
       // The MAC was checked against the scan list where the command came
       // in (has_node); here the rack finds its pump by it at once.
-      if (auto s = rack_.command(c->mac, c->outputs, c->issuer, now); !s) {
-        const rack::PumpView* pump = rack_.pump(c->mac);
+      if (auto s = rack().command(c->mac, c->outputs, c->issuer, now); !s) {
+        const rack::PumpView* pump = rack().pump(c->mac);
         log_.warn("command refused: {}",
                   pump ? pump->last_command_refused
                        : fmt::format("from {}: MAC {} is not in this port's scan list", c->issuer,
                                      c->mac.value()));
       }
     } else if (auto* r = std::get_if<Release>(&item)) {
-      if (rack_.release_command(r->mac, now)) {
+      if (rack().release_command(r->mac, now)) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
     } else if (auto* fn = std::get_if<std::function<void(CanBackend&)>>(&item)) {
@@ -157,19 +154,19 @@ void PortLoop::run() {
     // (A master that starts now checks its MAC anyway: no re-check for it.)
     const bool master_was_started = master_started_;
     if (!stopping) start_master_when_up(now);
-    while (scanner_->next_deadline() <= now) scanner_->on_timer(now);
+    while (scanner().next_deadline() <= now) scanner().on_timer(now);
     if (!drain_inbox(now) && !stopping) {
       stopping = true;
       stop_deadline = now + config_.shutdown_timeout;
       log_.info("stopping: idling and releasing every node");
-      scanner_->stop(now);
+      scanner().stop(now);
     }
     const BusState bus = backend_->counters().state;
     // A bus that comes back (bus-off recovered, the interface up again):
     // the master checks its own MAC again before it scans.
     if (bus != bus_seen_) {
       if (bus_lost(bus_seen_) && !bus_lost(bus) && master_was_started && !stopping) {
-        scanner_->recheck_mac(
+        scanner().recheck_mac(
             bus_seen_ == BusState::kDown ? "the interface is up again" : "bus-off recovered", now);
       }
       bus_seen_ = bus;
@@ -181,9 +178,9 @@ void PortLoop::run() {
     }
     publish(now, false);
     // Requests still queued are handled first: each gets its one reply.
-    if (stopping && !calls_waiting_ && (scanner_->stopped() || now >= stop_deadline)) break;
+    if (stopping && !calls_waiting_ && (scanner().stopped() || now >= stop_deadline)) break;
 
-    TimePoint wake = std::min({scanner_->next_deadline(), stop_deadline,
+    TimePoint wake = std::min({scanner().next_deadline(), stop_deadline,
                                port_status_time_ + config_.status_period, gateway_->next_expiry()});
     for (const auto& p : published_) {
       wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
@@ -193,7 +190,7 @@ void PortLoop::run() {
     FrameReceiver& receiver = *this;
     backend_->wait(wake, receiver);
   }
-  if (!scanner_->stopped()) log_.warn("stopped before every node was released");
+  if (!scanner().stopped()) log_.warn("stopped before every node was released");
   publish(backend_->now(), true);
   publisher_.port_stopped(config_.port);
   running_ = false;
@@ -203,7 +200,7 @@ void PortLoop::start_master_when_up(TimePoint now) {
   if (master_started_) return;
   if (backend_->counters().state != BusState::kDown) {
     master_started_ = true;
-    scanner_->start(now);
+    scanner().start(now);
     return;
   }
   if (!started_up_.load(std::memory_order_relaxed)) {
@@ -217,7 +214,7 @@ void PortLoop::start_master_when_up(TimePoint now) {
 }
 
 void PortLoop::publish(TimePoint now, bool force) {
-  const auto& views = rack_.pumps();
+  const auto& views = rack().pumps();
   for (std::size_t i = 0; i < views.size(); ++i) {
     const rack::PumpView& v = views[i];
     Published& p = published_[i];
@@ -235,7 +232,7 @@ void PortLoop::publish(TimePoint now, bool force) {
     }
     if (force || !p.status_once || v.status_changes != p.changes ||
         now >= p.status_time + config_.status_period) {
-      publisher_.node_status(config_.port, v, NodeStatusView::of(*scanner_->node(v.mac)),
+      publisher_.node_status(config_.port, v, NodeStatusView::of(*scanner().node(v.mac)),
                              std::max(source, p.status_time));
       p.changes = v.status_changes;
       p.status_time = now;
@@ -251,8 +248,8 @@ void PortLoop::publish_port(TimePoint now) {
   s.interface_name = backend_->interface_name();
   s.bitrate = backend_->bitrate();
   s.master_mac = config_.scanner.master_mac;
-  s.state = scanner_->state();
-  s.reason = scanner_->reason();
+  s.state = scanner().state();
+  s.reason = scanner().reason();
   s.bus = backend_->counters();
   bus_state_ = s.bus.state;
   // The interface's trouble first: the master's own state means little
@@ -268,7 +265,7 @@ void PortLoop::publish_port(TimePoint now) {
   }
   s.nodes_configured = static_cast<std::uint16_t>(config_.pumps.size());
   for (const auto& p : config_.pumps) {
-    if (scanner_->node(p.node.mac)->state() == devicenet::NodeState::kOnline) ++s.nodes_online;
+    if (scanner().node(p.node.mac)->state() == devicenet::NodeState::kOnline) ++s.nodes_online;
   }
   // Rates are measured over whole status periods; a state change in between
   // publishes the last measured ones.
@@ -297,7 +294,7 @@ void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
   double cycle_sum = 0;
   unsigned cycles = 0;
   for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
-    const auto* node = scanner_->node(config_.pumps[i].node.mac);
+    const auto* node = scanner().node(config_.pumps[i].node.mac);
     const std::uint64_t polls = node->counters().polls;
     if (node->state() == devicenet::NodeState::kOnline && polls > last_polls_[i]) {
       cycle_sum += 1000.0 * elapsed / static_cast<double>(polls - last_polls_[i]);
@@ -318,7 +315,7 @@ void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
 
 void PortLoop::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
   const auto start = std::chrono::steady_clock::now();
-  scanner_->on_frame(frame, rx_time);
+  scanner().on_frame(frame, rx_time);
   note_busy(start);
 }
 

@@ -24,6 +24,7 @@
 #include "bridge/rack/explicit_gateway.hpp"
 #include "bridge/rack/publish_gate.hpp"
 #include "bridge/rack/pump_rack.hpp"
+#include "bridge/rack/rack_port.hpp"
 
 namespace dnbridge::port {
 
@@ -112,7 +113,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void publish_port(TimePoint now);
   void update_metrics(const BusCounters& bus, TimePoint now);
 
-  // ScannerObserver, after the rack model (observers_): what the loop itself
+  // ScannerObserver, after the rack model (port_): what the loop itself
   // does with the master's events (the port's status, a log line, the
   // gateway's replies).
   void on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) override;
@@ -127,9 +128,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   std::unique_ptr<CanBackend> backend_;
   PortPublisher& publisher_;
   Logger log_;
-  rack::PumpRack rack_;
-  devicenet::ObserverFanout observers_;
-  std::optional<devicenet::Scanner> scanner_;
+  std::optional<rack::RackPort> port_;  // the master and the rack model
+  rack::PumpRack& rack() { return port_->pumps(); }
+  devicenet::Scanner& scanner() { return port_->scanner(); }
   std::optional<rack::ExplicitGateway> gateway_;
 
   struct Published {

@@ -4,8 +4,14 @@ namespace dnbridge::sim {
 
 SimMaster::SimMaster(SimWorld& world, devicenet::ScannerConfig config,
                      devicenet::ScannerObserver& observer, Logger log)
+    : SimMaster(world, [&](can::FrameSink& sink) -> devicenet::Scanner& {
+        return own_.emplace(std::move(config), sink, observer, std::move(log));
+      }) {}
+
+SimMaster::SimMaster(SimWorld& world,
+                     const std::function<devicenet::Scanner&(can::FrameSink& sink)>& build)
     : world_(world), handle_(world.bus().attach(*this)) {
-  scanner_.emplace(std::move(config), world.bus().sink(handle_), observer, std::move(log));
+  scanner_ = &build(world.bus().sink(handle_));
   world_.add(*this);
 }
 

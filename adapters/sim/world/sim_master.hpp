@@ -1,5 +1,6 @@
 #pragma once
 // The master's port on the simulated bus: a Scanner attached as one node.
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -12,6 +13,9 @@ class SimMaster final : public SimEndpoint {
  public:
   SimMaster(SimWorld& world, devicenet::ScannerConfig config, devicenet::ScannerObserver& observer,
             Logger log = {});
+  // The scanner `build` makes with the master's sink on the bus (a
+  // rack::RackPort's, for one), driven by this endpoint; it must outlive it.
+  SimMaster(SimWorld& world, const std::function<devicenet::Scanner&(can::FrameSink& sink)>& build);
   ~SimMaster() override;
 
   devicenet::Scanner& scanner() { return *scanner_; }
@@ -25,7 +29,8 @@ class SimMaster final : public SimEndpoint {
  private:
   SimWorld& world_;
   NodeHandle handle_;
-  std::optional<devicenet::Scanner> scanner_;
+  std::optional<devicenet::Scanner> own_;  // built by the first constructor
+  devicenet::Scanner* scanner_ = nullptr;
 };
 
 }  // namespace dnbridge::sim

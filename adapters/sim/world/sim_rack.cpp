@@ -16,13 +16,13 @@ SlaveOptions default_slave_options(devicenet::MacId mac) {
 }
 
 SimRack::SimRack(SimRackConfig config, LogSink* log)
-    : config_(std::move(config)), log_(log), world_(config_.bus), pumps_(config_.pumps) {
-  fanout_.add(pumps_);
-  auto port = rack::PumpRack::scanner_config(config_.port, config_.pumps);
-  if (config_.adjust_scan_list) config_.adjust_scan_list(port);
-  master_ = std::make_unique<SimMaster>(world_, std::move(port), fanout_,
-                                        log_ ? Logger(*log_, "master") : Logger());
-  pumps_.attach(master_->scanner());
+    : config_(std::move(config)), log_(log), world_(config_.bus) {
+  master_ =
+      std::make_unique<SimMaster>(world_, [this](can::FrameSink& sink) -> devicenet::Scanner& {
+        port_.emplace(config_.port, config_.pumps, sink, log_ ? Logger(*log_, "master") : Logger(),
+                      config_.adjust_scan_list);
+        return port_->scanner();
+      });
   if (config_.create_devices) {
     for (const auto& p : config_.pumps) add_device(default_slave_options(p.node.mac), std::nullopt);
   }
@@ -55,8 +55,8 @@ void SimRack::start() {
 }
 
 bool SimRack::all_online() const {
-  return std::all_of(pumps_.pumps().begin(), pumps_.pumps().end(),
-                     [](const rack::PumpView& v) { return v.online; });
+  const auto& pumps = port_->pumps().pumps();
+  return std::all_of(pumps.begin(), pumps.end(), [](const rack::PumpView& v) { return v.online; });
 }
 
 }  // namespace dnbridge::sim

@@ -11,6 +11,7 @@
 #include "adapters/sim/world/sim_slave.hpp"
 #include "adapters/sim/world/sim_world.hpp"
 #include "bridge/rack/pump_rack.hpp"
+#include "bridge/rack/rack_port.hpp"
 
 namespace dnbridge::sim {
 
@@ -36,11 +37,11 @@ class SimRack {
 
   SimWorld& world() { return world_; }
   TimePoint now() const { return world_.now(); }
-  devicenet::Scanner& scanner() { return master_->scanner(); }
+  devicenet::Scanner& scanner() { return port_->scanner(); }
   SimMaster& master() { return *master_; }
-  rack::PumpRack& pumps() { return pumps_; }
+  rack::PumpRack& pumps() { return port_->pumps(); }
   // Extra observers (tests record events); add before start().
-  void observe(devicenet::ScannerObserver& o) { fanout_.add(o); }
+  void observe(devicenet::ScannerObserver& o) { port_->observe(o); }
 
   // A simulated device, powered on at `power_on` if given.
   SimSlave& add_device(SlaveOptions options, std::optional<TimePoint> power_on);
@@ -55,9 +56,8 @@ class SimRack {
   SimRackConfig config_;
   LogSink* log_;
   SimWorld world_;
-  rack::PumpRack pumps_;
-  devicenet::ObserverFanout fanout_;
-  std::unique_ptr<SimMaster> master_;
+  std::optional<rack::RackPort> port_;  // the master and the rack model
+  std::unique_ptr<SimMaster> master_;   // drives port_'s scanner on the bus
   std::map<unsigned, std::unique_ptr<SimSlave>> devices_;
   bool started_ = false;
 };
