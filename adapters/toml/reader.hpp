@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include <cstdint>
+#include <exception>
 #include <optional>
 #include <set>
 #include <string>
@@ -90,7 +91,11 @@ class TableReader {
   // `where`: how problems name the table ("[[port]]", "[defaults]").
   TableReader(const toml::table& table, std::string where, Problems& problems)
       : table_(table), where_(std::move(where)), problems_(problems) {}
-  ~TableReader() { finish(); }
+  // Finishes, unless an exception is on its way through (the reading is
+  // abandoned then).
+  ~TableReader() {
+    if (std::uncaught_exceptions() == unwinding_) finish();
+  }
   TableReader(const TableReader&) = delete;
   TableReader& operator=(const TableReader&) = delete;
 
@@ -109,6 +114,7 @@ class TableReader {
   Problems& problems_;
   std::vector<std::string> declared_;
   bool finished_ = false;
+  int unwinding_ = std::uncaught_exceptions();
 };
 
 // `node` as a table, or "KEY must be a table (SPELLING), not ..." and null.

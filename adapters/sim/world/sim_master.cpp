@@ -11,7 +11,12 @@ SimMaster::SimMaster(SimWorld& world, devicenet::ScannerConfig config,
 SimMaster::SimMaster(SimWorld& world,
                      const std::function<devicenet::Scanner&(can::FrameSink& sink)>& build)
     : world_(world), handle_(world.bus().attach(*this)) {
-  scanner_ = &build(world.bus().sink(handle_));
+  try {
+    scanner_ = &build(world.bus().sink(handle_));
+  } catch (...) {
+    (void)world_.bus().detach(handle_);  // the bus must not keep an endpoint that never was
+    throw;
+  }
   world_.add(*this);
 }
 
