@@ -5,13 +5,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
-#include <cstring>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <span>
-#include <sstream>
 #include <tuple>
 #include <utility>
 
@@ -149,23 +145,9 @@ DeviceConfig parse_device_config(std::string_view text, std::string_view source_
 }
 
 DeviceConfig load_device_config(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw DeviceConfigError(
-        {fmt::format("{}: is a directory, not a device configuration", path.string())});
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw DeviceConfigError(
-        {fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno))});
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) {
-    throw DeviceConfigError(
-        {fmt::format("{}: cannot read: {}", path.string(), std::strerror(errno))});
-  }
-  return parse_device_config(text.str(), path.string());
+  auto file = toml_config::read_file(path, "a device configuration");
+  if (!file.text) throw DeviceConfigError({std::move(file.error)});
+  return parse_device_config(*file.text, path.string());
 }
 
 std::vector<sim::SlaveOptions> device_options(const std::vector<MacId>& macs,

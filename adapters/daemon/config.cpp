@@ -5,16 +5,12 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
-#include <cstring>
-#include <fstream>
 #include <initializer_list>
 #include <iterator>
 #include <limits>
 #include <map>
 #include <set>
 #include <span>
-#include <sstream>
 #include <tuple>
 #include <utility>
 
@@ -832,20 +828,9 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
 }
 
 DaemonConfig load_config_file(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw ConfigError({fmt::format("{}: is a directory, not a configuration file", path.string())});
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw ConfigError({fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno))});
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) {
-    throw ConfigError({fmt::format("{}: cannot read: {}", path.string(), std::strerror(errno))});
-  }
-  DaemonConfig config = parse_config(text.str(), path.string());
+  auto file = toml_config::read_file(path, "a configuration file");
+  if (!file.text) throw ConfigError({std::move(file.error)});
+  DaemonConfig config = parse_config(*file.text, path.string());
   // [security]'s relative paths are the configuration file's neighbours.
   if (config.security) {
     config.security->resolve_relative_to(std::filesystem::absolute(path).parent_path());

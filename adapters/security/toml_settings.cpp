@@ -3,10 +3,6 @@
 #include <fmt/format.h>
 
 #include <array>
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <sstream>
 #include <string_view>
 
 namespace dnbridge::security {
@@ -65,12 +61,10 @@ std::optional<Settings> read_table(const toml::node& node, toml_config::Problems
 
 Settings load_file(const std::filesystem::path& file) {
   const std::string name = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SettingsError(fmt::format("{}: cannot open: {}", name, std::strerror(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
+  auto text = toml_config::read_file(file, "a security file");
+  if (!text.text) throw SettingsError(text.error);
   toml_config::Problems problems(name);
-  const auto root = toml_config::parse(text.str(), problems);
+  const auto root = toml_config::parse(*text.text, problems);
   if (!root) throw SettingsError(toml_config::join_lines(problems.errors()));
   const toml::node* n = root->get("security");
   if (n == nullptr) {

@@ -3,6 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
 
 namespace dnbridge::toml_config {
 
@@ -31,6 +35,21 @@ std::vector<std::string> Problems::format(std::vector<Entry> list) const {
     out.push_back(fmt::format("{}:{}:{}: {}", source_, e.line, e.column, e.text));
   }
   return out;
+}
+
+FileText read_file(const std::filesystem::path& path, std::string_view what) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    return {std::nullopt, fmt::format("{}: is a directory, not {}", name, what)};
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {std::nullopt, fmt::format("{}: cannot open: {}", name, std::strerror(errno))};
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad())
+    return {std::nullopt, fmt::format("{}: cannot read: {}", name, std::strerror(errno))};
+  return {text.str(), {}};
 }
 
 std::optional<toml::table> parse(std::string_view text, Problems& problems) {

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <exception>
+#include <filesystem>
 #include <optional>
 #include <set>
 #include <string>
@@ -51,6 +52,14 @@ class Problems {
   std::vector<Entry> warnings_;
   std::set<std::tuple<std::uint32_t, std::uint32_t, std::string>> seen_;
 };
+
+// A configuration file's whole text, or why there is none: "PATH: is a
+// directory, not WHAT", "PATH: cannot open: REASON", "PATH: cannot read: REASON".
+struct FileText {
+  std::optional<std::string> text;
+  std::string error;
+};
+FileText read_file(const std::filesystem::path& path, std::string_view what);
 
 // `text` parsed, or its syntax error added to `problems`.
 std::optional<toml::table> parse(std::string_view text, Problems& problems);
