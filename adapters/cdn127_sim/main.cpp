@@ -15,6 +15,7 @@
 #include "adapters/cdn127_sim/control.hpp"
 #include "adapters/cdn127_sim/device_config.hpp"
 #include "adapters/cdn127_sim/sim_host.hpp"
+#include "adapters/version/version.hpp"
 
 namespace {
 
@@ -100,6 +101,9 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", level_name, "trace, debug, info, warn or error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
+  app.set_version_flag("--version",
+                       dnbridge::version::text("cdn127-sim", dnbridge::version::Dds::kNotUsed),
+                       "Print the version and source revision, and exit");
   CLI11_PARSE(app, argc, argv);
 
   std::vector<sim::SlaveOptions> devices;

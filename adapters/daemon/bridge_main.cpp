@@ -15,6 +15,7 @@
 #include "adapters/daemon/service_notify.hpp"
 #include "adapters/dds/loopback.hpp"
 #include "adapters/security/check.hpp"
+#include "adapters/version/version.hpp"
 
 namespace dnbridge::daemon {
 namespace {
@@ -75,7 +76,8 @@ int bridge_main(int argc, char** argv, const Program& program) {
                  "of each SocketCAN port's traffic, dnbridge-PORT-candump.log")
       ->capture_default_str();
   config_opt->excludes(simulate_opt);
-  app.set_version_flag("--version", fmt::format("{} {}", program.name, program.version));
+  app.set_version_flag("--version", version::text(program.name, version::Dds::kUsed),
+                       "Print the version, source revision and Cyclone DDS version, and exit");
   CLI11_PARSE(app, argc, argv);
 
   if (print_default) {

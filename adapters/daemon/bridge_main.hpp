@@ -11,8 +11,7 @@
 namespace dnbridge::daemon {
 
 struct Program {
-  std::string_view name;     // as --help and --version say it
-  std::string_view version;  // the project's version
+  std::string_view name;  // as --help and --version say it
   // The simulator's backends (simulated_backend_factory), or null.
   BackendFactory (*simulated_backends)(LogSink& log) = nullptr;
 };

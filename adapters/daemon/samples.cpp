@@ -7,6 +7,7 @@
 
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/states.hpp"
+#include "bridge/cip/data_types.hpp"
 
 namespace dnbridge::daemon {
 
@@ -126,7 +127,7 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.major_revision = id.major_revision;
   out.minor_revision = id.minor_revision;
   out.serial_number = id.serial_number;
-  set_string(out.product_name, id.product_name);
+  set_string(out.product_name, cip::utf8_from_iso8859_1(id.product_name));
   out.device_state_valid = node.device_state.has_value();
   out.device_state = node.device_state.value_or(0);
   // Identity.State is optional: a device read at start-up (its status

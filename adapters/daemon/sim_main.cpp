@@ -6,5 +6,5 @@
 
 int main(int argc, char** argv) {
   return dnbridge::daemon::bridge_main(
-      argc, argv, {"dnbridge-sim", DNBRIDGE_VERSION, &dnbridge::daemon::simulated_backend_factory});
+      argc, argv, {"dnbridge-sim", &dnbridge::daemon::simulated_backend_factory});
 }

@@ -19,6 +19,7 @@
 #include "adapters/demo/scenario.hpp"
 #include "adapters/sim/bus/pcap_writer.hpp"
 #include "adapters/sim/world/sim_rack.hpp"
+#include "adapters/version/version.hpp"
 
 namespace {
 
@@ -75,6 +76,9 @@ int main(int argc, char** argv) {
   app.add_option("--pcap", pcap_path,
                  "Record every frame on the bus to FILE (pcap, SocketCAN link type); read it with\n"
                  "  tshark -r FILE -d 'can.subdissector,devicenet'");
+  app.set_version_flag("--version",
+                       dnbridge::version::text("dnbridge-demo", dnbridge::version::Dds::kNotUsed),
+                       "Print the version and source revision, and exit");
   CLI11_PARSE(app, argc, argv);
 
   std::signal(SIGINT, on_signal);

@@ -32,14 +32,14 @@ CLI::App* add_racks(CLI::App& app);
 Exit run_racks(const GlobalOptions& options);
 
 struct ShowArgs {
-  std::string mac;
+  std::string node;  // MAC ID or name
 };
 CLI::App* add_show(CLI::App& app, ShowArgs& args);
 Exit run_show(const GlobalOptions& options, const ShowArgs& args);
 
 // --- watch_command.cpp ---------------------------------------------------------------
 struct WatchArgs {
-  std::vector<std::string> macs;
+  std::vector<std::string> nodes;  // MAC IDs or names
   bool lines = false;
   std::uint64_t count = 0;      // 0: no limit
   double duration_seconds = 0;  // 0: no limit
@@ -51,7 +51,7 @@ Exit run_watch(const GlobalOptions& options, const WatchArgs& args);
 enum class Output { kPump, kBallast, kAnalog };
 struct OutputArgs {
   Output output = Output::kPump;
-  std::string mac;
+  std::string node;   // MAC ID or name
   std::string value;  // on|off, or the analog value
   std::string issuer;  // default "dnbctl user@host"
   std::int32_t strength = 10;
@@ -64,7 +64,7 @@ Exit run_output(const GlobalOptions& options, const OutputArgs& args);
 enum class ExplicitKind { kGet, kSet, kService };
 struct ExplicitArgs {
   ExplicitKind kind = ExplicitKind::kGet;
-  std::string mac;
+  std::string node;  // MAC ID or name
   std::string service;
   std::string class_id;
   std::string instance_id;

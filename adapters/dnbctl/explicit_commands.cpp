@@ -57,7 +57,7 @@ CLI::App* add_explicit(CLI::App& app, ExplicitKind kind, ExplicitArgs& args) {
                                           "(e.g. Reset, 0x05, to class 1 instance 1).");
       break;
   }
-  cmd->add_option("MAC", args.mac, "The node's MAC ID (0..63)")->required();
+  cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
   if (kind == ExplicitKind::kService) {
     cmd->add_option("SERVICE", args.service, "CIP service code (0..0x7F)")->required();
   }
@@ -85,10 +85,9 @@ CLI::App* add_explicit(CLI::App& app, ExplicitKind kind, ExplicitArgs& args) {
 }
 
 Exit run_explicit(const GlobalOptions& o, const ExplicitArgs& args) {
-  auto mac = parse_mac(args.mac);
-  if (!mac) throw CommandError(Exit::kUsage, mac.error());
+  auto ref = parse_node(args.node);
+  if (!ref) throw CommandError(Exit::kUsage, ref.error());
   ExplicitExchange x;
-  x.mac = *mac;
   switch (args.kind) {
     case ExplicitKind::kGet: x.service = kGetAttributeSingle; break;
     case ExplicitKind::kSet: x.service = kSetAttributeSingle; break;
@@ -115,9 +114,10 @@ Exit run_explicit(const GlobalOptions& o, const ExplicitArgs& args) {
   install_interrupt_handlers();
 
   Client client = make_client(o);
-  const PortKey port = find_port(client, o, x.mac);
-  x.rack = port.rack;
-  x.port = port.port;
+  const NodeKey target = find_port(client, o, *ref);
+  x.rack = target.rack;
+  x.port = target.port;
+  x.mac = target.mac;
   // The start time makes the name unique even when a pid is reused while a
   // bridge still remembers the transactions of an earlier dnbctl.
   const auto started = std::chrono::duration_cast<std::chrono::milliseconds>(

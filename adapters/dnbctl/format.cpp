@@ -9,6 +9,7 @@
 
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/states.hpp"
+#include "adapters/dnbctl/utf8.hpp"
 #include "bridge/cip/general_status.hpp"
 #include "bridge/cip/service.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
@@ -47,10 +48,10 @@ std::string node_name(std::string_view rack, std::string_view port, unsigned mac
 
 std::string Table::render() const {
   std::vector<std::size_t> width(headers_.size());
-  for (std::size_t c = 0; c < headers_.size(); ++c) width[c] = headers_[c].size();
+  for (std::size_t c = 0; c < headers_.size(); ++c) width[c] = display_width(headers_[c]);
   for (const auto& row : rows_) {
     for (std::size_t c = 0; c < row.size() && c < width.size(); ++c) {
-      width[c] = std::max(width[c], row[c].size());
+      width[c] = std::max(width[c], display_width(row[c]));
     }
   }
   std::string out;
@@ -59,7 +60,7 @@ std::string Table::render() const {
     for (std::size_t c = 0; c < cells.size() && c < width.size(); ++c) {
       if (c != 0) l += "  ";
       l += cells[c];
-      if (c + 1 < cells.size()) l.append(width[c] - cells[c].size(), ' ');
+      if (c + 1 < cells.size()) l.append(width[c] - display_width(cells[c]), ' ');
     }
     while (!l.empty() && l.back() == ' ') l.pop_back();
     out += l;

@@ -56,10 +56,11 @@ void gather(Client& client, const GlobalOptions& o, const std::function<bool()>&
             const std::function<std::string()>& missing) {
   const Deadline deadline = deadline_after(o.timeout());
   if (!client.wait_until(deadline, found)) {
-    throw CommandError(Exit::kNotFound,
-                       fmt::format("no bridge answered on DDS domain {}{} within {:g} s", o.domain,
-                                   o.rack.empty() ? "" : fmt::format(" for rack \"{}\"", o.rack),
-                                   o.timeout_seconds));
+    throw CommandError(
+        Exit::kNotFound,
+        fmt::format("no bridge answered on DDS domain {}{} within {:g} s{}", o.domain,
+                    o.rack.empty() ? "" : fmt::format(" for rack \"{}\"", o.rack),
+                    o.timeout_seconds, client.ports().empty() ? no_bridge_causes(o) : ""));
   }
   const Deadline settle = std::min(deadline, deadline_after(kSettle));
   client.wait_until(settle, [] { return false; });
@@ -184,15 +185,15 @@ CLI::App* add_show(CLI::App& app, ShowArgs& args) {
       "Show one node: identity (vendor, product type and code, revision, serial number, product "
       "name), life-cycle state and reason, device state, poll sizes, expected packet rate, last "
       "error, last refused command, and counters (NodeStatus).");
-  cmd->add_option("MAC", args.mac, "The node's MAC ID (0..63)")->required();
+  cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
   return cmd;
 }
 
 Exit run_show(const GlobalOptions& o, const ShowArgs& args) {
-  auto mac = parse_mac(args.mac);
-  if (!mac) throw CommandError(Exit::kUsage, mac.error());
+  auto ref = parse_node(args.node);
+  if (!ref) throw CommandError(Exit::kUsage, ref.error());
   Client client = make_client(o);
-  const NodeKey key = find_node(client, o, *mac);
+  const NodeKey key = find_node(client, o, *ref);
   if (!client.wait_until(deadline_after(o.timeout()), [&] { return client.node(key) != nullptr; })) {
     throw CommandError(Exit::kNotFound,
                        fmt::format("{}: no NodeStatus within {:g} s",

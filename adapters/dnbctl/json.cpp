@@ -4,13 +4,29 @@
 
 #include <cmath>
 
+#include "adapters/dnbctl/utf8.hpp"
+
 namespace dnbridge::dnbctl {
 
 std::string json_quote(std::string_view s) {
   std::string out;
   out.reserve(s.size() + 2);
   out += '"';
-  for (char c : s) {
+  while (!s.empty()) {
+    const auto cp = next_code_point(s);
+    if (cp.value >= 0x80) {
+      // UTF-8 as it is; a byte that is not UTF-8 becomes U+FFFD, written
+      // as an escape so that a reader sees where the input was not text.
+      if (cp.value == kReplacementCharacter && cp.length == 1) {
+        out += "\\ufffd";
+      } else {
+        out.append(s.substr(0, cp.length));
+      }
+      s.remove_prefix(cp.length);
+      continue;
+    }
+    const char c = s.front();
+    s.remove_prefix(1);
     const auto u = static_cast<unsigned char>(c);
     switch (c) {
       case '"': out += "\\\""; break;
@@ -22,10 +38,6 @@ std::string json_quote(std::string_view s) {
       case '\f': out += "\\f"; break;
       default:
         if (u < 0x20 || u == 0x7F) {
-          out += fmt::format("\\u{:04x}", u);
-        } else if (u >= 0x80) {
-          // Device strings are ISO 8859-1 (CIP), not UTF-8: each byte is
-          // the code point of the same value.
           out += fmt::format("\\u{:04x}", u);
         } else {
           out += c;

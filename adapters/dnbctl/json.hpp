@@ -1,7 +1,8 @@
 #pragma once
 // A small streaming JSON writer for dnbctl's --json output: every command
 // prints one document (watch prints one per line). Keys and strings are
-// escaped per RFC 8259; numbers are written exactly (integers) or with a
+// escaped per RFC 8259: UTF-8 is written as it is, a byte that is not UTF-8
+// as \ufffd, controls as \u escapes; numbers are written exactly (integers) or with a
 // fixed number of decimals (measured values).
 #include <cstdint>
 #include <string>

@@ -1,15 +1,17 @@
 // dnbctl: the command-line client of dnbridge bridges, for people at a
 // terminal and for scripts.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 
 #include "adapters/dds/entity.hpp"
 #include "adapters/dnbctl/commands.hpp"
+#include "adapters/dnbctl/usage_hint.hpp"
 #include "adapters/security/check.hpp"
 #include "adapters/security/toml_settings.hpp"
+#include "adapters/version/version.hpp"
 
 namespace {
 
@@ -29,6 +31,9 @@ int main(int argc, char** argv) {
   CLI::App app{
       "dnbctl: inspect and command the pumps of dnbridge bridges (DeviceNet racks) over DDS."};
   app.footer(kFooter);
+  app.set_version_flag("--version",
+                       dnbridge::version::text("dnbctl", dnbridge::version::Dds::kUsed),
+                       "Print the version, source revision and Cyclone DDS version, and exit");
   app.require_subcommand(1);
   app.fallthrough();  // global options are accepted after the command too
 
@@ -76,6 +81,15 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() != 0) {
+      // A mistyped command or option: said with the closest known one.
+      const std::string hint = usage_hint(
+          app, std::span<const char* const>(argv + 1, static_cast<std::size_t>(argc - 1)));
+      if (!hint.empty()) {
+        std::fprintf(stderr, "dnbctl: %s\n", hint.c_str());
+        return code(Exit::kUsage);
+      }
+    }
     const int rc = app.exit(e);  // prints help, or the error with a hint
     return rc == 0 ? 0 : code(Exit::kUsage);
   }

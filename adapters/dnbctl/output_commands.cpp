@@ -64,19 +64,19 @@ CLI::App* add_output(CLI::App& app, Output output, OutputArgs& args) {
     case Output::kPump:
       cmd = app.add_subcommand("pump", "Switch a pump on or off (PumpCommand), keeping the N2 "
                                        "ballast and analog output as they are.");
-      cmd->add_option("MAC", args.mac, "The node's MAC ID (0..63)")->required();
+      cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
       cmd->add_option("STATE", args.value, "on or off")->required();
       break;
     case Output::kBallast:
       cmd = app.add_subcommand("ballast", "Switch a pump's N2 ballast on or off (PumpCommand), "
                                           "keeping the pump and analog output as they are.");
-      cmd->add_option("MAC", args.mac, "The node's MAC ID (0..63)")->required();
+      cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
       cmd->add_option("STATE", args.value, "on or off")->required();
       break;
     case Output::kAnalog:
       cmd = app.add_subcommand("aout", "Set a pump interface's analog output (PumpCommand), "
                                        "keeping the pump and N2 ballast as they are.");
-      cmd->add_option("MAC", args.mac, "The node's MAC ID (0..63)")->required();
+      cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
       cmd->add_option("VALUE", args.value,
                       "Volts with a V suffix, 0..10 (5.0V: rounded to the nearest of 4096 steps, "
                       "round(V*4095/10)), or a raw count 0..4095 (2048, 0x800)")
@@ -98,8 +98,8 @@ CLI::App* add_output(CLI::App& app, Output output, OutputArgs& args) {
 
 Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   // Everything typed is checked before anything is sent.
-  auto mac = parse_mac(args.mac);
-  if (!mac) throw CommandError(Exit::kUsage, mac.error());
+  auto ref = parse_node(args.node);
+  if (!ref) throw CommandError(Exit::kUsage, ref.error());
   std::optional<bool> on;
   std::optional<AnalogValue> analog;
   if (args.output == Output::kAnalog) {
@@ -115,7 +115,7 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   install_interrupt_handlers();
 
   Client client = make_client(o);
-  const NodeKey key = find_node(client, o, *mac);
+  const NodeKey key = find_node(client, o, *ref);
   const std::string name = node_name(key.rack, key.port, key.mac);
   // The outputs the device applies now (transient-local: at once).
   if (!client.wait_until(deadline_after(o.timeout()), [&] { return client.pump(key) != nullptr; })) {

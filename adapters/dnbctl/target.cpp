@@ -2,8 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <cstdlib>
 #include <set>
+#include <string>
+#include <string_view>
 #include <vector>
+
+#include "adapters/dds/fields.hpp"
+#include "bridge/common/closest.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
@@ -17,16 +23,40 @@ std::string where(const GlobalOptions& o) {
 
 std::string seconds_text(const GlobalOptions& o) { return fmt::format("{:g} s", o.timeout_seconds); }
 
-// The nodes with `mac` the options allow, from both node topics.
-std::set<NodeKey> candidates(const Client& client, const GlobalOptions& o, std::uint8_t mac) {
+bool refers_to(const NodeRef& ref, const NodeKey& k, const char* name) {
+  return ref.mac ? k.mac == *ref.mac : ref.name == dds::view(name);
+}
+
+// The nodes `ref` names that the options allow, from both node topics.
+std::set<NodeKey> candidates(const Client& client, const GlobalOptions& o, const NodeRef& ref) {
   std::set<NodeKey> found;
   for (const auto& [k, v] : client.nodes()) {
-    if (k.mac == mac && o.matches(k.rack, k.port)) found.insert(k);
+    if (o.matches(k.rack, k.port) && refers_to(ref, k, v.data->name)) found.insert(k);
   }
   for (const auto& [k, v] : client.pumps()) {
-    if (k.mac == mac && o.matches(k.rack, k.port)) found.insert(k);
+    if (o.matches(k.rack, k.port) && refers_to(ref, k, v.data->name)) found.insert(k);
   }
   return found;
+}
+
+std::string described(const NodeRef& ref) {
+  return ref.mac ? fmt::format("MAC {}", *ref.mac) : fmt::format("\"{}\"", ref.name);
+}
+
+// " (did you mean "pump-3"?)" when a node the options allow has a name
+// close to the one given.
+std::string name_hint(const Client& client, const GlobalOptions& o, const NodeRef& ref) {
+  if (ref.mac) return {};
+  std::vector<std::string> names;
+  for (const auto& [k, v] : client.nodes()) {
+    if (o.matches(k.rack, k.port)) names.emplace_back(dds::view(v.data->name));
+  }
+  for (const auto& [k, v] : client.pumps()) {
+    if (o.matches(k.rack, k.port)) names.emplace_back(dds::view(v.data->name));
+  }
+  const std::vector<std::string_view> views(names.begin(), names.end());
+  const auto near = closest(ref.name, views, 3);
+  return near ? fmt::format(" (did you mean \"{}\"?)", *near) : std::string{};
 }
 
 std::set<PortKey> candidate_ports(const Client& client, const GlobalOptions& o) {
@@ -62,26 +92,52 @@ void discover(Client& client, const GlobalOptions& o, Found found) {
 
 }  // namespace
 
-NodeKey find_node(Client& client, const GlobalOptions& o, std::uint8_t mac) {
-  discover(client, o, [&] { return candidates(client, o, mac); });
-  const auto found = candidates(client, o, mac);
+std::string no_bridge_causes(const GlobalOptions& o) {
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  const bool uri_set = uri != nullptr && *uri != '\0';
+  std::string s = fmt::format(
+      "\n  dnbctl looked on DDS domain {} (--domain, $DNBCTL_DOMAIN) with {}.", o.domain,
+      uri_set ? fmt::format("CYCLONEDDS_URI={}", uri)
+              : std::string("no CYCLONEDDS_URI: Cyclone DDS's defaults, multicast discovery "
+                            "on one network interface it chose"));
+  s += "\n  Likely causes: no bridge runs on that domain (its configuration's `domain`);";
+  s += uri_set ? "\n  this configuration does not reach the bridge's network (compare it with "
+                 "the bridge's own, /etc/dnbridge/cyclonedds.xml on a bridge host);"
+               : "\n  the bridge is pinned to another network: set CYCLONEDDS_URI as the "
+                 "bridge's (file:///etc/dnbridge/cyclonedds.xml on a bridge host; "
+                 "deploy/cyclonedds/loopback.xml for a simulated rack on this host);";
+  s += fmt::format(
+      "\n  a firewall drops DDS's UDP traffic (ports {} and up on this domain);"
+      "\n  DDS Security on the bridge and not here, or the reverse (--security).",
+      7400 + 250 * o.domain);
+  return s;
+}
+
+NodeKey find_node(Client& client, const GlobalOptions& o, const NodeRef& ref) {
+  discover(client, o, [&] { return candidates(client, o, ref); });
+  const auto found = candidates(client, o, ref);
   if (found.empty()) {
-    throw CommandError(Exit::kNotFound,
-                       fmt::format("no bridge reported a node with MAC {} {} within {}", mac,
-                                   where(o), seconds_text(o)));
+    throw CommandError(
+        Exit::kNotFound,
+        fmt::format("no bridge reported a node {} {} {} within {}{}{}", ref.mac ? "with" : "named",
+                    described(ref), where(o), seconds_text(o), name_hint(client, o, ref),
+                    client.ports().empty() ? no_bridge_causes(o) : ""));
   }
   if (found.size() > 1) {
     throw CommandError(Exit::kUsage,
-                       fmt::format("MAC {} is on more than one port ({}): give --rack and --port",
-                                   mac, list_of(found)));
+                       fmt::format("{} is on more than one port ({}): give --rack and --port",
+                                   described(ref), list_of(found)));
   }
   return *found.begin();
 }
 
-PortKey find_port(Client& client, const GlobalOptions& o, std::uint8_t mac) {
+NodeKey find_port(Client& client, const GlobalOptions& o, const NodeRef& ref) {
+  // A name must be a configured node's.
+  if (!ref.mac) return find_node(client, o, ref);
+  const std::uint8_t mac = *ref.mac;
   discover(client, o, [&] { return candidate_ports(client, o); });
-  const auto nodes = candidates(client, o, mac);
-  if (nodes.size() == 1) return PortKey{nodes.begin()->rack, nodes.begin()->port};
+  const auto nodes = candidates(client, o, ref);
+  if (nodes.size() == 1) return *nodes.begin();
   if (nodes.size() > 1) {
     throw CommandError(Exit::kUsage,
                        fmt::format("MAC {} is on more than one port ({}): give --rack and --port",
@@ -91,8 +147,8 @@ PortKey find_port(Client& client, const GlobalOptions& o, std::uint8_t mac) {
   // there is, whose bridge answers for it.
   const auto ports = candidate_ports(client, o);
   if (ports.empty()) {
-    throw CommandError(Exit::kNotFound, fmt::format("no bridge answered {} within {}", where(o),
-                                                    seconds_text(o)));
+    throw CommandError(Exit::kNotFound, fmt::format("no bridge answered {} within {}{}", where(o),
+                                                    seconds_text(o), no_bridge_causes(o)));
   }
   if (ports.size() > 1) {
     throw CommandError(Exit::kUsage,
@@ -100,7 +156,7 @@ PortKey find_port(Client& client, const GlobalOptions& o, std::uint8_t mac) {
                                    "give --rack and --port",
                                    mac, list_of(ports)));
   }
-  return *ports.begin();
+  return NodeKey{ports.begin()->rack, ports.begin()->port, mac};
 }
 
 }  // namespace dnbridge::dnbctl

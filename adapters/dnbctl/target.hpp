@@ -8,20 +8,28 @@
 
 #include "adapters/dnbctl/client.hpp"
 #include "adapters/dnbctl/options.hpp"
+#include "adapters/dnbctl/values.hpp"
 
 namespace dnbridge::dnbctl {
 
 // After the first match, how long other racks get to be heard.
 inline constexpr Duration kSettle = milliseconds(300);
 
-// The one node with this MAC among the racks and ports the options allow.
-// Throws CommandError: kNotFound when none answered within the timeout,
-// kUsage when several match (give --rack or --port).
-NodeKey find_node(Client& client, const GlobalOptions& options, std::uint8_t mac);
+// What to check when no bridge answered at all: the domain and network
+// configuration dnbctl used, and the usual causes (another domain,
+// CYCLONEDDS_URI not reaching the bridge's network, a firewall, DDS Security
+// on one side only). Lines to append to the error, each starting "\n  ".
+std::string no_bridge_causes(const GlobalOptions& options);
 
-// The port through which to address `mac`: the one whose bridge has the
-// node configured, or else the only port there is (its bridge then answers
-// "not in scan list"). Throws CommandError as find_node.
-PortKey find_port(Client& client, const GlobalOptions& options, std::uint8_t mac);
+// The one node `ref` names (by MAC or by name) among the racks and ports the
+// options allow. Throws CommandError: kNotFound when none answered within
+// the timeout (with the closest name as a hint, for a name), kUsage when
+// several match (give --rack or --port).
+NodeKey find_node(Client& client, const GlobalOptions& options, const NodeRef& ref);
+
+// Where to address an explicit request to `ref`: the port whose bridge has
+// the node configured, or else, for a MAC, the only port there is (its
+// bridge then answers "not in scan list"). Throws CommandError as find_node.
+NodeKey find_port(Client& client, const GlobalOptions& options, const NodeRef& ref);
 
 }  // namespace dnbridge::dnbctl

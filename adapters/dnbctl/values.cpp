@@ -65,6 +65,19 @@ Parsed<std::uint8_t> parse_mac(std::string_view text) {
   return static_cast<std::uint8_t>(*v);
 }
 
+Parsed<NodeRef> parse_node(std::string_view text) {
+  const std::string t(trim(text));
+  if (t.empty())
+    return Parsed<NodeRef>::failure("no node given: a MAC ID (0..63) or a node's name");
+  // A number is a MAC ID, and out of range is an error, never a name.
+  if (std::isdigit(static_cast<unsigned char>(t.front())) != 0) {
+    auto mac = parse_mac(t);
+    if (!mac) return Parsed<NodeRef>::failure(mac.error());
+    return NodeRef{*mac, {}};
+  }
+  return NodeRef{std::nullopt, t};
+}
+
 Parsed<bool> parse_on_off(std::string_view text) {
   const std::string t = lower(trim(text));
   if (t == "on" || t == "1" || t == "true") return true;
@@ -169,7 +182,7 @@ Parsed<std::string> decode_data(std::span<const std::uint8_t> data, Decoding as)
             "{} byte(s) are not a SHORT_STRING (a length byte, then that many characters)",
             data.size()));
       }
-      return std::string(*s);
+      return cip::utf8_from_iso8859_1(*s);
     }
     case Decoding::kUint:
     case Decoding::kInt: {

@@ -43,6 +43,15 @@ Parsed<std::uint64_t> parse_unsigned(std::string_view text, std::uint64_t max, s
 // A DeviceNet MAC ID, 0..63.
 Parsed<std::uint8_t> parse_mac(std::string_view text);
 
+// A node as a command names it: its MAC ID (a number, "12", "0x0C") or its
+// name in the bridge's configuration ("chamber-1-dry-pump").
+struct NodeRef {
+  std::optional<std::uint8_t> mac;  // set when given as a number
+  std::string name;                 // set otherwise
+  friend bool operator==(const NodeRef&, const NodeRef&) = default;
+};
+Parsed<NodeRef> parse_node(std::string_view text);
+
 // "on" or "off" (also 1/0, true/false).
 Parsed<bool> parse_on_off(std::string_view text);
 

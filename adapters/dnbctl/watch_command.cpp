@@ -11,6 +11,7 @@
 #include "adapters/dds/fields.hpp"
 #include "adapters/dnbctl/commands.hpp"
 #include "adapters/dnbctl/format.hpp"
+#include "adapters/dnbctl/target.hpp"
 #include "adapters/dnbctl/values.hpp"
 
 namespace dnbridge::dnbctl {
@@ -38,7 +39,7 @@ CLI::App* add_watch(CLI::App& app, WatchArgs& args) {
       "Live pump state (PumpState) of the given MACs, or of every pump: a table redrawn in place "
       "when stdout is a terminal, else (or with --lines) one line per sample; with --json one "
       "JSON document per line. Runs until Ctrl-C, --count or --duration.");
-  cmd->add_option("MAC", args.macs, "MAC IDs to watch (default: all)");
+  cmd->add_option("NODE", args.nodes, "The nodes to watch, by MAC ID or name (default: all)");
   cmd->add_flag("--lines", args.lines, "One line per sample even on a terminal");
   cmd->add_option("--count", args.count, "Stop after N samples");
   cmd->add_option("--duration", args.duration_seconds, "Stop after S seconds")
@@ -47,18 +48,22 @@ CLI::App* add_watch(CLI::App& app, WatchArgs& args) {
 }
 
 Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
-  std::set<std::uint8_t> macs;
-  for (const auto& text : args.macs) {
-    auto mac = parse_mac(text);
-    if (!mac) throw CommandError(Exit::kUsage, mac.error());
-    macs.insert(*mac);
+  std::vector<NodeRef> refs;
+  for (const auto& text : args.nodes) {
+    auto ref = parse_node(text);
+    if (!ref) throw CommandError(Exit::kUsage, ref.error());
+    refs.push_back(*ref);
   }
   const bool table = !args.lines && !o.json && isatty(STDOUT_FILENO) == 1;
   install_interrupt_handlers();
 
   Client client = make_client(o);
-  const auto wanted = [&](const NodeKey& k) {
-    return o.matches(k.rack, k.port) && (macs.empty() || macs.count(k.mac) != 0);
+  const auto wanted = [&](const NodeKey& k, const dnbridge_PumpState& s) {
+    if (!o.matches(k.rack, k.port)) return false;
+    if (refs.empty()) return true;
+    return std::any_of(refs.begin(), refs.end(), [&](const NodeRef& r) {
+      return r.mac ? *r.mac == k.mac : r.name == dds::view(s.name);
+    });
   };
   const auto start = std::chrono::steady_clock::now();
   const auto end = args.duration_seconds > 0
@@ -73,7 +78,8 @@ Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
   const auto redraw = [&] {
     std::vector<const dnbridge_PumpState*> rows;
     for (const auto& [k, p] : client.pumps()) {
-      if (wanted(k) && p.alive) rows.push_back(p.data.get());  // a gone bridge's pumps drop out
+      if (wanted(k, *p.data) && p.alive)
+        rows.push_back(p.data.get());  // a gone bridge's pumps drop out
     }
     // Home, clear screen, then the table.
     print(fmt::format("\x1b[H\x1b[2Jdnbctl watch: DDS domain {}, {} (Ctrl-C to stop)\n\n{}", o.domain,
@@ -84,7 +90,7 @@ Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
 
   while (!interrupted()) {
     client.refresh([&](const NodeKey& k, const Known<dnbridge_PumpState>& p) {
-      if (!wanted(k) || (args.count != 0 && seen >= args.count)) return;
+      if (!wanted(k, *p.data) || (args.count != 0 && seen >= args.count)) return;
       if (!p.alive) {
         // The bridge left: no new sample follows; its last one is cached.
         if (table) {
@@ -111,9 +117,10 @@ Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
     if (args.count != 0 && seen >= args.count) break;
     if (now >= end) break;
     if (seen == 0 && now >= first_deadline) {
-      throw CommandError(Exit::kNotFound,
-                         fmt::format("no bridge reported pump state on DDS domain {} within {:g} s",
-                                     o.domain, o.timeout_seconds));
+      throw CommandError(
+          Exit::kNotFound,
+          fmt::format("no bridge reported pump state on DDS domain {} within {:g} s{}", o.domain,
+                      o.timeout_seconds, client.ports().empty() ? no_bridge_causes(o) : ""));
     }
     // Wakes on new samples; the slice bounds how late a redraw, the end of
     // --duration or the timeout is noticed.

@@ -4,26 +4,9 @@
 
 #include <algorithm>
 
+#include "bridge/common/closest.hpp"
+
 namespace dnbridge::toml_config {
-namespace {
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0u : 1u)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
-}  // namespace
-
 std::vector<Problem> unknown_keys(const toml::table& table, std::string_view where,
                                   std::span<const std::string_view> known) {
   std::vector<Problem> out;
@@ -31,13 +14,7 @@ std::vector<Problem> unknown_keys(const toml::table& table, std::string_view whe
     const std::string_view name = key.str();
     if (std::find(known.begin(), known.end(), name) != known.end()) continue;
     std::string hint;
-    std::size_t best = 3;  // suggest only close matches
-    for (std::string_view k : known) {
-      if (const std::size_t d = edit_distance(name, k); d < best) {
-        best = d;
-        hint = fmt::format(" (did you mean '{}'?)", k);
-      }
-    }
+    if (const auto k = closest(name, known)) hint = fmt::format(" (did you mean '{}'?)", *k);
     out.push_back({key.source(), fmt::format("unknown key '{}' in {}{}", name, where, hint)});
   }
   return out;

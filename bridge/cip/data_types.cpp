@@ -71,4 +71,19 @@ std::string_view trim_padding(std::string_view text) noexcept {
   return text;
 }
 
+std::string utf8_from_iso8859_1(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x80) {
+      out += c;
+    } else {
+      out += static_cast<char>(0xC0 | (u >> 6));
+      out += static_cast<char>(0x80 | (u & 0x3F));
+    }
+  }
+  return out;
+}
+
 }  // namespace dnbridge::cip

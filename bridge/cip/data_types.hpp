@@ -10,6 +10,7 @@
 // allocates). Characters are passed through as they are (ISO 8859-1 by CIP).
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <string_view>
 
 #include "bridge/common/bytes.hpp"
@@ -42,5 +43,10 @@ Result<std::size_t> encode_string(std::string_view text, MutableBytes out) noexc
 // Some devices pad fixed-length names with NULs or spaces ("CDN127  "): the
 // text without that trailing padding.
 std::string_view trim_padding(std::string_view text) noexcept;
+
+// A device's characters (ISO 8859-1: each byte the code point of its value)
+// as UTF-8, the encoding of every string the bridge publishes: "\xB5s" is
+// "\xC2\xB5s". Allocates: for publishing, not for the codecs.
+std::string utf8_from_iso8859_1(std::string_view text);
 
 }  // namespace dnbridge::cip

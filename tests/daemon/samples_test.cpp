@@ -1,6 +1,7 @@
 // What the bridge publishes for a node whose analog input is off the scale:
 // the channel marked invalid in PumpState (raw as received, volts NaN), the
-// other inputs as decoded, and NodeStatus saying which input and counting.
+// other inputs as decoded, and NodeStatus saying which input and counting;
+// and strings, UTF-8 whatever the device sends.
 #include "adapters/daemon/samples.hpp"
 
 #include <gtest/gtest.h>
@@ -60,6 +61,25 @@ TEST(Samples, AnAnalogInputOffTheScaleIsInvalidAndNamed) {
   fill_node_status(*status, "r", "A", view, port::NodeStatusView::of(*scanner.node(pump.node.mac)));
   EXPECT_STREQ(status->invalid_inputs, "");
   EXPECT_EQ(status->counters.responses_with_invalid_inputs, 1u);
+}
+
+TEST(Samples, ADevicesProductNameIsPublishedAsUtf8) {
+  rack::PumpConfig pump;
+  pump.node.mac = devicenet::MacId::from(7).value();
+  pump.node.name = "Pumpe \xC3\xA4tz";  // UTF-8 from the configuration, as it is
+  pump.io = cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
+  rack::PumpRack rack({pump});
+  NullSink sink;
+  devicenet::Scanner scanner(rack::PumpRack::scanner_config({}, {pump}), sink, rack, Logger());
+  const rack::PumpView* view = rack.pump(pump.node.mac);
+  ASSERT_NE(view, nullptr);
+
+  auto node = port::NodeStatusView::of(*scanner.node(pump.node.mac));
+  node.identity.product_name = "\xB5Pump \xE4";  // ISO 8859-1, as the device sends it
+  dds::Owned<dnbridge_NodeStatus> status;
+  fill_node_status(*status, "r", "A", *view, node);
+  EXPECT_STREQ(status->product_name, "\xC2\xB5Pump \xC3\xA4");
+  EXPECT_STREQ(status->name, "Pumpe \xC3\xA4tz");
 }
 
 }  // namespace

@@ -1,14 +1,15 @@
 // The real dnbctl program, run as a child process, against a bridge of the
 // simulated rack (eight CDN127 pumps at MACs 1..8 on port "A") running in
-// this process. Both are pinned to loopback on a domain and discovery tag of
-// this process's own (test_domain.hpp). Node 3 holds its last outputs when no
-// commander is left, so what one dnbctl run commanded is still applied when
-// the next one reads it.
+// this process, under a rack name and a node name that are not ASCII. Both are pinned to loopback
+// on a domain and discovery tag of this process's own (test_domain.hpp). Node 3 holds its last
+// outputs when no commander is left, so what one dnbctl run commanded is still applied when the
+// next one reads it.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,11 @@ using testing::test_domain;
 // Bounds every wait for the bridge; never reached when things work.
 constexpr auto kReady = std::chrono::seconds(10);
 
+// UTF-8 names: "ätz-3 ラック" (9 characters in 15 bytes, 12 columns on a
+// terminal: the katakana are wide) and "Pumpe ä-2".
+constexpr const char* kRack = "\xC3\xA4tz-3 \xE3\x83\xA9\xE3\x83\x83\xE3\x82\xAF";
+constexpr const char* kNode2 = "Pumpe \xC3\xA4-2";
+
 std::size_t count(const std::string& text, const std::string& what) {
   std::size_t n = 0;
   for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
@@ -45,10 +51,12 @@ class DnbctlEndToEnd : public ::testing::Test {
     log_ = std::make_unique<daemon::StderrLogSink>(LogLevel::kWarn);
     daemon::DaemonConfig config = daemon::embedded_default_config();
     config.domain_id = test_domain();
+    config.rack = kRack;
     for (auto& node : config.ports.at(0).nodes) {
       if (node.pump.node.mac.value() == 3) {
         node.pump.no_commander = daemon::NoCommanderPolicy::kHoldLastOutputs;
       }
+      if (node.pump.node.mac.value() == 2) node.pump.node.name = kNode2;
     }
     bridge_ = std::make_unique<daemon::Daemon>(std::move(config), *log_,
                                                daemon::simulated_backend_factory(*log_));
@@ -138,7 +146,8 @@ std::unique_ptr<DnbctlEndToEnd::Observer> DnbctlEndToEnd::observer_;
 TEST_F(DnbctlEndToEnd, ListShowsTheEightNodesOnline) {
   const auto json = dnbctl({"list", "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.err;
-  EXPECT_NE(json.out.find("\"rack\": \"sim-rack\""), std::string::npos) << json.out;
+  EXPECT_NE(json.out.find(std::string("\"rack\": \"") + kRack + "\""), std::string::npos)
+      << json.out;
   EXPECT_NE(json.out.find("\"nodes_online\": 8"), std::string::npos) << json.out;
   EXPECT_EQ(count(json.out, "\"online\": true"), 8u) << json.out;
   EXPECT_EQ(count(json.out, "\"product\": \"CDN127\""), 8u) << json.out;
@@ -149,13 +158,47 @@ TEST_F(DnbctlEndToEnd, ListShowsTheEightNodesOnline) {
   EXPECT_EQ(count(table.out, "  online  yes  "), 8u) << table.out;
 }
 
+TEST_F(DnbctlEndToEnd, NonAsciiNamesRoundTripThroughJsonAndAlignInTables) {
+  const auto r = dnbctl({"list", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Parsed by a JSON library of its own: the names come back as configured.
+  const auto doc = nlohmann::json::parse(r.out);
+  std::vector<std::string> racks;
+  std::map<unsigned, std::string> names;
+  for (const auto& rack : doc.at("racks")) {
+    racks.push_back(rack.at("rack").get<std::string>());
+    for (const auto& port : rack.at("ports")) {
+      for (const auto& node : port.at("nodes")) {
+        names[node.at("mac").get<unsigned>()] = node.at("name").get<std::string>();
+      }
+    }
+  }
+  EXPECT_EQ(racks, std::vector<std::string>{kRack});
+  EXPECT_EQ(names.size(), 8u);
+  EXPECT_EQ(names[2], kNode2);
+  EXPECT_EQ(names[3], "pump-3");
+
+  // In the nodes' table, columns are padded to the width a terminal gives
+  // the names (the rack 12 columns, node 2's name 9), not to their bytes.
+  const auto table = dnbctl({"list", "--nodes"});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  const std::string rack(kRack);
+  for (const std::string& line : std::vector<std::string>{
+           "RACK          PORT  MAC  NAME       STATE   ONLINE  PRODUCT  REASON\n",
+           rack + "  A     2    " + kNode2 + "  online  yes     CDN127   polled",
+           rack + "  A     3    pump-3     online  yes     CDN127   polled"}) {
+    EXPECT_NE(table.out.find(line), std::string::npos) << line << "\nin:\n" << table.out;
+  }
+}
+
 TEST_F(DnbctlEndToEnd, ShowShowsTheIdentity) {
   const auto r = dnbctl({"show", "3"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* line :
-       {"node                      sim-rack/A/3 (pump-3)\n", "state                     online\n",
-        "product name              CDN127\n", "vendor                    59 (0x003B)\n",
-        "product code              1888 (0x0760)\n",
+       {"node                      \xC3\xA4tz-3 \xE3\x83\xA9\xE3\x83\x83\xE3\x82\xAF/A/3 "
+        "(pump-3)\n",
+        "state                     online\n", "product name              CDN127\n",
+        "vendor                    59 (0x003B)\n", "product code              1888 (0x0760)\n",
         "serial number             3 (0x00000003)\n"}) {
     EXPECT_NE(r.out.find(line), std::string::npos) << line << "\nin:\n" << r.out;
   }
@@ -167,12 +210,31 @@ TEST_F(DnbctlEndToEnd, ShowShowsTheIdentity) {
   EXPECT_EQ(absent.exit_code, 3);
   EXPECT_NE(absent.err.find("no bridge reported a node with MAC 9"), std::string::npos)
       << absent.err;
+  // The bridge was heard: no list of causes for not reaching one.
+  EXPECT_EQ(absent.err.find("Likely causes"), std::string::npos) << absent.err;
+}
+
+TEST_F(DnbctlEndToEnd, NodesAreNamedByMacOrByName) {
+  auto r = dnbctl({"show", kNode2});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(std::string(kRack) + "/A/2 (" + kNode2 + ")"), std::string::npos) << r.out;
+
+  r = dnbctl({"get", "pump-4", "0x01", "1", "6", "--as", "uint"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("/A/4"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("as uint: 4\n"), std::string::npos) << r.out;  // the serial number
+
+  r = dnbctl({"show", "pump4", "--timeout", "0.5"});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("no bridge reported a node named \"pump4\""), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(did you mean \"pump-4\"?)"), std::string::npos) << r.err;
 }
 
 TEST_F(DnbctlEndToEnd, OutputCommandsAreAppliedAndKeepTheOtherOutputs) {
   auto r = dnbctl({"pump", "3", "on"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("sim-rack/A/3 (pump-3): applied: pump on"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(std::string(kRack) + "/A/3 (pump-3): applied: pump on"), std::string::npos)
+      << r.out;
   EXPECT_TRUE(observer_->wait_pump(3, [](const dnbridge_PumpState& s) {
     return !s.outputs_idle && s.pump_on && dds::view(s.commanded_by).starts_with("dnbctl ");
   }));
@@ -255,6 +317,21 @@ TEST(Dnbctl, UsageErrorsExit2AndNothingFoundExits3) {
 
   r = testing::run(DNBCTL_PATH, {"frobnicate"});
   EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown command \"frobnicate\"; dnbctl --help lists them"),
+            std::string::npos)
+      << r.err;
+  r = testing::run(DNBCTL_PATH, {"--domain", domain, "lsit"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown command \"lsit\" (did you mean \"list\"?)"), std::string::npos)
+      << r.err;
+  r = testing::run(DNBCTL_PATH, {"--domian", domain, "list"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown option \"--domian\" (did you mean \"--domain\"?)"),
+            std::string::npos)
+      << r.err;
+  r = testing::run(DNBCTL_PATH, {"pump", "3", "on", "--strenght", "5"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("(did you mean \"--strength\"?)"), std::string::npos) << r.err;
   r = testing::run(DNBCTL_PATH, {"get", "3", "1", "1", "7", "--as", "float"});
   EXPECT_EQ(r.exit_code, 2);
   r = testing::run(DNBCTL_PATH, {"set", "3", "1", "1", "7", "abc"});
@@ -272,6 +349,15 @@ TEST(Dnbctl, UsageErrorsExit2AndNothingFoundExits3) {
   r = testing::run(DNBCTL_PATH, {"--domain", domain, "--timeout", "0.5", "list"});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("no bridge answered on DDS domain " + domain), std::string::npos) << r.err;
+  // What it used and what to check: the domain, the network configuration
+  // (the tests set CYCLONEDDS_URI), a firewall, DDS Security.
+  EXPECT_NE(r.err.find("dnbctl looked on DDS domain " + domain +
+                       " (--domain, $DNBCTL_DOMAIN) "
+                       "with CYCLONEDDS_URI="),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("a firewall drops DDS's UDP traffic"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(--security)"), std::string::npos) << r.err;
   r = testing::run(DNBCTL_PATH, {"--domain", domain, "--timeout", "0.5", "racks"});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("no bridge answered on DDS domain " + domain), std::string::npos) << r.err;

@@ -9,6 +9,7 @@
 #include "adapters/dds/sample.hpp"
 #include "adapters/dds/topics.hpp"
 #include "adapters/dnbctl/json.hpp"
+#include "adapters/dnbctl/utf8.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
@@ -127,9 +128,50 @@ TEST(Format, PortJsonCarriesTheExplicitCountsAndTheLoopsBusyTime) {
       << out.str();
 }
 
-TEST(Json, Latin1BytesAreEscapedAsCodePoints) {
-  // Device strings are ISO 8859-1: 0xB5 is U+00B5, never raw invalid UTF-8.
-  EXPECT_EQ(json_quote("\xB5s"), "\"\\u00b5s\"");
+TEST(Json, Utf8IsWrittenAsItIsAndBytesThatAreNotAsReplacement) {
+  EXPECT_EQ(json_quote("\xC3\xA4tz-3"), "\"\xC3\xA4tz-3\"");  // ä
+  EXPECT_EQ(json_quote("\xE3\x83\xA9\xF0\x9F\x98\x80"),
+            "\"\xE3\x83\xA9\xF0\x9F\x98\x80\"");              // ラ, an emoji
+  EXPECT_EQ(json_quote("\xEF\xBF\xBD"), "\"\xEF\xBF\xBD\"");  // U+FFFD itself
+  // Not UTF-8: a lone ISO 8859-1 byte, a stray continuation byte, a
+  // truncated sequence, an overlong form, a surrogate.
+  EXPECT_EQ(json_quote("\xB5s"), "\"\\ufffds\"");
+  EXPECT_EQ(json_quote("a\x80"), "\"a\\ufffd\"");
+  EXPECT_EQ(json_quote("\xE3\x83"), "\"\\ufffd\\ufffd\"");
+  EXPECT_EQ(json_quote("\xC0\xAF"), "\"\\ufffd\\ufffd\"");
+  EXPECT_EQ(json_quote("\xED\xA0\x80"), "\"\\ufffd\\ufffd\\ufffd\"");
+  EXPECT_EQ(json_quote("\t\x01\x7F"), "\"\\t\\u0001\\u007f\"");
+}
+
+TEST(Utf8, CodePointsAndTheirWidths) {
+  EXPECT_EQ(next_code_point("a").value, U'a');
+  const auto a_umlaut = next_code_point("\xC3\xA4x");
+  EXPECT_EQ(a_umlaut.value, U'\u00E4');
+  EXPECT_EQ(a_umlaut.length, 2u);
+  const auto emoji = next_code_point("\xF0\x9F\x98\x80");
+  EXPECT_EQ(emoji.value, U'\U0001F600');
+  EXPECT_EQ(emoji.length, 4u);
+  EXPECT_EQ(next_code_point("\xF4\x90\x80\x80").value, kReplacementCharacter);  // > U+10FFFF
+
+  EXPECT_EQ(display_width("etch-3"), 6u);
+  EXPECT_EQ(display_width("\xC3\xA4tz-3"), 5u);  // ätz-3: 5 characters, 6 bytes
+  EXPECT_EQ(display_width("a\xCC\x88tz"), 3u);   // a + combining diaeresis
+  EXPECT_EQ(display_width("\xE3\x83\xA9\xE3\x83\x83\xE3\x82\xAF"), 6u);  // ラック: wide
+  EXPECT_EQ(display_width("\xEF\xBC\xA1"), 2u);                          // full-width A
+  EXPECT_EQ(display_width("\xF0\x9F\x98\x80"), 2u);                      // emoji
+  EXPECT_EQ(display_width("\xB5"), 1u);  // not UTF-8: one replacement
+}
+
+TEST(Table, AlignsOnDisplayWidthNotBytes) {
+  Table t({"RACK", "PORT"});
+  t.add({"\xC3\xA4tz-3", "A"});                          // ätz-3
+  t.add({"\xE3\x83\xA9\xE3\x83\x83\xE3\x82\xAF", "B"});  // ラック, 6 columns
+  t.add({"etch-3", "C"});
+  EXPECT_EQ(t.render(),
+            "RACK    PORT\n"
+            "\xC3\xA4tz-3   A\n"
+            "\xE3\x83\xA9\xE3\x83\x83\xE3\x82\xAF  B\n"
+            "etch-3  C\n");
 }
 
 TEST(Names, StatusesHaveTheirNames) {

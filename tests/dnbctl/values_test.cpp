@@ -47,6 +47,17 @@ TEST(ParseMac, Accepts0To63) {
   EXPECT_EQ(v.error(), "MAC ID 64 is out of range 0..63");
 }
 
+TEST(Values, NodesByMacOrName) {
+  EXPECT_EQ(*parse_node("12"), (NodeRef{12, {}}));
+  EXPECT_EQ(*parse_node("0x0C"), (NodeRef{12, {}}));
+  EXPECT_EQ(*parse_node(" pump-3 "), (NodeRef{std::nullopt, "pump-3"}));
+  EXPECT_EQ(*parse_node("Pumpe \xC3\xA4-2"), (NodeRef{std::nullopt, "Pumpe \xC3\xA4-2"}));
+  // A number out of range is a wrong MAC, never a name.
+  EXPECT_FALSE(parse_node("64").ok());
+  EXPECT_NE(parse_node("64").error().find("out of range 0..63"), std::string::npos);
+  EXPECT_FALSE(parse_node("  ").ok());
+}
+
 TEST(ParseOnOff, TakesOnOffAndTheirSynonyms) {
   EXPECT_TRUE(*parse_on_off("on"));
   EXPECT_TRUE(*parse_on_off("ON"));

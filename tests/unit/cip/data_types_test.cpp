@@ -124,5 +124,12 @@ TEST(ShortString, GarbageDecodesConsistentlyOrFails) {
   }
 }
 
+TEST(ShortString, Iso8859_1CharactersBecomeUtf8) {
+  EXPECT_EQ(utf8_from_iso8859_1("CDN127"), "CDN127");
+  EXPECT_EQ(utf8_from_iso8859_1("\xB5s \xE4tz"), "\xC2\xB5s \xC3\xA4tz");
+  EXPECT_EQ(utf8_from_iso8859_1("\x80\xFF"), "\xC2\x80\xC3\xBF");
+  EXPECT_EQ(utf8_from_iso8859_1(""), "");
+}
+
 }  // namespace
 }  // namespace dnbridge::cip
