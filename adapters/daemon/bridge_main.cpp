@@ -73,7 +73,7 @@ int bridge_main(int argc, char** argv, const Program& program) {
   std::string candump_dir = "/tmp";
   app.add_option("--candump-dir", candump_dir,
                  "Where SIGUSR1 starts (and the next SIGUSR1 stops) a candump -l compatible log "
-                 "of each SocketCAN port's traffic, dnbridge-PORT-candump.log")
+                 "of each port's traffic, error frames included, dnbridge-PORT-candump.log")
       ->capture_default_str();
   config_opt->excludes(simulate_opt);
   app.set_version_flag("--version", version::text(program.name, version::Dds::kUsed),

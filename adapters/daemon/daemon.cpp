@@ -100,12 +100,14 @@ void Daemon::toggle_candump(const std::string& directory) {
   for (auto& p : ports_) {
     const std::string path = fmt::format("{}/dnbridge-{}-candump.log", directory, p->name());
     p->post([path, this](port::CanBackend& backend) {
-      auto* can = dynamic_cast<socketcan::SocketCanBackend*>(&backend);
-      if (!can) return;  // not SocketCAN (the simulator's bus): nothing to log
-      if (can->candump_logging()) {
-        can->stop_candump_log();
-      } else if (auto s = can->start_candump_log(path); !s) {
+      auto& log = backend.candump();
+      if (log.active()) {
+        log.stop();
+        log_.info("candump log of {} closed: {}", backend.interface_name(), log.path());
+      } else if (auto s = log.start(path, backend.interface_name()); !s) {
         log_.error("candump log {}: {}", path, s.error().message());
+      } else {
+        log_.info("candump log of {} to {}", backend.interface_name(), path);
       }
     });
   }

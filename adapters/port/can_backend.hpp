@@ -5,6 +5,7 @@
 #include <string>
 #include <string_view>
 
+#include "adapters/port/candump_log.hpp"
 #include "bridge/can/can_frame.hpp"
 #include "bridge/can/frame_sink.hpp"
 #include "bridge/common/time.hpp"
@@ -74,6 +75,14 @@ class CanBackend {
   // What is wrong with the interface, for operators ("vcan0 down: ..."); empty
   // when nothing is.
   virtual std::string problem() const { return {}; }
+
+  // The candump -l log of the port's traffic (SIGUSR1), started and stopped
+  // by whoever runs the port; every backend writes into it what it sends and
+  // receives, error frames included. The port's thread only.
+  CandumpLog& candump() noexcept { return candump_; }
+
+ protected:
+  CandumpLog candump_;
 };
 
 }  // namespace dnbridge::port

@@ -319,12 +319,13 @@ void SocketCanBackend::receive(port::FrameReceiver& receiver, bool& delivered, T
         ++stats_.received;
         ++bus_.frames;
         bus_.bits += can::frame_bits(r->frame);
-        if (candump_) log_frame(r->frame, r->kernel_time.value_or(wall));
+        candump_.frame(r->frame, r->kernel_time.value_or(wall));
         receiver.on_frame(r->frame, rx);
         delivered = true;
         break;
       case Received::Kind::kError:
         ++stats_.error_frames;
+        candump_.error_frame(r->raw_id, r->error_data, r->kernel_time.value_or(wall));
         on_error_frame(*r, rx);
         break;
       case Received::Kind::kForeign:
@@ -406,7 +407,7 @@ bool SocketCanBackend::try_write(const can::CanFrame& frame, TimePoint now) {
     ++bus_.frames;
     bus_.bits += can::frame_bits(frame);
     transmit_backoff_ = Duration::zero();
-    if (candump_) log_frame(frame, wall_now());
+    candump_.frame(frame, wall_now());
     return true;
   }
   const auto& e = s.error();
@@ -474,31 +475,6 @@ void SocketCanBackend::want_writable(bool on) {
   ev.events = EPOLLIN | (on ? EPOLLOUT : 0u);
   ev.data.u32 = kSocketToken;
   if (::epoll_ctl(epoll_.get(), EPOLL_CTL_MOD, socket_.fd(), &ev) == 0) writable_wanted_ = on;
-}
-
-// --- candump log ---------------------------------------------------------------
-
-Status SocketCanBackend::start_candump_log(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "a");
-  if (!f) return errno_code();
-  candump_.reset(f);
-  log_.info("candump log of {} to {}", options_.interface, path);
-  return {};
-}
-
-void SocketCanBackend::stop_candump_log() {
-  if (candump_) log_.info("candump log of {} closed", options_.interface);
-  candump_.reset();
-}
-
-void SocketCanBackend::log_frame(const can::CanFrame& frame, std::chrono::nanoseconds wall) {
-  // candump -l: "(seconds.microseconds) interface ID#DATA", identifier in
-  // three hex digits for standard frames.
-  const auto us = std::chrono::duration_cast<std::chrono::microseconds>(wall).count();
-  std::string data;
-  for (std::size_t i = 0; i < frame.len; ++i) data += fmt::format("{:02X}", frame.data[i]);
-  fmt::print(candump_.get(), "({}.{:06}) {} {:03X}#{}\n", us / 1'000'000, us % 1'000'000,
-             options_.interface, frame.id, data);
 }
 
 }  // namespace dnbridge::socketcan

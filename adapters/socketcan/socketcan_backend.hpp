@@ -109,12 +109,6 @@ class SocketCanBackend final : public port::CanBackend {
   TimePoint restart_at() const noexcept { return restart_at_; }
   bool is_up() const noexcept { return socket_.is_open(); }
 
-  // A candump -l compatible log of the port's traffic, both ways, from now
-  // until stop_candump_log() (for field diagnosis; the port's thread only).
-  Status start_candump_log(const std::string& path);
-  void stop_candump_log();
-  bool candump_logging() const noexcept { return candump_ != nullptr; }
-
  private:
   class Sink final : public can::FrameSink {
    public:
@@ -123,9 +117,6 @@ class SocketCanBackend final : public port::CanBackend {
 
    private:
     SocketCanBackend& backend_;
-  };
-  struct FileCloser {
-    void operator()(std::FILE* f) const noexcept { std::fclose(f); }
   };
 
   void transmit(const can::CanFrame& frame, TimePoint now);
@@ -143,7 +134,6 @@ class SocketCanBackend final : public port::CanBackend {
   void run_timers(TimePoint now);
   TimePoint own_deadline() const;
   void arm_timer(TimePoint at);
-  void log_frame(const can::CanFrame& frame, std::chrono::nanoseconds wall);
   std::optional<port::BusState> state_from_netlink();
 
   SocketCanOptions options_;
@@ -170,7 +160,6 @@ class SocketCanBackend final : public port::CanBackend {
 
   RateLimitedLog transmit_log_limit_;
   RateLimitedLog error_log_limit_;
-  std::unique_ptr<std::FILE, FileCloser> candump_;
 };
 
 }  // namespace dnbridge::socketcan

@@ -10,9 +10,14 @@
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
+#include <cstdio>
+#include <fstream>
 #include <future>
 #include <map>
 #include <mutex>
+#include <regex>
+#include <string>
+#include <vector>
 
 #include "adapters/sim/world/sim_backend.hpp"
 #include "adapters/sim/world/threaded_sim_backend.hpp"
@@ -223,6 +228,57 @@ TEST(PortLoop, RunsARackOnItsOwnThread) {
     EXPECT_EQ(publisher.node_states[m], devicenet::NodeState::kStopped) << m;
     EXPECT_FALSE(publisher.pumps[m].online) << m;
   }
+}
+
+// SIGUSR1's candump log on the simulated bus: both directions, as candump -l
+// writes them, until it is stopped.
+TEST(PortLoop, TheSimulatedBusWritesACandumpLog) {
+  RecordingPublisher publisher;
+  PortLoop loop(config_for({1}),
+                std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(1)}),
+                publisher, null_log_sink());
+  loop.start();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(1) && publisher.pumps[1].online; }));
+
+  const std::string path = ::testing::TempDir() + "port-loop-candump.log";
+  std::remove(path.c_str());
+  std::promise<bool> started;
+  loop.post(
+      [&](CanBackend& b) { started.set_value(b.candump().start(path, b.interface_name()).ok()); });
+  ASSERT_TRUE(started.get_future().get());
+
+  // The master's poll to MAC 1 (group 2 message 5: 40D) and the device's
+  // response (group 1 message 15: 3C1), each at least twice.
+  const auto lines = [&] {
+    std::ifstream in(path);
+    std::vector<std::string> all;
+    for (std::string line; std::getline(in, line);) all.push_back(line);
+    return all;
+  };
+  const auto count = [&](const std::string& id) {
+    const auto all = lines();
+    return std::count_if(all.begin(), all.end(), [&](const std::string& l) {
+      return l.find(" simulated " + id + "#") != std::string::npos;
+    });
+  };
+  ASSERT_TRUE(publisher.wait_for([&] { return count("40D") >= 2 && count("3C1") >= 2; }))
+      << "log: " << lines().size() << " lines";
+
+  std::promise<void> stopped;
+  loop.post([&](CanBackend& b) {
+    b.candump().stop();
+    stopped.set_value();
+  });
+  stopped.get_future().get();
+  for (const auto& line : lines()) {
+    EXPECT_TRUE(std::regex_match(
+        line, std::regex(R"(\(\d+\.\d{6}\) simulated [0-9A-F]{3}#([0-9A-F]{2})*)")))
+        << line;
+  }
+  loop.stop();
+  loop.join();
+  std::remove(path.c_str());
 }
 
 TEST(PortLoop, TheExplicitGatewayFollowsTheConfiguredPolicy) {

@@ -13,6 +13,8 @@
 #include <cerrno>
 #include <cstring>
 #include <deque>
+#include <fstream>
+#include <regex>
 #include <vector>
 
 #include "adapters/socketcan/socketcan_backend.hpp"
@@ -347,6 +349,33 @@ TEST_F(BackendFault, ErrorFramesDriveTheBusStateAndCounters) {
   EXPECT_EQ(b.stats().error_frames, 5u);
   send(b, 0x21);
   EXPECT_EQ(io.sent_ids(), std::vector<std::uint32_t>{0x21});
+}
+
+// SIGUSR1's candump log: what is sent, what is received, and error frames
+// with their identifier's flags, as candump -l writes them.
+TEST_F(BackendFault, TheCandumpLogHasBothDirectionsAndErrorFrames) {
+  SocketCanBackend b(options(BusOffRecovery::kReport), Logger(), io);
+  const std::string path = ::testing::TempDir() + "backend-candump.log";
+  std::remove(path.c_str());
+  ASSERT_TRUE(b.candump().start(path, "can0").ok());
+  send(b, 0x40D);
+  io.inject(0x3C1, {0x1F, 0x02});  // 8 bytes, as inject sends them
+  poll(b);
+  io.inject(CAN_ERR_FLAG | CAN_ERR_CRTL, crtl(CAN_ERR_CRTL_TX_WARNING, 96, 5));
+  poll(b);
+  b.candump().stop();
+  send(b, 0x40D);  // after the log stopped: not in it
+
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 3u);
+  const std::regex time(R"(^\(\d+\.\d{6}\) )");
+  for (const auto& l : lines) EXPECT_TRUE(std::regex_search(l, time)) << l;
+  EXPECT_NE(lines[0].find(") can0 40D#"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[1].find(") can0 3C1#1F02000000000000"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[2].find(") can0 20000004#0008000000006005"), std::string::npos) << lines[2];
+  std::remove(path.c_str());
 }
 
 TEST_F(BackendFault, BusOffWithRestartPolicyCallsTheRestartAfterTheDelay) {

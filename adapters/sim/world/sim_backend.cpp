@@ -31,6 +31,11 @@ SimSlave& SimBackend::device(devicenet::MacId mac) {
   return *it->second;
 }
 
+void SimBackend::MasterSink::send(const can::CanFrame& frame, TimePoint now) {
+  owner_.candump_.frame(frame, port::CandumpLog::wall_now());
+  owner_.world_.bus().sink(owner_.handle_).send(frame, now);
+}
+
 void SimBackend::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
   received_.emplace_back(frame, rx_time);
 }
@@ -44,6 +49,7 @@ void SimBackend::wait(TimePoint deadline, port::FrameReceiver& receiver) {
       while (!received_.empty()) {
         auto [frame, rx] = received_.front();
         received_.pop_front();
+        candump_.frame(frame, port::CandumpLog::wall_now());
         receiver.on_frame(frame, rx);
       }
       world_.run_until(std::max(world_.now(), now()));

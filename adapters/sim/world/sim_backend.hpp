@@ -24,7 +24,7 @@ class SimBackend final : public port::CanBackend, private BusPort {
              LogSink* log = nullptr);
   ~SimBackend() override;
 
-  can::FrameSink& sink() override { return world_.bus().sink(handle_); }
+  can::FrameSink& sink() override { return sink_; }
   TimePoint now() const override;
   void wait(TimePoint deadline, port::FrameReceiver& receiver) override;
   void wake() override;
@@ -37,10 +37,21 @@ class SimBackend final : public port::CanBackend, private BusPort {
   SimSlave& device(devicenet::MacId mac);
 
  private:
+  // What the master sends: into the candump log, then onto the bus.
+  class MasterSink final : public can::FrameSink {
+   public:
+    explicit MasterSink(SimBackend& owner) : owner_(owner) {}
+    void send(const can::CanFrame& frame, TimePoint now) override;
+
+   private:
+    SimBackend& owner_;
+  };
+
   void on_frame(const can::CanFrame& frame, TimePoint rx_time) override;
 
   SimWorld world_;
   NodeHandle handle_;
+  MasterSink sink_{*this};
   std::map<unsigned, std::unique_ptr<SimSlave>> devices_;
   std::deque<std::pair<can::CanFrame, TimePoint>> received_;
 

@@ -57,6 +57,7 @@ void ThreadedSimBackend::MasterSink::send(const can::CanFrame& frame, TimePoint 
   // Queued, as in a socket's send buffer; the world is woken for them when
   // the port waits (see wait()), so the frames of one turn of the port's loop
   // reach the bus together, at the times they were sent.
+  owner_.candump_.frame(frame, port::CandumpLog::wall_now());
   std::lock_guard lock(owner_.world_mutex_);
   owner_.to_world_.emplace_back(frame, now);
 }
@@ -147,7 +148,10 @@ void ThreadedSimBackend::wait(TimePoint deadline, port::FrameReceiver& receiver)
     wake_ = false;
     receiving_.swap(to_port_);
   }
-  for (const auto& [frame, rx] : receiving_) receiver.on_frame(frame, rx);
+  for (const auto& [frame, rx] : receiving_) {
+    candump_.frame(frame, port::CandumpLog::wall_now());
+    receiver.on_frame(frame, rx);
+  }
   receiving_.clear();
 }
 
