@@ -2,9 +2,15 @@
 # Checks the Debian packages .ci/package built on this machine: lintian (no
 # error or warning, no missing hardening), the hardening of every program,
 # then installs dnbridge alone, checks what it installed, adds dnbridge-sim,
-# purges both and checks the machine is as it was. Needs root (or sudo
-# without a password): dpkg -i and dpkg --purge. Fails, never skips: a
+# purges both and checks the system is as it was. Fails, never skips: a
 # missing .deb, file, user or tool is a failure.
+#
+# The machine itself is never touched: the packages are installed into a
+# copy-on-write view of its root (an overlay, in a mount namespace of the
+# test's own, entered with chroot), which goes away with the test. A
+# dnbridge already installed on the machine is purged in that view first, so
+# the test passes on a machine that runs dnbridge and leaves it running.
+# Needs root (or sudo without a password): mounts, chroot, dpkg.
 #   install_test.sh PATH/dnbridge_VERSION_ARCH.deb PATH/dnbridge-sim_VERSION_ARCH.deb
 set -euo pipefail
 
@@ -16,23 +22,62 @@ for f in "$deb" "$sim_deb"; do
 done
 deb=$(realpath "$deb")
 sim_deb=$(realpath "$sim_deb")
-as_root=()
-if [ "$(id -u)" -ne 0 ]; then
-  sudo -n true 2>/dev/null || fail "needs root or passwordless sudo for dpkg -i"
-  as_root=(sudo -n)
-fi
+self=$(realpath "$0")
+
+case ${DNBRIDGE_PACKAGE_VIEW:-} in
+  "")
+    # The machine: into a mount namespace of our own, as root.
+    as_root=()
+    if [ "$(id -u)" -ne 0 ]; then
+      sudo -n true 2>/dev/null || fail "needs root or passwordless sudo (mounts, chroot, dpkg)"
+      as_root=(sudo -n)
+    fi
+    command -v unshare >/dev/null || fail "unshare not found (package util-linux)"
+    exec "${as_root[@]}" env DNBRIDGE_PACKAGE_VIEW=namespace \
+      unshare --mount --propagation private -- bash "$self" "$deb" "$sim_deb"
+    ;;
+  namespace)
+    # The view: the root file system under an overlay whose changes go to a
+    # tmpfs, with /proc, /sys and /dev of the machine; the test runs in it.
+    base=$(mktemp -d /tmp/dnbridge-package-view.XXXXXX)
+    mount -t tmpfs tmpfs "$base"
+    mkdir "$base/upper" "$base/work" "$base/root"
+    mount -t overlay overlay -o "lowerdir=/,upperdir=$base/upper,workdir=$base/work" "$base/root" ||
+      fail "cannot mount an overlay of / (needs a kernel with overlayfs)"
+    mount -t proc proc "$base/root/proc"
+    mount --rbind /sys "$base/root/sys"
+    mount --rbind /dev "$base/root/dev"
+    mkdir -p "$base/root/tmp/dnbridge-package-test"
+    cp "$self" "$deb" "$sim_deb" "$base/root/tmp/dnbridge-package-test/"
+    status=0
+    chroot "$base/root" env DNBRIDGE_PACKAGE_VIEW=inside bash \
+      "/tmp/dnbridge-package-test/$(basename "$self")" \
+      "/tmp/dnbridge-package-test/$(basename "$deb")" \
+      "/tmp/dnbridge-package-test/$(basename "$sim_deb")" || status=$?
+    umount -l "$base/root/dev" "$base/root/sys" "$base/root/proc" "$base/root" "$base" || true
+    rmdir "$base" || true
+    exit "$status"
+    ;;
+  inside) ;;
+  *) fail "DNBRIDGE_PACKAGE_VIEW=$DNBRIDGE_PACKAGE_VIEW" ;;
+esac
+
 for tool in dpkg dpkg-deb dpkg-query systemd-analyze runuser getent lintian readelf man; do
   command -v "$tool" >/dev/null || fail "$tool not found"
 done
 
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "installed"; }
-# Nothing of someone else's is touched: purge would take these away.
-for p in dnbridge dnbridge-sim; do
-  installed $p && fail "a $p package is already installed; remove it first"
+# The view as a machine without dnbridge: what the machine has of it is
+# taken away here, in the view only.
+for p in dnbridge-sim dnbridge; do
+  if installed $p; then
+    echo "== $p is installed on this machine: purged in the test's view only"
+    dpkg --purge "$p" >/dev/null
+  fi
 done
-getent passwd dnbridge >/dev/null && fail "a user dnbridge already exists"
-getent group dnbridge >/dev/null && fail "a group dnbridge already exists"
-[ -e /etc/dnbridge ] && fail "/etc/dnbridge already exists"
+rm -rf /etc/dnbridge /var/log/dnbridge
+if getent passwd dnbridge >/dev/null; then userdel dnbridge; fi
+if getent group dnbridge >/dev/null; then groupdel dnbridge; fi
 accounts_before=$(getent passwd; getent group)
 
 # Every file (not directory) in the packages, as installed.
@@ -45,11 +90,7 @@ version=$(dpkg-deb -f "$deb" Version)
 [ "$(dpkg-deb -f "$sim_deb" Version)" = "$version" ] || fail "the two packages' versions differ"
 
 work=$(mktemp -d)
-purged=0
-cleanup() {
-  rm -rf "$work"
-  [ "$purged" = 1 ] || "${as_root[@]}" dpkg --purge dnbridge-sim dnbridge >/dev/null 2>&1 || true
-}
+cleanup() { rm -rf "$work"; }
 trap cleanup EXIT
 
 echo "== lintian"
@@ -99,7 +140,7 @@ systemd-analyze security --offline=true --threshold=15 "$work/dnbridge@rack-exam
   fail "the unit's exposure is above 1.5"
 
 echo "== dpkg -i $(basename "$deb")"
-"${as_root[@]}" dpkg -i "$deb"
+dpkg -i "$deb"
 installed dnbridge || fail "dpkg reports dnbridge not installed"
 
 echo "== files"
@@ -167,7 +208,7 @@ for f in /usr/bin/dnbridge-sim /usr/bin/cdn127-sim /usr/bin/dnbridge-demo; do
 done
 
 echo "== dpkg -i $(basename "$sim_deb")"
-"${as_root[@]}" dpkg -i "$sim_deb"
+dpkg -i "$sim_deb"
 installed dnbridge-sim || fail "dpkg reports dnbridge-sim not installed"
 for f in /usr/bin/dnbridge-sim /usr/bin/cdn127-sim /usr/bin/dnbridge-demo \
          /usr/share/dnbridge/cdn127-sim-example.toml /usr/share/doc/dnbridge-sim/copyright \
@@ -183,8 +224,7 @@ done
   fail "dnbridge-sim --check-config refuses the shipped configuration"
 
 echo "== dpkg --purge dnbridge-sim dnbridge"
-"${as_root[@]}" dpkg --purge dnbridge-sim dnbridge
-purged=1
+dpkg --purge dnbridge-sim dnbridge
 for p in dnbridge dnbridge-sim; do
   installed $p && fail "$p still installed after purge"
 done
