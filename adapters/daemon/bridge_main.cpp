@@ -131,6 +131,7 @@ int bridge_main(int argc, char** argv, const Program& program) {
 
   StderrLogSink log(config.log_level);
   if (!level_name.empty()) log.set_level(*parse_level(level_name));
+  log.add_field("RACK", config.rack);
   Logger main_log(log, "dnbridge");
   for (const auto& w : config.warnings)
     main_log.warn("{}", w);  // each warning starts with FILE:LINE:COLUMN

@@ -49,7 +49,7 @@ BackendFactory default_backend_factory(LogSink& log) {
     o.bus_off = p.bus_off_recovery;
     try {
       return std::make_unique<socketcan::SocketCanBackend>(
-          std::move(o), Logger(log, fmt::format("port {}", p.name)));
+          std::move(o), Logger(log, fmt::format("port {}", p.name)).with("PORT", p.name));
     } catch (const std::exception& e) {
       throw std::runtime_error(fmt::format("port {}: {}", p.name, e.what()));
     }

@@ -22,13 +22,11 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
     : config_(std::move(config)),
       backend_(std::move(backend)),
       publisher_(publisher),
-      log_(log, fmt::format("port {}", config_.port)) {
+      log_(Logger(log, fmt::format("port {}", config_.port)).with("PORT", config_.port)) {
   // The master's events reach the rack model first, then this loop.
-  port_.emplace(config_.scanner, config_.pumps, backend_->sink(),
-                Logger(log, fmt::format("port {}", config_.port)));
+  port_.emplace(config_.scanner, config_.pumps, backend_->sink(), log_);
   port_->observe(static_cast<devicenet::ScannerObserver&>(*this));
-  gateway_.emplace(scanner(), rack::ExplicitGateway::Limits{}, config_.explicit_policy,
-                   Logger(log, fmt::format("port {}", config_.port)));
+  gateway_.emplace(scanner(), rack::ExplicitGateway::Limits{}, config_.explicit_policy, log_);
   for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
     const rack::PublishPolicy policy =
         i < config_.publish.size() ? config_.publish[i] : rack::PublishPolicy{};
@@ -334,7 +332,11 @@ void PortLoop::on_port_state(devicenet::PortState s, const std::string&, TimePoi
 void PortLoop::on_node_state(MacId m, devicenet::NodeState f, devicenet::NodeState t,
                              const std::string& r, TimePoint) {
   if (t == devicenet::NodeState::kOnline || f == devicenet::NodeState::kOnline) {
-    log_.info("node {} {} -> {}: {}", m.value(), devicenet::to_string(f), devicenet::to_string(t),
+    const std::string mac = std::to_string(m.value());
+    log_.with("MAC", mac)
+        .with("NODE", mac)
+        .with("NODE_STATE", std::string(devicenet::to_string(t)))
+        .info("node {} {} -> {}: {}", m.value(), devicenet::to_string(f), devicenet::to_string(t),
               r);
   }
   port_dirty_ = true;

@@ -3,10 +3,13 @@
 // sink wants that level; anything on the frame path goes through a RateLimitedLog.
 #include <fmt/format.h>
 
+#include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "bridge/common/time.hpp"
 
@@ -16,19 +19,37 @@ enum class LogLevel : std::uint8_t { kTrace, kDebug, kInfo, kWarn, kError };
 
 std::string_view to_string(LogLevel level) noexcept;
 
+// A structured field of a log line, for sinks that keep them (the journal:
+// `journalctl -u dnbridge@rack-A MAC=12`). Names as journald takes them:
+// upper case letters, digits and underscores.
+struct LogField {
+  std::string_view name;
+  std::string_view value;
+};
+
 class LogSink {
  public:
   virtual ~LogSink() = default;
   virtual bool enabled(LogLevel level) const noexcept = 0;
   virtual void write(LogLevel level, std::string_view component, std::string_view message) = 0;
+  // With the fields of the logger that wrote it (what Logger calls); a sink
+  // that keeps none writes the line alone.
+  virtual void write_structured(LogLevel level, std::string_view component,
+                                std::string_view message, std::span<const LogField> fields) {
+    (void)fields;
+    write(level, component, message);
+  }
 };
 
 // A sink that drops everything.
 LogSink& null_log_sink() noexcept;
 
-// A component's handle on a sink: "port can0", "node 12", ...
+// A component's handle on a sink: "port can0", "node 12", ..., with the
+// structured fields every line it writes carries (RACK, PORT, MAC, ...).
 class Logger {
  public:
+  static constexpr std::size_t kMaxFields = 8;
+
   Logger() noexcept : sink_(&null_log_sink()) {}
   Logger(LogSink& sink, std::string component) : sink_(&sink), component_(std::move(component)) {}
 
@@ -36,10 +57,34 @@ class Logger {
   const std::string& component() const noexcept { return component_; }
   LogSink& sink() const noexcept { return *sink_; }
 
+  // This logger with one more field (replacing one of the same name), for
+  // every line it writes. At most kMaxFields; more are not kept.
+  Logger with(std::string_view name, std::string value) const {
+    Logger l = *this;
+    for (auto& [n, v] : l.fields_) {
+      if (n == name) {
+        v = std::move(value);
+        return l;
+      }
+    }
+    if (l.fields_.size() < kMaxFields) l.fields_.emplace_back(std::string(name), std::move(value));
+    return l;
+  }
+  // A logger of another component on the same sink, with these fields.
+  Logger named(std::string component) const {
+    Logger l = *this;
+    l.component_ = std::move(component);
+    return l;
+  }
+
   template <class... Args>
   void log(LogLevel level, fmt::format_string<Args...> format, Args&&... args) const {
     if (!sink_->enabled(level)) return;
-    sink_->write(level, component_, fmt::format(format, std::forward<Args>(args)...));
+    std::array<LogField, kMaxFields> fields;
+    for (std::size_t i = 0; i < fields_.size(); ++i)
+      fields[i] = {fields_[i].first, fields_[i].second};
+    sink_->write_structured(level, component_, fmt::format(format, std::forward<Args>(args)...),
+                            std::span<const LogField>(fields.data(), fields_.size()));
   }
   template <class... Args>
   void trace(fmt::format_string<Args...> f, Args&&... a) const {
@@ -65,6 +110,7 @@ class Logger {
  private:
   LogSink* sink_;
   std::string component_;
+  std::vector<std::pair<std::string, std::string>> fields_;
 };
 
 // A kind of message logged at most `burst` times per `window`: the rest are

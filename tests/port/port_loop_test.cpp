@@ -4,6 +4,8 @@
 // waits for events, never sleeps.
 #include "adapters/port/port_loop.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 #include <pthread.h>
 
@@ -228,6 +230,43 @@ TEST(PortLoop, RunsARackOnItsOwnThread) {
     EXPECT_EQ(publisher.node_states[m], devicenet::NodeState::kStopped) << m;
     EXPECT_FALSE(publisher.pumps[m].online) << m;
   }
+}
+
+// A node's state change in the log carries the fields the journal keeps:
+// PORT, MAC and NODE (the node's MAC ID), NODE_STATE.
+TEST(PortLoop, ANodesStateChangeIsLoggedWithItsFields) {
+  class Capture final : public LogSink {
+   public:
+    bool enabled(LogLevel level) const noexcept override { return level >= LogLevel::kInfo; }
+    void write(LogLevel, std::string_view, std::string_view) override {}
+    void write_structured(LogLevel, std::string_view, std::string_view message,
+                          std::span<const LogField> fields) override {
+      std::lock_guard lock(mutex);
+      std::string line(message);
+      for (const auto& f : fields) line += fmt::format(" {}={}", f.name, f.value);
+      lines.push_back(std::move(line));
+    }
+    std::mutex mutex;
+    std::vector<std::string> lines;
+  } log;
+  RecordingPublisher publisher;
+  PortLoop loop(config_for({2}),
+                std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(2)}),
+                publisher, log);
+  loop.start();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(2) && publisher.pumps[2].online; }));
+  loop.stop();
+  loop.join();
+  std::lock_guard lock(log.mutex);
+  const auto has = [&](const std::string& what) {
+    return std::any_of(log.lines.begin(), log.lines.end(),
+                       [&](const std::string& l) { return l.find(what) != std::string::npos; });
+  };
+  EXPECT_TRUE(has("-> online: ") && has(" PORT=A MAC=2 NODE=2 NODE_STATE=online"))
+      << fmt::format("{}", fmt::join(log.lines, "\n"));
+  EXPECT_TRUE(has(" PORT=A MAC=2 NODE=2 NODE_STATE=stopped"))
+      << fmt::format("{}", fmt::join(log.lines, "\n"));
 }
 
 // SIGUSR1's candump log on the simulated bus: both directions, as candump -l

@@ -55,7 +55,10 @@ void Node::set_state(NodeState next, std::string reason, TimePoint now) {
   const NodeState from = state_;
   state_ = next;
   reason_ = std::move(reason);
-  log_.debug("{} -> {}: {}", to_string(from), to_string(next), reason_);
+  if (log_.enabled(LogLevel::kDebug)) {
+    log_.with("NODE_STATE", std::string(to_string(next)))
+        .debug("{} -> {}: {}", to_string(from), to_string(next), reason_);
+  }
   observer_.on_node_state(config_.mac, from, next, reason_, now);
 }
 

@@ -75,7 +75,11 @@ Scanner::Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& ob
   validate(config_);
   nodes_.reserve(config_.nodes.size());
   for (const auto& n : config_.nodes) {
-    Logger node_log(log_.sink(), fmt::format("{} node {}", log_.component(), n.mac.value()));
+    // Every line of a node carries its MAC ID, as MAC and NODE.
+    const std::string mac = std::to_string(n.mac.value());
+    Logger node_log = log_.named(fmt::format("{} node {}", log_.component(), mac))
+                          .with("MAC", mac)
+                          .with("NODE", mac);
     nodes_.push_back(std::make_unique<Node>(n, config_, sink_, observer_, std::move(node_log)));
     by_mac_[n.mac.value()] = nodes_.back().get();
   }
@@ -85,7 +89,8 @@ void Scanner::set_state(PortState next, std::string reason, TimePoint now) {
   if (next == state_ && reason == reason_) return;
   state_ = next;
   reason_ = std::move(reason);
-  log_.info("port {}: {}", to_string(next), reason_);
+  log_.with("PORT_STATE", std::string(to_string(next)))
+      .info("port {}: {}", to_string(next), reason_);
   observer_.on_port_state(next, reason_, now);
 }
 
