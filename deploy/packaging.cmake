@@ -11,6 +11,7 @@
 #   /usr/share/dnbridge/cyclonedds/loopback.xml   DDS on this host only
 #   /usr/share/dnbridge/security  make-site-pki.sh: a site's DDS Security PKI
 #   /usr/share/dnbridge/networkd  systemd-networkd examples for the CAN interfaces
+#   /usr/share/dnbridge/prometheus  a scrape configuration and alert rules
 #   /usr/share/doc/dnbridge       operations.md (deploy/README.md), security.md
 #                                 (deploy/security/README.md), data-model.md
 #                                 (idl/README.md), copyright, changelog.gz
@@ -107,6 +108,9 @@ install(FILES ${PROJECT_SOURCE_DIR}/deploy/systemd/dnbridge.sysusers
         DESTINATION ${DNBRIDGE_SYSUSERS_DIR} RENAME dnbridge.conf COMPONENT bridge)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/deploy/security/make-site-pki.sh
         DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge/security COMPONENT bridge)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/prometheus/prometheus.yml
+              ${PROJECT_SOURCE_DIR}/deploy/prometheus/dnbridge-alerts.yml
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge/prometheus COMPONENT bridge)
 file(GLOB DNBRIDGE_NETWORKD_EXAMPLES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/deploy/networkd/*.network
      ${PROJECT_SOURCE_DIR}/deploy/networkd/*.link)
 install(FILES ${DNBRIDGE_NETWORKD_EXAMPLES}

@@ -697,6 +697,36 @@ rack::ExplicitPolicy read_explicit_policy(const toml::node& n, Problems& r) {
   return policy;
 }
 
+// [metrics]: listen = "HOST:PORT" (an IPv6 address in brackets, "[::1]:9731").
+std::optional<std::string> read_metrics(const toml::node& n, Problems& r) {
+  const toml::table* t = toml_config::as_table(n, "metrics", "[metrics]", r);
+  if (!t) return std::nullopt;
+  TableReader table(*t, "[metrics]", r);
+  const toml::node* listen = table.require("listen");
+  if (!listen) return std::nullopt;
+  auto v = read_string(*listen, "listen", r);
+  if (!v) return std::nullopt;
+  // HOST:PORT with a port 1..65535; the host a name or an address, an IPv6
+  // address in brackets.
+  const auto colon = v->rfind(':');
+  const std::string host = colon == std::string::npos ? std::string{} : v->substr(0, colon);
+  const std::string port = colon == std::string::npos ? std::string{} : v->substr(colon + 1);
+  unsigned long number = 0;
+  const bool port_ok = !port.empty() && port.size() <= 5 &&
+                       port.find_first_not_of("0123456789") == std::string::npos &&
+                       (number = std::stoul(port)) >= 1 && number <= 65535;
+  const bool bracketed = host.size() >= 2 && host.front() == '[' && host.back() == ']';
+  const bool host_ok = !host.empty() && (bracketed || host.find(':') == std::string::npos);
+  if (!port_ok || !host_ok) {
+    r.error(listen->source(),
+            fmt::format("listen = \"{}\" is not HOST:PORT (e.g. \"127.0.0.1:9731\", "
+                        "\"[::1]:9731\"; the port 1..65535)",
+                        *v));
+    return std::nullopt;
+  }
+  return *v;
+}
+
 std::optional<LogLevel> log_level_named(std::string_view name) {
   for (LogLevel l :
        {LogLevel::kTrace, LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarn, LogLevel::kError}) {
@@ -745,6 +775,10 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, Proble
 
   if (const toml::node* n = root.get("security")) {
     config.security = security::read_table(*n, r);
+  }
+
+  if (const toml::node* n = root.get("metrics")) {
+    config.metrics_listen = read_metrics(*n, r);
   }
 
   std::optional<TableReader> defaults;

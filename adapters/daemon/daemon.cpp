@@ -72,6 +72,12 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
                 rack::policy_key(kind), rack::name_of(kind), rack::risk_of(kind));
     }
   }
+  if (config_.metrics_listen) {
+    metrics_ =
+        std::make_shared<metrics::RackMetrics>(config_.rack, [this] { return process_counters(); });
+    tee_.emplace(publisher_, *metrics_);
+  }
+  port::PortPublisher& publisher = tee_ ? static_cast<port::PortPublisher&>(*tee_) : publisher_;
   std::map<std::string, port::PortLoop*, std::less<>> by_name;
   const std::string host_id = read_host_id();
   for (const auto& p : config_.ports) {
@@ -80,11 +86,30 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
               p.name, scanner.master_mac.value(), scanner.vendor_id, scanner.serial_number,
               p.master_serial_number ? "" : " (derived from this host's identifier)");
     ports_.push_back(std::make_unique<port::PortLoop>(loop_config(config_, p, host_id), backends(p),
-                                                      publisher_, log));
+                                                      publisher, log));
     by_name[p.name] = ports_.back().get();
   }
   input_.emplace(participant_, publisher_, config_.rack, std::move(by_name),
                  Logger(log, "dds input"));
+  if (metrics_) {
+    metrics_server_.emplace(*config_.metrics_listen, metrics_);
+    const auto listening = metrics_server_->ports();
+    log_.info("metrics on http://{}/metrics{}", *config_.metrics_listen,
+              listening.empty() ? std::string{} : fmt::format(" (port {})", listening.front()));
+  }
+}
+
+metrics::ProcessCounters Daemon::process_counters() const {
+  metrics::ProcessCounters c;
+  for (const auto& [name, q] : {std::pair{"state", publisher_.state_queue()},
+                                std::pair{"replies", publisher_.reply_queue()}}) {
+    c.queues.push_back({name, q.run, q.replaced, q.refused, q.waiting});
+  }
+  if (input_) {
+    c.commands_taken = input_->commands_taken();
+    c.requests_taken = input_->requests_taken();
+  }
+  return c;
 }
 
 Daemon::~Daemon() { stop(); }

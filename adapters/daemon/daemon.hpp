@@ -12,7 +12,9 @@
 #include "adapters/daemon/dds_input.hpp"
 #include "adapters/daemon/dds_publisher.hpp"
 #include "adapters/dds/participant.hpp"
+#include "adapters/metrics/rack_metrics.hpp"
 #include "adapters/port/port_loop.hpp"
+#include "adapters/port/publisher_tee.hpp"
 
 namespace dnbridge::daemon {
 
@@ -47,14 +49,25 @@ class Daemon {
   const DaemonConfig& config() const { return config_; }
   port::PortLoop* port(std::string_view name);
   const std::vector<std::unique_ptr<port::PortLoop>>& ports() const { return ports_; }
+  // The metrics endpoint ([metrics] listen), when configured.
+  const metrics::MetricsServer* metrics_server() const {
+    return metrics_server_ ? &*metrics_server_ : nullptr;
+  }
 
  private:
+  metrics::ProcessCounters process_counters() const;
+
   DaemonConfig config_;
   Logger log_;
   dds::Participant participant_;
   DdsPublisher publisher_;
+  // With [metrics]: the ports publish to DDS and to the metrics both.
+  std::shared_ptr<metrics::RackMetrics> metrics_;
+  std::optional<port::PublisherTee> tee_;
   std::vector<std::unique_ptr<port::PortLoop>> ports_;
   std::optional<DdsInput> input_;
+  // Last: no scrape reads the publisher or the input once they are gone.
+  std::optional<metrics::MetricsServer> metrics_server_;
   bool running_ = false;
 };
 

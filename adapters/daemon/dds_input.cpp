@@ -140,10 +140,12 @@ void DdsInput::run() {
 }
 
 void DdsInput::take_commands() {
-  take_batches(
-      [this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0, log_,
-      "pump commands",
-      [this](std::size_t i) { on_command(command_buffer_.data(i), command_buffer_.info(i)); });
+  take_batches([this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0,
+               log_, "pump commands",
+               [this](std::size_t i) {
+                 commands_taken_.fetch_add(1, std::memory_order_relaxed);
+                 on_command(command_buffer_.data(i), command_buffer_.info(i));
+               });
 }
 
 void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
@@ -192,6 +194,7 @@ bool DdsInput::take_requests() {
   return take_batches([this] { return requests_.take(request_buffer_, request_cdr_); },
                       request_buffer_.capacity(), kRequestBatches, log_, "explicit requests",
                       [this](std::size_t i) {
+                        requests_taken_.fetch_add(1, std::memory_order_relaxed);
                         if (request_buffer_.info(i).valid_data())
                           on_request(request_buffer_.data(i), request_cdr_[i]);
                       });

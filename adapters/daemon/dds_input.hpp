@@ -3,6 +3,7 @@
 // this rack. A waitset on a thread of its own takes them and hands each to
 // its port's loop through the loop's inbox; no DDS callback touches master
 // state. Requests for other racks are left to their bridges.
+#include <atomic>
 #include <functional>
 #include <map>
 #include <span>
@@ -29,6 +30,10 @@ class DdsInput {
   void start();
   void stop();  // returns when the thread has ended
 
+  // Samples taken so far (any thread).
+  std::uint64_t commands_taken() const noexcept { return commands_taken_.load(); }
+  std::uint64_t requests_taken() const noexcept { return requests_taken_.load(); }
+
  private:
   void run();
   void take_commands();
@@ -52,6 +57,8 @@ class DdsInput {
   std::thread thread_;
   RateLimitedLog warn_limit_;
   RateLimitedLog skew_limit_;
+  std::atomic<std::uint64_t> commands_taken_{0};
+  std::atomic<std::uint64_t> requests_taken_{0};
   std::uint64_t commands_stamped_ahead_ = 0;
   std::uint64_t requests_refused_for_names_ = 0;
 };

@@ -54,6 +54,9 @@ class DdsPublisher final : public port::PortPublisher {
 
   // Replies not written (the outbox full, or the write failed) for `port`.
   std::uint64_t replies_undelivered(const std::string& port) const;
+  // The outboxes' counters: the state samples' and the replies'.
+  Outbox::Counters state_queue() const { return state_out_.counters(); }
+  Outbox::Counters reply_queue() const { return reply_out_.counters(); }
   // Replies handed over at most this many at a time; more are undelivered.
   static constexpr std::size_t kReplyBacklog = 1024;
 

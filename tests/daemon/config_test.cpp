@@ -1174,5 +1174,24 @@ TEST(ConfigSafeState, MistakesAreErrorsWithTheirPosition) {
             "own fault and idle actions are kept");
 }
 
+TEST(ConfigFile, MetricsListenIsHostAndPort) {
+  EXPECT_FALSE(parse_config(ONE_PORT, "t.toml").metrics_listen);
+  EXPECT_EQ(
+      parse_config(ONE_PORT "[metrics]\nlisten = \"127.0.0.1:9731\"\n", "t.toml").metrics_listen,
+      "127.0.0.1:9731");
+  EXPECT_EQ(parse_config(ONE_PORT "[metrics]\nlisten = \"[::1]:9731\"\n", "t.toml").metrics_listen,
+            "[::1]:9731");
+  EXPECT_EQ(problems(ONE_PORT "[metrics]\nlisten = \"9731\"\n"),
+            "t.toml:7:10: listen = \"9731\" is not HOST:PORT (e.g. \"127.0.0.1:9731\", "
+            "\"[::1]:9731\"; the port 1..65535)");
+  EXPECT_THAT(problems(ONE_PORT "[metrics]\nlisten = \"::1:9731\"\n"),
+              HasSubstr("is not HOST:PORT"));
+  EXPECT_THAT(problems(ONE_PORT "[metrics]\nlisten = \"localhost:99999\"\n"),
+              HasSubstr("is not HOST:PORT"));
+  EXPECT_THAT(problems(ONE_PORT "[metrics]\n"), HasSubstr("listen"));
+  EXPECT_THAT(problems(ONE_PORT "[metrics]\nlisten = \"127.0.0.1:9731\"\nport = 1\n"),
+              HasSubstr("unknown key 'port' in [metrics]"));
+}
+
 }  // namespace
 }  // namespace dnbridge::daemon

@@ -156,7 +156,9 @@ for f in /usr/bin/dnbridge /usr/bin/dnbctl \
          /usr/share/doc/dnbridge/data-model.md /usr/share/doc/dnbridge/copyright \
          /usr/share/doc/dnbridge/changelog.gz /usr/share/man/man8/dnbridge.8.gz \
          /usr/share/man/man1/dnbctl.1.gz /usr/share/man/man5/dnbridge.toml.5.gz \
-         /usr/share/bash-completion/completions/dnbctl; do
+         /usr/share/bash-completion/completions/dnbctl \
+         /usr/share/dnbridge/prometheus/prometheus.yml \
+         /usr/share/dnbridge/prometheus/dnbridge-alerts.yml; do
   [ -f "$f" ] || fail "$f not installed"
 done
 for d in /lib/systemd/system /usr/lib/systemd/system; do

@@ -1,0 +1,40 @@
+#pragma once
+// One port's publications to two publishers, in order: the DDS face, then
+// another (the metrics). Each gets every call, on the port's thread.
+#include "adapters/port/port_publisher.hpp"
+
+namespace dnbridge::port {
+
+class PublisherTee final : public PortPublisher {
+ public:
+  PublisherTee(PortPublisher& first, PortPublisher& second) : first_(first), second_(second) {}
+
+  void pump_state(const std::string& port, const rack::PumpView& pump,
+                  TimePoint source_time) override {
+    first_.pump_state(port, pump, source_time);
+    second_.pump_state(port, pump, source_time);
+  }
+  void node_status(const std::string& port, const rack::PumpView& pump, const NodeStatusView& node,
+                   TimePoint source_time) override {
+    first_.node_status(port, pump, node, source_time);
+    second_.node_status(port, pump, node, source_time);
+  }
+  void port_status(const PortStatusView& status, TimePoint source_time) override {
+    first_.port_status(status, source_time);
+    second_.port_status(status, source_time);
+  }
+  void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) override {
+    first_.explicit_reply(port, answer);
+    second_.explicit_reply(port, answer);
+  }
+  void port_stopped(const std::string& port) override {
+    first_.port_stopped(port);
+    second_.port_stopped(port);
+  }
+
+ private:
+  PortPublisher& first_;
+  PortPublisher& second_;
+};
+
+}  // namespace dnbridge::port
