@@ -509,6 +509,40 @@ struct NodeSeen {
   std::uint32_t line;
 };
 
+// simulated_unconfigured = [MAC, ...]: a simulated port's devices at MACs
+// its nodes do not have.
+void read_simulated_unconfigured(const toml::node& n, PortConfig& port, Problems& r) {
+  const toml::array* list = n.as_array();
+  if (!list) {
+    r.error(n.source(), fmt::format("simulated_unconfigured must be an array of MAC IDs, not {}",
+                                    type_name(n.type())));
+    return;
+  }
+  if (port.interface != kSimulatedInterface) {
+    r.error(n.source(), "simulated_unconfigured is for a port whose interface is \"simulated\"");
+    return;
+  }
+  for (const toml::node& element : *list) {
+    auto mac = read_mac(element, "simulated_unconfigured", r);
+    if (!mac) continue;
+    const bool configured = std::any_of(port.nodes.begin(), port.nodes.end(),
+                                        [&](const auto& s) { return s.pump.node.mac == *mac; });
+    if (configured || *mac == port.master.master_mac) {
+      r.error(element.source(), fmt::format("simulated_unconfigured: MAC {} is {}", mac->value(),
+                                            configured ? "a configured node's" : "the master's"));
+    } else if (std::find(port.simulated_unconfigured.begin(), port.simulated_unconfigured.end(),
+                         *mac) != port.simulated_unconfigured.end()) {
+      r.error(element.source(),
+              fmt::format("simulated_unconfigured: MAC {} is given twice", mac->value()));
+    } else {
+      port.simulated_unconfigured.push_back(*mac);
+    }
+  }
+}
+
+void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
+                     TableReader* defaults, Problems& r);
+
 PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableReader* defaults,
                      Problems& r) {
   TableReader t(table, "[[port]]", r);
@@ -600,18 +634,29 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
             "allocate_retry_max_ms is shorter than allocate_retry_min_ms");
   }
 
+  read_port_nodes(t, table, port, defaults, r);
+  if (const toml::node* n = t.get("simulated_unconfigured")) {
+    read_simulated_unconfigured(*n, port, r);
+  }
+  return port;
+}
+
+// The port's [[port.node]] tables.
+void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
+                     TableReader* defaults, Problems& r) {
+  const toml::node* master_mac_node = t.get("master_mac");
   const toml::node* nodes = t.get("node");
   const toml::array* list = nodes ? nodes->as_array() : nullptr;
   if (nodes && (!list || !list->is_array_of_tables())) {
     r.error(nodes->source(), fmt::format("node must be an array of tables ([[port.node]]), not {}",
                                          type_name(nodes->type())));
-    return port;
+    return;
   }
   if (!list || list->empty()) {
     r.warning(table.source(), fmt::format("port \"{}\" has no [[port.node]]: its master scans "
                                           "nothing",
                                           port.name));
-    return port;
+    return;
   }
 
   std::map<std::uint8_t, NodeSeen> macs;
@@ -669,7 +714,6 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
     read_node_settings(Layers{&nt, defaults}, s, r);
     if (ok) port.nodes.push_back(std::move(s));
   }
-  return port;
 }
 
 // [explicit_policy]: one true/false key per class of guarded request, named

@@ -66,6 +66,10 @@ struct PortConfig {
   // (host_identity.hpp), so that bridges on one bus differ.
   std::optional<std::uint32_t> master_serial_number;
   std::vector<NodeSettings> nodes;
+  // interface = "simulated" only: simulated CDN127s on the bus at MACs the
+  // configuration does not have (simulated_unconfigured = [17]), as a
+  // device with its MAC switch set wrong would be.
+  std::vector<devicenet::MacId> simulated_unconfigured;
 };
 
 struct DaemonConfig {

@@ -210,6 +210,7 @@ void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,
   out.explicit_retained = s.explicit_retained;
   out.explicit_refused_for_limits = s.explicit_refused_for_limits;
   out.loop_longest_pass_ms = static_cast<float>(s.loop_longest_pass_ms);
+  dds::set_octets(out.unconfigured_macs, s.unconfigured_macs);
 }
 
 void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer& a) {

@@ -1,6 +1,7 @@
 #include "adapters/dnbctl/format.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cctype>
@@ -100,6 +101,25 @@ using RowKey = std::tuple<std::string_view, std::string_view, unsigned>;
 
 }  // namespace
 
+namespace {
+
+// "8/8 online", and the MACs heard that the configuration does not have:
+// "7/8 online; unconfigured heard: 17, 23".
+std::string nodes_text(const dnbridge_PortStatus& p) {
+  std::string s = fmt::format("{}/{} online", p.nodes_online, p.nodes_configured);
+  const auto macs = view(p.unconfigured_macs);
+  if (!macs.empty()) s += fmt::format("; unconfigured heard: {}", fmt::join(macs, ", "));
+  return s;
+}
+
+Json unconfigured_json(const dnbridge_PortStatus& p) {
+  std::vector<Json> macs;
+  for (const auto mac : view(p.unconfigured_macs)) macs.emplace_back(static_cast<unsigned>(mac));
+  return Json::values(std::move(macs));
+}
+
+}  // namespace
+
 Record port_record(const dnbridge_PortStatus& p) {
   Record r;
   r.add("port", std::string(view(p.port)), "port", view(p.port))
@@ -118,8 +138,10 @@ Record port_record(const dnbridge_PortStatus& p) {
       .add("load", fmt::format("{:.1f}%", p.bus_load_percent), "bus_load_percent",
            Decimal{p.bus_load_percent, 1})
       .json("scan_cycle_ms", Decimal{p.scan_cycle_ms, 1})
-      .add("nodes", fmt::format("{}/{} online", p.nodes_online, p.nodes_configured),
-           {{"nodes_online", p.nodes_online}, {"nodes_configured", p.nodes_configured}})
+      .add("nodes", nodes_text(p),
+           {{"nodes_online", p.nodes_online},
+            {"nodes_configured", p.nodes_configured},
+            {"unconfigured_macs", unconfigured_json(p)}})
       .json("explicit_outstanding", p.explicit_outstanding)
       .json("explicit_retained", p.explicit_retained)
       .json("explicit_refused_for_limits", p.explicit_refused_for_limits)

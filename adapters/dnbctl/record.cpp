@@ -22,6 +22,12 @@ Json Json::array(std::vector<Record> items) {
   return j;
 }
 
+Json Json::values(std::vector<Json> items) {
+  Json j;
+  j.value_ = std::make_shared<const std::vector<Json>>(std::move(items));
+  return j;
+}
+
 void Json::write(JsonWriter& out) const {
   struct Writer {
     JsonWriter& out;
@@ -36,6 +42,11 @@ void Json::write(JsonWriter& out) const {
     void operator()(const std::shared_ptr<const std::vector<Record>>& items) const {
       out.begin_array();
       for (const auto& r : *items) r.write(out);
+      out.end_array();
+    }
+    void operator()(const std::shared_ptr<const std::vector<Json>>& items) const {
+      out.begin_array();
+      for (const auto& v : *items) v.write(out);
       out.end_array();
     }
   };

@@ -30,7 +30,8 @@ struct Decimal {
 };
 
 // A JSON value: null, a boolean, an integer, a measured value, a string, a
-// number already in JSON's form, an object (a record) or an array of objects.
+// number already in JSON's form, an object (a record), an array of objects
+// or an array of values.
 class Json {
  public:
   Json() = default;
@@ -49,6 +50,7 @@ class Json {
   static Json digits(std::string text);
   static Json object(Record r);
   static Json array(std::vector<Record> items);
+  static Json values(std::vector<Json> items);
 
   void write(JsonWriter& out) const;
 
@@ -57,7 +59,8 @@ class Json {
     std::string text;
   };
   std::variant<std::nullptr_t, bool, std::uint64_t, std::int64_t, Decimal, std::string, Digits,
-               std::shared_ptr<const Record>, std::shared_ptr<const std::vector<Record>>>
+               std::shared_ptr<const Record>, std::shared_ptr<const std::vector<Record>>,
+               std::shared_ptr<const std::vector<Json>>>
       value_{nullptr};
 };
 

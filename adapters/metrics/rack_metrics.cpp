@@ -136,6 +136,9 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
         f.gauge("dnbridge_port_nodes_online", "Nodes online (polled)", port, s->nodes_online);
         f.gauge("dnbridge_port_nodes_configured", "Nodes of the port's configuration", port,
                 s->nodes_configured);
+        f.gauge("dnbridge_port_unconfigured_nodes",
+                "Nodes heard on the bus at MACs the configuration does not have", port,
+                static_cast<double>(s->unconfigured_macs.size()));
         f.gauge("dnbridge_port_explicit_outstanding",
                 "Explicit requests queued for the port or executing", port,
                 s->explicit_outstanding);

@@ -9,7 +9,8 @@
 //              dnbridge_can_transmit_errors, dnbridge_can_receive_errors,
 //              dnbridge_can_frames_total, dnbridge_can_bus_load_ratio,
 //              dnbridge_port_scan_cycle_seconds, dnbridge_port_nodes_online,
-//              dnbridge_port_nodes_configured, dnbridge_port_explicit_outstanding,
+//              dnbridge_port_nodes_configured, dnbridge_port_unconfigured_nodes,
+//              dnbridge_port_explicit_outstanding,
 //              dnbridge_port_explicit_refused_for_limits_total,
 //              dnbridge_port_loop_longest_pass_seconds
 //   per node   dnbridge_node_online, dnbridge_node_state{state}, dnbridge_node_polls_total,

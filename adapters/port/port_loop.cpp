@@ -280,6 +280,10 @@ void PortLoop::publish_port(TimePoint now) {
   s.explicit_refused_for_limits =
       gateway_->refused_for_limits() + calls_refused_.load(std::memory_order_relaxed);
   s.loop_longest_pass_ms = std::chrono::duration<double, std::milli>(longest_pass_).count();
+  const auto& heard = scanner().unconfigured_heard();
+  for (std::size_t mac = 0; mac < heard.size(); ++mac) {
+    if (heard.test(mac)) s.unconfigured_macs.push_back(static_cast<std::uint8_t>(mac));
+  }
   longest_pass_ = Duration::zero();
   nodes_online_.store(s.nodes_online, std::memory_order_relaxed);
   publisher_.port_status(s, std::max(now, port_event_time_));

@@ -119,6 +119,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) override;
   void on_node_state(devicenet::MacId m, devicenet::NodeState f, devicenet::NodeState t,
                      const std::string& r, TimePoint at) override;
+  void on_unconfigured_node(devicenet::MacId, TimePoint) override { port_dirty_ = true; }
   void on_explicit_result(std::uint32_t id, devicenet::MacId m, const devicenet::ExplicitResult& r,
                           TimePoint at) override;
   // FrameReceiver

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "adapters/port/can_backend.hpp"
 #include "bridge/devicenet/master/node.hpp"
@@ -31,6 +32,8 @@ struct PortStatusView {
   std::uint32_t explicit_retained = 0;
   std::uint64_t explicit_refused_for_limits = 0;
   double loop_longest_pass_ms = 0;  // since the previous PortStatus
+  // MACs heard on the bus that the configuration does not have, ascending.
+  std::vector<std::uint8_t> unconfigured_macs;
 };
 
 // A node as the master sees it, copied on the port's thread: what NodeStatus

@@ -1193,5 +1193,23 @@ TEST(ConfigFile, MetricsListenIsHostAndPort) {
               HasSubstr("unknown key 'port' in [metrics]"));
 }
 
+TEST(ConfigFile, SimulatedUnconfiguredNodesAreForASimulatedPortAtFreeMacs) {
+  const std::string nodes = "[[port.node]]\nmac = 1\nname = \"p\"\n";
+  const DaemonConfig c =
+      parse_config(ONE_PORT "simulated_unconfigured = [17, 42]\n" + nodes, "t.toml");
+  ASSERT_EQ(c.ports.at(0).simulated_unconfigured.size(), 2u);
+  EXPECT_EQ(c.ports.at(0).simulated_unconfigured[1], mac(42));
+  EXPECT_EQ(problems(ONE_PORT "simulated_unconfigured = [1, 0, 17, 17]\n" + nodes),
+            "t.toml:6:27: simulated_unconfigured: MAC 1 is a configured node's\n"
+            "t.toml:6:30: simulated_unconfigured: MAC 0 is the master's\n"
+            "t.toml:6:37: simulated_unconfigured: MAC 17 is given twice");
+  EXPECT_THAT(problems("rack = \"r\"\n[[port]]\nname = \"A\"\ninterface = \"can0\"\n"
+                       "bitrate = 500000\nsimulated_unconfigured = [17]\n"),
+              HasSubstr("simulated_unconfigured is for a port whose interface is \"simulated\""));
+  EXPECT_THAT(problems(ONE_PORT "simulated_unconfigured = 17\n"),
+              HasSubstr("simulated_unconfigured must be an array of MAC IDs"));
+  EXPECT_THAT(problems(ONE_PORT "simulated_unconfigured = [64]\n"), HasSubstr("64"));
+}
+
 }  // namespace
 }  // namespace dnbridge::daemon

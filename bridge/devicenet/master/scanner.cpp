@@ -199,7 +199,14 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
       }
       return;
     }
-    if (Node* n = find(id->mac); n && !message->response) n->on_duplicate_mac_request(rx_time);
+    if (Node* n = find(id->mac)) {
+      if (!message->response) n->on_duplicate_mac_request(rx_time);
+    } else {
+      heard_unconfigured(id->mac,
+                         message->response ? "answering a duplicate MAC ID check"
+                                           : "checking its MAC ID (powering up)",
+                         rx_time);
+    }
     return;
   }
 
@@ -211,6 +218,7 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
       n->on_poll_response(payload, rx_time);
     } else {
       ++counters_.unknown_nodes;
+      heard_unconfigured(id->mac, "answering another master's poll", rx_time);
     }
     return;
   }
@@ -220,11 +228,23 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
       n->on_explicit_frame(payload, rx_time);
     } else {
       ++counters_.unknown_nodes;
+      heard_unconfigured(id->mac, "answering another master's explicit request", rx_time);
     }
     return;
   }
   // Requests from other masters, other connection types, Group 3 and 4.
   ++counters_.foreign_frames;
+}
+
+void Scanner::heard_unconfigured(MacId mac, std::string_view how, TimePoint at) {
+  if (unconfigured_heard_.test(mac.value())) return;
+  unconfigured_heard_.set(mac.value());
+  log_.with("MAC", std::to_string(mac.value()))
+      .warn(
+          "a node at MAC {}, which the configuration does not have, was heard {}: a MAC switch "
+          "set wrong, or a node to configure",
+          mac.value(), how);
+  observer_.on_unconfigured_node(mac, at);
 }
 
 void Scanner::on_timer(TimePoint now) {

@@ -7,6 +7,7 @@
 // of the layer above. Frames go out through the FrameSink, events through the
 // ScannerObserver.
 #include <array>
+#include <bitset>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -70,6 +71,11 @@ class Scanner {
   const Node* node(MacId mac) const;
   const std::vector<std::unique_ptr<Node>>& nodes() const { return nodes_; }
   const PortCounters& counters() const { return counters_; }
+  // MACs heard on the bus (a duplicate MAC ID check, a response to another
+  // master) that the scan list does not have: a node whose MAC switch is set
+  // wrong, or one not yet configured. Kept while the port runs; each is
+  // logged once, when first heard.
+  const std::bitset<MacId::kMax + 1>& unconfigured_heard() const { return unconfigured_heard_; }
   const ScannerConfig& config() const { return config_; }
 
  private:
@@ -78,6 +84,8 @@ class Scanner {
   void dispatch(const can::CanFrame& frame, TimePoint rx_time);
   void finish_stopping(TimePoint now);
   Node* find(MacId mac);
+  // A frame from `mac`, which is not in the scan list and not the master's.
+  void heard_unconfigured(MacId mac, std::string_view how, TimePoint at);
 
   ScannerConfig config_;
   can::FrameSink& sink_;
@@ -90,6 +98,7 @@ class Scanner {
   std::string reason_ = "not started";
   std::uint32_t next_request_id_ = 1;
   PortCounters counters_;
+  std::bitset<MacId::kMax + 1> unconfigured_heard_;
   RateLimitedLog foreign_log_limit_;
 };
 

@@ -58,6 +58,9 @@ class ScannerObserver {
   // The end of an explicit request submitted with Scanner::request_explicit.
   virtual void on_explicit_result(std::uint32_t /*request_id*/, MacId /*mac*/,
                                   const ExplicitResult& /*result*/, TimePoint /*at*/) {}
+  // A node the scan list does not have was heard for the first time
+  // (Scanner::unconfigured_heard).
+  virtual void on_unconfigured_node(MacId /*mac*/, TimePoint /*at*/) {}
 };
 
 }  // namespace dnbridge::devicenet
@@ -88,6 +91,9 @@ class ObserverFanout final : public ScannerObserver {
   void on_explicit_result(std::uint32_t id, MacId m, const ExplicitResult& r,
                           TimePoint at) override {
     for (auto* o : observers_) o->on_explicit_result(id, m, r, at);
+  }
+  void on_unconfigured_node(MacId m, TimePoint at) override {
+    for (auto* o : observers_) o->on_unconfigured_node(m, at);
   }
 
  private:

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "bridge/devicenet/wire/duplicate_mac.hpp"
+
 namespace dnbridge::devicenet {
 namespace {
 
@@ -102,6 +104,45 @@ TEST(Scanner, ANegativeImmediatePollGapIsRefused) {
   EXPECT_THROW(Scanner(config, sink, observer, Logger()), std::invalid_argument);
   config.nodes[1].immediate_poll_min_gap = Duration::zero();  // every change polled at once
   EXPECT_NO_THROW(Scanner(config, sink, observer, Logger()));
+}
+
+// A node the scan list does not have, heard on the bus (powering up at a
+// MAC its switch was set to by mistake, or answering another master), is
+// noted once, and the observer told once; the scan list's nodes and the
+// master's own MAC are not.
+TEST(Scanner, NodesHeardAtUnconfiguredMacsAreNotedOnce) {
+  class Heard final : public ScannerObserver {
+   public:
+    void on_unconfigured_node(MacId m, TimePoint) override { macs.push_back(m.value()); }
+    std::vector<unsigned> macs;
+  } observer;
+  DiscardSink sink;
+  Scanner scanner(three_nodes(), sink, observer, Logger());
+  TimePoint now = TimePoint{} + seconds(100);
+  scanner.start(now);
+  const auto powering_up = [](unsigned m) {
+    return encode_duplicate_mac(mac(m), DuplicateMacMessage{false, 0, 59, 0x10000 + m}).value();
+  };
+  // During the master's own MAC check already, and twice (the check's two
+  // requests): noted once.
+  scanner.on_frame(powering_up(17), now);
+  scanner.on_frame(powering_up(17), now + milliseconds(1000));
+  scanner.on_frame(powering_up(2), now);  // a configured node powering up
+  for (int i = 0; i < 2; ++i) {
+    now = scanner.next_deadline();
+    scanner.on_timer(now);
+  }
+  ASSERT_EQ(scanner.state(), PortState::kRunning);
+  // A poll response from MAC 40, which some other master polls (Group 1
+  // message 15: 0x3C0 | MAC).
+  scanner.on_frame(can::CanFrame::make(0x3C0 | 40, Bytes{}).value(), now);
+  scanner.on_frame(can::CanFrame::make(0x3C0 | 40, Bytes{}).value(), now);
+  EXPECT_EQ(observer.macs, (std::vector<unsigned>{17, 40}));
+  EXPECT_TRUE(scanner.unconfigured_heard().test(17));
+  EXPECT_TRUE(scanner.unconfigured_heard().test(40));
+  EXPECT_FALSE(scanner.unconfigured_heard().test(2));
+  EXPECT_FALSE(scanner.unconfigured_heard().test(0));
+  EXPECT_EQ(scanner.unconfigured_heard().count(), 2u);
 }
 
 }  // namespace
