@@ -741,7 +741,8 @@ rack::ExplicitPolicy read_explicit_policy(const toml::node& n, Problems& r) {
   return policy;
 }
 
-// [metrics]: listen = "HOST:PORT" (an IPv6 address in brackets, "[::1]:9731").
+// [metrics]: listen = "HOST:PORT". IPv4 only: Debian's civetweb, which the
+// metrics server is built on, has no IPv6.
 std::optional<std::string> read_metrics(const toml::node& n, Problems& r) {
   const toml::table* t = toml_config::as_table(n, "metrics", "[metrics]", r);
   if (!t) return std::nullopt;
@@ -750,8 +751,7 @@ std::optional<std::string> read_metrics(const toml::node& n, Problems& r) {
   if (!listen) return std::nullopt;
   auto v = read_string(*listen, "listen", r);
   if (!v) return std::nullopt;
-  // HOST:PORT with a port 1..65535; the host a name or an address, an IPv6
-  // address in brackets.
+  // HOST:PORT with a port 1..65535; the host a name or an IPv4 address.
   const auto colon = v->rfind(':');
   const std::string host = colon == std::string::npos ? std::string{} : v->substr(0, colon);
   const std::string port = colon == std::string::npos ? std::string{} : v->substr(colon + 1);
@@ -759,12 +759,18 @@ std::optional<std::string> read_metrics(const toml::node& n, Problems& r) {
   const bool port_ok = !port.empty() && port.size() <= 5 &&
                        port.find_first_not_of("0123456789") == std::string::npos &&
                        (number = std::stoul(port)) >= 1 && number <= 65535;
-  const bool bracketed = host.size() >= 2 && host.front() == '[' && host.back() == ']';
-  const bool host_ok = !host.empty() && (bracketed || host.find(':') == std::string::npos);
-  if (!port_ok || !host_ok) {
+  if (!host.empty() && (host.front() == '[' || host.find(':') != std::string::npos)) {
     r.error(listen->source(),
-            fmt::format("listen = \"{}\" is not HOST:PORT (e.g. \"127.0.0.1:9731\", "
-                        "\"[::1]:9731\"; the port 1..65535)",
+            fmt::format("listen = \"{}\": the metrics server has no IPv6 (Debian's civetweb is "
+                        "built without it); use an IPv4 address or a host name, e.g. "
+                        "\"127.0.0.1:9731\"",
+                        *v));
+    return std::nullopt;
+  }
+  if (!port_ok || host.empty()) {
+    r.error(listen->source(),
+            fmt::format("listen = \"{}\" is not HOST:PORT (e.g. \"127.0.0.1:9731\"; the port "
+                        "1..65535)",
                         *v));
     return std::nullopt;
   }

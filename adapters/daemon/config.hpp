@@ -86,7 +86,7 @@ struct DaemonConfig {
   // XML configuration decides (CYCLONEDDS_URI), by default no security.
   std::optional<security::Settings> security;
   // Where the Prometheus metrics are served ([metrics] listen, "HOST:PORT",
-  // "[::1]:PORT" for IPv6); none: no metrics endpoint.
+  // IPv4); none: no metrics endpoint.
   std::optional<std::string> metrics_listen;
   std::string source;  // the file it came from, or "embedded default"
   // Things that load but look wrong, "FILE:LINE:COLUMN: text", for the log.

@@ -75,7 +75,9 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
   if (config_.metrics_listen) {
     metrics_ =
         std::make_shared<metrics::RackMetrics>(config_.rack, [this] { return process_counters(); });
-    tee_.emplace(publisher_, *metrics_);
+    // The metrics first: an update in memory, done before the DDS sample
+    // that says the same can reach anyone.
+    tee_.emplace(*metrics_, publisher_);
   }
   port::PortPublisher& publisher = tee_ ? static_cast<port::PortPublisher&>(*tee_) : publisher_;
   std::map<std::string, port::PortLoop*, std::less<>> by_name;

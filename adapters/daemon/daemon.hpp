@@ -41,8 +41,9 @@ class Daemon {
   // instances unregistered, the last samples acknowledged (bounded wait).
   void stop();
 
-  // Starts, or stops, a candump -l compatible log of every SocketCAN port's
-  // traffic, one file per port in `directory` (DIR/dnbridge-PORT-candump.log).
+  // Starts, or stops, a candump -l compatible log of every port's traffic,
+  // simulated ones included, one file per port in `directory`
+  // (DIR/dnbridge-PORT-candump.log).
   // Any thread; the ports open and close their files on their own threads.
   void toggle_candump(const std::string& directory);
 

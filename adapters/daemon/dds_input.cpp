@@ -140,16 +140,15 @@ void DdsInput::run() {
 }
 
 void DdsInput::take_commands() {
-  take_batches([this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0,
-               log_, "pump commands",
-               [this](std::size_t i) {
-                 commands_taken_.fetch_add(1, std::memory_order_relaxed);
-                 on_command(command_buffer_.data(i), command_buffer_.info(i));
-               });
+  take_batches(
+      [this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0, log_,
+      "pump commands",
+      [this](std::size_t i) { on_command(command_buffer_.data(i), command_buffer_.info(i)); });
 }
 
 void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
   if (dds::view(c.rack) != rack_) return;  // another bridge's pump
+  if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
   port::PortLoop* loop = port_of(dds::view(c.port));
   const auto mac = devicenet::MacId::from(c.mac);
   if (!loop || !mac || !loop->has_node(*mac)) {
@@ -194,7 +193,6 @@ bool DdsInput::take_requests() {
   return take_batches([this] { return requests_.take(request_buffer_, request_cdr_); },
                       request_buffer_.capacity(), kRequestBatches, log_, "explicit requests",
                       [this](std::size_t i) {
-                        requests_taken_.fetch_add(1, std::memory_order_relaxed);
                         if (request_buffer_.info(i).valid_data())
                           on_request(request_buffer_.data(i), request_cdr_[i]);
                       });
@@ -203,6 +201,7 @@ bool DdsInput::take_requests() {
 void DdsInput::on_request(const dnbridge_ExplicitRequest& r,
                           std::span<const unsigned char> serialized) {
   if (dds::view(r.rack) != rack_) return;
+  requests_taken_.fetch_add(1, std::memory_order_relaxed);
   rack::ExplicitCall call = call_of(r);
   if (dds::leading_string_has_nul(serialized)) {
     // The name reads as its part before the NUL: two such requesters would

@@ -30,7 +30,7 @@ class DdsInput {
   void start();
   void stop();  // returns when the thread has ended
 
-  // Samples taken so far (any thread).
+  // Samples with data for this rack taken so far (any thread).
   std::uint64_t commands_taken() const noexcept { return commands_taken_.load(); }
   std::uint64_t requests_taken() const noexcept { return requests_taken_.load(); }
 

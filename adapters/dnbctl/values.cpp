@@ -69,8 +69,12 @@ Parsed<NodeRef> parse_node(std::string_view text) {
   const std::string t(trim(text));
   if (t.empty())
     return Parsed<NodeRef>::failure("no node given: a MAC ID (0..63) or a node's name");
-  // A number is a MAC ID, and out of range is an error, never a name.
-  if (std::isdigit(static_cast<unsigned char>(t.front())) != 0) {
+  // A number (decimal, or hex with 0x) is a MAC ID, and out of range is an
+  // error, never a name; anything else ("3-dry-pump") is a name.
+  const bool hex = t.size() > 2 && t[0] == '0' && (t[1] == 'x' || t[1] == 'X') &&
+                   t.find_first_not_of("0123456789abcdefABCDEF", 2) == std::string::npos;
+  const bool decimal = t.find_first_not_of("0123456789") == std::string::npos;
+  if (hex || decimal) {
     auto mac = parse_mac(t);
     if (!mac) return Parsed<NodeRef>::failure(mac.error());
     return NodeRef{*mac, {}};

@@ -105,8 +105,14 @@ void RackMetrics::port_stopped(const std::string& port) {
 std::vector<MetricFamily> RackMetrics::Collect() const {
   Families f;
   {
-    std::lock_guard lock(mutex_);
-    for (const auto& [name, entry] : ports_) {
+    // A copy, so that the ports' threads wait only for it, not for the
+    // families and their labels.
+    std::map<std::string, PortEntry> ports;
+    {
+      std::lock_guard lock(mutex_);
+      ports = ports_;
+    }
+    for (const auto& [name, entry] : ports) {
       const Labels port{{"rack", rack_}, {"port", name}};
       const auto* s = entry.status ? &*entry.status : nullptr;
       f.gauge("dnbridge_port_up", "1 while the port's loop runs and scans its bus, else 0", port,
@@ -206,7 +212,7 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
 MetricsServer::MetricsServer(const std::string& listen, std::shared_ptr<RackMetrics> metrics)
     : metrics_(std::move(metrics)) {
   try {
-    // civetweb's listening_ports takes "HOST:PORT" and "[IPV6]:PORT" as given.
+    // civetweb's listening_ports takes "HOST:PORT" as given.
     exposer_ = std::make_unique<prometheus::Exposer>(listen, 2);
   } catch (const std::exception& e) {
     throw std::runtime_error(fmt::format("[metrics] listen = \"{}\": {}", listen, e.what()));

@@ -94,8 +94,9 @@ class RackMetrics final : public port::PortPublisher, public prometheus::Collect
   std::map<std::string, PortEntry> ports_;
 };
 
-// GET /metrics on `listen` ("HOST:PORT", "[::1]:PORT"; port 0: any free
-// one). Throws std::runtime_error if it cannot listen there.
+// GET /metrics on `listen` ("HOST:PORT", IPv4; port 0, which the
+// configuration refuses but tests use: any free one). Throws
+// std::runtime_error if it cannot listen there.
 class MetricsServer {
  public:
   MetricsServer(const std::string& listen, std::shared_ptr<RackMetrics> metrics);

@@ -280,7 +280,7 @@ void PortLoop::publish_port(TimePoint now) {
   s.explicit_refused_for_limits =
       gateway_->refused_for_limits() + calls_refused_.load(std::memory_order_relaxed);
   s.loop_longest_pass_ms = std::chrono::duration<double, std::milli>(longest_pass_).count();
-  const auto& heard = scanner().unconfigured_heard();
+  const auto heard = scanner().unconfigured_heard(backend_->now());
   for (std::size_t mac = 0; mac < heard.size(); ++mac) {
     if (heard.test(mac)) s.unconfigured_macs.push_back(static_cast<std::uint8_t>(mac));
   }

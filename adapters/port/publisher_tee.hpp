@@ -1,6 +1,6 @@
 #pragma once
-// One port's publications to two publishers, in order: the DDS face, then
-// another (the metrics). Each gets every call, on the port's thread.
+// One port's publications to two publishers, in order (the metrics, then
+// the DDS face). Each gets every call, on the port's thread.
 #include "adapters/port/port_publisher.hpp"
 
 namespace dnbridge::port {

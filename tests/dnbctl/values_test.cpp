@@ -52,6 +52,8 @@ TEST(Values, NodesByMacOrName) {
   EXPECT_EQ(*parse_node("0x0C"), (NodeRef{12, {}}));
   EXPECT_EQ(*parse_node(" pump-3 "), (NodeRef{std::nullopt, "pump-3"}));
   EXPECT_EQ(*parse_node("Pumpe \xC3\xA4-2"), (NodeRef{std::nullopt, "Pumpe \xC3\xA4-2"}));
+  EXPECT_EQ(*parse_node("3-dry-pump"), (NodeRef{std::nullopt, "3-dry-pump"}));  // not MAC 3
+  EXPECT_EQ(*parse_node("0x3G"), (NodeRef{std::nullopt, "0x3G"}));
   // A number out of range is a wrong MAC, never a name.
   EXPECT_FALSE(parse_node("64").ok());
   EXPECT_NE(parse_node("64").error().find("out of range 0..63"), std::string::npos);

@@ -73,6 +73,7 @@ Scanner::Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& ob
       log_(std::move(log)),
       mac_check_(config_.master_mac, mac_check_config(config_)) {
   validate(config_);
+  unconfigured_last_heard_.fill(kNever);
   nodes_.reserve(config_.nodes.size());
   for (const auto& n : config_.nodes) {
     // Every line of a node carries its MAC ID, as MAC and NODE.
@@ -96,6 +97,7 @@ void Scanner::set_state(PortState next, std::string reason, TimePoint now) {
 
 void Scanner::start(TimePoint now) {
   if (state_ != PortState::kStopped) return;
+  unconfigured_last_heard_.fill(kNever);
   set_state(PortState::kCheckingMac,
             fmt::format("checking that no other node has MAC {}", config_.master_mac.value()), now);
   sink_.send(mac_check_.start(now), now);
@@ -236,9 +238,20 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
   ++counters_.foreign_frames;
 }
 
+std::bitset<MacId::kMax + 1> Scanner::unconfigured_heard(TimePoint now) const {
+  std::bitset<MacId::kMax + 1> heard;
+  for (std::size_t mac = 0; mac < unconfigured_last_heard_.size(); ++mac) {
+    const TimePoint last = unconfigured_last_heard_[mac];
+    if (last != kNever && now - last < kUnconfiguredMemory) heard.set(mac);
+  }
+  return heard;
+}
+
 void Scanner::heard_unconfigured(MacId mac, std::string_view how, TimePoint at) {
-  if (unconfigured_heard_.test(mac.value())) return;
-  unconfigured_heard_.set(mac.value());
+  TimePoint& last = unconfigured_last_heard_[mac.value()];
+  const bool listed = last != kNever && at - last < kUnconfiguredMemory;
+  last = at;
+  if (listed) return;
   log_.with("MAC", std::to_string(mac.value()))
       .warn(
           "a node at MAC {}, which the configuration does not have, was heard {}: a MAC switch "

@@ -72,10 +72,12 @@ class Scanner {
   const std::vector<std::unique_ptr<Node>>& nodes() const { return nodes_; }
   const PortCounters& counters() const { return counters_; }
   // MACs heard on the bus (a duplicate MAC ID check, a response to another
-  // master) that the scan list does not have: a node whose MAC switch is set
-  // wrong, or one not yet configured. Kept while the port runs; each is
-  // logged once, when first heard.
-  const std::bitset<MacId::kMax + 1>& unconfigured_heard() const { return unconfigured_heard_; }
+  // master) that the scan list does not have, within kUnconfiguredMemory
+  // before `now`: a node whose MAC switch is set wrong, or one not yet
+  // configured. Each is logged when first heard, and again when heard after
+  // it was forgotten.
+  static constexpr Duration kUnconfiguredMemory = seconds(600);
+  std::bitset<MacId::kMax + 1> unconfigured_heard(TimePoint now) const;
   const ScannerConfig& config() const { return config_; }
 
  private:
@@ -98,7 +100,7 @@ class Scanner {
   std::string reason_ = "not started";
   std::uint32_t next_request_id_ = 1;
   PortCounters counters_;
-  std::bitset<MacId::kMax + 1> unconfigured_heard_;
+  std::array<TimePoint, MacId::kMax + 1> unconfigured_last_heard_;  // kNever: not heard
   RateLimitedLog foreign_log_limit_;
 };
 

@@ -108,9 +108,9 @@ TEST(Scanner, ANegativeImmediatePollGapIsRefused) {
 
 // A node the scan list does not have, heard on the bus (powering up at a
 // MAC its switch was set to by mistake, or answering another master), is
-// noted once, and the observer told once; the scan list's nodes and the
-// master's own MAC are not.
-TEST(Scanner, NodesHeardAtUnconfiguredMacsAreNotedOnce) {
+// noted, and the observer told once; the scan list's nodes and the master's
+// own MAC are not. Not heard for ten minutes, it is forgotten.
+TEST(Scanner, NodesHeardAtUnconfiguredMacsAreListedUntilNotHeardForTenMinutes) {
   class Heard final : public ScannerObserver {
    public:
     void on_unconfigured_node(MacId m, TimePoint) override { macs.push_back(m.value()); }
@@ -138,11 +138,22 @@ TEST(Scanner, NodesHeardAtUnconfiguredMacsAreNotedOnce) {
   scanner.on_frame(can::CanFrame::make(0x3C0 | 40, Bytes{}).value(), now);
   scanner.on_frame(can::CanFrame::make(0x3C0 | 40, Bytes{}).value(), now);
   EXPECT_EQ(observer.macs, (std::vector<unsigned>{17, 40}));
-  EXPECT_TRUE(scanner.unconfigured_heard().test(17));
-  EXPECT_TRUE(scanner.unconfigured_heard().test(40));
-  EXPECT_FALSE(scanner.unconfigured_heard().test(2));
-  EXPECT_FALSE(scanner.unconfigured_heard().test(0));
-  EXPECT_EQ(scanner.unconfigured_heard().count(), 2u);
+  const auto heard = scanner.unconfigured_heard(now);
+  EXPECT_TRUE(heard.test(17));
+  EXPECT_TRUE(heard.test(40));
+  EXPECT_FALSE(heard.test(2));
+  EXPECT_FALSE(heard.test(0));
+  EXPECT_EQ(heard.count(), 2u);
+
+  // Not heard for kUnconfiguredMemory: forgotten (a switch set right since);
+  // heard again afterwards: listed and told again.
+  const TimePoint later = now + Scanner::kUnconfiguredMemory;
+  scanner.on_frame(can::CanFrame::make(0x3C0 | 40, Bytes{}).value(), later - milliseconds(1));
+  EXPECT_EQ(scanner.unconfigured_heard(later).count(), 1u);
+  EXPECT_TRUE(scanner.unconfigured_heard(later).test(40));
+  scanner.on_frame(powering_up(17), later);
+  EXPECT_EQ(observer.macs, (std::vector<unsigned>{17, 40, 17}));
+  EXPECT_EQ(scanner.unconfigured_heard(later).count(), 2u);
 }
 
 }  // namespace
