@@ -99,10 +99,6 @@ std::string volts(double v) { return fmt::format("{:.3f} V", v); }
 // The order of the keys (rack, port, mac), for sorted output.
 using RowKey = std::tuple<std::string_view, std::string_view, unsigned>;
 
-}  // namespace
-
-namespace {
-
 // "8/8 online", and the MACs heard that the configuration does not have:
 // "7/8 online; unconfigured heard: 17, 23".
 std::string nodes_text(const dnbridge_PortStatus& p) {

@@ -60,7 +60,7 @@ void gather(Client& client, const GlobalOptions& o, const std::function<bool()>&
         Exit::kNotFound,
         fmt::format("no bridge answered on DDS domain {}{} within {:g} s{}", o.domain,
                     o.rack.empty() ? "" : fmt::format(" for rack \"{}\"", o.rack),
-                    o.timeout_seconds, client.ports().empty() ? no_bridge_causes(o) : ""));
+                    o.timeout_seconds, no_bridge_causes(client, o)));
   }
   const Deadline settle = std::min(deadline, deadline_after(kSettle));
   client.wait_until(settle, [] { return false; });

@@ -23,19 +23,24 @@ std::string where(const GlobalOptions& o) {
 
 std::string seconds_text(const GlobalOptions& o) { return fmt::format("{:g} s", o.timeout_seconds); }
 
-bool refers_to(const NodeRef& ref, const NodeKey& k, const char* name) {
-  return ref.mac ? k.mac == *ref.mac : ref.name == dds::view(name);
-}
-
-// The nodes `ref` names that the options allow, from both node topics.
-std::set<NodeKey> candidates(const Client& client, const GlobalOptions& o, const NodeRef& ref) {
-  std::set<NodeKey> found;
+// `fn(key, name)` for every node the options allow, from both node topics
+// (a node may be known from one only, so far).
+template <class Fn>
+void each_node(const Client& client, const GlobalOptions& o, Fn fn) {
   for (const auto& [k, v] : client.nodes()) {
-    if (o.matches(k.rack, k.port) && refers_to(ref, k, v.data->name)) found.insert(k);
+    if (o.matches(k.rack, k.port)) fn(k, dds::view(v.data->name));
   }
   for (const auto& [k, v] : client.pumps()) {
-    if (o.matches(k.rack, k.port) && refers_to(ref, k, v.data->name)) found.insert(k);
+    if (o.matches(k.rack, k.port)) fn(k, dds::view(v.data->name));
   }
+}
+
+// The nodes `ref` names that the options allow.
+std::set<NodeKey> candidates(const Client& client, const GlobalOptions& o, const NodeRef& ref) {
+  std::set<NodeKey> found;
+  each_node(client, o, [&](const NodeKey& k, std::string_view name) {
+    if (ref.matches(k.mac, name)) found.insert(k);
+  });
   return found;
 }
 
@@ -47,15 +52,9 @@ std::string described(const NodeRef& ref) {
 // close to the one given.
 std::string name_hint(const Client& client, const GlobalOptions& o, const NodeRef& ref) {
   if (ref.mac) return {};
-  std::vector<std::string> names;
-  for (const auto& [k, v] : client.nodes()) {
-    if (o.matches(k.rack, k.port)) names.emplace_back(dds::view(v.data->name));
-  }
-  for (const auto& [k, v] : client.pumps()) {
-    if (o.matches(k.rack, k.port)) names.emplace_back(dds::view(v.data->name));
-  }
-  const std::vector<std::string_view> views(names.begin(), names.end());
-  const auto near = closest(ref.name, views, 3);
+  std::vector<std::string_view> names;  // views into the client's samples
+  each_node(client, o, [&](const NodeKey&, std::string_view name) { names.push_back(name); });
+  const auto near = closest(ref.name, names, 3);
   return near ? fmt::format(" (did you mean \"{}\"?)", *near) : std::string{};
 }
 
@@ -92,7 +91,8 @@ void discover(Client& client, const GlobalOptions& o, Found found) {
 
 }  // namespace
 
-std::string no_bridge_causes(const GlobalOptions& o) {
+std::string no_bridge_causes(const Client& client, const GlobalOptions& o) {
+  if (!client.ports().empty()) return {};  // a bridge was heard: DDS works
   const char* uri = std::getenv("CYCLONEDDS_URI");
   const bool uri_set = uri != nullptr && *uri != '\0';
   std::string s = fmt::format(
@@ -121,7 +121,7 @@ NodeKey find_node(Client& client, const GlobalOptions& o, const NodeRef& ref) {
         Exit::kNotFound,
         fmt::format("no bridge reported a node {} {} {} within {}{}{}", ref.mac ? "with" : "named",
                     described(ref), where(o), seconds_text(o), name_hint(client, o, ref),
-                    client.ports().empty() ? no_bridge_causes(o) : ""));
+                    no_bridge_causes(client, o)));
   }
   if (found.size() > 1) {
     throw CommandError(Exit::kUsage,
@@ -148,7 +148,7 @@ NodeKey find_port(Client& client, const GlobalOptions& o, const NodeRef& ref) {
   const auto ports = candidate_ports(client, o);
   if (ports.empty()) {
     throw CommandError(Exit::kNotFound, fmt::format("no bridge answered {} within {}{}", where(o),
-                                                    seconds_text(o), no_bridge_causes(o)));
+                                                    seconds_text(o), no_bridge_causes(client, o)));
   }
   if (ports.size() > 1) {
     throw CommandError(Exit::kUsage,

@@ -15,11 +15,12 @@ namespace dnbridge::dnbctl {
 // After the first match, how long other racks get to be heard.
 inline constexpr Duration kSettle = milliseconds(300);
 
-// What to check when no bridge answered at all: the domain and network
-// configuration dnbctl used, and the usual causes (another domain,
+// When `client` heard no bridge at all, what to check: the domain and
+// network configuration dnbctl used, and the usual causes (another domain,
 // CYCLONEDDS_URI not reaching the bridge's network, a firewall, DDS Security
-// on one side only). Lines to append to the error, each starting "\n  ".
-std::string no_bridge_causes(const GlobalOptions& options);
+// on one side only). Lines to append to the error, each starting "\n  ";
+// empty when a bridge was heard.
+std::string no_bridge_causes(const Client& client, const GlobalOptions& options);
 
 // The one node `ref` names (by MAC or by name) among the racks and ports the
 // options allow. Throws CommandError: kNotFound when none answered within

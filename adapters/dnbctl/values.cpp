@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -33,6 +34,16 @@ int hex_digit(char c) {
   if (c >= 'a' && c <= 'f') return c - 'a' + 10;
   if (c >= 'A' && c <= 'F') return c - 'A' + 10;
   return -1;
+}
+
+// Digits of one number as parse_unsigned reads it: decimal, or hex with 0x
+// (whether it fits is parse_unsigned's to say).
+bool is_number(std::string_view s) {
+  const bool hex = has_hex_prefix(s);
+  if (hex) s.remove_prefix(2);
+  return !s.empty() && std::all_of(s.begin(), s.end(), [hex](char c) {
+    return hex ? hex_digit(c) >= 0 : (c >= '0' && c <= '9');
+  });
 }
 
 }  // namespace
@@ -71,10 +82,7 @@ Parsed<NodeRef> parse_node(std::string_view text) {
     return Parsed<NodeRef>::failure("no node given: a MAC ID (0..63) or a node's name");
   // A number (decimal, or hex with 0x) is a MAC ID, and out of range is an
   // error, never a name; anything else ("3-dry-pump") is a name.
-  const bool hex = t.size() > 2 && t[0] == '0' && (t[1] == 'x' || t[1] == 'X') &&
-                   t.find_first_not_of("0123456789abcdefABCDEF", 2) == std::string::npos;
-  const bool decimal = t.find_first_not_of("0123456789") == std::string::npos;
-  if (hex || decimal) {
+  if (is_number(t)) {
     auto mac = parse_mac(t);
     if (!mac) return Parsed<NodeRef>::failure(mac.error());
     return NodeRef{*mac, {}};

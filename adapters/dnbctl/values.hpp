@@ -48,6 +48,10 @@ Parsed<std::uint8_t> parse_mac(std::string_view text);
 struct NodeRef {
   std::optional<std::uint8_t> mac;  // set when given as a number
   std::string name;                 // set otherwise
+  // Whether it names the node at `node_mac` called `node_name`.
+  bool matches(std::uint8_t node_mac, std::string_view node_name) const {
+    return mac ? *mac == node_mac : name == node_name;
+  }
   friend bool operator==(const NodeRef&, const NodeRef&) = default;
 };
 Parsed<NodeRef> parse_node(std::string_view text);

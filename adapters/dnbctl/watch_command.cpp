@@ -61,9 +61,8 @@ Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
   const auto wanted = [&](const NodeKey& k, const dnbridge_PumpState& s) {
     if (!o.matches(k.rack, k.port)) return false;
     if (refs.empty()) return true;
-    return std::any_of(refs.begin(), refs.end(), [&](const NodeRef& r) {
-      return r.mac ? *r.mac == k.mac : r.name == dds::view(s.name);
-    });
+    return std::any_of(refs.begin(), refs.end(),
+                       [&](const NodeRef& r) { return r.matches(k.mac, dds::view(s.name)); });
   };
   const auto start = std::chrono::steady_clock::now();
   const auto end = args.duration_seconds > 0
@@ -120,7 +119,7 @@ Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
       throw CommandError(
           Exit::kNotFound,
           fmt::format("no bridge reported pump state on DDS domain {} within {:g} s{}", o.domain,
-                      o.timeout_seconds, client.ports().empty() ? no_bridge_causes(o) : ""));
+                      o.timeout_seconds, no_bridge_causes(client, o)));
     }
     // Wakes on new samples; the slice bounds how late a redraw, the end of
     // --duration or the timeout is noticed.

@@ -69,21 +69,24 @@ Labels with(Labels labels, std::string name, std::string value) {
 RackMetrics::RackMetrics(std::string rack, std::function<ProcessCounters()> process)
     : rack_(std::move(rack)), process_(std::move(process)) {}
 
-void RackMetrics::pump_state(const std::string& port, const rack::PumpView& pump, TimePoint) {
-  std::lock_guard lock(mutex_);
+RackMetrics::NodeEntry& RackMetrics::note_pump(const std::string& port,
+                                               const rack::PumpView& pump) {
   auto& node = ports_[port].nodes[pump.mac.value()];
   node.name = pump.name;
   node.commands_accepted = pump.commands_accepted;
   node.commands_refused = pump.commands_refused;
+  return node;
+}
+
+void RackMetrics::pump_state(const std::string& port, const rack::PumpView& pump, TimePoint) {
+  std::lock_guard lock(mutex_);
+  note_pump(port, pump);
 }
 
 void RackMetrics::node_status(const std::string& port, const rack::PumpView& pump,
                               const port::NodeStatusView& status, TimePoint) {
   std::lock_guard lock(mutex_);
-  auto& node = ports_[port].nodes[pump.mac.value()];
-  node.name = pump.name;
-  node.commands_accepted = pump.commands_accepted;
-  node.commands_refused = pump.commands_refused;
+  auto& node = note_pump(port, pump);
   node.has_status = true;
   node.state = status.state;
   node.counters = status.counters;

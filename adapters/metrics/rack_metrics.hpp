@@ -88,6 +88,9 @@ class RackMetrics final : public port::PortPublisher, public prometheus::Collect
     std::map<unsigned, NodeEntry> nodes;  // by MAC
   };
 
+  // The pump's name and command counters, into its entry (mutex_ held).
+  NodeEntry& note_pump(const std::string& port, const rack::PumpView& pump);
+
   std::string rack_;
   std::function<ProcessCounters()> process_;
   mutable std::mutex mutex_;
