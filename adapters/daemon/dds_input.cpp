@@ -28,6 +28,14 @@ constexpr std::size_t kBatch = 32;
 // Requests taken before the commands are looked at again.
 constexpr std::size_t kRequestBatches = 4;
 
+// A request serialized in more bytes than this is dropped unanswered. A
+// reply carries its requester name and may quote its port name, and the
+// reply writer's history (64 replies, dds::kReplyHistory) must stay far
+// below what Cyclone lets a writer hold unacknowledged (participant.cpp).
+// The largest request the bridge serves (512 bytes of data, names of 100
+// characters) takes under 900 bytes.
+constexpr std::size_t kMaxRequestBytes = 2048;
+
 // Takes, a buffer at a time, at most `batches` buffers (unlimited: 0): `take`
 // fills the buffer and returns how many samples it holds, `fn` handles the
 // i-th. True when samples may remain: taking resets DATA_AVAILABLE while
@@ -202,6 +210,18 @@ void DdsInput::on_request(const dnbridge_ExplicitRequest& r,
                           std::span<const unsigned char> serialized) {
   if (dds::view(r.rack) != rack_) return;
   requests_taken_.fetch_add(1, std::memory_order_relaxed);
+  if (serialized.size() > kMaxRequestBytes) {
+    // Not answered: the reply would carry the oversized name back.
+    ++requests_dropped_for_size_;
+    constexpr std::size_t kQuoted = 64;
+    const std::string_view requester = dds::view(r.requester);
+    warn_limit_.warn(log_, port::steady_now(),
+                     "explicit request (txid {}) from \"{}{}\" dropped unanswered: {} bytes "
+                     "serialized, at most {} served ({} such requests so far)",
+                     r.txid, requester.substr(0, kQuoted), requester.size() > kQuoted ? "..." : "",
+                     serialized.size(), kMaxRequestBytes, requests_dropped_for_size_);
+    return;
+  }
   rack::ExplicitCall call = call_of(r);
   if (dds::leading_string_has_nul(serialized)) {
     // The name reads as its part before the NUL: two such requesters would

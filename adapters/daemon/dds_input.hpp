@@ -61,6 +61,7 @@ class DdsInput {
   std::atomic<std::uint64_t> requests_taken_{0};
   std::uint64_t commands_stamped_ahead_ = 0;
   std::uint64_t requests_refused_for_names_ = 0;
+  std::uint64_t requests_dropped_for_size_ = 0;
 };
 
 }  // namespace dnbridge::daemon

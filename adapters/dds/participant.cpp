@@ -1,6 +1,7 @@
 #include "adapters/dds/participant.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <thread>
 
@@ -60,12 +61,61 @@ class ErrorCapture {
 // One creation at a time owns Cyclone's (process-wide) log sink.
 std::mutex g_creating;
 
-dds_entity_t create_participant(dds_domainid_t domain, const std::string& name,
-                                const Properties& properties) {
+// `created` (an entity or an error), or Error saying what Cyclone logged.
+dds_entity_t checked(dds_entity_t created, const std::string& errors,
+                     const std::string& attempted) {
+  if (created < 0 && !errors.empty()) {
+    throw Error(attempted, created, "refused by Cyclone DDS: " + errors);
+  }
+  return check(created, attempted);
+}
+
+// The bridge's domain settings: Cyclone's high-water mark of a writer's
+// unacknowledged data, fixed. Cyclone 0.10.2 makes a write wait once a
+// writer holds more unacknowledged bytes than the mark (adaptive by default:
+// from 1 KiB upwards, growing only while nothing is being resent) until they
+// fall to 1 KiB. A reader that acknowledges nothing any more (topics.hpp)
+// keeps them above that for good, and after any resend (a late reader's
+// history, a lost packet) the mark stops growing: from then on every write
+// of that writer waited and failed, for every reader. The bridge's writers
+// all keep a bounded history (keep-last: a sample per state instance, 64
+// replies), which bounds what they hold unacknowledged whatever their
+// readers do; fixed at 4 MiB, far above those bounds, the mark is never
+// reached. The operator's CYCLONEDDS_URI (files and fragments, as Cyclone
+// reads it) comes after and may override these.
+constexpr const char* kBridgeDomainConfig =
+    "<CycloneDDS><Domain id=\"any\"><Internal><Watermarks>"
+    "<WhcAdaptive>false</WhcAdaptive>"
+    "<WhcHighInit>4 MiB</WhcHighInit>"
+    "<WhcHigh>4 MiB</WhcHigh>"
+    "</Watermarks></Internal></Domain></CycloneDDS>";
+
+// Creates `domain` with the bridge's settings, unless this process has
+// joined it already (then its settings stay, and 0 is returned).
+dds_entity_t create_bridge_domain(dds_domainid_t domain) {
+  std::string errors;
+  dds_entity_t created = 0;
+  {
+    ErrorCapture capture;
+    std::string config = kBridgeDomainConfig;
+    if (const char* uri = std::getenv("CYCLONEDDS_URI"); uri && *uri) {
+      config += ',';
+      config += uri;
+    }
+    created = dds_create_domain(domain, config.c_str());
+    if (created < 0) errors = capture.errors();
+  }
+  if (created == DDS_RETCODE_PRECONDITION_NOT_MET) return 0;
+  return checked(created, errors, "creating domain " + std::to_string(domain));
+}
+
+Participant::Created create_participant(dds_domainid_t domain, const std::string& name,
+                                        const Properties& properties, bool bridge) {
   Qos qos;
   qos.entity_name(name);
   for (const auto& p : properties) qos.property(p.name, p.value);
   std::lock_guard lock(g_creating);
+  Entity own_domain(bridge ? create_bridge_domain(domain) : 0);
   dds_entity_t participant = 0;
   std::string errors;
   {
@@ -73,19 +123,31 @@ dds_entity_t create_participant(dds_domainid_t domain, const std::string& name,
     participant = dds_create_participant(domain, qos.get(), nullptr);
     if (participant < 0) errors = capture.errors();
   }
-  const std::string attempted = "creating the participant of domain " + std::to_string(domain);
-  if (participant < 0 && !errors.empty()) {
-    throw Error(attempted, participant, "refused by Cyclone DDS: " + errors);
-  }
-  return check(participant, attempted);
+  participant =
+      checked(participant, errors, "creating the participant of domain " + std::to_string(domain));
+  return {participant, own_domain.release()};
 }
 
 }  // namespace
 
 Participant::Participant(dds_domainid_t domain, std::string_view rack, const Properties& properties)
-    : Entity(create_participant(domain, participant_name(rack), properties)), domain_(domain) {}
+    : Participant(create_participant(domain, participant_name(rack), properties, true), domain) {}
 
 Participant::Participant(dds_domainid_t domain, ClientName client, const Properties& properties)
-    : Entity(create_participant(domain, std::string(client.name), properties)), domain_(domain) {}
+    : Participant(create_participant(domain, std::string(client.name), properties, false), domain) {
+}
+
+Participant::Participant(Created created, dds_domainid_t domain)
+    : Entity(created.participant), domain_(domain), own_domain_(created.domain) {}
+
+Participant::~Participant() {
+  reset();
+  // The domain goes with the last participant in it, as one that Cyclone
+  // created implicitly does. Left for Cyclone to tear down as the process
+  // exits, a domain with DDS Security plugins loaded crashed the process.
+  if (own_domain_ > 0 && dds_get_children(own_domain_, nullptr, 0) == 0) {
+    (void)dds_delete(own_domain_);
+  }
+}
 
 }  // namespace dnbridge::dds

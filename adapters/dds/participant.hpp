@@ -21,9 +21,10 @@ using Properties = std::vector<Property>;
 
 class Participant : public Entity {
  public:
-  // Joins `domain` as "dnbridge <rack>". Throws Error; when Cyclone refuses
-  // the participant, the message has the reason Cyclone logged (a DDS
-  // Security plugin's, for instance).
+  // Joins `domain` as "dnbridge <rack>", with the bridge's domain settings
+  // when this process is the first in it (participant.cpp). Throws Error;
+  // when Cyclone refuses the participant, the message has the reason Cyclone
+  // logged (a DDS Security plugin's, for instance).
   Participant(dds_domainid_t domain, std::string_view rack, const Properties& properties = {});
 
   // A participant that is not a bridge (a client such as dnbctl), named as
@@ -33,10 +34,25 @@ class Participant : public Entity {
   };
   Participant(dds_domainid_t domain, ClientName client, const Properties& properties = {});
 
+  // Deletes the participant, and the domain it created if no other
+  // participant is left in it.
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
   dds_domainid_t domain() const noexcept { return domain_; }
 
+  // A participant and the domain created for it (0: it joined one).
+  struct Created {
+    dds_entity_t participant;
+    dds_entity_t domain;
+  };
+
  private:
+  Participant(Created created, dds_domainid_t domain);
+
   dds_domainid_t domain_;
+  dds_entity_t own_domain_;
 };
 
 // "dnbridge <rack>": the participant name of a rack's bridge.

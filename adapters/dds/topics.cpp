@@ -86,9 +86,8 @@ Qos reply_writer_qos() {
   Qos qos;
   qos.reliable(kReplyMaxBlocking)
       .durability(Durability::kTransientLocal)
-      .keep_all()
-      .resource_limits(kReplyWriterMaxSamples, 1, kReplyWriterMaxSamples)
-      .durability_service_keep_last(kRepliesForLateReaders);
+      .keep_last(kReplyHistory)
+      .durability_service_keep_last(kReplyHistory);
   return qos;
 }
 

@@ -102,9 +102,8 @@ Qos request_reader_qos();
 
 // Replies are transient-local: the bridge may answer before its reply writer
 // has discovered the requester's reply reader (discovery of the two topics is
-// independent), and a volatile reply would then be lost. The writer keeps the
-// last kRepliesForLateReaders replies (durability service keep-last) for
-// such a late reader.
+// independent), and a volatile reply would then be lost. Such a late reader
+// gets the last kReplyHistory replies.
 //
 // Replies have no key: one instance, never unregistered while the bridge
 // runs. Keyed per transaction, each reply would register an instance of its
@@ -116,16 +115,20 @@ Qos request_reader_qos();
 // requesters never push out a requester's own, and keep those with their
 // requester name.
 //
-// The writer's history is keep-all, at most kReplyWriterMaxSamples samples:
-// when readers do not acknowledge, a write waits a short max_blocking_time
-// and fails, and what the writer holds stays bounded (Cyclone 0.10.2 keeps
-// each sample in a buffer of about 4 KB until every reader acknowledged it;
-// a keep-last writer, unbounded across instances, held 170 MB under a
-// burst). The bridge writes replies from a thread of its own: a reply reader
-// that does not acknowledge costs lost replies (counted on PortStatus),
-// never a poll.
-inline constexpr int32_t kRepliesForLateReaders = 256;
-inline constexpr int32_t kReplyWriterMaxSamples = 4096;
+// The writer's history is keep-last kReplyHistory of its one instance: a
+// reader that stops acknowledging (a client process whose Cyclone receive
+// thread waits, in a listener or on a reader that refuses a sample, and
+// which acknowledges nothing any more while its participant stays alive)
+// holds at most that many replies in the writer, never the writer itself.
+// Keep-all, the writer kept every reply that reader had not acknowledged;
+// once those passed Cyclone's high-water mark, every write waited and
+// failed, for every requester, for as long as that process lived. A reply a
+// working reader misses on the wire and asks for after kReplyHistory newer
+// ones were written is lost to it: its requester repeats the request and
+// gets the same reply (ExplicitGateway keeps completed transactions).
+// The bridge's participant also fixes Cyclone's high-water mark above what
+// its bounded histories can hold (participant.hpp).
+inline constexpr int32_t kReplyHistory = 64;
 Qos reply_writer_qos();
 Qos reply_reader_qos();
 

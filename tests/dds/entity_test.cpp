@@ -1,7 +1,13 @@
 // The RAII layer itself: names, set-up errors, waitsets and guard
 // conditions, read conditions and instance look-up.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -154,6 +160,53 @@ TEST_F(DdsTest, MatchedCounts) {
   ASSERT_TRUE(wait_for(participant_, writer));
   EXPECT_EQ(writer.matched_subscriptions().value(), 1U);
   EXPECT_EQ(reader.matched_publications().value(), 1U);
+}
+
+// A bridge's participant that is the first of its process in its domain
+// creates the domain (with the bridge's settings, participant.cpp) and
+// deletes it when it goes, unless another participant is still in it.
+TEST(BridgeDomain, GoesWithTheBridgeParticipantUnlessAnotherIsLeftInIt) {
+  // A domain no other participant of this process is in (test domains are
+  // 100 to 199; another process's is told apart by its discovery tag).
+  const dds_domainid_t domain = test_domain() < 150 ? test_domain() + 50 : test_domain() - 50;
+  {
+    Participant bridge(domain, "domain-test");
+    EXPECT_EQ(dds_create_domain(domain, nullptr), DDS_RETCODE_PRECONDITION_NOT_MET);
+  }
+  const dds_entity_t again = dds_create_domain(domain, nullptr);
+  ASSERT_GT(again, 0) << "the domain outlived its bridge participant";
+  ASSERT_EQ(dds_delete(again), DDS_RETCODE_OK);
+
+  // The settings Cyclone read for the domain (its trace of the
+  // configuration), the operator's CYCLONEDDS_URI after them.
+  const std::string uri = std::getenv("CYCLONEDDS_URI");
+  const std::string trace =
+      ::testing::TempDir() + "bridge-domain-" + std::to_string(getpid()) + ".log";
+  ASSERT_EQ(setenv("CYCLONEDDS_URI",
+                   (uri + ",<Tracing><Category>config</Category><OutputFile>" + trace +
+                    "</OutputFile></Tracing>")
+                       .c_str(),
+                   1),
+            0);
+  auto bridge = std::make_unique<Participant>(domain, "domain-test");
+  ASSERT_EQ(setenv("CYCLONEDDS_URI", uri.c_str(), 1), 0);
+  std::ifstream file(trace);
+  std::stringstream read;
+  read << file.rdbuf();
+  const std::string config = read.str();
+  for (const char* setting :
+       {"Watermarks/WhcAdaptive/#text: false {0}", "Watermarks/WhcHighInit/#text: 4 MiB {0}",
+        "Watermarks/WhcHigh/#text: 4 MiB {0}", "Tracing/OutputFile"}) {
+    EXPECT_NE(config.find(setting), std::string::npos) << setting << " not in " << trace;
+  }
+  std::remove(trace.c_str());
+
+  Participant client(domain, Participant::ClientName{"domain-test client"});
+  bridge.reset();
+  EXPECT_TRUE(client.entity_name().ok()) << "the client's participant went with the bridge's";
+  const dds_entity_t left = dds_get_parent(client.handle());
+  ASSERT_GT(left, 0);
+  EXPECT_EQ(dds_delete(left), DDS_RETCODE_OK);  // and with it the client's participant
 }
 
 }  // namespace

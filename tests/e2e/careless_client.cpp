@@ -28,13 +28,16 @@
 //       an ExplicitReply reader with an early reply QoS (keep-all, at most 4
 //       samples per instance), never taken from: once it holds 4 replies it
 //       rejects the next, and Cyclone's delivery in this process waits for
-//       it. Writes one request (txid 1) again each time a
-//       reply came, until the reader rejects one (at most REPEATS times),
-//       prints "stalled after N" (or "not stalled after N"); then GETS Gets
-//       (txids 2..GETS+1, nodes 1..8 in turn), prints "sent OK FAILED" (writes
-//       that succeeded and failed); answers the line "status" with
-//       "rejected N" (replies its reader rejected); stays until the end of
-//       stdin.
+//       it (synchronous delivery: its receive thread waits, so this process
+//       acknowledges nothing more on any topic). Readers of PumpState,
+//       NodeStatus and PortStatus as well, matched before the stall, which
+//       then acknowledge nothing either. Writes one request (txid 1) again
+//       each time a reply came, until the reader rejects one (at most
+//       REPEATS times), prints "stalled after N" (or "not stalled after N");
+//       on the line "gets" writes GETS Gets (txids 2..GETS+1, nodes 1..8 in
+//       turn), prints "sent OK FAILED" (writes that succeeded and failed);
+//       answers the line "status" with "rejected N" (replies its reader
+//       rejected); stays until the end of stdin.
 //   three-writers STRENGTH LEASE_MS READERS
 //       three PumpCommand writers in this one participant with the documented
 //       command writer QoS, writer N commanding pump N on (analog 100 x N,
@@ -184,7 +187,16 @@ int stall_replies(dds_domainid_t domain, const std::string& requester, std::uint
                                               rejecting_reply_reader_qos());
   dds::Writer<dnbridge_ExplicitRequest> writer(participant, request_topic,
                                                dds::request_writer_qos());
+  dds::Topic<dnbridge_PumpState> pump_topic(participant);
+  dds::Topic<dnbridge_NodeStatus> node_topic(participant);
+  dds::Topic<dnbridge_PortStatus> port_topic(participant);
+  dds::Reader<dnbridge_PumpState> pumps(participant, pump_topic, dds::state_reader_qos());
+  dds::Reader<dnbridge_NodeStatus> nodes(participant, node_topic, dds::state_reader_qos());
+  dds::Reader<dnbridge_PortStatus> ports(participant, port_topic, dds::state_reader_qos());
   await_writer(participant, replies, "the ExplicitReply reader");
+  await_writer(participant, pumps, "the PumpState reader");
+  await_writer(participant, nodes, "the NodeStatus reader");
+  await_writer(participant, ports, "the PortStatus reader");
   await_reader(participant, writer, "the ExplicitRequest writer");
   std::uint32_t ok = 0;
   std::uint32_t failed = 0;
@@ -215,11 +227,14 @@ int stall_replies(dds_domainid_t domain, const std::string& requester, std::uint
     (void)dds_take_status(replies.handle(), &status, DDS_DATA_AVAILABLE_STATUS);
   }
   say((rejected() > 0 ? "stalled after " : "not stalled after ") + std::to_string(written));
-  for (std::uint32_t txid = 2; txid < 2 + gets; ++txid) write(txid, node_of(txid));
-  say("sent " + std::to_string(ok) + " " + std::to_string(failed));
   std::string line;
   while (next_line(line)) {
-    if (line == "status") say("rejected " + std::to_string(rejected()));
+    if (line == "gets") {
+      for (std::uint32_t txid = 2; txid < 2 + gets; ++txid) write(txid, node_of(txid));
+      say("sent " + std::to_string(ok) + " " + std::to_string(failed));
+    } else if (line == "status") {
+      say("rejected " + std::to_string(rejected()));
+    }
   }
   // Deleting a reader that Cyclone's delivery waits for may wait too.
   std::_Exit(0);

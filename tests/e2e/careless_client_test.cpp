@@ -310,13 +310,20 @@ TEST_F(CarelessClientTest, RequesterThatNeverUnregistersDelaysNeitherCommandsNor
 // 3. A client whose ExplicitReply reader is never taken from, with the reply
 // QoS of before eeaf5de (keep-all, at most 4 samples per instance): after 4
 // replies of the transaction it repeats, the reader rejects the next, and
-// Cyclone's delivery in that client's process waits for it, for good. The
-// bridge's reply writer then has a reader that acknowledges nothing. The
-// client goes on with 600 Gets. Every node stays online throughout, no poll
+// Cyclone's delivery in that client's process waits for it, for good. That
+// process then acknowledges nothing, on any topic: the bridge's reply writer
+// and its state writers have a reader that holds what they wrote. Readers
+// that join late (transient-local, as a supervisor or dnbctl started now)
+// make the bridge's writers resend what the stalled reader holds; with a
+// keep-all reply writer and Cyclone's adaptive high-water mark, from then
+// on every reply write waited and failed, for everyone. The client goes on
+// with 600 Gets. Every node stays online throughout, no poll
 // times out or is retried, every PortStatus says 8 nodes online and a longest
 // loop pass of at most 5 ms (PortStatus.loop_longest_pass_ms; it leaves out
-// the frames handled while the loop waits, hence the poll counters too), and
-// this client's own Get is answered within 1 s.
+// the frames handled while the loop waits, hence the poll counters too), the
+// early and the late NodeStatus readers get every node's status every
+// period, and this client's own Get is answered within 1 s, to its early
+// and its late reply reader.
 // A pass's length is wall time: on a loaded machine it also counts the time
 // other processes held the CPU (passes of under 1 ms of the port thread's own
 // CPU time were seen at 7.8 ms, preempted). The bridge's port thread runs under
@@ -381,6 +388,28 @@ TEST_F(CarelessClientTest, ReplyReaderThatNeverTakesCostsNoPollAndNoNode) {
   ASSERT_TRUE(stalled.has_value()) << "the careless client did not start";
   ASSERT_EQ(stalled->rfind("stalled after ", 0), 0u) << *stalled;
   report("careless client started -> its reply reader rejected a reply", ms_since(started));
+  // Late joiners, as a supervisor or dnbctl started now: readers of
+  // NodeStatus and ExplicitReply (both transient-local) that ask the
+  // bridge's writers for what they hold, samples the stalled client never
+  // acknowledged. Those writers resend them: from then on, with the stalled
+  // client still matched, they count as writers that are resending data.
+  Subscription<dnbridge_NodeStatus> late_nodes(supervisor_, node_topic_, dds::state_reader_qos());
+  Subscription<dnbridge_ExplicitReply> late_replies(supervisor_, reply_topic_,
+                                                    dds::reply_reader_qos());
+  ASSERT_TRUE(late_nodes.matched(1));
+  ASSERT_TRUE(late_replies.matched(1));
+  watch.add(late_nodes);
+  watch.add(late_replies);
+  ASSERT_TRUE(watch.until(
+      [&] {
+        for (unsigned mac = 1; mac <= kPumps; ++mac) {
+          if (!late_nodes.latest(pump_mac(mac))) return false;
+        }
+        return late_replies.latest([](const auto&) { return true; }) != nullptr;
+      },
+      kEventTimeout))
+      << "a late reader did not get the bridge's last NodeStatus and replies";
+  ASSERT_TRUE(client.send_line("gets"));
   const auto sent = line_from_client(seconds(30));
   ASSERT_TRUE(sent.has_value()) << "the careless client did not write its Gets";
   report("careless client started -> its Gets written", ms_since(started));
@@ -389,20 +418,27 @@ TEST_F(CarelessClientTest, ReplyReaderThatNeverTakesCostsNoPollAndNoNode) {
   // The run goes on for three more status periods (1 s), replies still
   // coming: three more NodeStatus of every node, three more PortStatus.
   const std::size_t nodes_at_sent = nodes_.history().size();
+  const std::size_t late_nodes_at_sent = late_nodes.history().size();
   const std::size_t ports_at_sent = ports_.history().size();
-  const auto three_more = [&] {
+  const auto three_of_every_node = [](const Subscription<dnbridge_NodeStatus>& s,
+                                      std::size_t from) {
     std::vector<unsigned> node_samples(kPumps + 1, 0);
-    for (std::size_t i = nodes_at_sent; i < nodes_.history().size(); ++i) {
-      const auto& n = nodes_.history()[i].sample;
+    for (std::size_t i = from; i < s.history().size(); ++i) {
+      const auto& n = s.history()[i].sample;
       if (n.valid_data() && n->mac <= kPumps) ++node_samples[n->mac];
     }
     return std::all_of(node_samples.begin() + 1, node_samples.end(),
-                       [](unsigned c) { return c >= 3; }) &&
+                       [](unsigned c) { return c >= 3; });
+  };
+  const auto three_more = [&] {
+    return three_of_every_node(nodes_, nodes_at_sent) &&
+           three_of_every_node(late_nodes, late_nodes_at_sent) &&
            ports_.history().size() >= ports_at_sent + 3;
   };
   EXPECT_TRUE(watch.until(three_more, seconds(15)))
       << "not three status periods' NodeStatus and PortStatus within 15 s: "
       << nodes_.history().size() - nodes_at_sent << " NodeStatus, "
+      << late_nodes.history().size() - late_nodes_at_sent << " NodeStatus to the late reader, "
       << ports_.history().size() - ports_at_sent << " PortStatus";
   const double run_ms = ms_since(started);
   report("run (careless client started -> three status periods after its writes)", run_ms);
@@ -456,9 +492,17 @@ TEST_F(CarelessClientTest, ReplyReaderThatNeverTakesCostsNoPollAndNoNode) {
   ASSERT_TRUE(rejected.has_value());
   std::printf("[ measured ] careless client's reply reader: %s\n", rejected->c_str());
 
-  // This client is still served.
+  // This client is still served, its early reader and its late one alike.
   const auto get = get_round_trip(requests, replies, 1, seconds(1));
   EXPECT_TRUE(get.has_value()) << "the well-behaved Get was not answered within 1 s";
+  EXPECT_TRUE(late_replies.until(
+      [&] {
+        return late_replies.latest([&](const dnbridge_ExplicitReply& r) {
+          return r.txid == 1 && dds::view(r.requester) == requester_;
+        }) != nullptr;
+      },
+      seconds(1)))
+      << "the late reply reader did not get the well-behaved Get's reply";
   if (get) report("well-behaved Get written -> reply, the careless reader stalled", *get);
 }
 

@@ -129,6 +129,33 @@ TEST_F(ExplicitTest, ARequesterNameWithANulInsideIsRefused) {
   EXPECT_TRUE(log_.contains(LogLevel::kWarn, "goes on past a NUL character"));
 }
 
+TEST_F(ExplicitTest, AnOversizedRequestIsDroppedUnansweredAndTheLargestServedOneIsAnswered) {
+  ASSERT_NO_FATAL_FAILURE(start_online());
+  // A reply quotes its requester and may quote its port: a request of over
+  // 2 KiB serialized is not answered, so that no reply can be that large.
+  Request oversized = get(90, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kVendor);
+  oversized.port = std::string(3000, 'p');
+  ASSERT_NO_FATAL_FAILURE(send(oversized));
+  // The largest request the bridge serves: 512 bytes of data, a port name of
+  // 100 characters (no such port here).
+  Request largest = get(91, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kVendor);
+  largest.port = std::string(100, 'q');
+  largest.data.assign(512, 0x55);
+  ASSERT_NO_FATAL_FAILURE(send(largest));
+  const auto answered = reply(91);
+  ASSERT_TRUE(answered) << "the largest request the bridge serves was not answered";
+  EXPECT_EQ(answered->status, kInvalidPort) << answered->message;
+  // One reply writer, in order: the first request's reply would be there.
+  EXPECT_EQ(reply_count(90), 0u);
+  EXPECT_TRUE(log_.contains(LogLevel::kWarn, "dropped unanswered"));
+  // And the bridge goes on serving.
+  ASSERT_NO_FATAL_FAILURE(
+      send(get(92, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kVendor)));
+  const auto vendor = reply(92);
+  ASSERT_TRUE(vendor);
+  EXPECT_EQ(vendor->status, kSuccess) << vendor->message;
+}
+
 TEST_F(ExplicitTest, RepeatedRequestGetsTheSameReplyAndIsNotExecutedTwice) {
   ASSERT_NO_FATAL_FAILURE(start_online());
   auto wire = std::make_shared<WireCount>();
