@@ -43,6 +43,9 @@ class EventRecorder final : public devicenet::ScannerObserver {
                           TimePoint) override {
     explicit_results.push_back({id, m, r});
   }
+  void on_bus_scan(const devicenet::BusScan& scan, TimePoint) override {
+    bus_scans.push_back(scan);
+  }
 
   std::vector<Transition> of(MacId m) const {
     std::vector<Transition> out;
@@ -62,6 +65,7 @@ class EventRecorder final : public devicenet::ScannerObserver {
   std::string port_reason;
   std::vector<Transition> transitions;
   std::vector<ExplicitDone> explicit_results;
+  std::vector<devicenet::BusScan> bus_scans;
 };
 
 inline rack::PumpConfig pump(unsigned mac_value,

@@ -120,6 +120,8 @@ struct ScannerConfig {
   // about nodes x window / poll period frames at once: the CAN interface's
   // transmit queue should hold that many.
   Duration poll_batch_window = milliseconds(2);
+  // A bus scan's wait for each answer of a node it asks (bus_probe.hpp).
+  Duration scan_response_timeout = milliseconds(1000);
   std::vector<NodeConfig> nodes;
 };
 

@@ -87,6 +87,9 @@ Scanner::Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& ob
 }
 
 void Scanner::set_state(PortState next, std::string reason, TimePoint now) {
+  if (next != PortState::kRunning && probe_) {
+    end_bus_scan(fmt::format("port {}: {}", to_string(next), reason), now);
+  }
   if (next == state_ && reason == reason_) return;
   state_ = next;
   reason_ = std::move(reason);
@@ -220,6 +223,7 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
       n->on_poll_response(payload, rx_time);
     } else {
       ++counters_.unknown_nodes;
+      answering_other_master_.set(id->mac.value());
       heard_unconfigured(id->mac, "answering another master's poll", rx_time);
     }
     return;
@@ -228,8 +232,19 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
       id->message_id == static_cast<std::uint8_t>(Group2Message::kSlaveExplicitResponse)) {
     if (Node* n = find(id->mac)) {
       n->on_explicit_frame(payload, rx_time);
+      return;
+    }
+    if (probe_ && probe_->on_frame(id->mac, payload, rx_time)) {
+      if (probe_->done()) end_bus_scan({}, rx_time);
+      return;
+    }
+    ++counters_.unknown_nodes;
+    // The header names the master the response is for: a late answer to
+    // this master's own scan is not another master's.
+    if (!payload.empty() && decode_header(payload[0]).mac == config_.master_mac) {
+      heard_unconfigured(id->mac, "answering this master's bus scan late", rx_time);
     } else {
-      ++counters_.unknown_nodes;
+      answering_other_master_.set(id->mac.value());
       heard_unconfigured(id->mac, "answering another master's explicit request", rx_time);
     }
     return;
@@ -269,6 +284,10 @@ void Scanner::on_timer(TimePoint now) {
     return;
   }
   if (state_ != PortState::kRunning && state_ != PortState::kStopping) return;
+  if (probe_ && now >= probe_->deadline()) {
+    probe_->on_timer(now);
+    if (probe_->done()) end_bus_scan({}, now);
+  }
   bool polled = false;
   for (auto& n : nodes_) {
     if (now < n->deadline()) continue;
@@ -288,9 +307,74 @@ void Scanner::on_timer(TimePoint now) {
 TimePoint Scanner::next_deadline() const {
   if (state_ == PortState::kCheckingMac) return mac_check_.deadline();
   if (state_ != PortState::kRunning && state_ != PortState::kStopping) return kNever;
-  TimePoint t = kNever;
+  TimePoint t = probe_ ? probe_->deadline() : kNever;
   for (const auto& n : nodes_) t = std::min(t, n->deadline());
   return t;
+}
+
+Status Scanner::scan_bus(TimePoint now) {
+  if (state_ != PortState::kRunning) return Errc::kStopped;
+  if (probe_) return Errc::kBusy;
+  std::vector<MacId> ask;
+  std::vector<MacId> others;
+  const auto heard = unconfigured_heard(now);
+  for (unsigned m = 0; m <= MacId::kMax; ++m) {
+    const MacId mac = *MacId::from(m);
+    if (mac == config_.master_mac || find(mac)) continue;
+    if (heard.test(m) && answering_other_master_.test(m)) {
+      others.push_back(mac);
+    } else {
+      ask.push_back(mac);
+    }
+  }
+  log_.info(
+      "bus scan: asking {} MACs the scan list does not have ({} heard answering another "
+      "master are not asked)",
+      ask.size(), others.size());
+  probe_ = std::make_unique<BusProbe>(config_.master_mac, std::move(ask), others,
+                                      BusProbe::Config{config_.scan_response_timeout}, sink_);
+  probe_started_ = now;
+  probe_->start(now);
+  if (probe_->done()) end_bus_scan({}, now);
+  return {};
+}
+
+void Scanner::end_bus_scan(std::string_view why, TimePoint now) {
+  if (!probe_) return;
+  if (!why.empty()) probe_->cancel(why, now);
+  BusScan scan;
+  scan.findings = probe_->findings();
+  scan.started = probe_started_;
+  scan.finished = now;
+  scan.error = std::string(why);
+  probe_.reset();
+  const auto count = [&](ScanOutcome o) {
+    return std::count_if(scan.findings.begin(), scan.findings.end(),
+                         [o](const ScanFinding& f) { return f.outcome == o; });
+  };
+  log_.info("bus scan {}: {} nodes answered, {} held by another master, {} silent{}",
+            why.empty() ? "done" : "ended early", count(ScanOutcome::kIdentified),
+            count(ScanOutcome::kOwnedByOtherMaster) + count(ScanOutcome::kAnsweringOtherMaster),
+            count(ScanOutcome::kNoAnswer), why.empty() ? "" : fmt::format(" ({})", why));
+  observer_.on_bus_scan(scan, now);
+}
+
+std::string_view to_string(ScanOutcome outcome) noexcept {
+  switch (outcome) {
+    case ScanOutcome::kIdentified:
+      return "identified";
+    case ScanOutcome::kNoAnswer:
+      return "no answer";
+    case ScanOutcome::kRefused:
+      return "refused";
+    case ScanOutcome::kOwnedByOtherMaster:
+      return "owned by another master";
+    case ScanOutcome::kAnsweringOtherMaster:
+      return "answering another master";
+    case ScanOutcome::kNotAsked:
+      return "not asked";
+  }
+  return "?";
 }
 
 Status Scanner::set_outputs(MacId mac, Bytes data, TimePoint now) {

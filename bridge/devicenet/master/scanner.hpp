@@ -20,6 +20,7 @@
 #include "bridge/common/log.hpp"
 #include "bridge/common/result.hpp"
 #include "bridge/common/time.hpp"
+#include "bridge/devicenet/master/bus_probe.hpp"
 #include "bridge/devicenet/master/node.hpp"
 #include "bridge/devicenet/master/scan_list.hpp"
 #include "bridge/devicenet/master/scanner_events.hpp"
@@ -64,6 +65,12 @@ class Scanner {
   // carries. kNotConnected when the node holds no connection, kBusy when its
   // queue is full, kOutOfRange for a MAC not in the scan list.
   Result<std::uint32_t> request_explicit(MacId mac, const RequestMessage& request, TimePoint now);
+  // Starts a bus scan (bus_probe.hpp) of every MAC but the master's and the
+  // scan list's; on_bus_scan() tells its end. kStopped unless the port is
+  // running, kBusy while a scan is under way. The scan list's nodes are
+  // never addressed; MACs heard answering another master are not asked.
+  Status scan_bus(TimePoint now);
+  bool scanning_bus() const { return probe_ != nullptr; }
 
   PortState state() const { return state_; }
   const std::string& reason() const { return reason_; }
@@ -88,6 +95,9 @@ class Scanner {
   Node* find(MacId mac);
   // A frame from `mac`, which is not in the scan list and not the master's.
   void heard_unconfigured(MacId mac, std::string_view how, TimePoint at);
+  // Ends the bus scan under way, if any, and reports it; `why` (not empty)
+  // when it ends early.
+  void end_bus_scan(std::string_view why, TimePoint now);
 
   ScannerConfig config_;
   can::FrameSink& sink_;
@@ -101,6 +111,10 @@ class Scanner {
   std::uint32_t next_request_id_ = 1;
   PortCounters counters_;
   std::array<TimePoint, MacId::kMax + 1> unconfigured_last_heard_;  // kNever: not heard
+  // Of those, the ones last heard answering another master's request.
+  std::bitset<MacId::kMax + 1> answering_other_master_;
+  std::unique_ptr<BusProbe> probe_;
+  TimePoint probe_started_{};
   RateLimitedLog foreign_log_limit_;
 };
 

@@ -40,6 +40,33 @@ struct NodeIdentity {
   std::optional<std::uint8_t> state;
 };
 
+// What a bus scan (Scanner::scan_bus) found at one MAC the scan list does
+// not have.
+enum class ScanOutcome : std::uint8_t {
+  kIdentified,            // allocated, Identity read (what it refused: detail), released
+  kNoAnswer,              // nothing answered the Allocate
+  kRefused,               // the Allocate was refused (detail)
+  kOwnedByOtherMaster,    // refused: another master holds it (0x0C/0x01)
+  kAnsweringOtherMaster,  // heard answering another master: not asked
+  kNotAsked,              // the scan ended first (detail: why)
+};
+std::string_view to_string(ScanOutcome outcome) noexcept;
+
+struct ScanFinding {
+  MacId mac;
+  ScanOutcome outcome = ScanOutcome::kNotAsked;
+  NodeIdentity identity;  // kIdentified; Status and State are not read
+  std::string detail;     // for people; empty when there is nothing to add
+};
+
+// A whole scan: every MAC but the master's and the scan list's, in order.
+struct BusScan {
+  std::vector<ScanFinding> findings;
+  TimePoint started{};
+  TimePoint finished{};
+  std::string error;  // why it ended early (the port stopped); empty when complete
+};
+
 class ScannerObserver {
  public:
   virtual ~ScannerObserver() = default;
@@ -61,6 +88,8 @@ class ScannerObserver {
   // A node the scan list does not have was heard for the first time
   // (Scanner::unconfigured_heard).
   virtual void on_unconfigured_node(MacId /*mac*/, TimePoint /*at*/) {}
+  // The end of a bus scan started with Scanner::scan_bus.
+  virtual void on_bus_scan(const BusScan& /*scan*/, TimePoint /*at*/) {}
 };
 
 }  // namespace dnbridge::devicenet
@@ -94,6 +123,9 @@ class ObserverFanout final : public ScannerObserver {
   }
   void on_unconfigured_node(MacId m, TimePoint at) override {
     for (auto* o : observers_) o->on_unconfigured_node(m, at);
+  }
+  void on_bus_scan(const BusScan& s, TimePoint at) override {
+    for (auto* o : observers_) o->on_bus_scan(s, at);
   }
 
  private:
