@@ -619,6 +619,7 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
   timing("fault_recheck_ms", tm.fault_recheck);
   timing("poll_response_timeout_ms", tm.poll_response_timeout);
   timing("explicit_response_timeout_ms", tm.explicit_messaging.response_timeout);
+  timing("scan_response_timeout_ms", tm.scan_response_timeout);
   if (const toml::node* n = t.get("poll_batch_ms")) {
     if (auto v = read_ms(*n, "poll_batch_ms", 0, kMaxPollBatchMs, r)) tm.poll_batch_window = *v;
   }

@@ -13,7 +13,7 @@
 namespace dnbridge::daemon {
 namespace {
 
-enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3 };
+enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3, kScanRequests = 4 };
 
 // A command stamped further ahead of this host's clock is reported.
 constexpr Duration kClockSkewReported = seconds(1);
@@ -30,7 +30,7 @@ constexpr std::size_t kRequestBatches = 4;
 
 // A request serialized in more bytes than this is dropped unanswered. A
 // reply carries its requester name and may quote its port name, and the
-// reply writer's history (64 replies, dds::kReplyHistory) must stay far
+// reply writer's history (256 replies, dds::kReplyHistory) must stay far
 // below what Cyclone lets a writer hold unacknowledged (participant.cpp).
 // The largest request the bridge serves (512 bytes of data, names of 100
 // characters) takes under 900 bytes.
@@ -66,6 +66,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       log_(std::move(log)),
       commands_(participant, publisher.command_topic(), dds::command_reader_qos()),
       requests_(participant, publisher.request_topic(), dds::request_reader_qos()),
+      scan_requests_(participant, publisher.scan_request_topic(), dds::request_reader_qos()),
       command_buffer_(kBatch),
       request_buffer_(kBatch),
       stop_(participant),
@@ -75,13 +76,15 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   // (every status) a matched writer's SUBSCRIPTION_MATCHED, never read here,
   // would keep the waitset triggered and this thread spinning.
   for (const dds::Entity* reader :
-       {static_cast<const dds::Entity*>(&commands_), static_cast<const dds::Entity*>(&requests_)}) {
+       {static_cast<const dds::Entity*>(&commands_), static_cast<const dds::Entity*>(&requests_),
+        static_cast<const dds::Entity*>(&scan_requests_)}) {
     if (!reader->set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
       throw std::runtime_error("setting the status mask of a DDS input reader failed");
     }
   }
   waitset_.attach(commands_, kCommands);
   waitset_.attach(requests_, kRequests);
+  waitset_.attach(scan_requests_, kScanRequests);
   waitset_.attach(stop_, kStop);
 }
 
@@ -128,6 +131,7 @@ void DdsInput::run() {
       if (token == kStop) return;
       commands_waiting = commands_waiting || token == kCommands;
       requests = requests || token == kRequests;
+      if (token == kScanRequests) take_scan_requests();
     }
     if (commands_waiting) {
       const TimePoint now = port::steady_now();
@@ -204,6 +208,39 @@ bool DdsInput::take_requests() {
                         if (request_buffer_.info(i).valid_data())
                           on_request(request_buffer_.data(i), request_cdr_[i]);
                       });
+}
+
+void DdsInput::take_scan_requests() {
+  // Few, and each asks for at most one scan of a port: all at once.
+  auto taken = scan_requests_.take();
+  if (!taken) {
+    log_.error("taking bus scan requests failed: {}", taken.error().message());
+    return;
+  }
+  for (const auto& sample : *taken) {
+    if (!sample.valid_data()) continue;  // a requester unregistered its request
+    const auto& r = sample.data();
+    if (dds::view(r.rack) != rack_) continue;
+    port::ScanCall call{std::string(dds::view(r.requester)), r.txid};
+    const std::string_view port = dds::view(r.port);
+    if (call.requester.size() + port.size() > kMaxRequestBytes) {
+      warn_limit_.warn(log_, port::steady_now(),
+                       "bus scan request (txid {}) dropped unanswered: names of {} bytes, at "
+                       "most {} served",
+                       call.txid, call.requester.size() + port.size(), kMaxRequestBytes);
+      continue;
+    }
+    if (port::PortLoop* loop = port_of(port)) {
+      loop->scan_request(std::move(call));
+      continue;
+    }
+    port::BusScanAnswer refusal;
+    refusal.requester = std::move(call.requester);
+    refusal.txid = call.txid;
+    refusal.status = rack::TransactionStatus::kInvalidPort;
+    refusal.message = fmt::format("rack {} has no port \"{}\"", rack_, port);
+    publisher_.bus_scan_reply(std::string(port), refusal);
+  }
 }
 
 void DdsInput::on_request(const dnbridge_ExplicitRequest& r,

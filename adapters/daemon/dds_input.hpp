@@ -1,8 +1,9 @@
 #pragma once
-// What reaches the bridge from DDS: pump commands and explicit requests for
-// this rack. A waitset on a thread of its own takes them and hands each to
-// its port's loop through the loop's inbox; no DDS callback touches master
-// state. Requests for other racks are left to their bridges.
+// What reaches the bridge from DDS: pump commands, explicit requests and
+// bus scan requests for this rack. A waitset on a thread of its own takes
+// them and hands each to its port's loop through the loop's inbox; no DDS
+// callback touches master state. Requests for other racks are left to their
+// bridges.
 #include <atomic>
 #include <functional>
 #include <map>
@@ -38,6 +39,7 @@ class DdsInput {
   void run();
   void take_commands();
   bool take_requests();  // true when requests may remain
+  void take_scan_requests();
   void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
   void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
   void note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
@@ -49,6 +51,7 @@ class DdsInput {
   Logger log_;
   dds::Reader<dnbridge_PumpCommand> commands_;
   dds::Reader<dnbridge_ExplicitRequest> requests_;
+  dds::Reader<dnbridge_BusScanRequest> scan_requests_;
   dds::TakeBuffer<dnbridge_PumpCommand> command_buffer_;
   dds::TakeBuffer<dnbridge_ExplicitRequest> request_buffer_;
   std::vector<std::vector<unsigned char>> request_cdr_;

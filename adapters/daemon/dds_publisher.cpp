@@ -31,10 +31,13 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
       command_topic_(participant),
       request_topic_(participant),
       reply_topic_(participant),
+      scan_request_topic_(participant),
+      scan_reply_topic_(participant),
       pump_writer_(participant, pump_topic_, dds::state_writer_qos(state_deadline)),
       node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
       port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
       reply_writer_(participant, reply_topic_, dds::reply_writer_qos()),
+      scan_reply_writer_(participant, scan_reply_topic_, dds::reply_writer_qos()),
       // State samples are keyed (one waits per instance): the capacity only
       // bounds the unregistrations of a port that stops.
       state_out_("dds state out", 64),
@@ -89,6 +92,15 @@ void DdsPublisher::explicit_reply(const std::string& port, const rack::ExplicitA
   fill_explicit_reply(**sample, answer);
   const bool queued = reply_out_.post([this, sample, port] {
     if (!check(reply_writer_.write(**sample), "ExplicitReply")) undelivered(port);
+  });
+  if (!queued) undelivered(port);
+}
+
+void DdsPublisher::bus_scan_reply(const std::string& port, const port::BusScanAnswer& answer) {
+  auto sample = std::make_shared<dds::Owned<dnbridge_BusScanReply>>();
+  fill_bus_scan_reply(**sample, rack_, port, answer);
+  const bool queued = reply_out_.post([this, sample, port] {
+    if (!check(scan_reply_writer_.write(**sample), "BusScanReply")) undelivered(port);
   });
   if (!queued) undelivered(port);
 }
@@ -150,6 +162,7 @@ void DdsPublisher::flush(Duration timeout) {
   (void)node_writer_.wait_for_acks(left());
   (void)port_writer_.wait_for_acks(left());
   (void)reply_writer_.wait_for_acks(left());
+  (void)scan_reply_writer_.wait_for_acks(left());
 }
 
 }  // namespace dnbridge::daemon

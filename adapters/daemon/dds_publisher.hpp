@@ -45,6 +45,7 @@ class DdsPublisher final : public port::PortPublisher {
                    const port::NodeStatusView& node, TimePoint source_time) override;
   void port_status(const port::PortStatusView& status, TimePoint source_time) override;
   void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) override;
+  void bus_scan_reply(const std::string& port, const port::BusScanAnswer& answer) override;
   void port_stopped(const std::string& port) override;
 
   // Waits (at most `timeout`) until what was handed over is written and every
@@ -62,6 +63,9 @@ class DdsPublisher final : public port::PortPublisher {
 
   const dds::Topic<dnbridge_PumpCommand>& command_topic() const { return command_topic_; }
   const dds::Topic<dnbridge_ExplicitRequest>& request_topic() const { return request_topic_; }
+  const dds::Topic<dnbridge_BusScanRequest>& scan_request_topic() const {
+    return scan_request_topic_;
+  }
 
  private:
   // Logs a failed write (rate-limited); true when it succeeded.
@@ -76,10 +80,13 @@ class DdsPublisher final : public port::PortPublisher {
   dds::Topic<dnbridge_PumpCommand> command_topic_;
   dds::Topic<dnbridge_ExplicitRequest> request_topic_;
   dds::Topic<dnbridge_ExplicitReply> reply_topic_;
+  dds::Topic<dnbridge_BusScanRequest> scan_request_topic_;
+  dds::Topic<dnbridge_BusScanReply> scan_reply_topic_;
   dds::Writer<dnbridge_PumpState> pump_writer_;
   dds::Writer<dnbridge_NodeStatus> node_writer_;
   dds::Writer<dnbridge_PortStatus> port_writer_;
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;
+  dds::Writer<dnbridge_BusScanReply> scan_reply_writer_;
 
   void undelivered(const std::string& port);
 

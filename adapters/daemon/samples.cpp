@@ -223,6 +223,43 @@ void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer
   set_string(out.message, a.message);
 }
 
+void fill_bus_scan_reply(dnbridge_BusScanReply& out, std::string_view rack, std::string_view port,
+                         const port::BusScanAnswer& a) {
+  set_string(out.requester, a.requester);
+  out.txid = a.txid;
+  set_string(out.rack, rack);
+  set_string(out.port, port);
+  out.status = static_cast<std::uint8_t>(a.status);
+  set_string(out.message, a.message);
+  const auto ms = [](Duration d) {
+    const auto n = std::chrono::duration_cast<milliseconds>(d).count();
+    return static_cast<std::uint32_t>(
+        std::clamp<std::int64_t>(n, 0, std::numeric_limits<std::uint32_t>::max()));
+  };
+  out.duration_ms = ms(a.duration);
+  out.age_ms = ms(a.age);
+  // The sample owns its findings (freed with it): allocated as a DDS buffer.
+  auto& seq = out.findings;
+  seq._length = seq._maximum = static_cast<std::uint32_t>(a.findings.size());
+  seq._release = true;
+  seq._buffer =
+      a.findings.empty() ? nullptr : dds_sequence_dnbridge_ScanFinding_allocbuf(a.findings.size());
+  for (std::size_t i = 0; i < a.findings.size(); ++i) {
+    const auto& f = a.findings[i];
+    auto& o = seq._buffer[i];
+    o.mac = f.mac.value();
+    o.found = dds::found_to_idl(f.outcome);
+    o.vendor_id = f.identity.vendor_id;
+    o.product_type = f.identity.product_type;
+    o.product_code = f.identity.product_code;
+    o.major_revision = f.identity.major_revision;
+    o.minor_revision = f.identity.minor_revision;
+    o.serial_number = f.identity.serial_number;
+    set_string(o.product_name, f.identity.product_name);
+    set_string(o.detail, f.detail);
+  }
+}
+
 cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& c) {
   cdn127::PumpOutputs o;
   o.pump_on = c.pump_on;

@@ -19,6 +19,8 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
 void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,
                       const port::PortStatusView& status);
 void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer& answer);
+void fill_bus_scan_reply(dnbridge_BusScanReply& out, std::string_view rack, std::string_view port,
+                         const port::BusScanAnswer& answer);
 
 // A command sample's outputs, as the rack model takes them.
 profiles::cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& command);

@@ -78,11 +78,11 @@ dds_entity_t checked(dds_entity_t created, const std::string& errors,
 // keeps them above that for good, and after any resend (a late reader's
 // history, a lost packet) the mark stops growing: from then on every write
 // of that writer waited and failed, for every reader. The bridge's writers
-// all keep a bounded history (keep-last: a sample per state instance, 64
-// replies), which bounds what they hold unacknowledged whatever their
-// readers do; fixed at 4 MiB, far above those bounds, the mark is never
-// reached. The operator's CYCLONEDDS_URI (files and fragments, as Cyclone
-// reads it) comes after and may override these.
+// all keep a bounded history (keep-last: a sample per state instance, 256
+// replies of at most a few KiB, as requests over 2 KiB are not answered),
+// which bounds what they hold unacknowledged whatever their readers do;
+// fixed at 4 MiB, above those bounds, the mark is not reached. The operator's CYCLONEDDS_URI (files
+// and fragments, as Cyclone reads it) comes after and may override these.
 constexpr const char* kBridgeDomainConfig =
     "<CycloneDDS><Domain id=\"any\"><Internal><Watermarks>"
     "<WhcAdaptive>false</WhcAdaptive>"

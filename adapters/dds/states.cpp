@@ -57,6 +57,17 @@ constexpr std::array<std::pair<AnalogKind, dnbridge_SafeAction>, 4> kAnalogActio
     {AnalogKind::kValue, dnbridge_SAFE_ACTION_VALUE},
 }};
 
+using devicenet::ScanOutcome;
+
+constexpr std::array<std::pair<ScanOutcome, std::uint8_t>, 6> kScanOutcomes{{
+    {ScanOutcome::kIdentified, dnbridge_FOUND_IDENTIFIED},
+    {ScanOutcome::kNoAnswer, dnbridge_FOUND_NO_ANSWER},
+    {ScanOutcome::kRefused, dnbridge_FOUND_REFUSED},
+    {ScanOutcome::kOwnedByOtherMaster, dnbridge_FOUND_OWNED_BY_OTHER_MASTER},
+    {ScanOutcome::kAnsweringOtherMaster, dnbridge_FOUND_ANSWERING_OTHER_MASTER},
+    {ScanOutcome::kNotAsked, dnbridge_FOUND_NOT_ASKED},
+}};
+
 template <class Table, class Core>
 auto idl_of(const Table& table, Core core, decltype(table[0].second) otherwise) {
   const auto it = std::find_if(table.begin(), table.end(),
@@ -117,6 +128,19 @@ std::string_view name_of(dnbridge_SafeAction action) {
     return profiles::cdn127::to_string(*core);
   }
   return action == dnbridge_SAFE_ACTION_VALUE ? "value" : "unknown";
+}
+
+std::uint8_t found_to_idl(devicenet::ScanOutcome outcome) {
+  return idl_of(kScanOutcomes, outcome, dnbridge_FOUND_NOT_ASKED);
+}
+
+std::optional<devicenet::ScanOutcome> found_from_idl(std::uint8_t found) {
+  return core_of(kScanOutcomes, found);
+}
+
+std::string_view found_name(std::uint8_t found) {
+  if (const auto core = found_from_idl(found)) return devicenet::to_string(*core);
+  return "unknown";
 }
 
 }  // namespace dnbridge::dds

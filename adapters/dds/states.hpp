@@ -2,6 +2,7 @@
 // The data model's state enums and the bridge's own, one table per enum
 // (states.cpp) for both directions; and one name per state, the core's,
 // which the logs, dnbctl's text and its JSON all use.
+#include <cstdint>
 #include <optional>
 #include <string_view>
 
@@ -34,5 +35,11 @@ std::string_view name_of(dnbridge_PortLifecycle state);
 std::string_view name_of(dnbridge_BusState state);
 // "off", "on", "hold" (the core's), "value", "unknown".
 std::string_view name_of(dnbridge_SafeAction action);
+
+// A bus scan finding's FOUND_* value (an octet constant, not an enum).
+std::uint8_t found_to_idl(devicenet::ScanOutcome outcome);
+std::optional<devicenet::ScanOutcome> found_from_idl(std::uint8_t found);
+// "identified", "no answer", ... (the core's); "unknown".
+std::string_view found_name(std::uint8_t found);
 
 }  // namespace dnbridge::dds

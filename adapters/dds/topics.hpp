@@ -43,6 +43,16 @@ struct TopicTraits<dnbridge_ExplicitReply> {
   static constexpr const char* kName = "dnbridge/ExplicitReply";
   static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_ExplicitReply_desc;
 };
+template <>
+struct TopicTraits<dnbridge_BusScanRequest> {
+  static constexpr const char* kName = "dnbridge/BusScanRequest";
+  static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_BusScanRequest_desc;
+};
+template <>
+struct TopicTraits<dnbridge_BusScanReply> {
+  static constexpr const char* kName = "dnbridge/BusScanReply";
+  static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_BusScanReply_desc;
+};
 
 // --- State topics: PumpState, NodeStatus, PortStatus -------------------------
 // Reliable, transient-local, keep-last 1: a late joiner gets each instance's
@@ -128,8 +138,12 @@ Qos request_reader_qos();
 // gets the same reply (ExplicitGateway keeps completed transactions).
 // The bridge's participant also fixes Cyclone's high-water mark above what
 // its bounded histories can hold (participant.hpp).
-inline constexpr int32_t kReplyHistory = 64;
+inline constexpr int32_t kReplyHistory = 256;
 Qos reply_writer_qos();
 Qos reply_reader_qos();
+
+// BusScanRequest / BusScanReply (a port's bus scan) follow the same
+// contract: request_*_qos() for requests (keyed by requester and txid),
+// reply_*_qos() for replies (no key, one instance).
 
 }  // namespace dnbridge::dds

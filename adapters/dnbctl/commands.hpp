@@ -3,12 +3,13 @@
 // command line (add_*) and runs when chosen (run_*). A run returns the exit
 // code or throws CommandError; output goes to stdout, errors to stderr.
 #include <CLI/CLI.hpp>
-
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "adapters/dnbctl/client.hpp"
+#include "adapters/dnbctl/format.hpp"
 #include "adapters/dnbctl/options.hpp"
 
 namespace dnbridge::dnbctl {
@@ -20,6 +21,17 @@ Client make_client(const GlobalOptions& options);
 void print(const std::string& text);
 
 // --- inspect_commands.cpp: list, racks, show ------------------------------------
+// What list, racks and scan share: whether a port the options allow was
+// heard; waiting until one is (else CommandError kNotFound), a moment for
+// other bridges, then until nothing is `missing` or the timeout (a note on
+// stderr says what is missing); what is missing of the allowed ports' nodes.
+bool any_port(const Client& client, const GlobalOptions& o);
+void gather(Client& client, const GlobalOptions& o, const std::function<bool()>& found,
+            const std::function<std::string()>& missing);
+std::string nodes_missing(const Client& client, const GlobalOptions& o);
+// The nodes the options allow, each with its PumpState when seen.
+std::vector<NodeRow> node_rows(const Client& client, const GlobalOptions& o);
+
 struct ListArgs {
   bool nodes_only = false;
   bool ports_only = false;
@@ -74,5 +86,10 @@ struct ExplicitArgs {
 };
 CLI::App* add_explicit(CLI::App& app, ExplicitKind kind, ExplicitArgs& args);
 Exit run_explicit(const GlobalOptions& options, const ExplicitArgs& args);
+
+// --- scan_command.cpp ------------------------------------------------------------------
+// scan: takes only the global options (--rack, --port, --json, --timeout).
+CLI::App* add_scan(CLI::App& app);
+Exit run_scan(const GlobalOptions& options);
 
 }  // namespace dnbridge::dnbctl

@@ -41,6 +41,8 @@ bool complete(const Client& client, const GlobalOptions& o) {
   return true;
 }
 
+}  // namespace
+
 bool any_port(const Client& client, const GlobalOptions& o) {
   for (const auto& [key, port] : client.ports()) {
     if (o.matches(key.rack, key.port)) return true;
@@ -73,6 +75,8 @@ std::string nodes_missing(const Client& client, const GlobalOptions& o) {
   return complete(client, o) ? std::string() : "not every configured node was reported";
 }
 
+namespace {
+
 // The rows list and racks show: what the options allow.
 std::vector<PortRow> port_rows(const Client& client, const GlobalOptions& o) {
   std::vector<PortRow> ports;
@@ -81,6 +85,8 @@ std::vector<PortRow> port_rows(const Client& client, const GlobalOptions& o) {
   }
   return ports;
 }
+
+}  // namespace
 
 std::vector<NodeRow> node_rows(const Client& client, const GlobalOptions& o) {
   std::vector<NodeRow> nodes;
@@ -91,8 +97,6 @@ std::vector<NodeRow> node_rows(const Client& client, const GlobalOptions& o) {
   }
   return nodes;
 }
-
-}  // namespace
 
 CLI::App* add_list(CLI::App& app, ListArgs& args) {
   auto* cmd = app.add_subcommand(

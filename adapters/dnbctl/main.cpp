@@ -77,6 +77,7 @@ int main(int argc, char** argv) {
   auto* set_cmd = add_explicit(app, ExplicitKind::kSet, set);
   auto* service_cmd = add_explicit(app, ExplicitKind::kService, service);
   auto* show_cmd = add_show(app, show);
+  auto* scan_cmd = add_scan(app);
 
   try {
     app.parse(argc, argv);
@@ -116,6 +117,7 @@ int main(int argc, char** argv) {
     if (get_cmd->parsed()) rc = run_explicit(options, get);
     if (set_cmd->parsed()) rc = run_explicit(options, set);
     if (service_cmd->parsed()) rc = run_explicit(options, service);
+    if (scan_cmd->parsed()) rc = run_scan(options);
     return code(rc);
   } catch (const CommandError& e) {
     std::fprintf(stderr, "dnbctl: %s\n", e.what());

@@ -67,6 +67,7 @@ class RackMetrics final : public port::PortPublisher, public prometheus::Collect
                    const port::NodeStatusView& node, TimePoint) override;
   void port_status(const port::PortStatusView& status, TimePoint) override;
   void explicit_reply(const std::string&, const rack::ExplicitAnswer&) override {}
+  void bus_scan_reply(const std::string&, const port::BusScanAnswer&) override {}
   void port_stopped(const std::string& port) override;
 
   // prometheus::Collectable: the metric families now (the server's thread).

@@ -87,6 +87,67 @@ void PortLoop::explicit_request(rack::ExplicitCall call) {
                                                      kMaxQueuedCalls, config_.port)));
 }
 void PortLoop::post(std::function<void(CanBackend&)> fn) { push(std::move(fn)); }
+void PortLoop::scan_request(ScanCall call) { push(std::move(call)); }
+
+void PortLoop::handle_scan_call(ScanCall call, TimePoint now) {
+  if (last_scan_ && last_scan_->error.empty() && now - last_scan_->finished < kScanHoldoff &&
+      !scanner().scanning_bus()) {
+    answer_scan(call, *last_scan_, now);
+    return;
+  }
+  const auto refuse = [&](rack::TransactionStatus status, std::string message) {
+    BusScanAnswer a;
+    a.requester = call.requester;
+    a.txid = call.txid;
+    a.status = status;
+    a.message = std::move(message);
+    publisher_.bus_scan_reply(config_.port, a);
+  };
+  if (scan_waiters_.size() >= kMaxScanWaiters) {
+    refuse(rack::TransactionStatus::kOutOfBuffers,
+           fmt::format("{} requests already wait for port {}'s bus scan", kMaxScanWaiters,
+                       config_.port));
+    return;
+  }
+  // Waiting before the scan starts: a scan with nothing to ask ends at once.
+  scan_waiters_.push_back(call);
+  if (scanner().scanning_bus()) return;
+  if (auto started = scanner().scan_bus(now); !started) {
+    scan_waiters_.pop_back();
+    refuse(rack::TransactionStatus::kPortOffline,
+           fmt::format("port {} is not scanning its nodes ({}: {}): no bus scan", config_.port,
+                       devicenet::to_string(scanner().state()), scanner().reason()));
+  }
+}
+
+void PortLoop::on_bus_scan(const devicenet::BusScan& scan, TimePoint at) {
+  last_scan_ = scan;
+  std::vector<ScanCall> waiters;
+  waiters.swap(scan_waiters_);
+  for (const auto& call : waiters) answer_scan(call, scan, at);
+}
+
+void PortLoop::answer_scan(const ScanCall& call, const devicenet::BusScan& scan, TimePoint now) {
+  BusScanAnswer a;
+  a.requester = call.requester;
+  a.txid = call.txid;
+  a.duration = scan.finished - scan.started;
+  a.age = now - scan.finished;
+  a.findings = scan.findings;
+  const auto seconds_of = [](Duration d) { return std::chrono::duration<double>(d).count(); };
+  if (scan.error.empty()) {
+    a.status = rack::TransactionStatus::kSuccess;
+    a.message =
+        a.age > Duration::zero()
+            ? fmt::format("port {}: the bus scan of {:.1f} s ago (at most one every {:.0f} s)",
+                          config_.port, seconds_of(a.age), seconds_of(kScanHoldoff))
+            : fmt::format("port {}: bus scanned in {:.1f} s", config_.port, seconds_of(a.duration));
+  } else {
+    a.status = rack::TransactionStatus::kPortOffline;
+    a.message = fmt::format("port {}: bus scan cut short ({})", config_.port, scan.error);
+  }
+  publisher_.bus_scan_reply(config_.port, a);
+}
 
 void PortLoop::push(Item item) {
   {
@@ -124,6 +185,8 @@ bool PortLoop::drain_inbox(TimePoint now) {
       if (rack().release_command(r->mac, now)) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
+    } else if (auto* scan = std::get_if<ScanCall>(&item)) {
+      handle_scan_call(std::move(*scan), now);
     } else if (auto* fn = std::get_if<std::function<void(CanBackend&)>>(&item)) {
       (*fn)(*backend_);
     } else {

@@ -38,6 +38,12 @@ struct PortLoopConfig {
   Duration shutdown_timeout = seconds(3);    // for idling and releasing every node
 };
 
+// A bus scan request as received (BusScanRequest).
+struct ScanCall {
+  std::string requester;
+  std::uint32_t txid = 0;
+};
+
 class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver {
  public:
   // Throws std::invalid_argument for a configuration the master refuses.
@@ -64,6 +70,15 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // Requests handled in one pass of the loop; the rest wait for the next
   // pass, which comes at once, after the bus's timers and frames.
   static constexpr std::size_t kCallsPerPass = 32;
+  // A bus scan (devicenet::Scanner::scan_bus), answered through the
+  // publisher when it ends. One scan at a time: a request while one runs
+  // waits for it (at most kMaxScanWaiters, the rest answered at once with
+  // "out of buffers"); one within kScanHoldoff after a complete scan gets
+  // that scan again, so that requests cannot make the bus scanned more
+  // often.
+  void scan_request(ScanCall call);
+  static constexpr std::size_t kMaxScanWaiters = 64;
+  static constexpr Duration kScanHoldoff = seconds(30);
   // Runs `fn` on the port's thread with its backend (tests and tools only).
   void post(std::function<void(CanBackend&)> fn);
 
@@ -97,7 +112,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     devicenet::MacId mac;
   };
   struct Stop {};
-  using Item = std::variant<Command, Release, Stop, std::function<void(CanBackend&)>>;
+  using Item = std::variant<Command, Release, Stop, ScanCall, std::function<void(CanBackend&)>>;
 
   void run();
   // Starts the master once the interface is up: its duplicate MAC ID check
@@ -120,6 +135,11 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void on_node_state(devicenet::MacId m, devicenet::NodeState f, devicenet::NodeState t,
                      const std::string& r, TimePoint at) override;
   void on_unconfigured_node(devicenet::MacId, TimePoint) override { port_dirty_ = true; }
+  void on_bus_scan(const devicenet::BusScan& scan, TimePoint at) override;
+  void handle_scan_call(ScanCall call, TimePoint now);
+  void answer_scan(const ScanCall& call, const devicenet::BusScan& scan, TimePoint now);
+  std::vector<ScanCall> scan_waiters_;
+  std::optional<devicenet::BusScan> last_scan_;
   void on_explicit_result(std::uint32_t id, devicenet::MacId m, const devicenet::ExplicitResult& r,
                           TimePoint at) override;
   // FrameReceiver

@@ -54,6 +54,18 @@ struct NodeStatusView {
   static NodeStatusView of(const devicenet::Node& node);
 };
 
+// The answer to a bus scan request (BusScanRequest): a port's scan, run for
+// it or joined, or the last one again.
+struct BusScanAnswer {
+  std::string requester;
+  std::uint32_t txid = 0;
+  rack::TransactionStatus status = rack::TransactionStatus::kSuccess;
+  std::string message;
+  Duration duration{};  // the scan's
+  Duration age{};       // since the scan ended, when it answered an earlier request
+  std::vector<devicenet::ScanFinding> findings;
+};
+
 class PortPublisher {
  public:
   virtual ~PortPublisher() = default;
@@ -67,6 +79,8 @@ class PortPublisher {
   virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;
   // `port`: the port whose gateway answers; empty for a request no port took.
   virtual void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) = 0;
+  // `port`: the port scanned, or the port asked for when it does not exist.
+  virtual void bus_scan_reply(const std::string& port, const BusScanAnswer& answer) = 0;
   // The port has stopped: its instances are unregistered (never disposed).
   virtual void port_stopped(const std::string& port) = 0;
 };

@@ -27,6 +27,10 @@ class PublisherTee final : public PortPublisher {
     first_.explicit_reply(port, answer);
     second_.explicit_reply(port, answer);
   }
+  void bus_scan_reply(const std::string& port, const BusScanAnswer& answer) override {
+    first_.bus_scan_reply(port, answer);
+    second_.bus_scan_reply(port, answer);
+  }
   void port_stopped(const std::string& port) override {
     first_.port_stopped(port);
     second_.port_stopped(port);

@@ -24,10 +24,10 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
                       later runs keep the site's, which changes only with
                       --new-ca)
   --bridge NAME       a rack's bridge: publishes PumpState, NodeStatus,
-                      PortStatus and ExplicitReply, reads PumpCommand and
-                      ExplicitRequest
+                      PortStatus, ExplicitReply and BusScanReply, reads
+                      PumpCommand, ExplicitRequest and BusScanRequest
   --supervisor NAME   a supervisory host: reads every dnbridge topic, writes
-                      PumpCommand and ExplicitRequest
+                      PumpCommand, ExplicitRequest and BusScanRequest
   --monitor NAME      a monitoring host: reads PumpState, NodeStatus and
                       PortStatus only
   --days N            validity of new identities and of the permissions
@@ -280,15 +280,18 @@ EOF
 topics() { for t in "$@"; do echo "            <topic>dnbridge/$t</topic>"; done; }
 publish_of() {
   case $1 in
-    bridge) topics PumpState NodeStatus PortStatus ExplicitReply ;;
-    supervisor) topics PumpCommand ExplicitRequest ;;
+    bridge) topics PumpState NodeStatus PortStatus ExplicitReply BusScanReply ;;
+    supervisor) topics PumpCommand ExplicitRequest BusScanRequest ;;
     monitor) ;;
   esac
 }
 subscribe_of() {
   case $1 in
-    bridge) topics PumpCommand ExplicitRequest ;;
-    supervisor) topics PumpState NodeStatus PortStatus ExplicitReply PumpCommand ExplicitRequest ;;
+    bridge) topics PumpCommand ExplicitRequest BusScanRequest ;;
+    supervisor)
+      topics PumpState NodeStatus PortStatus ExplicitReply PumpCommand ExplicitRequest \
+        BusScanRequest BusScanReply
+      ;;
     monitor) topics PumpState NodeStatus PortStatus ;;
   esac
 }

@@ -202,6 +202,7 @@ TEST(ConfigFile, NodeSettingsOverrideDefaults) {
       "poll_response_timeout_ms = 20\n"
       "poll_batch_ms = 0\n"
       "explicit_response_timeout_ms = 1500\n"
+      "scan_response_timeout_ms = 300\n"
       "max_consecutive_errors = 4\n"
       "[[port.node]]\n"
       "mac = 1\n"
@@ -230,6 +231,7 @@ TEST(ConfigFile, NodeSettingsOverrideDefaults) {
   EXPECT_EQ(p.master.poll_response_timeout, milliseconds(20));
   EXPECT_EQ(p.master.poll_batch_window, Duration::zero());
   EXPECT_EQ(p.master.explicit_messaging.response_timeout, milliseconds(1500));
+  EXPECT_EQ(p.master.scan_response_timeout, milliseconds(300));
   EXPECT_EQ(p.master.max_consecutive_errors, 4u);
 
   const NodeSettings& a = p.nodes.at(0);

@@ -54,6 +54,11 @@ class RecordingPublisher final : public PortPublisher {
     ++port_samples;
     changed_.notify_all();
   }
+  void bus_scan_reply(const std::string&, const BusScanAnswer& a) override {
+    std::lock_guard lock(mutex_);
+    scans.push_back(a);
+    changed_.notify_all();
+  }
   void explicit_reply(const std::string&, const rack::ExplicitAnswer& a) override {
     std::lock_guard lock(mutex_);
     replies.push_back(a);
@@ -85,6 +90,7 @@ class RecordingPublisher final : public PortPublisher {
   std::optional<PortStatusView> port;
   std::vector<std::string> port_reasons;  // each new one
   std::vector<rack::ExplicitAnswer> replies;
+  std::vector<BusScanAnswer> scans;
   std::size_t pump_samples = 0, status_samples = 0, port_samples = 0;
   bool stopped = false;
 
@@ -609,6 +615,66 @@ TEST(PortLoop, APortWaitingForItsInterfaceStopsAtOnce) {
   loop.stop();
   loop.join();
   EXPECT_TRUE(publisher.stopped);
+}
+
+// Bus scan requests: two that come together get the one scan, which finds
+// the device the scan list does not have; a port whose interface is absent
+// answers "port off-line" at once and asks nothing.
+TEST(PortLoop, BusScanRequestsShareAScanAndAPortOffTheBusRefusesThem) {
+  RecordingPublisher publisher;
+  PortLoopConfig config = config_for({1});
+  config.scanner.scan_response_timeout = milliseconds(100);  // a silent MAC: 100 ms
+  PortLoop loop(
+      config,
+      std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(1), mac(9)}),
+      publisher, null_log_sink());
+  loop.start();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(1) && publisher.pumps[1].online; }));
+  loop.scan_request({"first", 1});
+  loop.scan_request({"second", 7});
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.scans.size() >= 2; }, std::chrono::seconds(60)));
+  {
+    std::lock_guard lock(publisher.mutex());
+    ASSERT_EQ(publisher.scans.size(), 2u);
+    const BusScanAnswer& a = publisher.scans[0];
+    const BusScanAnswer& b = publisher.scans[1];
+    EXPECT_EQ(a.requester, "first");
+    EXPECT_EQ(b.requester, "second");
+    EXPECT_EQ(b.txid, 7u);
+    for (const BusScanAnswer* x : {&a, &b}) {
+      EXPECT_EQ(x->status, rack::TransactionStatus::kSuccess) << x->message;
+      EXPECT_EQ(x->age, Duration::zero()) << "not the scan run for it";
+      EXPECT_EQ(x->duration, a.duration);
+      ASSERT_EQ(x->findings.size(), 62u);  // all but the master (0) and node 1
+      const auto& at9 = x->findings[7];
+      EXPECT_EQ(at9.mac, mac(9));
+      EXPECT_EQ(at9.outcome, devicenet::ScanOutcome::kIdentified) << at9.detail;
+      EXPECT_EQ(at9.identity.product_code, profiles::cdn127::kProductCode);
+    }
+  }
+  loop.stop();
+  loop.join();
+
+  RecordingPublisher offline;
+  PortLoop absent(config_for({1}),
+                  std::make_unique<UnpluggedBackend>(std::make_unique<sim::SimBackend>(
+                      can::kBitrate500k, std::vector<MacId>{mac(1)})),
+                  offline, null_log_sink());
+  absent.start();
+  ASSERT_TRUE(offline.wait_for([&] { return offline.port_samples >= 1; }));
+  absent.scan_request({"third", 3});
+  ASSERT_TRUE(offline.wait_for([&] { return !offline.scans.empty(); }));
+  {
+    std::lock_guard lock(offline.mutex());
+    EXPECT_EQ(offline.scans[0].status, rack::TransactionStatus::kPortOffline);
+    EXPECT_NE(offline.scans[0].message.find("not scanning its nodes"), std::string::npos)
+        << offline.scans[0].message;
+    EXPECT_TRUE(offline.scans[0].findings.empty());
+  }
+  absent.stop();
+  absent.join();
 }
 
 }  // namespace

@@ -81,6 +81,26 @@ class CheckingObserver final : public devicenet::ScannerObserver {
     ++results_;
   }
 
+  // A scan's findings: every MAC but the master's and the scan list's, once,
+  // ascending; an identity only where the node was identified.
+  void on_bus_scan(const devicenet::BusScan& scan, TimePoint at) override {
+    check_time(at);
+    FUZZ_CHECK(scan.started <= scan.finished && scan.finished == at);
+    FUZZ_CHECK(scan.findings.size() == MacId::kMax - config_.nodes.size());
+    unsigned previous = 0;
+    bool first = true;
+    for (const auto& f : scan.findings) {
+      FUZZ_CHECK(f.mac != config_.master_mac && find(f.mac) == nullptr);
+      FUZZ_CHECK(first || f.mac.value() > previous);
+      first = false;
+      previous = f.mac.value();
+      if (f.outcome != devicenet::ScanOutcome::kIdentified) {
+        FUZZ_CHECK(f.identity.vendor_id == 0 && f.identity.product_name.empty());
+      }
+      if (f.outcome == devicenet::ScanOutcome::kNotAsked) FUZZ_CHECK(!scan.error.empty());
+    }
+  }
+
   NodeState state(MacId mac) const { return states_[mac.value()]; }
   // The scanner it observes, for what the events do not carry.
   void watch(const devicenet::Scanner& scanner) { scanner_ = &scanner; }
@@ -188,6 +208,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case fuzz::Op::kStop:
         scanner.stop(now);
         break;
+      case fuzz::Op::kScanBus: {
+        const bool can_start = scanner.state() == PortState::kRunning && !scanner.scanning_bus();
+        FUZZ_CHECK(scanner.scan_bus(now).ok() == can_start);
+        break;
+      }
     }
     // The work a received frame or request starts may be due at once.
     run_timers(scanner, now);

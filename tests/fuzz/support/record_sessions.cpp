@@ -51,9 +51,10 @@ class Stream {
 
 struct Scenario {
   std::string name;
-  std::vector<bool> devices;  // a CDN127 at MAC 1, MAC 2
+  std::vector<bool> devices;  // a CDN127 at MAC 1, MAC 2, ... (the scan list: 1 and 2)
   bool stop_at_end = true;
   Duration length = seconds(6);
+  bool scan_bus = false;  // a bus scan after the explicit request
 };
 
 void write(const std::string& path, const std::vector<std::uint8_t>& bytes) {
@@ -83,7 +84,7 @@ void run(const Scenario& s, const std::string& scanner_dir, const std::string& s
   scanner.start(now);
   for (auto& d : slaves) d->power_on(now);
   const TimePoint end = now + s.length;
-  bool outputs_set = false, request_sent = false, stopped = false;
+  bool outputs_set = false, request_sent = false, scan_started = false, stopped = false;
 
   const auto deliver = [&] {
     while (!queue.empty()) {
@@ -150,6 +151,11 @@ void run(const Scenario& s, const std::string& scanner_dir, const std::string& s
         m.instance_id = 1;
         m.attribute = 7;
         (void)scanner.request_explicit(n1->mac(), m, now);
+      } else if (s.scan_bus && request_sent && !scan_started &&
+                 now >= fuzz::kSessionStart + seconds(5)) {
+        scan_started = true;
+        master_in.add(Op::kScanBus, now, 0, {});
+        (void)scanner.scan_bus(now);
       }
     }
   }
@@ -173,6 +179,8 @@ int main(int argc, char** argv) {
       {"both_online_then_stop", {true, true}, true, seconds(6)},
       {"one_absent", {true, false}, false, seconds(4)},
       {"startup_only", {true, true}, false, milliseconds(1500)},
+      // A CDN127 at MAC 4, which the scan list does not have: found by the scan.
+      {"bus_scan", {true, true, false, true}, true, seconds(15), true},
   };
   for (const auto& s : scenarios) run(s, argv[1], argv[2]);
   return 0;

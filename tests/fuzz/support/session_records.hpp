@@ -26,12 +26,13 @@
 namespace dnbridge::fuzz {
 
 enum class Op : std::uint8_t {
-  kFrame = 0,            // 0..7 and 13..15: a received frame
-  kTimer = 8,            // time passes, nothing else
-  kSetOutputs = 9,       // scanner: set_outputs(node data[0] % n, data[1..])
-  kSetIdle = 10,         // scanner: set_idle(node data[0] % n, data[1] & 1)
-  kRequestExplicit = 11, // scanner: request_explicit(node data[0] % n, request in data[1..])
-  kStop = 12,            // scanner: stop(); slave: power cycle
+  kFrame = 0,             // 0..7, 14 and 15: a received frame
+  kTimer = 8,             // time passes, nothing else
+  kSetOutputs = 9,        // scanner: set_outputs(node data[0] % n, data[1..])
+  kSetIdle = 10,          // scanner: set_idle(node data[0] % n, data[1] & 1)
+  kRequestExplicit = 11,  // scanner: request_explicit(node data[0] % n, request in data[1..])
+  kStop = 12,             // scanner: stop(); slave: power cycle
+  kScanBus = 13,          // scanner: scan_bus()
 };
 
 inline constexpr Duration kStepUnit = microseconds(100);
@@ -52,7 +53,7 @@ inline std::optional<Record> next_record(ByteReader& in) noexcept {
   if (!in.ok()) return std::nullopt;
   Record r;
   const unsigned op = head >> 4;
-  r.op = op == 8 || (op >= 9 && op <= 12) ? static_cast<Op>(op) : Op::kFrame;
+  r.op = op >= 8 && op <= 13 ? static_cast<Op>(op) : Op::kFrame;
   r.step = kStepUnit * step;
   if (r.op == Op::kFrame) r.frame.id = in.u16le();
   const std::size_t len = head & 0x0FU;
