@@ -211,36 +211,44 @@ bool DdsInput::take_requests() {
 }
 
 void DdsInput::take_scan_requests() {
-  // Few, and each asks for at most one scan of a port: all at once.
-  auto taken = scan_requests_.take();
-  if (!taken) {
-    log_.error("taking bus scan requests failed: {}", taken.error().message());
+  // Each asks for at most one scan of a port: every one waiting, taken now
+  // (a take resets DATA_AVAILABLE: what a full take leaves would wait for
+  // the next request).
+  for (;;) {
+    auto taken = scan_requests_.take(kBatch);
+    if (!taken) {
+      log_.error("taking bus scan requests failed: {}", taken.error().message());
+      return;
+    }
+    for (const auto& sample : *taken) on_scan_request(sample);
+    if (taken->size() < kBatch) return;
+  }
+}
+
+void DdsInput::on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample) {
+  if (!sample.valid_data()) return;  // a requester unregistered its request
+  const auto& r = sample.data();
+  if (dds::view(r.rack) != rack_) return;
+  port::ScanCall call{std::string(dds::view(r.requester)), r.txid};
+  const std::string_view port = dds::view(r.port);
+  // A reply carries the requester name and may quote the port's.
+  if (call.requester.size() + port.size() > kMaxRequestBytes) {
+    warn_limit_.warn(log_, port::steady_now(),
+                     "bus scan request (txid {}) dropped unanswered: names of {} bytes, at "
+                     "most {} served",
+                     call.txid, call.requester.size() + port.size(), kMaxRequestBytes);
     return;
   }
-  for (const auto& sample : *taken) {
-    if (!sample.valid_data()) continue;  // a requester unregistered its request
-    const auto& r = sample.data();
-    if (dds::view(r.rack) != rack_) continue;
-    port::ScanCall call{std::string(dds::view(r.requester)), r.txid};
-    const std::string_view port = dds::view(r.port);
-    if (call.requester.size() + port.size() > kMaxRequestBytes) {
-      warn_limit_.warn(log_, port::steady_now(),
-                       "bus scan request (txid {}) dropped unanswered: names of {} bytes, at "
-                       "most {} served",
-                       call.txid, call.requester.size() + port.size(), kMaxRequestBytes);
-      continue;
-    }
-    if (port::PortLoop* loop = port_of(port)) {
-      loop->scan_request(std::move(call));
-      continue;
-    }
-    port::BusScanAnswer refusal;
-    refusal.requester = std::move(call.requester);
-    refusal.txid = call.txid;
-    refusal.status = rack::TransactionStatus::kInvalidPort;
-    refusal.message = fmt::format("rack {} has no port \"{}\"", rack_, port);
-    publisher_.bus_scan_reply(std::string(port), refusal);
+  if (port::PortLoop* loop = port_of(port)) {
+    loop->scan_request(std::move(call));
+    return;
   }
+  port::BusScanAnswer refusal;
+  refusal.requester = std::move(call.requester);
+  refusal.txid = call.txid;
+  refusal.status = rack::TransactionStatus::kInvalidPort;
+  refusal.message = fmt::format("rack {} has no port \"{}\"", rack_, port);
+  publisher_.bus_scan_reply(std::string(port), refusal);
 }
 
 void DdsInput::on_request(const dnbridge_ExplicitRequest& r,

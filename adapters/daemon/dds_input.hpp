@@ -40,6 +40,7 @@ class DdsInput {
   void take_commands();
   bool take_requests();  // true when requests may remain
   void take_scan_requests();
+  void on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample);
   void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
   void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
   void note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);

@@ -37,7 +37,7 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
       node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
       port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
       reply_writer_(participant, reply_topic_, dds::reply_writer_qos()),
-      scan_reply_writer_(participant, scan_reply_topic_, dds::reply_writer_qos()),
+      scan_reply_writer_(participant, scan_reply_topic_, dds::scan_reply_writer_qos()),
       // State samples are keyed (one waits per instance): the capacity only
       // bounds the unregistrations of a port that stops.
       state_out_("dds state out", 64),

@@ -141,6 +141,9 @@ Participant::Participant(Created created, dds_domainid_t domain)
     : Entity(created.participant), domain_(domain), own_domain_(created.domain) {}
 
 Participant::~Participant() {
+  // Under the creation lock: a bridge participant created meanwhile must
+  // not find the domain and then lose it.
+  std::lock_guard lock(g_creating);
   reset();
   // The domain goes with the last participant in it, as one that Cyclone
   // created implicitly does. Left for Cyclone to tear down as the process

@@ -91,6 +91,15 @@ Qos reply_writer_qos() {
   return qos;
 }
 
+Qos scan_reply_writer_qos() {
+  Qos qos;
+  qos.reliable(kReplyMaxBlocking)
+      .durability(Durability::kTransientLocal)
+      .keep_last(kScanReplyHistory)
+      .durability_service_keep_last(kScanReplyHistory);
+  return qos;
+}
+
 Qos reply_reader_qos() {
   Qos qos;
   qos.reliable(kMaxBlocking).durability(Durability::kTransientLocal).keep_all();

@@ -144,6 +144,11 @@ Qos reply_reader_qos();
 
 // BusScanRequest / BusScanReply (a port's bus scan) follow the same
 // contract: request_*_qos() for requests (keyed by requester and txid),
-// reply_*_qos() for replies (no key, one instance).
+// reply_reader_qos() for reply readers (no key, one instance). A scan reply
+// is larger (up to 63 findings, some 30 KiB at most): the writer keeps the
+// last kScanReplyHistory, which bounds what it holds for a reader that
+// stopped acknowledging to well under a MiB.
+inline constexpr int32_t kScanReplyHistory = 16;
+Qos scan_reply_writer_qos();
 
 }  // namespace dnbridge::dds

@@ -29,7 +29,8 @@ namespace cdn127 = profiles::cdn127;
 
 constexpr dds::WaitSet::Token kScanReplies = 11;
 // A scan asks up to 63 MACs, eight at a time, 1 s for a silent one: about
-// 8 s; a node that answers takes longer. The reply is awaited this long.
+// 8 s; a node that answers takes longer. The reply is awaited this long, or
+// --timeout if that is longer.
 constexpr Duration kScanWait = seconds(60);
 // A request with no reply yet is written again this often (a bridge that
 // matched late; the same transaction joins the same scan).
@@ -55,17 +56,12 @@ bool is_cdn127(const dnbridge_ScanFinding& f) {
          f.product_code == cdn127::kProductCode;
 }
 
-// The lines that add an unconfigured node to the rack configuration, under
-// its port's [[port]] table.
+// The lines that add an unconfigured CDN127 to the rack configuration,
+// under its port's [[port]] table (the bridge's only profile is the
+// CDN127's: nothing is suggested for another device).
 std::string configuration_lines(const dnbridge_ScanFinding& f) {
-  std::string s =
-      fmt::format("  [[port.node]]\n  mac = {}\n  name = \"node-{}\"\n  serial = 0x{:08X}\n", f.mac,
-                  f.mac, f.serial_number);
-  if (!is_cdn127(f)) {
-    s += fmt::format("  identity = {{ vendor_id = {}, product_type = {}, product_code = {} }}\n",
-                     f.vendor_id, f.product_type, f.product_code);
-  }
-  return s;
+  return fmt::format("  [[port.node]]\n  mac = {}\n  name = \"node-{}\"\n  serial = 0x{:08X}\n",
+                     f.mac, f.mac, f.serial_number);
 }
 
 std::string revision_text(std::uint8_t major, std::uint8_t minor) {
@@ -127,8 +123,13 @@ Record finding_record(const PortKey& port, const dnbridge_ScanFinding& f) {
   } else {
     identity_fields(r, 0, 0, 0, 0, 0, 0, "");
   }
-  r.add("detail", std::string(dds::view(f.detail)), "detail", std::string(dds::view(f.detail)));
-  if (identified) r.json("suggested_configuration", configuration_lines(f));
+  std::string detail(dds::view(f.detail));
+  if (identified && !is_cdn127(f)) {
+    detail = "not a CDN127, the one device dnbridge has a profile for" +
+             (detail.empty() ? "" : "; " + detail);
+  }
+  r.add("detail", detail, "detail", detail);
+  if (identified && is_cdn127(f)) r.json("suggested_configuration", configuration_lines(f));
   return r;
 }
 
@@ -145,8 +146,9 @@ CLI::App* add_scan(CLI::App& app) {
       "answers at the other MAC IDs, which the bridge asks once each (Allocate of the explicit "
       "connection, the Identity object, Release; never a node of its scan list, never one "
       "another master holds). Each row says whether the node is configured; for an "
-      "unconfigured one found, the configuration lines that would add it follow the table. A "
-      "scan takes some 8 s; a port scanned within the last 30 s answers with that scan. --json "
+      "unconfigured CDN127 found, the configuration lines that would add it follow the table. A "
+      "scan takes some 8 s (the reply is awaited 60 s, or --timeout if longer); a port scanned "
+      "within the last 30 s answers with that scan. --json "
       "gives one record per node found (mac, vendor_id, product_type, product_code, "
       "serial_number, product_name, configured, ...) and each port's scan.");
 }
@@ -189,7 +191,8 @@ Exit run_scan(const GlobalOptions& o) {
 
   // Until a bridge's request reader matched: a volatile request written
   // before is lost.
-  const Deadline deadline = deadline_after(kScanWait);
+  const Duration wait = std::max(kScanWait, o.timeout());
+  const Deadline deadline = deadline_after(wait);
   (void)client.wait_until(deadline_after(o.timeout()), [&] {
     auto n = writer.matched_subscriptions();
     return n.ok() && *n > 0;
@@ -255,7 +258,7 @@ Exit run_scan(const GlobalOptions& o) {
       summary += fmt::format(
           "rack {} port {}: no reply from the bridge within {:.0f} s: the "
           "configured nodes only\n",
-          s.key.rack, s.key.port, std::chrono::duration<double>(kScanWait).count());
+          s.key.rack, s.key.port, std::chrono::duration<double>(wait).count());
     } else {
       const dnbridge_BusScanReply& r = s.reply->data();
       std::vector<Json> silent;
@@ -266,7 +269,9 @@ Exit run_scan(const GlobalOptions& o) {
           continue;
         }
         by_mac.insert_or_assign(f.mac, finding_record(s.key, f));
-        if (f.found == dnbridge_FOUND_IDENTIFIED) port_suggestions += configuration_lines(f) + "\n";
+        if (f.found == dnbridge_FOUND_IDENTIFIED && is_cdn127(f)) {
+          port_suggestions += configuration_lines(f) + "\n";
+        }
       }
       port.json("status", r.status)
           .json("message", std::string(dds::view(r.message)))
@@ -305,7 +310,7 @@ Exit run_scan(const GlobalOptions& o) {
   }
   if (!answered) {
     std::fprintf(stderr, "dnbctl: not every port's bridge answered the scan within %.0f s\n",
-                 std::chrono::duration<double>(kScanWait).count());
+                 std::chrono::duration<double>(wait).count());
     return Exit::kNotFound;
   }
   return all_ok ? Exit::kOk : Exit::kFailed;

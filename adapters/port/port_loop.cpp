@@ -90,6 +90,13 @@ void PortLoop::post(std::function<void(CanBackend&)> fn) { push(std::move(fn)); 
 void PortLoop::scan_request(ScanCall call) { push(std::move(call)); }
 
 void PortLoop::handle_scan_call(ScanCall call, TimePoint now) {
+  // A request written again while its scan runs (a requester repeats until
+  // answered) is the same transaction: it waits once.
+  if (std::any_of(scan_waiters_.begin(), scan_waiters_.end(), [&](const ScanCall& w) {
+        return w.requester == call.requester && w.txid == call.txid;
+      })) {
+    return;
+  }
   if (last_scan_ && last_scan_->error.empty() && now - last_scan_->finished < kScanHoldoff &&
       !scanner().scanning_bus()) {
     answer_scan(call, *last_scan_, now);
@@ -107,6 +114,13 @@ void PortLoop::handle_scan_call(ScanCall call, TimePoint now) {
     refuse(rack::TransactionStatus::kOutOfBuffers,
            fmt::format("{} requests already wait for port {}'s bus scan", kMaxScanWaiters,
                        config_.port));
+    return;
+  }
+  if (!scanner().scanning_bus() &&
+      (bus_seen_ == BusState::kBusOff || bus_seen_ == BusState::kDown)) {
+    // Every MAC would be silent: a scan would say nothing is there.
+    refuse(rack::TransactionStatus::kPortOffline,
+           fmt::format("port {}: the bus is {}: no bus scan", config_.port, to_string(bus_seen_)));
     return;
   }
   // Waiting before the scan starts: a scan with nothing to ask ends at once.

@@ -179,7 +179,9 @@ TEST(BridgeDomain, GoesWithTheBridgeParticipantUnlessAnotherIsLeftInIt) {
 
   // The settings Cyclone read for the domain (its trace of the
   // configuration), the operator's CYCLONEDDS_URI after them.
-  const std::string uri = std::getenv("CYCLONEDDS_URI");
+  const char* set = std::getenv("CYCLONEDDS_URI");
+  ASSERT_NE(set, nullptr) << "the loopback environment sets CYCLONEDDS_URI";
+  const std::string uri = set;
   const std::string trace =
       ::testing::TempDir() + "bridge-domain-" + std::to_string(getpid()) + ".log";
   ASSERT_EQ(setenv("CYCLONEDDS_URI",

@@ -42,6 +42,7 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
  public:
   Slot(can::FrameSink& sink, MacId master, MacId mac, Config config)
       : client_(master, mac, ExplicitClient::Config{config.response_timeout, {}}, sink, *this),
+        allocate_timeout_(config.allocate_timeout),
         allocate_data_{allocation::kExplicit, master.value()} {
     finding_.mac = mac;
   }
@@ -53,8 +54,8 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
 
   void start(TimePoint now) {
     step_ = kAllocate;
-    submit(connection_request(cip::Service::kAllocateMasterSlave, Bytes(allocate_data_)), true,
-           now);
+    submit(connection_request(cip::Service::kAllocateMasterSlave, Bytes(allocate_data_)), true, now,
+           allocate_timeout_);
   }
 
   void cancel(std::string_view why, TimePoint now) {
@@ -70,8 +71,9 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
   static constexpr int kAllocate = -1;
   static constexpr int kRelease = static_cast<int>(kIdentityReads.size());
 
-  void submit(const RequestMessage& m, bool unconnected, TimePoint now) {
-    if (!client_.submit(0, m, unconnected, now)) {
+  void submit(const RequestMessage& m, bool unconnected, TimePoint now,
+              std::optional<Duration> timeout = std::nullopt) {
+    if (!client_.submit(0, m, unconnected, now, timeout)) {
       // Cannot happen with one request at a time; reported rather than hung.
       end(ScanOutcome::kRefused, "request could not be queued");
     }
@@ -80,6 +82,9 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
   void end(ScanOutcome outcome, std::string detail) {
     if (done_) return;
     finding_.outcome = outcome;
+    // An identity only whole: what was read of one refused in part is not
+    // enough to configure the device by (the detail says what was refused).
+    if (outcome != ScanOutcome::kIdentified) finding_.identity = {};
     if (!detail.empty()) note(detail);
     done_ = true;
   }
@@ -95,7 +100,8 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
       after_allocate(r, now);
     } else if (step_ == kRelease) {
       if (!r.ok()) note("Release refused: " + status_text(r));
-      end(ScanOutcome::kIdentified, "");
+      // What a configuration needs of the device: who made it and what it is.
+      end(identity_read_ ? ScanOutcome::kIdentified : ScanOutcome::kRefused, "");
     } else {
       after_read(r);
       next(now);
@@ -157,12 +163,18 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
         break;
       default:
         if (auto value = read_uint(data)) {
-          if (target.attribute == cip::identity_attr::kVendor)
+          if (target.attribute == cip::identity_attr::kVendor) {
             id.vendor_id = static_cast<std::uint16_t>(*value);
-          if (target.attribute == cip::identity_attr::kProductType)
+            vendor_read_ = true;
+          }
+          if (target.attribute == cip::identity_attr::kProductType) {
             id.product_type = static_cast<std::uint16_t>(*value);
-          if (target.attribute == cip::identity_attr::kProductCode)
+            type_read_ = true;
+          }
+          if (target.attribute == cip::identity_attr::kProductCode) {
             id.product_code = static_cast<std::uint16_t>(*value);
+            identity_read_ = vendor_read_ && type_read_;
+          }
           // The CDN127 manual types the serial number UINT, the ODVA
           // Identity object UDINT: either is taken.
           if (target.attribute == cip::identity_attr::kSerialNumber) id.serial_number = *value;
@@ -192,7 +204,11 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
   }
 
   ExplicitClient client_;
+  Duration allocate_timeout_;
   std::array<std::uint8_t, 2> allocate_data_;
+  bool vendor_read_ = false;
+  bool type_read_ = false;
+  bool identity_read_ = false;  // vendor, product type and product code
   std::array<std::uint8_t, 1> release_data_{};
   int step_ = kAllocate;
   bool done_ = false;
@@ -205,8 +221,10 @@ BusProbe::BusProbe(MacId master, std::vector<MacId> probe,
     : master_(master), waiting_(std::move(probe)), config_(config), sink_(sink) {
   std::reverse(waiting_.begin(), waiting_.end());
   for (MacId mac : answering_other_master) {
-    findings_.push_back(
-        {mac, ScanOutcome::kAnsweringOtherMaster, {}, "heard answering another master: not asked"});
+    findings_.push_back({mac,
+                         ScanOutcome::kAnsweringOtherMaster,
+                         {},
+                         "heard answering another master's polls: not asked"});
   }
 }
 

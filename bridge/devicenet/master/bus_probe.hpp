@@ -5,7 +5,7 @@
 // asked once per probe, nothing is retried, and at most kSlots MACs are
 // asked at a time: a scan of an empty bus costs some 70 frames. A node that
 // refuses the Allocate (another master holds it) is left alone; so is one
-// the master heard answering another master, which is never asked.
+// the master heard answering another master's polls, which is not asked.
 //
 // Sans-IO, driven by the Scanner (scanner.hpp): frames on Group 2 message 3
 // from a probed MAC come in through on_frame(), time through on_timer().
@@ -31,9 +31,12 @@ class BusProbe {
   static constexpr std::size_t kSlots = 8;
 
   struct Config {
-    // A probed node's answer to each request; a MAC silent for this long
-    // after the Allocate is taken for empty.
-    Duration response_timeout = milliseconds(1000);
+    // A MAC silent for this long after the Allocate is taken for empty.
+    Duration allocate_timeout = milliseconds(1000);
+    // The answer to each later request (Gets, Release), of a node that
+    // answered: longer than the 1 s a slave waits before it sends an
+    // unacknowledged response fragment again.
+    Duration response_timeout = milliseconds(2000);
   };
 
   // `probe`: the MACs to ask, in that order; `answering_other_master`: MACs

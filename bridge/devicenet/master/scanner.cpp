@@ -74,6 +74,7 @@ Scanner::Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& ob
       mac_check_(config_.master_mac, mac_check_config(config_)) {
   validate(config_);
   unconfigured_last_heard_.fill(kNever);
+  answering_other_master_.reset();
   nodes_.reserve(config_.nodes.size());
   for (const auto& n : config_.nodes) {
     // Every line of a node carries its MAC ID, as MAC and NODE.
@@ -101,6 +102,7 @@ void Scanner::set_state(PortState next, std::string reason, TimePoint now) {
 void Scanner::start(TimePoint now) {
   if (state_ != PortState::kStopped) return;
   unconfigured_last_heard_.fill(kNever);
+  answering_other_master_.reset();
   set_state(PortState::kCheckingMac,
             fmt::format("checking that no other node has MAC {}", config_.master_mac.value()), now);
   sink_.send(mac_check_.start(now), now);
@@ -207,6 +209,8 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
     if (Node* n = find(id->mac)) {
       if (!message->response) n->on_duplicate_mac_request(rx_time);
     } else {
+      // Powering up, it has no master (yet).
+      if (!message->response) answering_other_master_.reset(id->mac.value());
       heard_unconfigured(id->mac,
                          message->response ? "answering a duplicate MAC ID check"
                                            : "checking its MAC ID (powering up)",
@@ -223,7 +227,7 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
       n->on_poll_response(payload, rx_time);
     } else {
       ++counters_.unknown_nodes;
-      answering_other_master_.set(id->mac.value());
+      answering_other_master_.set(id->mac.value());  // polled: another master holds it
       heard_unconfigured(id->mac, "answering another master's poll", rx_time);
     }
     return;
@@ -234,19 +238,20 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
       n->on_explicit_frame(payload, rx_time);
       return;
     }
-    if (probe_ && probe_->on_frame(id->mac, payload, rx_time)) {
+    // The header names the master the response is for.
+    const bool for_this_master =
+        !payload.empty() && decode_header(payload[0]).mac == config_.master_mac;
+    if (for_this_master && probe_ && probe_->on_frame(id->mac, payload, rx_time)) {
       if (probe_->done()) end_bus_scan({}, rx_time);
       return;
     }
     ++counters_.unknown_nodes;
-    // The header names the master the response is for: a late answer to
-    // this master's own scan is not another master's.
-    if (!payload.empty() && decode_header(payload[0]).mac == config_.master_mac) {
-      heard_unconfigured(id->mac, "answering this master's bus scan late", rx_time);
-    } else {
-      answering_other_master_.set(id->mac.value());
-      heard_unconfigured(id->mac, "answering another master's explicit request", rx_time);
-    }
+    // An explicit answer to another master does not say that master holds
+    // the node (it may be scanning too): only its polls do.
+    heard_unconfigured(id->mac,
+                       for_this_master ? "answering this master's bus scan late"
+                                       : "answering another master's explicit request",
+                       rx_time);
     return;
   }
   // Requests from other masters, other connection types, Group 3 and 4.
@@ -331,8 +336,10 @@ Status Scanner::scan_bus(TimePoint now) {
       "bus scan: asking {} MACs the scan list does not have ({} heard answering another "
       "master are not asked)",
       ask.size(), others.size());
-  probe_ = std::make_unique<BusProbe>(config_.master_mac, std::move(ask), others,
-                                      BusProbe::Config{config_.scan_response_timeout}, sink_);
+  probe_ = std::make_unique<BusProbe>(
+      config_.master_mac, std::move(ask), others,
+      BusProbe::Config{config_.scan_response_timeout, config_.explicit_messaging.response_timeout},
+      sink_);
   probe_started_ = now;
   probe_->start(now);
   if (probe_->done()) end_bus_scan({}, now);

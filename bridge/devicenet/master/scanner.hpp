@@ -68,7 +68,8 @@ class Scanner {
   // Starts a bus scan (bus_probe.hpp) of every MAC but the master's and the
   // scan list's; on_bus_scan() tells its end. kStopped unless the port is
   // running, kBusy while a scan is under way. The scan list's nodes are
-  // never addressed; MACs heard answering another master are not asked.
+  // never addressed; MACs heard answering another master's polls are not
+  // asked.
   Status scan_bus(TimePoint now);
   bool scanning_bus() const { return probe_ != nullptr; }
 
@@ -111,7 +112,8 @@ class Scanner {
   std::uint32_t next_request_id_ = 1;
   PortCounters counters_;
   std::array<TimePoint, MacId::kMax + 1> unconfigured_last_heard_;  // kNever: not heard
-  // Of those, the ones last heard answering another master's request.
+  // Of those, the ones heard answering another master's polls since they
+  // were last heard powering up.
   std::bitset<MacId::kMax + 1> answering_other_master_;
   std::unique_ptr<BusProbe> probe_;
   TimePoint probe_started_{};

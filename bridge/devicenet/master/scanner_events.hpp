@@ -43,9 +43,10 @@ struct NodeIdentity {
 // What a bus scan (Scanner::scan_bus) found at one MAC the scan list does
 // not have.
 enum class ScanOutcome : std::uint8_t {
-  kIdentified,            // allocated, Identity read (what it refused: detail), released
+  kIdentified,            // allocated, vendor, product type and code read (what else it
+                          // refused: detail), released
   kNoAnswer,              // nothing answered the Allocate
-  kRefused,               // the Allocate was refused (detail)
+  kRefused,               // the Allocate or those three Gets were refused (detail)
   kOwnedByOtherMaster,    // refused: another master holds it (0x0C/0x01)
   kAnsweringOtherMaster,  // heard answering another master: not asked
   kNotAsked,              // the scan ended first (detail: why)
