@@ -3,7 +3,7 @@
 // MAC: Allocate of the explicit connection on the Group 2 unconnected port,
 // Gets of the Identity object, Release of what was allocated. Each MAC is
 // asked once per probe, nothing is retried, and at most kSlots MACs are
-// asked at a time: a scan of an empty bus costs some 70 frames. A node that
+// asked at a time: a silent MAC costs one frame. A node that
 // refuses the Allocate (another master holds it) is left alone; so is one
 // the master heard answering another master's polls, which is not asked.
 //
