@@ -32,6 +32,17 @@ Qos command_common() {
 // acknowledge) is given up soon; the requester repeats and gets it again.
 constexpr Duration kReplyMaxBlocking = milliseconds(10);
 
+// A reply writer keeping the last `history` replies of its one instance,
+// for late readers and for resends alike.
+Qos reply_writer_keeping(int32_t history) {
+  Qos qos;
+  qos.reliable(kReplyMaxBlocking)
+      .durability(Durability::kTransientLocal)
+      .keep_last(history)
+      .durability_service_keep_last(history);
+  return qos;
+}
+
 }  // namespace
 
 Qos state_writer_qos(Duration deadline) {
@@ -82,23 +93,9 @@ Qos request_reader_qos() {
   return qos;
 }
 
-Qos reply_writer_qos() {
-  Qos qos;
-  qos.reliable(kReplyMaxBlocking)
-      .durability(Durability::kTransientLocal)
-      .keep_last(kReplyHistory)
-      .durability_service_keep_last(kReplyHistory);
-  return qos;
-}
+Qos reply_writer_qos() { return reply_writer_keeping(kReplyHistory); }
 
-Qos scan_reply_writer_qos() {
-  Qos qos;
-  qos.reliable(kReplyMaxBlocking)
-      .durability(Durability::kTransientLocal)
-      .keep_last(kScanReplyHistory)
-      .durability_service_keep_last(kScanReplyHistory);
-  return qos;
-}
+Qos scan_reply_writer_qos() { return reply_writer_keeping(kScanReplyHistory); }
 
 Qos reply_reader_qos() {
   Qos qos;
