@@ -334,7 +334,7 @@ Status Scanner::scan_bus(TimePoint now) {
   }
   log_.info(
       "bus scan: asking {} MACs the scan list does not have ({} heard answering another "
-      "master are not asked)",
+      "master's polls are not asked)",
       ask.size(), others.size());
   probe_ = std::make_unique<BusProbe>(
       config_.master_mac, std::move(ask), others,
