@@ -243,12 +243,9 @@ void DdsInput::on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sampl
     loop->scan_request(std::move(call));
     return;
   }
-  port::BusScanAnswer refusal;
-  refusal.requester = std::move(call.requester);
-  refusal.txid = call.txid;
-  refusal.status = rack::TransactionStatus::kInvalidPort;
-  refusal.message = fmt::format("rack {} has no port \"{}\"", rack_, port);
-  publisher_.bus_scan_reply(std::string(port), refusal);
+  publisher_.bus_scan_reply(std::string(port),
+                            port::refuse(call, rack::TransactionStatus::kInvalidPort,
+                                         fmt::format("rack {} has no port \"{}\"", rack_, port)));
 }
 
 void DdsInput::on_request(const dnbridge_ExplicitRequest& r,

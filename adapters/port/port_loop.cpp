@@ -103,12 +103,7 @@ void PortLoop::handle_scan_call(ScanCall call, TimePoint now) {
     return;
   }
   const auto refuse = [&](rack::TransactionStatus status, std::string message) {
-    BusScanAnswer a;
-    a.requester = call.requester;
-    a.txid = call.txid;
-    a.status = status;
-    a.message = std::move(message);
-    publisher_.bus_scan_reply(config_.port, a);
+    publisher_.bus_scan_reply(config_.port, port::refuse(call, status, std::move(message)));
   };
   if (scan_waiters_.size() >= kMaxScanWaiters) {
     refuse(rack::TransactionStatus::kOutOfBuffers,

@@ -38,12 +38,6 @@ struct PortLoopConfig {
   Duration shutdown_timeout = seconds(3);    // for idling and releasing every node
 };
 
-// A bus scan request as received (BusScanRequest).
-struct ScanCall {
-  std::string requester;
-  std::uint32_t txid = 0;
-};
-
 class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver {
  public:
   // Throws std::invalid_argument for a configuration the master refuses.

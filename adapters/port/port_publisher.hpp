@@ -54,6 +54,12 @@ struct NodeStatusView {
   static NodeStatusView of(const devicenet::Node& node);
 };
 
+// A bus scan request as received (BusScanRequest).
+struct ScanCall {
+  std::string requester;
+  std::uint32_t txid = 0;
+};
+
 // The answer to a bus scan request (BusScanRequest): a port's scan, run for
 // it or joined, or the last one again.
 struct BusScanAnswer {
@@ -65,6 +71,18 @@ struct BusScanAnswer {
   Duration age{};       // since the scan ended, when it answered an earlier request
   std::vector<devicenet::ScanFinding> findings;
 };
+
+// An answer that refuses `call` without a scan (as rack::refuse for an
+// explicit request).
+inline BusScanAnswer refuse(const ScanCall& call, rack::TransactionStatus status,
+                            std::string message) {
+  BusScanAnswer a;
+  a.requester = call.requester;
+  a.txid = call.txid;
+  a.status = status;
+  a.message = std::move(message);
+  return a;
+}
 
 class PortPublisher {
  public:

@@ -74,7 +74,6 @@ Scanner::Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& ob
       mac_check_(config_.master_mac, mac_check_config(config_)) {
   validate(config_);
   unconfigured_last_heard_.fill(kNever);
-  answering_other_master_.reset();
   nodes_.reserve(config_.nodes.size());
   for (const auto& n : config_.nodes) {
     // Every line of a node carries its MAC ID, as MAC and NODE.
