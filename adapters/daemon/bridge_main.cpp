@@ -129,8 +129,9 @@ int bridge_main(int argc, char** argv, const Program& program) {
   const bool pinned = simulate && std::getenv("CYCLONEDDS_URI") == nullptr;
   if (pinned) setenv("CYCLONEDDS_URI", dds::loopback_config().c_str(), 0);
 
+  // A level given on the command line stays through reloads.
+  if (!level_name.empty()) config.log_level = *parse_level(level_name);
   StderrLogSink log(config.log_level);
-  if (!level_name.empty()) log.set_level(*parse_level(level_name));
   log.add_field("RACK", config.rack);
   Logger main_log(log, "dnbridge");
   for (const auto& w : config.warnings)
@@ -151,21 +152,40 @@ int bridge_main(int argc, char** argv, const Program& program) {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGUSR1);
+  sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  ReloadSource reload;
+  if (!config_file.empty()) {
+    reload.load = [config_file, level_name] {
+      DaemonConfig c = load_config_file(config_file);
+      if (!level_name.empty()) c.log_level = *parse_level(level_name);
+      return c;
+    };
+    reload.set_log_level = [&log](LogLevel level) { log.set_level(level); };
+  }
 
   try {
     Daemon bridge(config, log,
-                  with_simulator ? program.simulated_backends(log) : default_backend_factory(log));
+                  with_simulator ? program.simulated_backends(log) : default_backend_factory(log),
+                  std::move(reload));
     bridge.start();
     ServiceNotifier service(bridge, Logger(log, "systemd"));
     service.start();
-    main_log.info("running ({}); SIGINT or SIGTERM stops it in order, SIGUSR1 toggles candump logs",
-                  config.source);
+    main_log.info(
+        "running ({}); SIGINT or SIGTERM stops it in order, SIGHUP reads the configuration again, "
+        "SIGUSR1 toggles candump logs",
+        config.source);
     int signal = 0;
     for (;;) {
       sigwait(&signals, &signal);
-      if (signal != SIGUSR1) break;
-      bridge.toggle_candump(candump_dir);
+      if (signal == SIGUSR1) {
+        bridge.toggle_candump(candump_dir);
+      } else if (signal == SIGHUP) {
+        bridge.request_reload({});
+      } else {
+        break;
+      }
     }
     main_log.info("{}: stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
     service.stopping();

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "adapters/daemon/host_identity.hpp"
+#include "adapters/port/thread_name.hpp"
 #include "adapters/socketcan/socketcan_backend.hpp"
 
 namespace dnbridge::daemon {
@@ -33,6 +34,18 @@ port::PortLoopConfig loop_config(const DaemonConfig& rack, const PortConfig& p,
   return c;
 }
 
+// What the explicit gateway lets through beyond Gets is a site decision
+// worth seeing at every start and reload.
+void warn_of_policy(Logger& log, const rack::ExplicitPolicy& policy) {
+  for (std::size_t i = 0; i < rack::kGuardedRequestKinds; ++i) {
+    const auto kind = static_cast<rack::GuardedRequest>(i);
+    if (policy.allows(kind)) {
+      log.warn("[explicit_policy] {} = true: remote requesters may send {}; risk: {}",
+               rack::policy_key(kind), rack::name_of(kind), rack::risk_of(kind));
+    }
+  }
+}
+
 }  // namespace
 
 BackendFactory default_backend_factory(LogSink& log) {
@@ -56,22 +69,17 @@ BackendFactory default_backend_factory(LogSink& log) {
   };
 }
 
-Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
+Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends, ReloadSource reload)
     : config_(std::move(config)),
       log_(log, "dnbridge"),
+      reload_source_(std::move(reload)),
+      host_id_(read_host_id()),
+      offered_deadline_(offered_deadline(config_)),
       participant_(static_cast<dds_domainid_t>(config_.domain_id), config_.rack,
                    config_.security ? security::participant_properties(*config_.security)
                                     : dds::Properties{}),
-      publisher_(participant_, config_.rack, offered_deadline(config_), Logger(log, "dds")) {
-  // What the explicit gateway lets through beyond Gets is a site decision
-  // worth seeing at every start.
-  for (std::size_t i = 0; i < rack::kGuardedRequestKinds; ++i) {
-    const auto kind = static_cast<rack::GuardedRequest>(i);
-    if (config_.explicit_policy.allows(kind)) {
-      log_.warn("[explicit_policy] {} = true: remote requesters may send {}; risk: {}",
-                rack::policy_key(kind), rack::name_of(kind), rack::risk_of(kind));
-    }
-  }
+      publisher_(participant_, config_.rack, offered_deadline_, Logger(log, "dds")) {
+  warn_of_policy(log_, config_.explicit_policy);
   if (config_.metrics_listen) {
     metrics_ =
         std::make_shared<metrics::RackMetrics>(config_.rack, [this] { return process_counters(); });
@@ -81,18 +89,17 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends)
   }
   port::PortPublisher& publisher = tee_ ? static_cast<port::PortPublisher&>(*tee_) : publisher_;
   std::map<std::string, port::PortLoop*, std::less<>> by_name;
-  const std::string host_id = read_host_id();
   for (const auto& p : config_.ports) {
-    const devicenet::ScannerConfig scanner = to_scanner_config(p, host_id);
+    const devicenet::ScannerConfig scanner = to_scanner_config(p, host_id_);
     log_.info("port {}: master MAC {}, duplicate MAC ID identity vendor {} serial 0x{:08X}{}",
               p.name, scanner.master_mac.value(), scanner.vendor_id, scanner.serial_number,
               p.master_serial_number ? "" : " (derived from this host's identifier)");
-    ports_.push_back(std::make_unique<port::PortLoop>(loop_config(config_, p, host_id), backends(p),
-                                                      publisher, log));
+    ports_.push_back(std::make_unique<port::PortLoop>(loop_config(config_, p, host_id_),
+                                                      backends(p), publisher, log));
     by_name[p.name] = ports_.back().get();
   }
   input_.emplace(participant_, publisher_, config_.rack, std::move(by_name),
-                 Logger(log, "dds input"));
+                 Logger(log, "dds input"), [this](ReloadCall call) { request_reload(call); });
   if (metrics_) {
     metrics_server_.emplace(*config_.metrics_listen, metrics_);
     const auto listening = metrics_server_->ports();
@@ -145,6 +152,9 @@ void Daemon::start() {
   running_ = true;
   log_.info("rack {}: {} port(s) on DDS domain {}", config_.rack, ports_.size(), config_.domain_id);
   for (auto& p : ports_) p->start();
+  reloads_stop_ = false;
+  reload_thread_ = std::thread([this] { run_reloads(); });
+  port::name_thread(reload_thread_, "reload");
   input_->start();
 }
 
@@ -152,10 +162,167 @@ void Daemon::stop() {
   if (!running_) return;
   running_ = false;
   input_->stop();
+  {
+    std::lock_guard lock(reloads_mutex_);
+    reloads_stop_ = true;
+  }
+  reloads_changed_.notify_all();
+  if (reload_thread_.joinable()) reload_thread_.join();
   for (auto& p : ports_) p->stop();
   for (auto& p : ports_) p->join();
   publisher_.flush(seconds(2));
   log_.info("rack {}: stopped", config_.rack);
+}
+
+void Daemon::request_reload(ReloadCall call) {
+  {
+    std::lock_guard lock(reloads_mutex_);
+    const auto same = [&](const ReloadCall& r) {
+      return !call.requester.empty() && r.requester == call.requester && r.txid == call.txid;
+    };
+    if ((reloading_ && same(*reloading_)) || std::any_of(reloads_.begin(), reloads_.end(), same)) {
+      return;
+    }
+    for (const auto& [done, report] : reloaded_) {
+      if (same(done)) {
+        publisher_.reload_reply(call, report);
+        return;
+      }
+    }
+    if (reloads_.size() < kMaxReloadsWaiting) {
+      reloads_.push_back(std::move(call));
+      reloads_changed_.notify_all();
+      return;
+    }
+  }
+  ReloadReport busy;
+  busy.status = ReloadStatus::kBusy;
+  busy.message =
+      fmt::format("{} reloads already wait: ask again once they are done", kMaxReloadsWaiting);
+  if (!call.requester.empty()) publisher_.reload_reply(call, busy);
+}
+
+void Daemon::run_reloads() {
+  for (;;) {
+    ReloadCall call;
+    {
+      std::unique_lock lock(reloads_mutex_);
+      reloads_changed_.wait(lock, [&] { return reloads_stop_ || !reloads_.empty(); });
+      if (reloads_stop_) return;
+      call = std::move(reloads_.front());
+      reloads_.pop_front();
+      reloading_ = call;
+    }
+    const ReloadReport report = reload();
+    log_report(report, call.requester.empty()
+                           ? std::string("SIGHUP")
+                           : fmt::format("{} (txid {})", call.requester, call.txid));
+    std::lock_guard lock(reloads_mutex_);
+    reloading_.reset();
+    if (call.requester.empty()) continue;
+    publisher_.reload_reply(call, report);
+    reloaded_.emplace_back(std::move(call), report);
+    if (reloaded_.size() > kReloadsRetained) reloaded_.pop_front();
+  }
+}
+
+void Daemon::log_report(const ReloadReport& r, std::string_view origin) {
+  const std::string head = fmt::format("reload asked by {}: {}", origin, r.message);
+  if (r.status == ReloadStatus::kApplied) {
+    log_.info("{}", head);
+  } else {
+    log_.error("{}", head);
+  }
+  for (const auto& line : r.applied) log_.info("reload: {}", line);
+  for (const auto& line : r.needs_restart) log_.warn("reload: needs a restart: {}", line);
+  for (const auto& line : r.problems) log_.error("reload: {}", line);
+}
+
+ReloadReport Daemon::reload() {
+  std::lock_guard lock(reload_mutex_);
+  ReloadReport r;
+  if (!reload_source_.load) {
+    r.status = ReloadStatus::kNoFile;
+    r.message = "the bridge runs its embedded default: there is no file to read again";
+    return r;
+  }
+  DaemonConfig next;
+  try {
+    next = reload_source_.load();
+  } catch (const ConfigError& e) {
+    r.status = ReloadStatus::kRefused;
+    r.problems = e.problems();
+  } catch (const std::exception& e) {
+    r.status = ReloadStatus::kRefused;
+    r.problems = {e.what()};
+  }
+  r.file = r.status == ReloadStatus::kRefused ? config_.source : next.source;
+  ReloadPlan plan;
+  std::vector<port::PortLoopConfig> loops;
+  if (r.status != ReloadStatus::kRefused) {
+    plan = plan_reload(config_, next, offered_deadline_);
+    // Every port's scan list as its master takes it, before any is applied.
+    for (const auto& p : plan.in_force.ports) {
+      try {
+        loops.push_back(loop_config(plan.in_force, p, host_id_));
+        devicenet::Scanner::check(
+            rack::PumpRack::scanner_config(loops.back().scanner, loops.back().pumps));
+      } catch (const std::exception& e) {
+        r.status = ReloadStatus::kRefused;
+        r.problems.push_back(fmt::format("port {}: {}", p.name, e.what()));
+      }
+    }
+  }
+  if (r.status == ReloadStatus::kRefused) {
+    r.message = fmt::format("{}: {} problem(s): nothing changed", r.file, r.problems.size());
+    return r;
+  }
+  std::vector<std::pair<std::string, std::future<port::PortChange>>> pending;
+  for (auto& c : loops) {
+    port::PortLoop* loop = port(c.port);
+    if (!loop) continue;
+    std::string name = c.port;
+    auto done = loop->reconfigure(std::move(c));
+    pending.emplace_back(std::move(name), std::move(done));
+  }
+  bool policy_changed = false;
+  for (auto& [name, done] : pending) {
+    if (done.wait_for(kReloadWait) != std::future_status::ready) {
+      r.problems.push_back(fmt::format(
+          "port {}: did not confirm the change within {} s (it applies it at its next pass)", name,
+          std::chrono::duration_cast<std::chrono::seconds>(kReloadWait).count()));
+      continue;
+    }
+    const port::PortChange change = done.get();
+    if (!change.refused.empty()) {
+      r.problems.push_back(fmt::format("port {}: not applied: {}", name, change.refused));
+      continue;
+    }
+    policy_changed = policy_changed || change.explicit_policy_changed;
+    for (auto& line : describe(name, change)) r.applied.push_back(std::move(line));
+  }
+  if (plan.in_force.log_level != config_.log_level) {
+    if (reload_source_.set_log_level) reload_source_.set_log_level(plan.in_force.log_level);
+    r.applied.push_back(fmt::format("log_level {} (was {})", to_string(plan.in_force.log_level),
+                                    to_string(config_.log_level)));
+  }
+  if (policy_changed) warn_of_policy(log_, plan.in_force.explicit_policy);
+  for (const auto& w : plan.in_force.warnings) log_.warn("{}", w);
+  r.needs_restart = std::move(plan.needs_restart);
+  config_ = std::move(plan.in_force);
+  r.status = r.problems.empty() ? ReloadStatus::kApplied : ReloadStatus::kIncomplete;
+  if (!r.problems.empty()) {
+    r.message = fmt::format("{}: checked; not every port applied it", r.file);
+  } else if (r.applied.empty()) {
+    r.message = fmt::format("{}: nothing differs from the configuration in force{}", r.file,
+                            r.needs_restart.empty() ? "" : " that can change without a restart");
+  } else {
+    r.message = fmt::format("{}: applied ({} change(s){})", r.file, r.applied.size(),
+                            r.needs_restart.empty() ? std::string()
+                                                    : fmt::format("; {} setting(s) need a restart",
+                                                                  r.needs_restart.size()));
+  }
+  return r;
 }
 
 }  // namespace dnbridge::daemon

@@ -2,15 +2,20 @@
 // The bridge of one rack: a DDS participant "dnbridge <rack>", a port loop
 // per CAN port, the DDS input thread. start() and stop() are called from one
 // thread (main, or a test).
+#include <condition_variable>
+#include <deque>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/dds_input.hpp"
 #include "adapters/daemon/dds_publisher.hpp"
+#include "adapters/daemon/reload.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/metrics/rack_metrics.hpp"
 #include "adapters/port/port_loop.hpp"
@@ -25,11 +30,20 @@ namespace dnbridge::daemon {
 using BackendFactory = std::function<std::unique_ptr<port::CanBackend>(const PortConfig&)>;
 BackendFactory default_backend_factory(LogSink& log);
 
+// What a reload needs from the program that runs the bridge.
+struct ReloadSource {
+  // Reads the configuration again (the file the bridge started with);
+  // throws ConfigError. Empty: the bridge runs its embedded default.
+  std::function<DaemonConfig()> load;
+  // Sets the log level a reloaded file has (unless the command line fixed it).
+  std::function<void(LogLevel)> set_log_level;
+};
+
 class Daemon {
  public:
   // Throws on set-up failures (DDS entities, CAN interfaces, a configuration
   // the master refuses), with a message that says what failed.
-  Daemon(DaemonConfig config, LogSink& log, BackendFactory backends);
+  Daemon(DaemonConfig config, LogSink& log, BackendFactory backends, ReloadSource reload = {});
   Daemon(DaemonConfig config, LogSink& log)
       : Daemon(std::move(config), log, default_backend_factory(log)) {}
   ~Daemon();
@@ -47,6 +61,23 @@ class Daemon {
   // Any thread; the ports open and close their files on their own threads.
   void toggle_candump(const std::string& directory);
 
+  // Reads the configuration again, checks it whole, and applies only what
+  // differs (reload.hpp): a file with problems changes nothing. Waits for
+  // every port to apply it (at most kReloadWait each). One at a time; any
+  // thread but a port's, while running.
+  ReloadReport reload();
+  static constexpr Duration kReloadWait = seconds(5);
+  // From any thread: a reload on the bridge's reload thread. Its report goes
+  // to the log and, for a request from DDS (a requester), as a ReloadReply.
+  // Past kMaxReloadsWaiting, answered at once: busy. A request written again
+  // (same requester and txid: a client repeats until answered) is one
+  // reload: while it waits or runs it is not queued again, and once done,
+  // among the last kReloadsRetained, it gets the same report again.
+  void request_reload(ReloadCall call);
+  static constexpr std::size_t kMaxReloadsWaiting = 8;
+  static constexpr std::size_t kReloadsRetained = 16;
+
+  // The configuration in force (after reloads); not while a reload runs.
   const DaemonConfig& config() const { return config_; }
   port::PortLoop* port(std::string_view name);
   const std::vector<std::unique_ptr<port::PortLoop>>& ports() const { return ports_; }
@@ -57,9 +88,15 @@ class Daemon {
 
  private:
   metrics::ProcessCounters process_counters() const;
+  void run_reloads();
+  void log_report(const ReloadReport& report, std::string_view origin);
 
   DaemonConfig config_;
   Logger log_;
+  ReloadSource reload_source_;
+  std::string host_id_;
+  Duration offered_deadline_{};
+  std::mutex reload_mutex_;  // one reload at a time; held by reload()
   dds::Participant participant_;
   DdsPublisher publisher_;
   // With [metrics]: the ports publish to DDS and to the metrics both.
@@ -70,6 +107,15 @@ class Daemon {
   // Last: no scrape reads the publisher or the input once they are gone.
   std::optional<metrics::MetricsServer> metrics_server_;
   bool running_ = false;
+
+  // The reload thread and its queue.
+  std::mutex reloads_mutex_;
+  std::condition_variable reloads_changed_;
+  std::deque<ReloadCall> reloads_;
+  std::optional<ReloadCall> reloading_;                       // the one running
+  std::deque<std::pair<ReloadCall, ReloadReport>> reloaded_;  // the last done, newest last
+  bool reloads_stop_ = false;
+  std::thread reload_thread_;
 };
 
 }  // namespace dnbridge::daemon

@@ -13,7 +13,13 @@
 namespace dnbridge::daemon {
 namespace {
 
-enum Token : dds::WaitSet::Token { kCommands = 1, kRequests = 2, kStop = 3, kScanRequests = 4 };
+enum Token : dds::WaitSet::Token {
+  kCommands = 1,
+  kRequests = 2,
+  kStop = 3,
+  kScanRequests = 4,
+  kReloadRequests = 5,
+};
 
 // A command stamped further ahead of this host's clock is reported.
 constexpr Duration kClockSkewReported = seconds(1);
@@ -56,10 +62,26 @@ bool take_batches(Take take, std::size_t capacity, std::size_t batches, Logger& 
   return true;
 }
 
+// Takes every sample waiting (a take resets DATA_AVAILABLE: what a full
+// take leaves would wait for the next sample) and hands each to `fn`.
+template <class T, class Fn>
+void take_all(dds::Reader<T>& reader, Logger& log, const char* what, Fn fn) {
+  for (;;) {
+    auto taken = reader.take(kBatch);
+    if (!taken) {
+      log.error("taking {} failed: {}", what, taken.error().message());
+      return;
+    }
+    for (const auto& sample : *taken) fn(sample);
+    if (taken->size() < kBatch) return;
+  }
+}
+
 }  // namespace
 
 DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
-                   std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log)
+                   std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log,
+                   std::function<void(ReloadCall)> reload)
     : rack_(std::move(rack)),
       publisher_(publisher),
       ports_(std::move(ports)),
@@ -67,6 +89,8 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       commands_(participant, publisher.command_topic(), dds::command_reader_qos()),
       requests_(participant, publisher.request_topic(), dds::request_reader_qos()),
       scan_requests_(participant, publisher.scan_request_topic(), dds::request_reader_qos()),
+      reload_requests_(participant, publisher.reload_request_topic(), dds::request_reader_qos()),
+      reload_(std::move(reload)),
       command_buffer_(kBatch),
       request_buffer_(kBatch),
       stop_(participant),
@@ -77,7 +101,8 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   // would keep the waitset triggered and this thread spinning.
   for (const dds::Entity* reader :
        {static_cast<const dds::Entity*>(&commands_), static_cast<const dds::Entity*>(&requests_),
-        static_cast<const dds::Entity*>(&scan_requests_)}) {
+        static_cast<const dds::Entity*>(&scan_requests_),
+        static_cast<const dds::Entity*>(&reload_requests_)}) {
     if (!reader->set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
       throw std::runtime_error("setting the status mask of a DDS input reader failed");
     }
@@ -85,6 +110,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   waitset_.attach(commands_, kCommands);
   waitset_.attach(requests_, kRequests);
   waitset_.attach(scan_requests_, kScanRequests);
+  waitset_.attach(reload_requests_, kReloadRequests);
   waitset_.attach(stop_, kStop);
 }
 
@@ -132,6 +158,7 @@ void DdsInput::run() {
       commands_waiting = commands_waiting || token == kCommands;
       requests = requests || token == kRequests;
       if (token == kScanRequests) take_scan_requests();
+      if (token == kReloadRequests) take_reload_requests();
     }
     if (commands_waiting) {
       const TimePoint now = port::steady_now();
@@ -211,18 +238,9 @@ bool DdsInput::take_requests() {
 }
 
 void DdsInput::take_scan_requests() {
-  // Each asks for at most one scan of a port: every one waiting, taken now
-  // (a take resets DATA_AVAILABLE: what a full take leaves would wait for
-  // the next request).
-  for (;;) {
-    auto taken = scan_requests_.take(kBatch);
-    if (!taken) {
-      log_.error("taking bus scan requests failed: {}", taken.error().message());
-      return;
-    }
-    for (const auto& sample : *taken) on_scan_request(sample);
-    if (taken->size() < kBatch) return;
-  }
+  // Each asks for at most one scan of a port: every one waiting, taken now.
+  take_all(scan_requests_, log_, "bus scan requests",
+           [this](const auto& sample) { on_scan_request(sample); });
 }
 
 void DdsInput::on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample) {
@@ -246,6 +264,25 @@ void DdsInput::on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sampl
   publisher_.bus_scan_reply(std::string(port),
                             port::refuse(call, rack::TransactionStatus::kInvalidPort,
                                          fmt::format("rack {} has no port \"{}\"", rack_, port)));
+}
+
+void DdsInput::take_reload_requests() {
+  take_all(reload_requests_, log_, "reload requests",
+           [this](const dds::Sample<dnbridge_ReloadRequest>& sample) {
+             if (!sample.valid_data()) return;
+             const auto& r = sample.data();
+             if (dds::view(r.rack) != rack_) return;
+             ReloadCall call{std::string(dds::view(r.requester)), r.txid};
+             if (call.requester.empty() || call.requester.size() > kMaxRequestBytes) {
+               // No name to answer to, or one too long to carry back.
+               warn_limit_.warn(log_, port::steady_now(),
+                                "reload request (txid {}) dropped unanswered: a requester name of "
+                                "{} bytes (1 to {} served)",
+                                call.txid, call.requester.size(), kMaxRequestBytes);
+               return;
+             }
+             if (reload_) reload_(std::move(call));
+           });
 }
 
 void DdsInput::on_request(const dnbridge_ExplicitRequest& r,

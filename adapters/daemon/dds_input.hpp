@@ -1,6 +1,6 @@
 #pragma once
-// What reaches the bridge from DDS: pump commands, explicit requests and
-// bus scan requests for this rack. A waitset on a thread of its own takes
+// What reaches the bridge from DDS: pump commands, explicit requests, bus
+// scan requests and reload requests for this rack. A waitset on a thread of its own takes
 // them and hands each to its port's loop through the loop's inbox; no DDS
 // callback touches master state. Requests for other racks are left to their
 // bridges.
@@ -22,8 +22,11 @@ namespace dnbridge::daemon {
 
 class DdsInput {
  public:
+  // `reload`: called (on the input's thread) with each reload request for
+  // this rack; it must return at once (Daemon::request_reload queues it).
   DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
-           std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log);
+           std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log,
+           std::function<void(ReloadCall)> reload = {});
   ~DdsInput();
   DdsInput(const DdsInput&) = delete;
   DdsInput& operator=(const DdsInput&) = delete;
@@ -41,6 +44,7 @@ class DdsInput {
   bool take_requests();  // true when requests may remain
   void take_scan_requests();
   void on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample);
+  void take_reload_requests();
   void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
   void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
   void note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
@@ -53,6 +57,8 @@ class DdsInput {
   dds::Reader<dnbridge_PumpCommand> commands_;
   dds::Reader<dnbridge_ExplicitRequest> requests_;
   dds::Reader<dnbridge_BusScanRequest> scan_requests_;
+  dds::Reader<dnbridge_ReloadRequest> reload_requests_;
+  std::function<void(ReloadCall)> reload_;
   dds::TakeBuffer<dnbridge_PumpCommand> command_buffer_;
   dds::TakeBuffer<dnbridge_ExplicitRequest> request_buffer_;
   std::vector<std::vector<unsigned char>> request_cdr_;

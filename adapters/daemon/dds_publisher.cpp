@@ -33,11 +33,14 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
       reply_topic_(participant),
       scan_request_topic_(participant),
       scan_reply_topic_(participant),
+      reload_request_topic_(participant),
+      reload_reply_topic_(participant),
       pump_writer_(participant, pump_topic_, dds::state_writer_qos(state_deadline)),
       node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
       port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
       reply_writer_(participant, reply_topic_, dds::reply_writer_qos()),
       scan_reply_writer_(participant, scan_reply_topic_, dds::scan_reply_writer_qos()),
+      reload_reply_writer_(participant, reload_reply_topic_, dds::scan_reply_writer_qos()),
       // State samples are keyed (one waits per instance): the capacity only
       // bounds the unregistrations of a port that stops.
       state_out_("dds state out", 64),
@@ -54,6 +57,16 @@ namespace {
 
 std::string instance_key(char topic, const std::string& port, std::uint8_t mac = 0) {
   return fmt::format("{}{}/{}", topic, mac, port);
+}
+
+// A node's instance of a state topic.
+template <class T>
+dds::Owned<T> key_of(const std::string& rack, const std::string& port, std::uint8_t mac) {
+  dds::Owned<T> key;
+  dds::set_string(key->rack, rack);
+  dds::set_string(key->port, port);
+  key->mac = mac;
+  return key;
 }
 
 }  // namespace
@@ -105,6 +118,16 @@ void DdsPublisher::bus_scan_reply(const std::string& port, const port::BusScanAn
   if (!queued) undelivered(port);
 }
 
+void DdsPublisher::reload_reply(const ReloadCall& call, const ReloadReport& report) {
+  auto sample = std::make_shared<dds::Owned<dnbridge_ReloadReply>>();
+  fill_reload_reply(**sample, rack_, call, report);
+  // Counted with no port's replies: a reload is the rack's.
+  const bool queued = reply_out_.post([this, sample] {
+    if (!check(reload_reply_writer_.write(**sample), "ReloadReply")) undelivered({});
+  });
+  if (!queued) undelivered({});
+}
+
 void DdsPublisher::undelivered(const std::string& port) {
   std::lock_guard lock(mutex_);
   ++undelivered_[port];
@@ -114,6 +137,28 @@ std::uint64_t DdsPublisher::replies_undelivered(const std::string& port) const {
   std::lock_guard lock(mutex_);
   auto it = undelivered_.find(port);
   return it == undelivered_.end() ? 0 : it->second;
+}
+
+void DdsPublisher::release_node(const std::string& port, std::uint8_t mac, bool dispose) {
+  const auto now = dds::dds_now();
+  const auto pump_key = key_of<dnbridge_PumpState>(rack_, port, mac);
+  const auto node_key = key_of<dnbridge_NodeStatus>(rack_, port, mac);
+  if (dispose) {
+    check(pump_writer_.dispose(*pump_key, now), "PumpState disposal");
+    check(node_writer_.dispose(*node_key, now), "NodeStatus disposal");
+  }
+  check(pump_writer_.unregister_instance(*pump_key, now), "PumpState unregistration");
+  check(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
+}
+
+void DdsPublisher::node_removed(const std::string& port, devicenet::MacId mac) {
+  {
+    std::lock_guard lock(mutex_);
+    written_[port].erase(mac.value());
+  }
+  // Disposed: the pump is no longer the rack's, which unregistering (the
+  // bridge gone) would not say. After its last samples, in the same outbox.
+  state_out_.post_always([this, port, mac] { release_node(port, mac.value(), true); });
 }
 
 void DdsPublisher::port_stopped(const std::string& port) {
@@ -126,19 +171,8 @@ void DdsPublisher::port_stopped(const std::string& port) {
     macs = written_[port];
   }
   state_out_.post_always([this, port, macs] {
+    for (std::uint8_t mac : macs) release_node(port, mac, false);
     const auto now = dds::dds_now();
-    for (std::uint8_t mac : macs) {
-      dds::Owned<dnbridge_PumpState> pump_key;
-      dds::set_string(pump_key->rack, rack_);
-      dds::set_string(pump_key->port, port);
-      pump_key->mac = mac;
-      check(pump_writer_.unregister_instance(*pump_key, now), "PumpState unregistration");
-      dds::Owned<dnbridge_NodeStatus> node_key;
-      dds::set_string(node_key->rack, rack_);
-      dds::set_string(node_key->port, port);
-      node_key->mac = mac;
-      check(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
-    }
     dds::Owned<dnbridge_PortStatus> port_key;
     dds::set_string(port_key->rack, rack_);
     dds::set_string(port_key->port, port);

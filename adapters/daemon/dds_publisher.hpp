@@ -12,6 +12,7 @@
 #include <string>
 
 #include "adapters/daemon/outbox.hpp"
+#include "adapters/daemon/reload.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/time.hpp"
 #include "adapters/dds/topic.hpp"
@@ -47,6 +48,9 @@ class DdsPublisher final : public port::PortPublisher {
   void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) override;
   void bus_scan_reply(const std::string& port, const port::BusScanAnswer& answer) override;
   void port_stopped(const std::string& port) override;
+  void node_removed(const std::string& port, devicenet::MacId mac) override;
+  // The answer to a ReloadRequest (any thread).
+  void reload_reply(const ReloadCall& call, const ReloadReport& report);
 
   // Waits (at most `timeout`) until what was handed over is written and every
   // reader has acknowledged it: the last samples of a shutdown reach their
@@ -66,10 +70,16 @@ class DdsPublisher final : public port::PortPublisher {
   const dds::Topic<dnbridge_BusScanRequest>& scan_request_topic() const {
     return scan_request_topic_;
   }
+  const dds::Topic<dnbridge_ReloadRequest>& reload_request_topic() const {
+    return reload_request_topic_;
+  }
 
  private:
   // Logs a failed write (rate-limited); true when it succeeded.
   bool check(Status s, const char* what);
+  // A node's PumpState and NodeStatus instances unregistered, after being
+  // disposed when `dispose` (on the state outbox's thread).
+  void release_node(const std::string& port, std::uint8_t mac, bool dispose);
 
   std::string rack_;
   Logger log_;
@@ -82,11 +92,14 @@ class DdsPublisher final : public port::PortPublisher {
   dds::Topic<dnbridge_ExplicitReply> reply_topic_;
   dds::Topic<dnbridge_BusScanRequest> scan_request_topic_;
   dds::Topic<dnbridge_BusScanReply> scan_reply_topic_;
+  dds::Topic<dnbridge_ReloadRequest> reload_request_topic_;
+  dds::Topic<dnbridge_ReloadReply> reload_reply_topic_;
   dds::Writer<dnbridge_PumpState> pump_writer_;
   dds::Writer<dnbridge_NodeStatus> node_writer_;
   dds::Writer<dnbridge_PortStatus> port_writer_;
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;
   dds::Writer<dnbridge_BusScanReply> scan_reply_writer_;
+  dds::Writer<dnbridge_ReloadReply> reload_reply_writer_;
 
   void undelivered(const std::string& port);
 

@@ -7,6 +7,7 @@
 // so that `journalctl -u dnbridge@rack-A MAC=12` finds a node's lines; the
 // journal keeps the time. Should the journal refuse an entry, the line goes
 // to standard error with its syslog priority ("<4>port A: ...").
+#include <atomic>
 #include <cstdio>
 #include <functional>
 #include <mutex>
@@ -26,11 +27,14 @@ class StderrLogSink final : public LogSink {
   using JournalSend = std::function<int(std::span<const std::string> fields)>;
 
   explicit StderrLogSink(LogLevel level, std::FILE* out = stderr);
-  bool enabled(LogLevel level) const noexcept override { return level >= level_; }
+  bool enabled(LogLevel level) const noexcept override {
+    return level >= level_.load(std::memory_order_relaxed);
+  }
   void write(LogLevel level, std::string_view component, std::string_view message) override;
   void write_structured(LogLevel level, std::string_view component, std::string_view message,
                         std::span<const LogField> fields) override;
-  void set_level(LogLevel level) noexcept { level_ = level; }
+  // Any thread (a reload changes it while the ports log).
+  void set_level(LogLevel level) noexcept { level_.store(level, std::memory_order_relaxed); }
 
   // A field every entry carries (the rack's name, RACK). Before logging starts.
   void add_field(std::string name, std::string value);
@@ -43,7 +47,7 @@ class StderrLogSink final : public LogSink {
   static JournalSend journal_of_stderr();
 
  private:
-  LogLevel level_;
+  std::atomic<LogLevel> level_;
   std::FILE* out_;
   JournalSend journal_;
   std::vector<std::pair<std::string, std::string>> fields_;

@@ -260,6 +260,34 @@ void fill_bus_scan_reply(dnbridge_BusScanReply& out, std::string_view rack, std:
   }
 }
 
+namespace {
+
+// A sequence of strings the sample owns (freed with it).
+void set_strings(dds_sequence_string& seq, const std::vector<std::string>& lines) {
+  seq._length = seq._maximum = static_cast<std::uint32_t>(lines.size());
+  seq._release = true;
+  seq._buffer = lines.empty() ? nullptr : dds_sequence_string_allocbuf(lines.size());
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    seq._buffer[i] = nullptr;
+    set_string(seq._buffer[i], lines[i]);
+  }
+}
+
+}  // namespace
+
+void fill_reload_reply(dnbridge_ReloadReply& out, std::string_view rack, const ReloadCall& call,
+                       const ReloadReport& r) {
+  set_string(out.requester, call.requester);
+  out.txid = call.txid;
+  set_string(out.rack, rack);
+  out.status = static_cast<std::uint8_t>(r.status);
+  set_string(out.message, r.message);
+  set_string(out.file, r.file);
+  set_strings(out.applied, r.applied);
+  set_strings(out.needs_restart, r.needs_restart);
+  set_strings(out.problems, r.problems);
+}
+
 cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& c) {
   cdn127::PumpOutputs o;
   o.pump_on = c.pump_on;

@@ -4,6 +4,7 @@
 #include <string>
 #include <string_view>
 
+#include "adapters/daemon/reload.hpp"
 #include "adapters/dds/sample.hpp"
 #include "adapters/port/port_publisher.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
@@ -21,6 +22,9 @@ void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,
 void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer& answer);
 void fill_bus_scan_reply(dnbridge_BusScanReply& out, std::string_view rack, std::string_view port,
                          const port::BusScanAnswer& answer);
+
+void fill_reload_reply(dnbridge_ReloadReply& out, std::string_view rack, const ReloadCall& call,
+                       const ReloadReport& report);
 
 // A command sample's outputs, as the rack model takes them.
 profiles::cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& command);

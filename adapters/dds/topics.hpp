@@ -53,6 +53,16 @@ struct TopicTraits<dnbridge_BusScanReply> {
   static constexpr const char* kName = "dnbridge/BusScanReply";
   static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_BusScanReply_desc;
 };
+template <>
+struct TopicTraits<dnbridge_ReloadRequest> {
+  static constexpr const char* kName = "dnbridge/ReloadRequest";
+  static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_ReloadRequest_desc;
+};
+template <>
+struct TopicTraits<dnbridge_ReloadReply> {
+  static constexpr const char* kName = "dnbridge/ReloadReply";
+  static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_ReloadReply_desc;
+};
 
 // --- State topics: PumpState, NodeStatus, PortStatus -------------------------
 // Reliable, transient-local, keep-last 1: a late joiner gets each instance's
@@ -150,5 +160,7 @@ Qos reply_reader_qos();
 // stopped acknowledging to well under a MiB.
 inline constexpr int32_t kScanReplyHistory = 16;
 Qos scan_reply_writer_qos();
+// ReloadRequest / ReloadReply (a configuration read again) follow it too,
+// with scan_reply_writer_qos() for the replies (a few KiB each at most).
 
 }  // namespace dnbridge::dds

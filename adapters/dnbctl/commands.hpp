@@ -92,4 +92,10 @@ Exit run_explicit(const GlobalOptions& options, const ExplicitArgs& args);
 CLI::App* add_scan(CLI::App& app);
 Exit run_scan(const GlobalOptions& options);
 
+// --- reload_command.cpp ----------------------------------------------------------------
+// reload: takes only the global options (--rack, --json, --timeout; --port
+// is refused: a reload is a rack's).
+CLI::App* add_reload(CLI::App& app);
+Exit run_reload(const GlobalOptions& options);
+
 }  // namespace dnbridge::dnbctl

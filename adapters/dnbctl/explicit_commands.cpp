@@ -1,8 +1,6 @@
 // get, set, service: explicit messaging with a node through its bridge
 // (ExplicitRequest / ExplicitReply).
-#include <chrono>
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cstdio>
 
@@ -118,12 +116,7 @@ Exit run_explicit(const GlobalOptions& o, const ExplicitArgs& args) {
   x.rack = target.rack;
   x.port = target.port;
   x.mac = target.mac;
-  // The start time makes the name unique even when a pid is reused while a
-  // bridge still remembers the transactions of an earlier dnbctl.
-  const auto started = std::chrono::duration_cast<std::chrono::milliseconds>(
-                           std::chrono::system_clock::now().time_since_epoch())
-                           .count();
-  Requester requester(client, fmt::format("dnbctl@{}:{}:{:x}", host_name(), getpid(), started));
+  Requester requester(client, requester_name());
   if (!requester.execute(client, x, deadline_after(o.timeout()))) {
     throw CommandError(Exit::kNotFound,
                        fmt::format("{}: no reply from the bridge of rack \"{}\" within {:g} s",

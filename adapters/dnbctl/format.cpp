@@ -577,4 +577,58 @@ void explicit_json(JsonWriter& out, const ExplicitExchange& x, Decoding as,
   explicit_record(x, as, decoded).write(out);
 }
 
+std::string_view reload_status_word(std::uint8_t status) {
+  switch (status) {
+    case dnbridge_RELOAD_APPLIED:
+      return "applied";
+    case dnbridge_RELOAD_REFUSED:
+      return "refused";
+    case dnbridge_RELOAD_BUSY:
+      return "busy";
+    case dnbridge_RELOAD_NO_FILE:
+      return "no-file";
+    case dnbridge_RELOAD_INCOMPLETE:
+      return "incomplete";
+    default:
+      break;
+  }
+  return "unknown";
+}
+
+namespace {
+
+// A list of the reply as `reload` shows it: in text its heading, then one
+// indented line per entry, nothing when empty; in JSON an array of strings.
+void add_lines(Record& r, std::string heading, std::string key, const dds_sequence_string& seq) {
+  std::vector<std::string_view> entries;
+  if (seq._buffer != nullptr) {
+    for (std::uint32_t i = 0; i < seq._length; ++i) entries.push_back(view(seq._buffer[i]));
+  }
+  std::vector<Json> items(entries.begin(), entries.end());
+  r.add(entries.empty() ? "" : std::move(heading), "", std::move(key),
+        Json::values(std::move(items)));
+  for (const auto e : entries) r.text(fmt::format("  {}", e), "");
+}
+
+// A reload's reply as `reload` shows it.
+Record reload_record(const dnbridge_ReloadReply& r) {
+  const std::string_view word = reload_status_word(r.status);
+  const std::string message(view(r.message));
+  const std::string file(view(r.file));
+  Record rec;
+  rec.add(fmt::format("rack {}: {}", view(r.rack), message.empty() ? word : message), "",
+          {{"rack", std::string(view(r.rack))}, {"status", word}, {"message", message}})
+      .add(file.empty() ? "" : "file: ", file, "file", file);
+  add_lines(rec, "applied:", "applied", r.applied);
+  add_lines(rec, "needs a restart:", "needs_restart", r.needs_restart);
+  add_lines(rec, "problems:", "problems", r.problems);
+  return rec;
+}
+
+}  // namespace
+
+std::string reload_text(const dnbridge_ReloadReply& r) { return reload_record(r).lines(0); }
+
+void reload_json(JsonWriter& out, const dnbridge_ReloadReply& r) { reload_record(r).write(out); }
+
 }  // namespace dnbridge::dnbctl

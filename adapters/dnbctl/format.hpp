@@ -119,4 +119,16 @@ std::string explicit_text(const ExplicitExchange& x, Decoding as,
 void explicit_json(JsonWriter& out, const ExplicitExchange& x, Decoding as,
                    const std::optional<Parsed<std::string>>& decoded);
 
+// --- reload ---------------------------------------------------------------------------
+// A ReloadReply's status (RELOAD_*) as one word: "applied", "refused",
+// "busy", "no-file", "incomplete"; "unknown" for any other value.
+std::string_view reload_status_word(std::uint8_t status);
+// "rack R: " and the bridge's message, the file read, then the lines
+// applied, those that need a restart and the problems, each list under its
+// heading ("applied:", "needs a restart:", "problems:") when not empty.
+std::string reload_text(const dnbridge_ReloadReply& r);
+// {"rack", "status" (the word), "message", "file", "applied": [...],
+//  "needs_restart": [...], "problems": [...]}
+void reload_json(JsonWriter& out, const dnbridge_ReloadReply& r);
+
 }  // namespace dnbridge::dnbctl

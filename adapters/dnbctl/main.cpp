@@ -78,6 +78,7 @@ int main(int argc, char** argv) {
   auto* service_cmd = add_explicit(app, ExplicitKind::kService, service);
   auto* show_cmd = add_show(app, show);
   auto* scan_cmd = add_scan(app);
+  auto* reload_cmd = add_reload(app);
 
   try {
     app.parse(argc, argv);
@@ -118,6 +119,7 @@ int main(int argc, char** argv) {
     if (set_cmd->parsed()) rc = run_explicit(options, set);
     if (service_cmd->parsed()) rc = run_explicit(options, service);
     if (scan_cmd->parsed()) rc = run_scan(options);
+    if (reload_cmd->parsed()) rc = run_reload(options);
     return code(rc);
   } catch (const CommandError& e) {
     std::fprintf(stderr, "dnbctl: %s\n", e.what());

@@ -3,7 +3,6 @@
 // as the bridge reports them (NodeStatus). One row per node found; for an
 // unconfigured CDN127, the configuration lines that would add it.
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -12,14 +11,12 @@
 #include <span>
 
 #include "adapters/dds/fields.hpp"
-#include "adapters/dds/reader.hpp"
 #include "adapters/dds/sample.hpp"
 #include "adapters/dds/states.hpp"
-#include "adapters/dds/topics.hpp"
-#include "adapters/dds/writer.hpp"
 #include "adapters/dnbctl/commands.hpp"
 #include "adapters/dnbctl/format.hpp"
 #include "adapters/dnbctl/record.hpp"
+#include "adapters/dnbctl/requester.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
 namespace dnbridge::dnbctl {
@@ -41,8 +38,6 @@ constexpr std::uint8_t kStatusSuccess = dnbridge_STATUS_SUCCESS;
 struct PortScan {
   PortKey key;
   std::uint8_t master_mac = 0;
-  std::uint32_t txid = 0;
-  dds::Owned<dnbridge_BusScanRequest> request;
   std::optional<dds::Sample<dnbridge_BusScanReply>> reply;
 };
 
@@ -159,74 +154,34 @@ Exit run_scan(const GlobalOptions& o) {
   gather(
       client, o, [&] { return any_port(client, o); }, [&] { return nodes_missing(client, o); });
 
-  dds::Topic<dnbridge_BusScanRequest> request_topic(client.participant());
-  dds::Topic<dnbridge_BusScanReply> reply_topic(client.participant());
-  dds::Writer<dnbridge_BusScanRequest> writer(client.participant(), request_topic,
-                                              dds::request_writer_qos());
-  dds::Reader<dnbridge_BusScanReply> reader(client.participant(), reply_topic,
-                                            dds::reply_reader_qos());
-  dds::ReadCondition replies(reader, DDS_ANY_STATE);
-  client.attach(replies, kScanReplies);
-  const auto started = std::chrono::duration_cast<std::chrono::milliseconds>(
-                           std::chrono::system_clock::now().time_since_epoch())
-                           .count();
-  const std::string requester = fmt::format("dnbctl@{}:{}:{:x}", host_name(), getpid(), started);
+  Transactions<dnbridge_BusScanRequest, dnbridge_BusScanReply> transactions(client, kScanReplies);
+  const std::string requester = requester_name();
 
   std::vector<PortScan> scans;
+  std::vector<dds::Owned<dnbridge_BusScanRequest>> requests;
   for (const auto& [key, port] : client.ports()) {
     if (!o.matches(key.rack, key.port) || !port.alive) continue;
-    PortScan s;
-    s.key = key;
-    s.master_mac = port.data->master_mac;
-    s.txid = static_cast<std::uint32_t>(scans.size() + 1);
-    dds::set_string(s.request->requester, requester);
-    s.request->txid = s.txid;
-    dds::set_string(s.request->rack, key.rack);
-    dds::set_string(s.request->port, key.port);
-    scans.push_back(std::move(s));
+    scans.push_back({key, port.data->master_mac, std::nullopt});
+    dds::Owned<dnbridge_BusScanRequest>& request = requests.emplace_back();
+    dds::set_string(request->requester, requester);
+    request->txid = static_cast<std::uint32_t>(requests.size());
+    dds::set_string(request->rack, key.rack);
+    dds::set_string(request->port, key.port);
   }
   if (scans.empty()) {
     throw CommandError(Exit::kNotFound, "no port with a live bridge to scan");
   }
 
-  // Until a bridge's request reader matched: a volatile request written
-  // before is lost.
   const Duration wait = std::max(kScanWait, o.timeout());
   const Deadline deadline = deadline_after(wait);
-  (void)client.wait_until(deadline_after(o.timeout()), [&] {
-    auto n = writer.matched_subscriptions();
-    return n.ok() && *n > 0;
-  });
-  auto next_write = std::chrono::steady_clock::now();
-  const auto all_answered = [&] {
-    auto taken = reader.take();
-    if (taken) {
-      for (auto& sample : *taken) {
-        if (!sample.valid_data()) continue;
-        const auto& r = sample.data();
-        if (dds::view(r.requester) != requester) continue;
-        for (auto& s : scans) {
-          if (s.txid != r.txid || s.reply) continue;
-          s.reply.emplace(std::move(sample));
-          break;
-        }
-      }
-    }
-    if (std::all_of(scans.begin(), scans.end(),
-                    [](const PortScan& s) { return s.reply.has_value(); })) {
-      return true;
-    }
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= next_write) {
-      for (const auto& s : scans) {
-        if (!s.reply) (void)writer.write(*s.request);
-      }
-      next_write = now + kRepeatAfter;
-    }
-    return false;
-  };
-  const bool answered = client.wait_until(deadline, all_answered);
-  for (const auto& s : scans) (void)writer.unregister_instance(*s.request);
+  // A bridge that matches later gets the repeats.
+  (void)transactions.await_reader(client, deadline_after(o.timeout()));
+  auto replies = transactions.exchange(client, requests, deadline, kRepeatAfter);
+  bool answered = true;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    scans[i].reply = std::move(replies[i]);
+    answered = answered && scans[i].reply.has_value();
+  }
 
   // The rows: per port, the configured nodes, then what the scan found.
   const std::vector<NodeRow> nodes = node_rows(client, o);

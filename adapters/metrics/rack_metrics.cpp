@@ -105,6 +105,11 @@ void RackMetrics::port_stopped(const std::string& port) {
   ports_[port].stopped = true;
 }
 
+void RackMetrics::node_removed(const std::string& port, devicenet::MacId mac) {
+  std::lock_guard lock(mutex_);
+  ports_[port].nodes.erase(mac.value());
+}
+
 std::vector<MetricFamily> RackMetrics::Collect() const {
   Families f;
   {

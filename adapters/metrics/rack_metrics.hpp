@@ -69,6 +69,7 @@ class RackMetrics final : public port::PortPublisher, public prometheus::Collect
   void explicit_reply(const std::string&, const rack::ExplicitAnswer&) override {}
   void bus_scan_reply(const std::string&, const port::BusScanAnswer&) override {}
   void port_stopped(const std::string& port) override;
+  void node_removed(const std::string& port, devicenet::MacId mac) override;
 
   // prometheus::Collectable: the metric families now (the server's thread).
   std::vector<prometheus::MetricFamily> Collect() const override;

@@ -32,8 +32,13 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
         i < config_.publish.size() ? config_.publish[i] : rack::PublishPolicy{};
     published_.push_back(Published{rack::PumpStateGate(policy)});
   }
-  last_polls_.assign(config_.pumps.size(), 0);
-  for (const auto& p : config_.pumps) scan_list_.set(p.node.mac.value());
+  note_scan_list();
+}
+
+void PortLoop::note_scan_list() {
+  std::uint64_t bits = 0;
+  for (const auto& p : config_.pumps) bits |= std::uint64_t{1} << p.node.mac.value();
+  scan_list_.store(bits, std::memory_order_relaxed);
 }
 
 PortLoop::~PortLoop() {
@@ -59,8 +64,6 @@ std::string PortLoop::problem() const {
   std::lock_guard lock(problem_mutex_);
   return problem_;
 }
-
-bool PortLoop::has_node(MacId mac) const { return scan_list_.test(mac.value()); }
 
 void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs,
                        std::string issuer) {
@@ -88,6 +91,83 @@ void PortLoop::explicit_request(rack::ExplicitCall call) {
 }
 void PortLoop::post(std::function<void(CanBackend&)> fn) { push(std::move(fn)); }
 void PortLoop::scan_request(ScanCall call) { push(std::move(call)); }
+
+std::future<PortChange> PortLoop::reconfigure(PortLoopConfig next) {
+  Reconfigure r{std::make_shared<PortLoopConfig>(std::move(next)),
+                std::make_shared<std::promise<PortChange>>()};
+  auto done = r.done->get_future();
+  push(std::move(r));
+  return done;
+}
+
+void PortLoop::apply(const Reconfigure& r, TimePoint now) {
+  PortLoopConfig& next = *r.config;
+  PortChange change;
+  try {
+    change.scan_list = port_->reconfigure(next.scanner, next.pumps, now);
+  } catch (const std::exception& e) {
+    change.refused = e.what();
+    log_.error("configuration not applied: {}", change.refused);
+    r.done->set_value(std::move(change));
+    return;
+  }
+  const auto& sc = change.scan_list;
+  const auto listed = [](const std::vector<MacId>& macs, MacId mac) {
+    return std::find(macs.begin(), macs.end(), mac) != macs.end();
+  };
+  const auto policy_of = [&](MacId mac) {
+    for (std::size_t i = 0; i < next.pumps.size() && i < next.publish.size(); ++i) {
+      if (next.pumps[i].node.mac == mac) return next.publish[i];
+    }
+    return rack::PublishPolicy{};
+  };
+  // What is published of each pump follows the rack's views, in their
+  // order: a node kept keeps its gate (a new one if its policy changed), a
+  // new or re-configured one starts afresh.
+  std::array<std::optional<Published>, MacId::kMax + 1> kept;
+  const auto& before = config_.pumps;
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    kept[before[i].node.mac.value()] = std::move(published_[i]);
+  }
+  published_.clear();
+  for (const auto& v : rack().pumps()) {
+    const rack::PublishPolicy policy = policy_of(v.mac);
+    auto& old = kept[v.mac.value()];
+    if (!old || listed(sc.added, v.mac) || listed(sc.reconfigured, v.mac)) {
+      published_.push_back(Published{rack::PumpStateGate(policy)});
+      continue;
+    }
+    if (!(old->gate.policy() == policy)) {
+      old->gate = rack::PumpStateGate(policy);
+      change.publish_changed.push_back(v.mac);
+    }
+    published_.push_back(std::move(*old));
+  }
+  for (MacId mac : sc.removed) publisher_.node_removed(config_.port, mac);
+  if (!(gateway_->policy() == next.explicit_policy)) {
+    gateway_->set_policy(next.explicit_policy);
+    change.explicit_policy_changed = true;
+  }
+  config_.pumps = std::move(next.pumps);
+  config_.publish = std::move(next.publish);
+  config_.explicit_policy = next.explicit_policy;
+  note_scan_list();
+  port_dirty_ = true;
+  port_event_time_ = now;
+  const auto macs = [](const std::vector<MacId>& list) {
+    std::string s;
+    for (MacId m : list) s += fmt::format("{}{}", s.empty() ? "" : " ", m.value());
+    return s.empty() ? std::string("none") : s;
+  };
+  log_.info(
+      "configuration applied: added {}; removed {}; configured again {}; policies changed {}; "
+      "publish policies changed {}; untouched {}{}{}",
+      macs(sc.added), macs(sc.removed), macs(sc.reconfigured), macs(sc.updated),
+      macs(change.publish_changed), macs(sc.unchanged),
+      sc.timings_changed ? "; the port's timings changed" : "",
+      change.explicit_policy_changed ? "; the explicit policy changed" : "");
+  r.done->set_value(std::move(change));
+}
 
 void PortLoop::handle_scan_call(ScanCall call, TimePoint now) {
   // A request written again while its scan runs (a requester repeats until
@@ -196,6 +276,14 @@ bool PortLoop::drain_inbox(TimePoint now) {
       }
     } else if (auto* scan = std::get_if<ScanCall>(&item)) {
       handle_scan_call(std::move(*scan), now);
+    } else if (auto* re = std::get_if<Reconfigure>(&item)) {
+      if (keep_running) {
+        apply(*re, now);
+      } else {
+        PortChange refused;
+        refused.refused = "the port is stopping";
+        re->done->set_value(std::move(refused));
+      }
     } else if (auto* fn = std::get_if<std::function<void(CanBackend&)>>(&item)) {
       (*fn)(*backend_);
     } else {
@@ -333,10 +421,10 @@ void PortLoop::publish_port(TimePoint now) {
     std::lock_guard lock(problem_mutex_);
     if (problem != problem_) problem_ = problem;
   }
-  s.nodes_configured = static_cast<std::uint16_t>(config_.pumps.size());
-  for (const auto& p : config_.pumps) {
-    if (scanner().node(p.node.mac)->state() == devicenet::NodeState::kOnline) ++s.nodes_online;
-  }
+  const auto& views = rack().pumps();
+  s.nodes_configured = static_cast<std::uint16_t>(views.size());
+  s.nodes_online = static_cast<std::uint16_t>(
+      std::count_if(views.begin(), views.end(), [](const auto& v) { return v.online; }));
   // Rates are measured over whole status periods; a state change in between
   // publishes the last measured ones.
   if (now - metrics_time_ >= config_.status_period) update_metrics(s.bus, now);
@@ -367,14 +455,16 @@ void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
   const double elapsed = std::chrono::duration<double>(now - metrics_time_).count();
   double cycle_sum = 0;
   unsigned cycles = 0;
-  for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
-    const auto* node = scanner().node(config_.pumps[i].node.mac);
+  const auto& views = rack().pumps();
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const auto* node = scanner().node(views[i].mac);
+    std::uint64_t& last = published_[i].polls;
     const std::uint64_t polls = node->counters().polls;
-    if (node->state() == devicenet::NodeState::kOnline && polls > last_polls_[i]) {
-      cycle_sum += 1000.0 * elapsed / static_cast<double>(polls - last_polls_[i]);
+    if (node->state() == devicenet::NodeState::kOnline && polls > last) {
+      cycle_sum += 1000.0 * elapsed / static_cast<double>(polls - last);
       ++cycles;
     }
-    last_polls_[i] = polls;
+    last = polls;
   }
   metrics_.frames_per_second = static_cast<double>(bus.frames - last_counters_.frames) / elapsed;
   const auto bitrate = backend_->bitrate();

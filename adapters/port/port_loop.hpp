@@ -5,10 +5,12 @@
 // (the DDS input) talk to it through its inbox, which wakes it. State is
 // published from here.
 #include <atomic>
+#include <bit>
 #include <bitset>
 #include <chrono>
 #include <deque>
 #include <functional>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -36,6 +38,19 @@ struct PortLoopConfig {
   rack::ExplicitPolicy explicit_policy;      // the rack's [explicit_policy]
   Duration status_period = seconds(1);       // NodeStatus/PortStatus at least this often
   Duration shutdown_timeout = seconds(3);    // for idling and releasing every node
+};
+
+// What a configuration read again changed on a port (PortLoop::reconfigure).
+struct PortChange {
+  rack::ScanListChange scan_list;
+  std::vector<devicenet::MacId> publish_changed;  // nodes kept whose publish policy changed
+  bool explicit_policy_changed = false;
+  // Not empty: the port refused the configuration, and nothing changed.
+  std::string refused;
+
+  bool any() const {
+    return scan_list.any() || !publish_changed.empty() || explicit_policy_changed;
+  }
 };
 
 class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver {
@@ -73,12 +88,22 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void scan_request(ScanCall call);
   static constexpr std::size_t kMaxScanWaiters = 64;
   static constexpr Duration kScanHoldoff = seconds(30);
+  // A configuration read again (a reload): the port's scan list, its
+  // timings, its pumps' publish policies and the explicit policy, applied
+  // on the port's thread at its next pass, only where they differ
+  // (rack::RackPort::reconfigure); nodes not changed keep polling,
+  // untouched. The port's name, interface and master stay as they are
+  // (they need a restart). Removed nodes' instances are disposed. The
+  // future says what changed; it is never fulfilled once the loop stopped.
+  std::future<PortChange> reconfigure(PortLoopConfig next);
   // Runs `fn` on the port's thread with its backend (tests and tools only).
   void post(std::function<void(CanBackend&)> fn);
 
   const std::string& name() const { return config_.port; }
   // Whether `mac` is in the port's scan list (any thread).
-  bool has_node(devicenet::MacId mac) const;
+  bool has_node(devicenet::MacId mac) const {
+    return (scan_list_.load(std::memory_order_relaxed) >> mac.value()) & 1u;
+  }
 
   // For a service manager, from any thread. The port has finished its
   // start-up checks once its master left the duplicate MAC ID check, either
@@ -91,7 +116,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   std::uint64_t heartbeat() const { return heartbeat_.load(std::memory_order_relaxed); }
   // Nodes online as of the last PortStatus.
   std::uint16_t nodes_online() const { return nodes_online_.load(std::memory_order_relaxed); }
-  std::size_t nodes_configured() const { return config_.pumps.size(); }
+  std::size_t nodes_configured() const {
+    return static_cast<std::size_t>(std::popcount(scan_list_.load(std::memory_order_relaxed)));
+  }
   // What keeps the port off the bus as of the last PortStatus ("interface
   // can7 absent"); empty when nothing does.
   std::string problem() const;
@@ -106,7 +133,14 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     devicenet::MacId mac;
   };
   struct Stop {};
-  using Item = std::variant<Command, Release, Stop, ScanCall, std::function<void(CanBackend&)>>;
+  struct Reconfigure {
+    std::shared_ptr<PortLoopConfig> config;
+    std::shared_ptr<std::promise<PortChange>> done;
+  };
+  using Item =
+      std::variant<Command, Release, Stop, ScanCall, Reconfigure, std::function<void(CanBackend&)>>;
+  void apply(const Reconfigure& r, TimePoint now);
+  void note_scan_list();
 
   void run();
   // Starts the master once the interface is up: its duplicate MAC ID check
@@ -155,8 +189,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     TimePoint status_time{};
     bool status_once = false;
     TimePoint event_time{};  // latest event of this node: the source time
+    std::uint64_t polls = 0;  // the node's polls at the last metrics update
   };
-  std::vector<Published> published_;
+  std::vector<Published> published_;  // in the rack's order of pumps
   TimePoint started_{};              // when run() began
   bool master_started_ = false;
   bool port_dirty_ = true;
@@ -165,7 +200,6 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   BusCounters last_counters_{};
   BusState bus_state_ = BusState::kUnknown;  // as last published
   BusState bus_seen_ = BusState::kUnknown;   // as last seen by the loop
-  std::vector<std::uint64_t> last_polls_;
   TimePoint metrics_time_{};
   struct Metrics {
     double frames_per_second = 0;
@@ -179,7 +213,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void note_busy(std::chrono::steady_clock::time_point since);
   Duration longest_pass_{};
 
-  std::bitset<64> scan_list_;  // by MAC; set at construction, read from any thread
+  std::atomic<std::uint64_t> scan_list_{0};  // bit per MAC; set on the port's thread
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
   std::deque<rack::ExplicitCall> calls_;

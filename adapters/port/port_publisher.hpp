@@ -101,6 +101,9 @@ class PortPublisher {
   virtual void bus_scan_reply(const std::string& port, const BusScanAnswer& answer) = 0;
   // The port has stopped: its instances are unregistered (never disposed).
   virtual void port_stopped(const std::string& port) = 0;
+  // The node left the port's configuration (a reload): its instances are
+  // disposed, after its last samples.
+  virtual void node_removed(const std::string& port, devicenet::MacId mac) = 0;
 };
 
 }  // namespace dnbridge::port

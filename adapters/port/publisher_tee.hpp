@@ -35,6 +35,10 @@ class PublisherTee final : public PortPublisher {
     first_.port_stopped(port);
     second_.port_stopped(port);
   }
+  void node_removed(const std::string& port, devicenet::MacId mac) override {
+    first_.node_removed(port, mac);
+    second_.node_removed(port, mac);
+  }
 
  private:
   PortPublisher& first_;

@@ -121,6 +121,8 @@ class ExplicitGateway {
   // Requests answered "out of buffers" because a limit was reached.
   std::uint64_t refused_for_limits() const { return refused_for_limits_; }
   const ExplicitPolicy& policy() const { return policy_; }
+  // For requests taken from now on (a configuration read again).
+  void set_policy(const ExplicitPolicy& policy) { policy_ = policy; }
 
  private:
   using Key = std::pair<std::string, std::uint32_t>;

@@ -30,23 +30,78 @@ devicenet::ScannerConfig PumpRack::scanner_config(devicenet::ScannerConfig port,
   return port;
 }
 
+PumpRack::Slot PumpRack::slot_of(const PumpConfig& p) {
+  auto format = cdn127::poll_format(p.io);
+  if (!format) {
+    throw std::invalid_argument(
+        fmt::format("node {}: invalid I/O configuration", p.node.mac.value()));
+  }
+  return {p.io, *format, p.no_commander, p.resume};
+}
+
+PumpView PumpRack::view_of(const PumpConfig& p) {
+  PumpView v;
+  v.mac = p.node.mac;
+  v.name = p.node.name;
+  v.reason = "not started";
+  v.safe_state_source = p.safe_state.source;
+  return v;
+}
+
 PumpRack::PumpRack(const std::vector<PumpConfig>& pumps) {
   index_.fill(-1);
-  for (const auto& p : pumps) {
-    auto format = cdn127::poll_format(p.io);
-    if (!format) {
-      throw std::invalid_argument(
-          fmt::format("node {}: invalid I/O configuration", p.node.mac.value()));
-    }
-    index_[p.node.mac.value()] = static_cast<int>(views_.size());
-    PumpView v;
-    v.mac = p.node.mac;
-    v.name = p.node.name;
-    v.reason = "not started";
-    v.safe_state_source = p.safe_state.source;
-    views_.push_back(std::move(v));
-    slots_.push_back({p.io, *format, p.no_commander, p.resume});
+  for (const auto& p : pumps) add(p);
+}
+
+void PumpRack::add(const PumpConfig& p) {
+  if (index_[p.node.mac.value()] >= 0) {
+    throw std::invalid_argument(fmt::format("node {} is in the rack twice", p.node.mac.value()));
   }
+  slots_.push_back(slot_of(p));
+  index_[p.node.mac.value()] = static_cast<int>(views_.size());
+  views_.push_back(view_of(p));
+}
+
+void PumpRack::remove(MacId mac) {
+  const int i = index_[mac.value()];
+  if (i < 0) return;
+  views_.erase(views_.begin() + i);
+  slots_.erase(slots_.begin() + i);
+  index_.fill(-1);
+  for (std::size_t k = 0; k < views_.size(); ++k) {
+    index_[views_[k].mac.value()] = static_cast<int>(k);
+  }
+}
+
+void PumpRack::replace(const PumpConfig& p) {
+  const int i = index_[p.node.mac.value()];
+  if (i < 0) return add(p);
+  const auto index = static_cast<std::size_t>(i);
+  slots_[index] = slot_of(p);
+  PumpView& v = views_[index];
+  // Its counters go on (they are the pump's, whatever its settings); the
+  // rest starts again.
+  PumpView fresh = view_of(p);
+  fresh.commands_accepted = v.commands_accepted;
+  fresh.commands_refused = v.commands_refused;
+  fresh.responses_with_invalid_inputs = v.responses_with_invalid_inputs;
+  fresh.reason = "configuration changed: released, to be configured again";
+  fresh.state_since = v.state_since;
+  fresh.idle_cause = IdleCause::kReconfigured;
+  fresh.changes = v.changes + 1;
+  fresh.status_changes = v.status_changes + 1;
+  v = std::move(fresh);
+}
+
+void PumpRack::update(const PumpConfig& p) {
+  PumpView* v = find(p.node.mac);
+  if (!v) return;
+  Slot& slot = slots_[static_cast<std::size_t>(index_[p.node.mac.value()])];
+  slot.no_commander = p.no_commander;
+  slot.resume = p.resume;
+  v->name = p.node.name;
+  ++v->changes;
+  ++v->status_changes;
 }
 
 PumpView* PumpRack::find(MacId mac) {
@@ -67,6 +122,8 @@ std::string_view to_string(IdleCause cause) noexcept {
       return "idle: no live commander";
     case IdleCause::kAfterLoss:
       return "idle: waiting for a new command after reconnection";
+    case IdleCause::kReconfigured:
+      return "idle: configured again after a reload, waiting for a new command";
   }
   return "idle";
 }

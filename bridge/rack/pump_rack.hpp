@@ -49,6 +49,7 @@ enum class IdleCause : std::uint8_t {
   kNoCommandYet,  // nothing commanded since the bridge started
   kNoCommander,   // the last commander went away
   kAfterLoss,     // back after a loss: a new command is needed (ResumePolicy::kFreshCommand)
+  kReconfigured,  // configured again after a reload: a new command is needed
 };
 std::string_view to_string(IdleCause cause) noexcept;
 
@@ -136,6 +137,18 @@ class PumpRack final : public devicenet::ScannerObserver {
   // keeps its last outputs.
   Status release_command(devicenet::MacId mac, TimePoint now);
 
+  // Live changes, made together with the master's scan list
+  // (RackPort::reconfigure). A new pump's view is absent, with no command.
+  void add(const PumpConfig& pump);
+  void remove(devicenet::MacId mac);
+  // The pump's device settings changed: the master releases it and
+  // configures it again, so its view starts afresh, in its place, and no
+  // command survives.
+  void replace(const PumpConfig& pump);
+  // Only what the bridge itself does with the pump changed (its name, its
+  // no-commander and resume policies): view and command are kept.
+  void update(const PumpConfig& pump);
+
   const std::vector<PumpView>& pumps() const { return views_; }
   const PumpView* pump(devicenet::MacId mac) const;
   devicenet::PortState port_state() const { return port_state_; }
@@ -165,6 +178,8 @@ class PumpRack final : public devicenet::ScannerObserver {
   Status refuse(PumpView& view, Status why, std::string text);
   PumpView* find(devicenet::MacId mac);
   void refresh_applied(std::size_t index);
+  static Slot slot_of(const PumpConfig& pump);
+  static PumpView view_of(const PumpConfig& pump);
 
   devicenet::Scanner* scanner_ = nullptr;
   std::vector<PumpView> views_;

@@ -15,6 +15,32 @@
 
 namespace dnbridge::rack {
 
+// What a new scan list changes in the one in force, node by node (by MAC,
+// ascending in each list).
+struct ScanListChange {
+  std::vector<devicenet::MacId> added;
+  std::vector<devicenet::MacId> removed;
+  // Its device settings differ (I/O configuration, safe state, identity,
+  // timings, serial): released, then configured again.
+  std::vector<devicenet::MacId> reconfigured;
+  // Only what the bridge does with it differs (name, no-commander and
+  // resume policies): applied in place, the node untouched.
+  std::vector<devicenet::MacId> updated;
+  std::vector<devicenet::MacId> unchanged;
+  // The port's timings (devicenet::Scanner::same_timings).
+  bool timings_changed = false;
+
+  bool any() const {
+    return timings_changed || !added.empty() || !removed.empty() || !reconfigured.empty() ||
+           !updated.empty();
+  }
+};
+
+ScanListChange compare(const devicenet::ScannerConfig& port_before,
+                       const std::vector<PumpConfig>& before,
+                       const devicenet::ScannerConfig& port_after,
+                       const std::vector<PumpConfig>& after);
+
 class RackPort {
  public:
   // `port`: the master's MAC and timings (its nodes come from `pumps`).
@@ -31,12 +57,21 @@ class RackPort {
   // starts.
   void observe(devicenet::ScannerObserver& observer) { observers_.add(observer); }
 
+  // Applies a new scan list and the port's timings while the port runs:
+  // only what differs (compare()); nodes not named keep polling, untouched.
+  // The master's MAC and duplicate MAC ID identity are not changed here.
+  // Checks the whole first: throws std::invalid_argument, changing nothing,
+  // for a scan list the master refuses.
+  ScanListChange reconfigure(const devicenet::ScannerConfig& port,
+                             const std::vector<PumpConfig>& pumps, TimePoint now);
+
   devicenet::Scanner& scanner() { return *scanner_; }
   const devicenet::Scanner& scanner() const { return *scanner_; }
   PumpRack& pumps() { return pumps_; }
   const PumpRack& pumps() const { return pumps_; }
 
  private:
+  std::vector<PumpConfig> in_force_;
   PumpRack pumps_;
   devicenet::ObserverFanout observers_;
   std::optional<devicenet::Scanner> scanner_;

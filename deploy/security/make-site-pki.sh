@@ -24,10 +24,12 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
                       later runs keep the site's, which changes only with
                       --new-ca)
   --bridge NAME       a rack's bridge: publishes PumpState, NodeStatus,
-                      PortStatus, ExplicitReply and BusScanReply, reads
-                      PumpCommand, ExplicitRequest and BusScanRequest
+                      PortStatus, ExplicitReply, BusScanReply and
+                      ReloadReply, reads PumpCommand, ExplicitRequest,
+                      BusScanRequest and ReloadRequest
   --supervisor NAME   a supervisory host: reads every dnbridge topic, writes
-                      PumpCommand, ExplicitRequest and BusScanRequest
+                      PumpCommand, ExplicitRequest, BusScanRequest and
+                      ReloadRequest
   --monitor NAME      a monitoring host: reads PumpState, NodeStatus and
                       PortStatus only
   --days N            validity of new identities and of the permissions
@@ -280,17 +282,17 @@ EOF
 topics() { for t in "$@"; do echo "            <topic>dnbridge/$t</topic>"; done; }
 publish_of() {
   case $1 in
-    bridge) topics PumpState NodeStatus PortStatus ExplicitReply BusScanReply ;;
-    supervisor) topics PumpCommand ExplicitRequest BusScanRequest ;;
+    bridge) topics PumpState NodeStatus PortStatus ExplicitReply BusScanReply ReloadReply ;;
+    supervisor) topics PumpCommand ExplicitRequest BusScanRequest ReloadRequest ;;
     monitor) ;;
   esac
 }
 subscribe_of() {
   case $1 in
-    bridge) topics PumpCommand ExplicitRequest BusScanRequest ;;
+    bridge) topics PumpCommand ExplicitRequest BusScanRequest ReloadRequest ;;
     supervisor)
       topics PumpState NodeStatus PortStatus ExplicitReply PumpCommand ExplicitRequest \
-        BusScanRequest BusScanReply
+        BusScanRequest BusScanReply ReloadRequest ReloadReply
       ;;
     monitor) topics PumpState NodeStatus PortStatus ;;
   esac

@@ -49,9 +49,12 @@ constexpr unsigned kUnconfigured = 17;
 
 class DnbctlEndToEnd : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    log_ = std::make_unique<daemon::StderrLogSink>(LogLevel::kWarn);
+  // The bridge's configuration; what a reload reads is this with
+  // `reload_edit_` applied, or, when `reload_problem_` is set, a file with
+  // that problem.
+  static daemon::DaemonConfig suite_config() {
     daemon::DaemonConfig config = daemon::embedded_default_config();
+    config.source = "dnbctl-e2e.toml";
     config.domain_id = test_domain();
     config.rack = kRack;
     for (auto& node : config.ports.at(0).nodes) {
@@ -62,8 +65,20 @@ class DnbctlEndToEnd : public ::testing::Test {
     }
     // A CDN127 the configuration does not have (a MAC switch set wrong).
     config.ports.at(0).simulated_unconfigured = {devicenet::MacId::from(kUnconfigured).value()};
-    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), *log_,
-                                               daemon::simulated_backend_factory(*log_));
+    return config;
+  }
+
+  static void SetUpTestSuite() {
+    log_ = std::make_unique<daemon::StderrLogSink>(LogLevel::kWarn);
+    daemon::ReloadSource reload;
+    reload.load = [] {
+      if (!reload_problem_.empty()) throw daemon::ConfigError({reload_problem_});
+      auto c = suite_config();
+      if (reload_edit_) reload_edit_(c);
+      return c;
+    };
+    bridge_ = std::make_unique<daemon::Daemon>(
+        suite_config(), *log_, daemon::simulated_backend_factory(*log_), std::move(reload));
     bridge_->start();
     observer_ = std::make_unique<Observer>();
   }
@@ -141,6 +156,9 @@ class DnbctlEndToEnd : public ::testing::Test {
   static std::unique_ptr<daemon::StderrLogSink> log_;
   static std::unique_ptr<daemon::Daemon> bridge_;
   static std::unique_ptr<Observer> observer_;
+  // What the next reload reads (set before the dnbctl run that asks for it).
+  static inline std::function<void(daemon::DaemonConfig&)> reload_edit_;
+  static inline std::string reload_problem_;
 };
 
 std::unique_ptr<daemon::StderrLogSink> DnbctlEndToEnd::log_;
@@ -422,6 +440,51 @@ TEST(Dnbctl, UsageErrorsExit2AndNothingFoundExits3) {
   r = testing::run(DNBCTL_PATH, {"--domain", domain, "--timeout", "0.5", "racks"});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("no bridge answered on DDS domain " + domain), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace dnbridge::dnbctl
+
+namespace dnbridge::dnbctl {
+namespace {
+
+// dnbctl reload: the bridge reads its configuration again. Unchanged, it
+// applies nothing; with a node renamed, that change; with a problem,
+// nothing, and dnbctl says why and exits 1.
+TEST_F(DnbctlEndToEnd, ReloadAppliesWhatChangedAndReportsProblems) {
+  const auto unchanged = dnbctl({"reload", "--json"});
+  ASSERT_EQ(unchanged.exit_code, 0) << unchanged.err << unchanged.out;
+  const auto doc = nlohmann::json::parse(unchanged.out);
+  EXPECT_EQ(doc.at("rack"), kRack);
+  EXPECT_EQ(doc.at("status"), "applied");
+  EXPECT_EQ(doc.at("file"), "dnbctl-e2e.toml");
+  EXPECT_TRUE(doc.at("applied").empty()) << doc;
+  EXPECT_TRUE(doc.at("problems").empty()) << doc;
+
+  reload_edit_ = [](daemon::DaemonConfig& c) { c.ports.at(0).nodes.at(5).pump.node.name = "six"; };
+  const auto renamed = dnbctl({"--rack", kRack, "reload"});
+  ASSERT_EQ(renamed.exit_code, 0) << renamed.err << renamed.out;
+  EXPECT_NE(renamed.out.find("port A: node 6 name or policies changed"), std::string::npos)
+      << renamed.out;
+  EXPECT_TRUE(observer_->wait_pump(
+      6, [](const dnbridge_PumpState& s) { return dds::view(s.name) == "six" && s.online; }));
+
+  reload_problem_ = "dnbctl-e2e.toml:12:3: poll_period_ms must be positive";
+  const auto refused = dnbctl({"reload", "--json"});
+  reload_problem_.clear();
+  EXPECT_EQ(refused.exit_code, 1) << refused.err << refused.out;
+  const auto no = nlohmann::json::parse(refused.out);
+  EXPECT_EQ(no.at("status"), "refused");
+  ASSERT_EQ(no.at("problems").size(), 1u) << no;
+  EXPECT_EQ(no.at("problems").at(0), "dnbctl-e2e.toml:12:3: poll_period_ms must be positive");
+  EXPECT_NE(refused.err.find("reload refused"), std::string::npos) << refused.err;
+
+  // Back as the other tests know it.
+  reload_edit_ = nullptr;
+  const auto back = dnbctl({"reload"});
+  EXPECT_EQ(back.exit_code, 0) << back.err << back.out;
+  EXPECT_TRUE(observer_->wait_pump(
+      6, [](const dnbridge_PumpState& s) { return dds::view(s.name) == "pump-6"; }));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <limits>
 
 #include "adapters/dds/fields.hpp"
@@ -397,6 +398,85 @@ TEST(Explicit, SuccessWithoutData) {
             "status: 1 (transaction completed)\n"
             "CIP general status: 0x00 (success)\n"
             "data: none\n");
+}
+
+// A string sequence as a sample read from DDS holds it, freed with the
+// sample.
+void set_strings(dds_sequence_string& seq, std::initializer_list<std::string_view> lines) {
+  seq._buffer = static_cast<char**>(dds_alloc(sizeof(char*) * lines.size()));
+  seq._maximum = seq._length = static_cast<std::uint32_t>(lines.size());
+  seq._release = true;
+  std::uint32_t i = 0;
+  for (const auto line : lines) {
+    seq._buffer[i] = nullptr;
+    set_string(seq._buffer[i++], line);
+  }
+}
+
+Owned<dnbridge_ReloadReply> reload_reply(std::uint8_t status) {
+  Owned<dnbridge_ReloadReply> r;
+  set_string(r->requester, "dnbctl@host:1:2");
+  r->txid = 1;
+  set_string(r->rack, "sim-rack");
+  r->status = status;
+  set_string(r->file, "/etc/dnbridge/sim-rack.toml");
+  return r;
+}
+
+TEST(Reload, AppliedListsWhatChangedAndWhatWaitsForARestart) {
+  auto r = reload_reply(dnbridge_RELOAD_APPLIED);
+  set_string(r->message, "configuration applied: 2 changes");
+  set_strings(r->applied, {"port A: node 12 added", "port A: node 3 renamed \"dry-pump\""});
+  set_strings(r->needs_restart, {"metrics address"});
+  EXPECT_EQ(reload_text(*r),
+            "rack sim-rack: configuration applied: 2 changes\n"
+            "file: /etc/dnbridge/sim-rack.toml\n"
+            "applied:\n"
+            "  port A: node 12 added\n"
+            "  port A: node 3 renamed \"dry-pump\"\n"
+            "needs a restart:\n"
+            "  metrics address\n");
+  JsonWriter out(false);
+  reload_json(out, *r);
+  EXPECT_EQ(out.str(),
+            R"({"rack":"sim-rack","status":"applied","message":"configuration applied: 2 changes",)"
+            R"("file":"/etc/dnbridge/sim-rack.toml","applied":["port A: node 12 added",)"
+            R"("port A: node 3 renamed \"dry-pump\""],"needs_restart":["metrics address"],)"
+            R"("problems":[]})");
+}
+
+TEST(Reload, RefusedListsTheProblemsOnly) {
+  auto r = reload_reply(dnbridge_RELOAD_REFUSED);
+  set_string(r->message, "the file has problems: nothing changed");
+  set_strings(r->problems, {"/etc/dnbridge/sim-rack.toml:12:7: unknown key 'nmae'"});
+  EXPECT_EQ(reload_text(*r),
+            "rack sim-rack: the file has problems: nothing changed\n"
+            "file: /etc/dnbridge/sim-rack.toml\n"
+            "problems:\n"
+            "  /etc/dnbridge/sim-rack.toml:12:7: unknown key 'nmae'\n");
+  JsonWriter out(false);
+  reload_json(out, *r);
+  EXPECT_NE(out.str().find(R"("status":"refused",)"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find(R"("applied":[],"needs_restart":[],"problems":["/etc/)"),
+            std::string::npos)
+      << out.str();
+}
+
+TEST(Reload, StatusWordsAndAReplyWithoutFileOrMessage) {
+  EXPECT_EQ(reload_status_word(dnbridge_RELOAD_APPLIED), "applied");
+  EXPECT_EQ(reload_status_word(dnbridge_RELOAD_REFUSED), "refused");
+  EXPECT_EQ(reload_status_word(dnbridge_RELOAD_BUSY), "busy");
+  EXPECT_EQ(reload_status_word(dnbridge_RELOAD_NO_FILE), "no-file");
+  EXPECT_EQ(reload_status_word(dnbridge_RELOAD_INCOMPLETE), "incomplete");
+  EXPECT_EQ(reload_status_word(0), "unknown");
+  auto r = reload_reply(dnbridge_RELOAD_NO_FILE);
+  set_string(r->file, "");
+  EXPECT_EQ(reload_text(*r), "rack sim-rack: no-file\n");
+  JsonWriter out(false);
+  reload_json(out, *r);
+  EXPECT_EQ(out.str(),
+            R"({"rack":"sim-rack","status":"no-file","message":"","file":"","applied":[],)"
+            R"("needs_restart":[],"problems":[]})");
 }
 
 }  // namespace

@@ -88,12 +88,15 @@ class CapturingLog final : public LogSink {
     lines_.push_back({level, std::string(component), std::string(message)});
   }
   // Whether a line at `level` contains `text`.
-  bool contains(LogLevel level, std::string_view text) const {
+  bool contains(LogLevel level, std::string_view text) const { return count(level, text) > 0; }
+  // How many lines at `level` contain `text`.
+  std::size_t count(LogLevel level, std::string_view text) const {
     std::lock_guard lock(mutex_);
+    std::size_t n = 0;
     for (const auto& l : lines_) {
-      if (l.level == level && l.message.find(text) != std::string::npos) return true;
+      if (l.level == level && l.message.find(text) != std::string::npos) ++n;
     }
-    return false;
+    return n;
   }
   void dump() const {
     std::lock_guard lock(mutex_);
@@ -266,10 +269,10 @@ class BridgeTest : public ::testing::Test {
 
   // Builds the bridge (not started) and waits until the supervisor and the
   // bridge have discovered each other on every topic.
-  void make_bridge(daemon::DaemonConfig config = rack_config()) {
+  void make_bridge(daemon::DaemonConfig config = rack_config(), daemon::ReloadSource reload = {}) {
     created_wall_ = wall_now();
-    bridge_ = std::make_unique<daemon::Daemon>(std::move(config), log_,
-                                               daemon::simulated_backend_factory(log_));
+    bridge_ = std::make_unique<daemon::Daemon>(
+        std::move(config), log_, daemon::simulated_backend_factory(log_), std::move(reload));
     ASSERT_TRUE(pumps_.matched(1));
     ASSERT_TRUE(nodes_.matched(1));
     ASSERT_TRUE(ports_.matched(1));
@@ -293,8 +296,8 @@ class BridgeTest : public ::testing::Test {
   }
 
   // Built, started, and every pump online as the supervisor sees it.
-  void start_online(daemon::DaemonConfig config = rack_config()) {
-    ASSERT_NO_FATAL_FAILURE(make_bridge(std::move(config)));
+  void start_online(daemon::DaemonConfig config = rack_config(), daemon::ReloadSource reload = {}) {
+    ASSERT_NO_FATAL_FAILURE(make_bridge(std::move(config), std::move(reload)));
     start_bridge();
     ASSERT_TRUE(pumps_.until([&] { return all_online(); }, seconds(10)));
   }

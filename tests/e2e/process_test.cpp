@@ -3,8 +3,13 @@
 // Cyclone's domain and never touch the network), and SIGTERM stops it in
 // order. Its configuration is the embedded default on this process's domain;
 // CYCLONEDDS_URI (loopback, this process's discovery tag) is inherited.
+#include <poll.h>
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <sstream>
 
 #include "bridge_fixture.hpp"
 #include "bridge_process.hpp"
@@ -54,6 +59,62 @@ TEST_F(BridgeTest, DnbridgeProcessServesTheSupervisorAndStopsInOrderOnSigterm) {
   for (unsigned mac = 1; mac <= kPumps; ++mac) {
     EXPECT_FALSE(pumps_.latest(pump_mac(mac))->online) << mac;
   }
+  EXPECT_EQ(bridge.wait(), 0);
+  std::filesystem::remove(config);
+}
+
+// What a child wrote to its standard error until `text` appeared in it, or
+// `timeout` passed (then the text is not in what is returned).
+std::string stderr_until(ChildProcess& child, std::string_view text, Duration timeout) {
+  std::string seen;
+  const auto deadline = SteadyClock::now() + timeout;
+  while (seen.find(text) == std::string::npos) {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyClock::now());
+    if (left.count() <= 0) break;
+    pollfd p{child.stderr_fd(), POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(left.count())) != 1) break;
+    char buf[1024];
+    const ssize_t n = ::read(child.stderr_fd(), buf, sizeof buf);
+    if (n <= 0) break;
+    seen.append(buf, static_cast<std::size_t>(n));
+  }
+  return seen;
+}
+
+// systemctl reload sends SIGHUP: the process reads its file again. One with
+// a problem changes nothing, says where (at error level) and the bridge
+// goes on; a good one is applied (a node renamed on DDS) without a restart.
+TEST_F(BridgeTest, SighupReadsTheConfigurationFileAgain) {
+  const auto config = write_simulated_rack_config(test_domain());
+  std::stringstream original;
+  original << std::ifstream(config).rdbuf();
+  const std::string good = original.str();
+  ChildOptions options;
+  options.capture_stderr = true;
+  ChildProcess bridge({DNBRIDGE_BINARY, "--config", config.string()}, options);
+  ASSERT_TRUE(pumps_.matched(1));
+  ASSERT_TRUE(pumps_.until([&] { return all_online(); }, seconds(10)));
+
+  std::string bad = good;
+  bad.replace(bad.find("poll_period_ms = 100"), 20, "poll_period_ms = -5");
+  std::ofstream(config) << bad;
+  ASSERT_TRUE(bridge.signal(SIGHUP));
+  const std::string log = stderr_until(bridge, "nothing changed", seconds(10));
+  EXPECT_NE(log.find("reload asked by SIGHUP"), std::string::npos) << log;
+  EXPECT_NE(log.find(config.string() + ":"), std::string::npos) << log;
+  EXPECT_NE(log.find("nothing changed"), std::string::npos) << log;
+
+  std::string renamed = good;
+  renamed.replace(renamed.find("name = \"pump-5\""), 15, "name = \"pump five\"");
+  std::ofstream(config) << renamed;
+  ASSERT_TRUE(bridge.signal(SIGHUP));
+  ASSERT_TRUE(pumps_.until([&] {
+    const auto* five = pumps_.latest(pump_mac(5));
+    return five && dds::view(five->name) == "pump five";
+  }));
+  EXPECT_TRUE(pumps_.latest(pump_mac(1))->online);
+  ASSERT_TRUE(bridge.signal(SIGTERM));
   EXPECT_EQ(bridge.wait(), 0);
   std::filesystem::remove(config);
 }

@@ -69,6 +69,12 @@ class RecordingPublisher final : public PortPublisher {
     stopped = true;
     changed_.notify_all();
   }
+  void node_removed(const std::string&, MacId m) override {
+    std::lock_guard lock(mutex_);
+    removed.push_back(m.value());
+    pumps.erase(m.value());
+    changed_.notify_all();
+  }
 
   // Waits (at most `timeout`) until `done()` holds; checked under the lock.
   template <class F>
@@ -91,6 +97,7 @@ class RecordingPublisher final : public PortPublisher {
   std::vector<std::string> port_reasons;  // each new one
   std::vector<rack::ExplicitAnswer> replies;
   std::vector<BusScanAnswer> scans;
+  std::vector<unsigned> removed;  // node_removed, in order
   std::size_t pump_samples = 0, status_samples = 0, port_samples = 0;
   bool stopped = false;
 
@@ -677,6 +684,73 @@ TEST(PortLoop, BusScanRequestsShareAScanAndAPortOffTheBusRefusesThem) {
   }
   absent.stop();
   absent.join();
+}
+
+}  // namespace
+}  // namespace dnbridge::port
+
+namespace dnbridge::port {
+namespace {
+
+// A configuration read again reaches the port's thread: the removed node's
+// instances go, the added one is published and commanded, the explicit
+// policy and the publish policies follow; a refused scan list changes
+// nothing and says why.
+TEST(PortLoop, AReconfigurationIsAppliedOnThePortsThread) {
+  RecordingPublisher publisher;
+  PortLoop loop(config_for({1, 2}),
+                std::make_unique<sim::SimBackend>(can::kBitrate500k,
+                                                  std::vector<MacId>{mac(1), mac(2), mac(3)}),
+                publisher, null_log_sink());
+  loop.start();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.port && publisher.port->nodes_online == 2; }));
+  EXPECT_FALSE(loop.has_node(mac(3)));
+
+  PortLoopConfig next = config_for({1, 3});
+  next.publish[0].max_period = milliseconds(300);
+  next.explicit_policy.allow_output_writes = true;
+  auto done = loop.reconfigure(next);
+  ASSERT_EQ(done.wait_for(std::chrono::seconds(10)), std::future_status::ready);
+  const PortChange change = done.get();
+  EXPECT_TRUE(change.refused.empty()) << change.refused;
+  EXPECT_EQ(change.scan_list.added, std::vector<MacId>{mac(3)});
+  EXPECT_EQ(change.scan_list.removed, std::vector<MacId>{mac(2)});
+  EXPECT_EQ(change.scan_list.unchanged, std::vector<MacId>{mac(1)});
+  EXPECT_EQ(change.publish_changed, std::vector<MacId>{mac(1)});
+  EXPECT_TRUE(change.explicit_policy_changed);
+  EXPECT_TRUE(loop.has_node(mac(3)));
+  EXPECT_FALSE(loop.has_node(mac(2)));
+  EXPECT_EQ(loop.nodes_configured(), 2u);
+
+  ASSERT_TRUE(publisher.wait_for([&] {
+    return publisher.removed == std::vector<unsigned>{2} && publisher.pumps.count(3) &&
+           publisher.pumps[3].online && publisher.port->nodes_online == 2 &&
+           publisher.port->nodes_configured == 2;
+  }));
+  profiles::cdn127::PumpOutputs out;
+  out.pump_on = true;
+  loop.command(mac(3), out, "supervisor-1");
+  ASSERT_TRUE(publisher.wait_for([&] { return !publisher.pumps[3].outputs_idle; }));
+  // Node 2 was idled and released (two exchanges, begun before node 3's
+  // first Allocate), not left to its connections' watchdogs.
+  std::promise<std::pair<bool, bool>> released;
+  loop.post([&](CanBackend& b) {
+    const auto& d = static_cast<sim::SimBackend&>(b).device(mac(2)).device();
+    released.set_value({d.poll_state() != sim::ConnectionState::kEstablished,
+                        d.explicit_state() != sim::ConnectionState::kEstablished});
+  });
+  EXPECT_EQ(released.get_future().get(), std::make_pair(true, true));
+
+  // A node at the master's MAC: refused whole.
+  auto refused = loop.reconfigure(config_for({0, 1, 3}));
+  ASSERT_EQ(refused.wait_for(std::chrono::seconds(10)), std::future_status::ready);
+  const PortChange none = refused.get();
+  EXPECT_NE(none.refused.find("master's MAC"), std::string::npos) << none.refused;
+  EXPECT_FALSE(loop.has_node(mac(0)));
+  EXPECT_TRUE(loop.has_node(mac(3)));
+  loop.stop();
+  loop.join();
 }
 
 }  // namespace

@@ -40,6 +40,8 @@ class SimRack {
   devicenet::Scanner& scanner() { return port_->scanner(); }
   SimMaster& master() { return *master_; }
   rack::PumpRack& pumps() { return port_->pumps(); }
+  // The master and the rack model together (a live reconfiguration).
+  rack::RackPort& port() { return *port_; }
   // Extra observers (tests record events); add before start().
   void observe(devicenet::ScannerObserver& o) { port_->observe(o); }
 

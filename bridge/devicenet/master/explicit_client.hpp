@@ -93,6 +93,8 @@ class ExplicitClient {
   bool idle() const noexcept { return !outstanding_ && count_ == 0; }
   // The response timeout a request gets unless it names its own.
   Duration response_timeout() const noexcept { return config_.response_timeout; }
+  // For requests submitted from now on (a live change of the port's timings).
+  void set_response_timeout(Duration timeout) noexcept { config_.response_timeout = timeout; }
   std::size_t queued() const noexcept { return count_ + (outstanding_ ? 1 : 0); }
   const ExplicitCounters& counters() const noexcept { return counters_; }
 

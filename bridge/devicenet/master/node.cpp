@@ -24,18 +24,28 @@ ExplicitClient::Config client_config(const NodeConfig& node, const ScannerConfig
 
 }  // namespace
 
-Node::Node(const NodeConfig& config, const ScannerConfig& port, can::FrameSink& sink,
+Node::Node(NodeConfig config, const ScannerConfig& port, can::FrameSink& sink,
            ScannerObserver& observer, Logger log)
-    : config_(config),
+    : config_(std::move(config)),
       port_(port),
       sink_(sink),
       observer_(observer),
       log_(std::move(log)),
-      client_(port.master_mac, config.mac, client_config(config, port), sink, *this),
+      client_(port.master_mac, config_.mac, client_config(config_, port), sink, *this),
       retry_delay_(port.allocate_retry_min),
-      jitter_state_(0x9E3779B9u ^ (static_cast<std::uint32_t>(config.mac.value()) * 0x85EBCA6Bu)),
-      poll_epr_(config.expected_packet_rate),
-      explicit_epr_(config.explicit_packet_rate) {}
+      jitter_state_(0x9E3779B9u ^ (static_cast<std::uint32_t>(config_.mac.value()) * 0x85EBCA6Bu)),
+      poll_epr_(config_.expected_packet_rate),
+      explicit_epr_(config_.explicit_packet_rate) {}
+
+void Node::apply_port_timings() {
+  client_.set_response_timeout(client_config(config_, port_).response_timeout);
+}
+
+void Node::retire(std::string why, TimePoint now) {
+  reports_data_ = false;
+  shutdown_why_ = std::move(why);
+  begin_shutdown(now);
+}
 
 void Node::start(TimePoint now, TimePoint first_attempt) {
   started_ = true;
@@ -142,7 +152,7 @@ void Node::begin_shutdown(TimePoint now) {
     release(Step::kReleaseShutdown, held_connections(), now);
     return;
   }
-  set_state(NodeState::kStopped, "orderly shutdown", now);
+  set_state(NodeState::kStopped, shutdown_why_, now);
 }
 
 void Node::release_for_shutdown(TimePoint now) {

@@ -31,7 +31,10 @@ class Node final : private ExplicitClient::Listener {
   // Internal request tags have this bit set; external request ids must not.
   static constexpr std::uint32_t kInternalTag = 0x8000'0000u;
 
-  Node(const NodeConfig& config, const ScannerConfig& port, can::FrameSink& sink,
+  // `port`: the port's settings, read when they are used (live changes of
+  // its timings reach the node; apply_port_timings() for the explicit
+  // response timeout). The node keeps its own copy of `config`.
+  Node(NodeConfig config, const ScannerConfig& port, can::FrameSink& sink,
        ScannerObserver& observer, Logger log);
 
   // Begins allocation at `first_attempt` (the scanner staggers nodes); the
@@ -39,6 +42,14 @@ class Node final : private ExplicitClient::Listener {
   void start(TimePoint now, TimePoint first_attempt);
   // Orderly shutdown: an idle poll, then Release. stopped() tells when done.
   void begin_shutdown(TimePoint now);
+  // Orderly shutdown of a node taken out of the scan list (or out to be
+  // configured again): as begin_shutdown(), but its poll data is no longer
+  // reported (the rack may already decode that MAC's data otherwise).
+  // `why` ends the reasons of its last states ("taken out of the scan list").
+  void retire(std::string why, TimePoint now);
+  // The port's explicit response timeout changed: requests from now on use
+  // it (unless the node has its own).
+  void apply_port_timings();
   // Stops at once without sending anything (the port lost its MAC).
   void halt(std::string_view reason, TimePoint now);
   // Forgets its connections without sending anything and waits for start()
@@ -234,7 +245,7 @@ class Node final : private ExplicitClient::Listener {
   void bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now);
   TimePoint next_poll_slot(TimePoint after) const;
 
-  const NodeConfig& config_;
+  const NodeConfig config_;
   const ScannerConfig& port_;
   can::FrameSink& sink_;
   ScannerObserver& observer_;
@@ -249,6 +260,8 @@ class Node final : private ExplicitClient::Listener {
   bool poll_requested_ = false;  // Allocate(poll) sent: the device may hold it unanswered
   bool shutting_down_ = false;
   bool started_ = false;
+  bool reports_data_ = true;  // false once retired
+  std::string shutdown_why_ = "orderly shutdown";
   TimePoint retry_at_ = kNever;
   Duration retry_delay_{};
   std::uint32_t jitter_state_ = 0;  // xorshift state, seeded from the MAC

@@ -318,7 +318,7 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
       connected_ = poll_allocated_ = poll_requested_ = false;
       // Whatever the answer, a faulted node is left alone until the re-check.
       if (step == Step::kReleaseShutdown) {
-        set_state(NodeState::kStopped, "released by orderly shutdown", now);
+        set_state(NodeState::kStopped, "released by " + shutdown_why_, now);
       }
       return;
     case Step::kAllocateExplicit:

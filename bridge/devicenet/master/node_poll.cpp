@@ -150,7 +150,7 @@ void Node::accept_poll_response(Bytes data, TimePoint now) {
   ++counters_.responses;
   applied_idle_ = sent_idle_;
   applied_outputs_ = sent_outputs_;
-  observer_.on_poll_response(config_.mac, data, now);
+  if (reports_data_) observer_.on_poll_response(config_.mac, data, now);
   if (shutting_down_) {
     if (outputs_dirty_) {
       send_poll(now);  // the idle poll, after the one that was outstanding

@@ -36,6 +36,8 @@ struct AttributeSetting {
   std::string name;  // for reasons and logs, e.g. "Configuration.NumAnalogInput"
   bool keep_device_value = false;
   std::uint32_t device_value_max = 0;
+
+  friend bool operator==(const AttributeSetting&, const AttributeSetting&) = default;
 };
 
 // Where the device reports the poll connection's sizes: Connection instance 2
@@ -48,6 +50,8 @@ struct SizeSource {
   std::uint8_t consumed_attribute = 0;
   bool one_byte = false;    // USINT rather than UINT
   std::string object_name;  // for reasons: "Configuration"
+
+  friend bool operator==(const SizeSource&, const SizeSource&) = default;
 };
 
 // Device-specific knowledge the node life cycle needs, as data: built by a
@@ -62,6 +66,8 @@ struct NodeProfile {
   std::string format_description;           // e.g. "request 4 B [DOUT PAD AOUT] ..."
   bool has_size_fallback = false;
   SizeSource size_fallback;
+
+  friend bool operator==(const NodeProfile&, const NodeProfile&) = default;
 };
 
 struct NodeConfig {
@@ -93,6 +99,8 @@ struct NodeConfig {
   // This node's own timeouts, for slow devices; the port's otherwise.
   std::optional<Duration> explicit_response_timeout;
   std::optional<Duration> poll_response_timeout;
+
+  friend bool operator==(const NodeConfig&, const NodeConfig&) = default;
 };
 
 struct ScannerConfig {

@@ -18,37 +18,42 @@ DuplicateMacCheck::Config mac_check_config(const ScannerConfig& c) {
   return m;
 }
 
-void validate(const ScannerConfig& c) {
-  std::array<bool, MacId::kMax + 1> seen{};
-  for (const auto& n : c.nodes) {
-    const unsigned mac = n.mac.value();
-    if (mac > MacId::kMax)
-      throw std::invalid_argument(fmt::format("node MAC {} out of range", mac));
-    if (n.mac == c.master_mac) {
-      throw std::invalid_argument(fmt::format("node {} has the master's MAC", mac));
-    }
-    if (seen[mac])
-      throw std::invalid_argument(fmt::format("MAC {} is in the scan list twice", mac));
-    seen[mac] = true;
-    if (n.poll_period <= Duration::zero()) {
-      throw std::invalid_argument(fmt::format("node {}: poll period must be positive", mac));
-    }
-    if (n.immediate_poll_min_gap < Duration::zero()) {
-      throw std::invalid_argument(
-          fmt::format("node {}: immediate poll minimum gap must not be negative", mac));
-    }
-    if (n.expected_packet_rate < n.poll_period) {
-      throw std::invalid_argument(
-          fmt::format("node {}: expected packet rate shorter than the poll period", mac));
-    }
-    if (n.profile.consumed_size > Node::kMaxIoSize || n.profile.produced_size > Node::kMaxIoSize) {
-      throw std::invalid_argument(
-          fmt::format("node {}: poll messages over {} bytes", mac, Node::kMaxIoSize));
-    }
+// One node's own settings, and its MAC against the master's.
+void validate_node(const ScannerConfig& c, const NodeConfig& n) {
+  const unsigned mac = n.mac.value();
+  if (mac > MacId::kMax) throw std::invalid_argument(fmt::format("node MAC {} out of range", mac));
+  if (n.mac == c.master_mac) {
+    throw std::invalid_argument(fmt::format("node {} has the master's MAC", mac));
+  }
+  if (n.poll_period <= Duration::zero()) {
+    throw std::invalid_argument(fmt::format("node {}: poll period must be positive", mac));
+  }
+  if (n.immediate_poll_min_gap < Duration::zero()) {
+    throw std::invalid_argument(
+        fmt::format("node {}: immediate poll minimum gap must not be negative", mac));
+  }
+  if (n.expected_packet_rate < n.poll_period) {
+    throw std::invalid_argument(
+        fmt::format("node {}: expected packet rate shorter than the poll period", mac));
+  }
+  if (n.profile.consumed_size > Node::kMaxIoSize || n.profile.produced_size > Node::kMaxIoSize) {
+    throw std::invalid_argument(
+        fmt::format("node {}: poll messages over {} bytes", mac, Node::kMaxIoSize));
   }
 }
 
 }  // namespace
+
+void Scanner::check(const ScannerConfig& c) {
+  std::array<bool, MacId::kMax + 1> seen{};
+  for (const auto& n : c.nodes) {
+    validate_node(c, n);
+    if (seen[n.mac.value()]) {
+      throw std::invalid_argument(fmt::format("MAC {} is in the scan list twice", n.mac.value()));
+    }
+    seen[n.mac.value()] = true;
+  }
+}
 
 std::string_view to_string(PortState state) noexcept {
   switch (state) {
@@ -72,18 +77,126 @@ Scanner::Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& ob
       observer_(observer),
       log_(std::move(log)),
       mac_check_(config_.master_mac, mac_check_config(config_)) {
-  validate(config_);
+  check(config_);
   unconfigured_last_heard_.fill(kNever);
   nodes_.reserve(config_.nodes.size());
-  for (const auto& n : config_.nodes) {
-    // Every line of a node carries its MAC ID, as MAC and NODE.
-    const std::string mac = std::to_string(n.mac.value());
-    Logger node_log = log_.named(fmt::format("{} node {}", log_.component(), mac))
-                          .with("MAC", mac)
-                          .with("NODE", mac);
-    nodes_.push_back(std::make_unique<Node>(n, config_, sink_, observer_, std::move(node_log)));
-    by_mac_[n.mac.value()] = nodes_.back().get();
+  for (const auto& n : config_.nodes) make_node(n);
+}
+
+Node& Scanner::make_node(NodeConfig config) {
+  // Every line of a node carries its MAC ID, as MAC and NODE.
+  const std::string mac = std::to_string(config.mac.value());
+  Logger node_log = log_.named(fmt::format("{} node {}", log_.component(), mac))
+                        .with("MAC", mac)
+                        .with("NODE", mac);
+  const std::uint8_t at = config.mac.value();
+  nodes_.push_back(
+      std::make_unique<Node>(std::move(config), config_, sink_, observer_, std::move(node_log)));
+  by_mac_[at] = nodes_.back().get();
+  return *nodes_.back();
+}
+
+bool Scanner::same_timings(const ScannerConfig& a, const ScannerConfig& b) {
+  return a.explicit_messaging.response_timeout == b.explicit_messaging.response_timeout &&
+         a.allocate_retry_min == b.allocate_retry_min &&
+         a.allocate_retry_max == b.allocate_retry_max && a.fault_recheck == b.fault_recheck &&
+         a.max_consecutive_errors == b.max_consecutive_errors &&
+         a.poll_response_timeout == b.poll_response_timeout &&
+         a.poll_batch_window == b.poll_batch_window &&
+         a.scan_response_timeout == b.scan_response_timeout;
+}
+
+void Scanner::retune(const ScannerConfig& next) {
+  if (same_timings(config_, next)) return;
+  config_.explicit_messaging.response_timeout = next.explicit_messaging.response_timeout;
+  config_.allocate_retry_min = next.allocate_retry_min;
+  config_.allocate_retry_max = next.allocate_retry_max;
+  config_.fault_recheck = next.fault_recheck;
+  config_.max_consecutive_errors = next.max_consecutive_errors;
+  config_.poll_response_timeout = next.poll_response_timeout;
+  config_.poll_batch_window = next.poll_batch_window;
+  config_.scan_response_timeout = next.scan_response_timeout;
+  for (auto& n : nodes_) n->apply_port_timings();
+  for (auto& n : leaving_) n->apply_port_timings();
+  log_.info("port timings changed: in force for every node");
+}
+
+Status Scanner::add_node(NodeConfig node, TimePoint now) {
+  if (state_ == PortState::kStopping) return Errc::kStopped;
+  validate_node(config_, node);
+  const MacId mac = node.mac;
+  if (find(mac)) {
+    throw std::invalid_argument(fmt::format("MAC {} is in the scan list twice", mac.value()));
   }
+  end_bus_scan("the scan list changed", now);
+  // Heard before as a node the configuration did not have: now it has it.
+  unconfigured_last_heard_[mac.value()] = kNever;
+  answering_other_master_.reset(mac.value());
+  Node& n = make_node(std::move(node));
+  const bool leaving =
+      std::any_of(leaving_.begin(), leaving_.end(), [&](const auto& l) { return l->mac() == mac; });
+  log_.info("node {} added to the scan list{}", mac.value(),
+            leaving ? ": it starts once its MAC's previous node is released" : "");
+  if (state_ == PortState::kDuplicateMac) {
+    n.halt("port stopped: duplicate master MAC", now);
+  } else if (state_ == PortState::kRunning && !leaving) {
+    n.set_poll_phase(now);
+    n.start(now, now);
+  }
+  // Otherwise the node starts when the port scans (begin_scanning) or when
+  // the one leaving is released (reap).
+  return {};
+}
+
+Status Scanner::remove_node(MacId mac, TimePoint now) {
+  if (state_ == PortState::kStopping) return Errc::kStopped;
+  Node* n = find(mac);
+  if (!n) return Errc::kOutOfRange;
+  end_bus_scan("the scan list changed", now);
+  by_mac_[mac.value()] = nullptr;
+  auto it = std::find_if(nodes_.begin(), nodes_.end(), [&](const auto& p) { return p.get() == n; });
+  std::unique_ptr<Node> node = std::move(*it);
+  nodes_.erase(it);
+  if (state_ != PortState::kRunning) {
+    // No connection to give back: the node was never started, or its
+    // connections went with the bus or the master's MAC.
+    log_.info("node {} taken out of the scan list", mac.value());
+    return {};
+  }
+  log_.info("node {} taken out of the scan list: idle, then released", mac.value());
+  node->retire("taking it out of the scan list", now);
+  leaving_.push_back(std::move(node));
+  reap(now);
+  return {};
+}
+
+void Scanner::reap(TimePoint now) {
+  for (auto it = leaving_.begin(); it != leaving_.end();) {
+    if (!(*it)->stopped()) {
+      ++it;
+      continue;
+    }
+    const MacId mac = (*it)->mac();
+    it = leaving_.erase(it);
+    log_.info("node {} released: out of the scan list", mac.value());
+    Node* next = find(mac);
+    if (next && state_ == PortState::kRunning) {
+      next->set_poll_phase(now);
+      next->start(now, now);
+    }
+  }
+}
+
+void Scanner::drop_leaving(std::string_view reason, TimePoint now) {
+  for (auto& n : leaving_) n->halt(reason, now);
+  leaving_.clear();
+}
+
+Node* Scanner::route(MacId mac) {
+  for (auto& n : leaving_) {
+    if (n->mac() == mac) return n.get();
+  }
+  return find(mac);
 }
 
 void Scanner::set_state(PortState next, std::string reason, TimePoint now) {
@@ -135,6 +248,7 @@ void Scanner::recheck_mac(std::string_view why, TimePoint now) {
   // Whatever the nodes had is gone with the bus: they are allocated afresh
   // once the master's MAC is checked again.
   for (auto& n : nodes_) n->suspend(fmt::format("{}: the master checks its MAC again", why), now);
+  drop_leaving(fmt::format("{}: released with the bus", why), now);
   set_state(PortState::kCheckingMac,
             fmt::format("{}: checking again that no other node has MAC {}", why,
                         config_.master_mac.value()),
@@ -156,7 +270,9 @@ void Scanner::stop(TimePoint now) {
 bool Scanner::stopped() const {
   if (state_ == PortState::kStopped || state_ == PortState::kDuplicateMac) return true;
   if (state_ != PortState::kStopping) return false;
-  return std::all_of(nodes_.begin(), nodes_.end(), [](const auto& n) { return n->stopped(); });
+  const auto done = [](const auto& n) { return n->stopped(); };
+  return std::all_of(nodes_.begin(), nodes_.end(), done) &&
+         std::all_of(leaving_.begin(), leaving_.end(), done);
 }
 
 Node* Scanner::find(MacId mac) { return by_mac_[mac.value()]; }
@@ -165,6 +281,7 @@ const Node* Scanner::node(MacId mac) const { return by_mac_[mac.value()]; }
 
 void Scanner::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
   dispatch(frame, rx_time);
+  if (!leaving_.empty()) reap(rx_time);
   finish_stopping(rx_time);
 }
 
@@ -201,11 +318,12 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
                         message->vendor_id, message->serial_number, config_.master_mac.value());
         log_.error("{}: port stopped", reason);
         for (auto& n : nodes_) n->halt("port stopped: duplicate master MAC", rx_time);
+        drop_leaving("port stopped: duplicate master MAC", rx_time);
         set_state(PortState::kDuplicateMac, reason, rx_time);
       }
       return;
     }
-    if (Node* n = find(id->mac)) {
+    if (Node* n = route(id->mac)) {
       if (!message->response) n->on_duplicate_mac_request(rx_time);
     } else {
       // Powering up, it has no master (yet).
@@ -222,7 +340,7 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
 
   if (id->group == MessageGroup::k1 &&
       id->message_id == static_cast<std::uint8_t>(Group1Message::kSlavePollResponse)) {
-    if (Node* n = find(id->mac)) {
+    if (Node* n = route(id->mac)) {
       n->on_poll_response(payload, rx_time);
     } else {
       ++counters_.unknown_nodes;
@@ -233,7 +351,7 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
   }
   if (id->group == MessageGroup::k2 &&
       id->message_id == static_cast<std::uint8_t>(Group2Message::kSlaveExplicitResponse)) {
-    if (Node* n = find(id->mac)) {
+    if (Node* n = route(id->mac)) {
       n->on_explicit_frame(payload, rx_time);
       return;
     }
@@ -292,6 +410,10 @@ void Scanner::on_timer(TimePoint now) {
     probe_->on_timer(now);
     if (probe_->done()) end_bus_scan({}, now);
   }
+  for (auto& n : leaving_) {
+    if (now >= n->deadline()) n->on_timer(now);
+  }
+  if (!leaving_.empty()) reap(now);
   bool polled = false;
   for (auto& n : nodes_) {
     if (now < n->deadline()) continue;
@@ -313,6 +435,7 @@ TimePoint Scanner::next_deadline() const {
   if (state_ != PortState::kRunning && state_ != PortState::kStopping) return kNever;
   TimePoint t = probe_ ? probe_->deadline() : kNever;
   for (const auto& n : nodes_) t = std::min(t, n->deadline());
+  for (const auto& n : leaving_) t = std::min(t, n->deadline());
   return t;
 }
 
@@ -324,7 +447,7 @@ Status Scanner::scan_bus(TimePoint now) {
   const auto heard = unconfigured_heard(now);
   for (unsigned m = 0; m <= MacId::kMax; ++m) {
     const MacId mac = *MacId::from(m);
-    if (mac == config_.master_mac || find(mac)) continue;
+    if (mac == config_.master_mac || route(mac)) continue;
     if (heard.test(m) && answering_other_master_.test(m)) {
       others.push_back(mac);
     } else {

@@ -43,6 +43,9 @@ class Scanner {
   // immediate poll gap).
   Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& observer, Logger log);
   Scanner(const Scanner&) = delete;
+  // The constructor's check of a scan list, alone (a configuration read
+  // again is checked whole before anything of it is applied).
+  static void check(const ScannerConfig& config);
   Scanner& operator=(const Scanner&) = delete;
 
   // Starts the duplicate MAC ID check; scanning follows when it passes.
@@ -73,9 +76,33 @@ class Scanner {
   Status scan_bus(TimePoint now);
   bool scanning_bus() const { return probe_ != nullptr; }
 
+  // Live changes (a configuration read again). A node not named is not
+  // touched: it keeps its connections and its poll slot. A bus scan under
+  // way ends early when the scan list changes.
+  //
+  // The port's timings: every ScannerConfig field but the master's MAC, its
+  // duplicate MAC ID identity (vendor, serial number, window) and the
+  // nodes. retune() takes them from `next` for every node at once.
+  static bool same_timings(const ScannerConfig& a, const ScannerConfig& b);
+  void retune(const ScannerConfig& next);
+  // Adds a node: it starts at once while the port scans or, when its MAC is
+  // still being released (remove_node), once that is done. Throws
+  // std::invalid_argument for a node the scan list cannot take (as the
+  // constructor); kStopped while the port stops.
+  Status add_node(NodeConfig node, TimePoint now);
+  // Takes a node out of the scan list at once: no outputs, idle or requests
+  // are taken for it any more. While the port scans it gets one idle poll
+  // and is released, as at shutdown; frames from its MAC reach it until
+  // then. kOutOfRange for a MAC not in the scan list, kStopped while the
+  // port stops.
+  Status remove_node(MacId mac, TimePoint now);
+  // Nodes taken out of the scan list and not yet released.
+  std::size_t nodes_leaving() const { return leaving_.size(); }
+
   PortState state() const { return state_; }
   const std::string& reason() const { return reason_; }
   bool stopped() const;
+  // The scan list's node at `mac`; null for a MAC it does not have.
   const Node* node(MacId mac) const;
   const std::vector<std::unique_ptr<Node>>& nodes() const { return nodes_; }
   const PortCounters& counters() const { return counters_; }
@@ -86,6 +113,8 @@ class Scanner {
   // it was forgotten.
   static constexpr Duration kUnconfiguredMemory = seconds(600);
   std::bitset<MacId::kMax + 1> unconfigured_heard(TimePoint now) const;
+  // The port's settings; the scan list is nodes() (config().nodes is what
+  // the scanner was built with).
   const ScannerConfig& config() const { return config_; }
 
  private:
@@ -94,6 +123,14 @@ class Scanner {
   void dispatch(const can::CanFrame& frame, TimePoint rx_time);
   void finish_stopping(TimePoint now);
   Node* find(MacId mac);
+  // Where a frame from `mac` goes: a node being released, or the scan list's.
+  Node* route(MacId mac);
+  Node& make_node(NodeConfig config);
+  // Nodes released after remove_node() go; a node added at the same MAC
+  // starts then.
+  void reap(TimePoint now);
+  // Leaving nodes whose connections are gone anyway (bus lost, port halted).
+  void drop_leaving(std::string_view reason, TimePoint now);
   // A frame from `mac`, which is not in the scan list and not the master's.
   void heard_unconfigured(MacId mac, std::string_view how, TimePoint at);
   // Ends the bus scan under way, if any, and reports it; `why` (not empty)
@@ -106,6 +143,7 @@ class Scanner {
   Logger log_;
   std::vector<std::unique_ptr<Node>> nodes_;
   std::array<Node*, MacId::kMax + 1> by_mac_{};
+  std::vector<std::unique_ptr<Node>> leaving_;  // removed, being idled and released
   DuplicateMacCheck mac_check_;
   PortState state_ = PortState::kStopped;
   std::string reason_ = "not started";

@@ -13,6 +13,8 @@ namespace dnbridge::profiles::cdn127 {
 struct SafeStateConfig {
   SafeState values;
   SafeStateSource source = SafeStateSource::kConfiguration;
+
+  friend bool operator==(const SafeStateConfig&, const SafeStateConfig&) = default;
 };
 
 // The poll connection uses assemblies 103 (produced) and 104 (consumed),
