@@ -178,18 +178,24 @@ void Daemon::request_reload(ReloadCall call) {
   {
     std::lock_guard lock(reloads_mutex_);
     const auto same = [&](const ReloadCall& r) {
-      return !call.requester.empty() && r.requester == call.requester && r.txid == call.txid;
+      return r.requester == call.requester && r.txid == call.txid;
     };
-    if ((reloading_ && same(*reloading_)) || std::any_of(reloads_.begin(), reloads_.end(), same)) {
-      return;
-    }
-    for (const auto& [done, report] : reloaded_) {
-      if (same(done)) {
-        publisher_.reload_reply(call, report);
-        return;
+    // A SIGHUP (no requester) while one waits is that one.
+    if (std::any_of(reloads_.begin(), reloads_.end(), same)) return;
+    if (!call.requester.empty()) {
+      if (std::any_of(reloading_.begin(), reloading_.end(), same)) return;
+      const auto now = std::chrono::steady_clock::now();
+      while (!reloaded_.empty() && now - reloaded_.front().at > kReloadRetention) {
+        reloaded_.pop_front();
+      }
+      for (const auto& a : reloaded_) {
+        if (same(a.call)) {
+          publisher_.reload_reply(call, *a.report);
+          return;
+        }
       }
     }
-    if (reloads_.size() < kMaxReloadsWaiting) {
+    if (reloads_.size() < kMaxReloadsWaiting || call.requester.empty()) {
       reloads_.push_back(std::move(call));
       reloads_changed_.notify_all();
       return;
@@ -197,36 +203,48 @@ void Daemon::request_reload(ReloadCall call) {
   }
   ReloadReport busy;
   busy.status = ReloadStatus::kBusy;
-  busy.message =
-      fmt::format("{} reloads already wait: ask again once they are done", kMaxReloadsWaiting);
-  if (!call.requester.empty()) publisher_.reload_reply(call, busy);
+  busy.message = fmt::format("{} reload requests already wait: ask again once they are answered",
+                             kMaxReloadsWaiting);
+  publisher_.reload_reply(call, busy);
 }
 
 void Daemon::run_reloads() {
   for (;;) {
-    ReloadCall call;
     {
       std::unique_lock lock(reloads_mutex_);
       reloads_changed_.wait(lock, [&] { return reloads_stop_ || !reloads_.empty(); });
+      reloads_changed_.wait_until(lock, last_reload_end_ + kReloadHoldoff,
+                                  [&] { return reloads_stop_; });
       if (reloads_stop_) return;
-      call = std::move(reloads_.front());
-      reloads_.pop_front();
-      reloading_ = call;
+      reloading_.swap(reloads_);
     }
-    const ReloadReport report = reload();
-    log_report(report, call.requester.empty()
-                           ? std::string("SIGHUP")
-                           : fmt::format("{} (txid {})", call.requester, call.txid));
+    const auto report = std::make_shared<const ReloadReport>(reload());
+    log_report(*report, reloading_);
     std::lock_guard lock(reloads_mutex_);
-    reloading_.reset();
-    if (call.requester.empty()) continue;
-    publisher_.reload_reply(call, report);
-    reloaded_.emplace_back(std::move(call), report);
-    if (reloaded_.size() > kReloadsRetained) reloaded_.pop_front();
+    const auto now = std::chrono::steady_clock::now();
+    last_reload_end_ = now;
+    for (auto& call : reloading_) {
+      if (call.requester.empty()) continue;
+      publisher_.reload_reply(call, *report);
+      reloaded_.push_back({std::move(call), report, now});
+      if (reloaded_.size() > kReloadsRetained) reloaded_.pop_front();
+    }
+    reloading_.clear();
   }
 }
 
-void Daemon::log_report(const ReloadReport& r, std::string_view origin) {
+void Daemon::log_report(const ReloadReport& r, const std::vector<ReloadCall>& asked_by) {
+  std::string origin;
+  std::size_t requests = 0;
+  for (const auto& call : asked_by) {
+    if (call.requester.empty()) {
+      origin = "SIGHUP";
+    } else if (requests++ == 0) {
+      origin +=
+          fmt::format("{}{} (txid {})", origin.empty() ? "" : ", ", call.requester, call.txid);
+    }
+  }
+  if (requests > 1) origin += fmt::format(" and {} other request(s)", requests - 1);
   const std::string head = fmt::format("reload asked by {}: {}", origin, r.message);
   if (r.status == ReloadStatus::kApplied) {
     log_.info("{}", head);

@@ -69,13 +69,19 @@ class Daemon {
   static constexpr Duration kReloadWait = seconds(5);
   // From any thread: a reload on the bridge's reload thread. Its report goes
   // to the log and, for a request from DDS (a requester), as a ReloadReply.
-  // Past kMaxReloadsWaiting, answered at once: busy. A request written again
+  // Every request that arrives while none runs, or while one runs, is
+  // answered by the next reload, which reads the file after they came; a
+  // reload starts at least kReloadHoldoff after the last one ended, so that
+  // requests cannot make the bridge do more. Past kMaxReloadsWaiting
+  // requests waiting, answered at once: busy. A request written again
   // (same requester and txid: a client repeats until answered) is one
-  // reload: while it waits or runs it is not queued again, and once done,
-  // among the last kReloadsRetained, it gets the same report again.
+  // request: while it waits or runs it waits once, and once answered (the
+  // last kReloadsRetained, for kReloadRetention) it gets the same report.
   void request_reload(ReloadCall call);
-  static constexpr std::size_t kMaxReloadsWaiting = 8;
-  static constexpr std::size_t kReloadsRetained = 16;
+  static constexpr std::size_t kMaxReloadsWaiting = 64;
+  static constexpr Duration kReloadHoldoff = seconds(1);
+  static constexpr std::size_t kReloadsRetained = 64;
+  static constexpr Duration kReloadRetention = seconds(60);
 
   // The configuration in force (after reloads); not while a reload runs.
   const DaemonConfig& config() const { return config_; }
@@ -89,7 +95,7 @@ class Daemon {
  private:
   metrics::ProcessCounters process_counters() const;
   void run_reloads();
-  void log_report(const ReloadReport& report, std::string_view origin);
+  void log_report(const ReloadReport& report, const std::vector<ReloadCall>& asked_by);
 
   DaemonConfig config_;
   Logger log_;
@@ -111,9 +117,15 @@ class Daemon {
   // The reload thread and its queue.
   std::mutex reloads_mutex_;
   std::condition_variable reloads_changed_;
-  std::deque<ReloadCall> reloads_;
-  std::optional<ReloadCall> reloading_;                       // the one running
-  std::deque<std::pair<ReloadCall, ReloadReport>> reloaded_;  // the last done, newest last
+  std::vector<ReloadCall> reloads_;    // what the next reload answers
+  std::vector<ReloadCall> reloading_;  // what the one running answers
+  struct Answered {
+    ReloadCall call;
+    std::shared_ptr<const ReloadReport> report;
+    std::chrono::steady_clock::time_point at;
+  };
+  std::deque<Answered> reloaded_;  // newest last
+  std::chrono::steady_clock::time_point last_reload_end_{};
   bool reloads_stop_ = false;
   std::thread reload_thread_;
 };

@@ -88,29 +88,39 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       log_(std::move(log)),
       commands_(participant, publisher.command_topic(), dds::command_reader_qos()),
       requests_(participant, publisher.request_topic(), dds::request_reader_qos()),
-      scan_requests_(participant, publisher.scan_request_topic(), dds::request_reader_qos()),
-      reload_requests_(participant, publisher.reload_request_topic(), dds::request_reader_qos()),
       reload_(std::move(reload)),
       command_buffer_(kBatch),
       request_buffer_(kBatch),
       stop_(participant),
       waitset_(participant) {
+  // Readers of the services that DDS Security grants (the publisher has
+  // their topics), each as far as it grants it.
+  if (const auto* topic = publisher.scan_request_topic()) {
+    scan_requests_ = unless_denied(log_, "the bus scan's requests (dnbridge/BusScanRequest)", [&] {
+      return dds::Reader<dnbridge_BusScanRequest>(participant, *topic, dds::request_reader_qos());
+    });
+  }
+  if (const auto* topic = publisher.reload_request_topic()) {
+    reload_requests_ = unless_denied(log_, "reload requests (dnbridge/ReloadRequest)", [&] {
+      return dds::Reader<dnbridge_ReloadRequest>(participant, *topic, dds::request_reader_qos());
+    });
+  }
   // A reader's status condition stays triggered while any status in its mask
   // is set, and taking resets only DATA_AVAILABLE: with the default mask
   // (every status) a matched writer's SUBSCRIPTION_MATCHED, never read here,
   // would keep the waitset triggered and this thread spinning.
-  for (const dds::Entity* reader :
-       {static_cast<const dds::Entity*>(&commands_), static_cast<const dds::Entity*>(&requests_),
-        static_cast<const dds::Entity*>(&scan_requests_),
-        static_cast<const dds::Entity*>(&reload_requests_)}) {
+  std::vector<const dds::Entity*> readers{&commands_, &requests_};
+  if (scan_requests_) readers.push_back(&*scan_requests_);
+  if (reload_requests_) readers.push_back(&*reload_requests_);
+  for (const dds::Entity* reader : readers) {
     if (!reader->set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
       throw std::runtime_error("setting the status mask of a DDS input reader failed");
     }
   }
   waitset_.attach(commands_, kCommands);
   waitset_.attach(requests_, kRequests);
-  waitset_.attach(scan_requests_, kScanRequests);
-  waitset_.attach(reload_requests_, kReloadRequests);
+  if (scan_requests_) waitset_.attach(*scan_requests_, kScanRequests);
+  if (reload_requests_) waitset_.attach(*reload_requests_, kReloadRequests);
   waitset_.attach(stop_, kStop);
 }
 
@@ -239,7 +249,7 @@ bool DdsInput::take_requests() {
 
 void DdsInput::take_scan_requests() {
   // Each asks for at most one scan of a port: every one waiting, taken now.
-  take_all(scan_requests_, log_, "bus scan requests",
+  take_all(*scan_requests_, log_, "bus scan requests",
            [this](const auto& sample) { on_scan_request(sample); });
 }
 
@@ -267,7 +277,7 @@ void DdsInput::on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sampl
 }
 
 void DdsInput::take_reload_requests() {
-  take_all(reload_requests_, log_, "reload requests",
+  take_all(*reload_requests_, log_, "reload requests",
            [this](const dds::Sample<dnbridge_ReloadRequest>& sample) {
              if (!sample.valid_data()) return;
              const auto& r = sample.data();

@@ -56,8 +56,9 @@ class DdsInput {
   Logger log_;
   dds::Reader<dnbridge_PumpCommand> commands_;
   dds::Reader<dnbridge_ExplicitRequest> requests_;
-  dds::Reader<dnbridge_BusScanRequest> scan_requests_;
-  dds::Reader<dnbridge_ReloadRequest> reload_requests_;
+  // Absent when DDS Security does not grant the service (unless_denied).
+  std::optional<dds::Reader<dnbridge_BusScanRequest>> scan_requests_;
+  std::optional<dds::Reader<dnbridge_ReloadRequest>> reload_requests_;
   std::function<void(ReloadCall)> reload_;
   dds::TakeBuffer<dnbridge_PumpCommand> command_buffer_;
   dds::TakeBuffer<dnbridge_ExplicitRequest> request_buffer_;

@@ -1,6 +1,7 @@
 #include "adapters/daemon/dds_publisher.hpp"
 
 #include <algorithm>
+#include <array>
 #include <memory>
 
 #include "adapters/daemon/samples.hpp"
@@ -31,16 +32,20 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
       command_topic_(participant),
       request_topic_(participant),
       reply_topic_(participant),
-      scan_request_topic_(participant),
-      scan_reply_topic_(participant),
-      reload_request_topic_(participant),
-      reload_reply_topic_(participant),
       pump_writer_(participant, pump_topic_, dds::state_writer_qos(state_deadline)),
       node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
       port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
       reply_writer_(participant, reply_topic_, dds::reply_writer_qos()),
-      scan_reply_writer_(participant, scan_reply_topic_, dds::scan_reply_writer_qos()),
-      reload_reply_writer_(participant, reload_reply_topic_, dds::scan_reply_writer_qos()),
+      scan_(unless_denied(log_, "the bus scan (dnbridge/BusScanRequest, BusScanReply)",
+                          [&] {
+                            return Service<dnbridge_BusScanRequest, dnbridge_BusScanReply>(
+                                participant, dds::scan_reply_writer_qos());
+                          })),
+      reload_(unless_denied(log_, "reload over DDS (dnbridge/ReloadRequest, ReloadReply)",
+                            [&] {
+                              return Service<dnbridge_ReloadRequest, dnbridge_ReloadReply>(
+                                  participant, dds::scan_reply_writer_qos());
+                            })),
       // State samples are keyed (one waits per instance): the capacity only
       // bounds the unregistrations of a port that stops.
       state_out_("dds state out", 64),
@@ -113,7 +118,7 @@ void DdsPublisher::bus_scan_reply(const std::string& port, const port::BusScanAn
   auto sample = std::make_shared<dds::Owned<dnbridge_BusScanReply>>();
   fill_bus_scan_reply(**sample, rack_, port, answer);
   const bool queued = reply_out_.post([this, sample, port] {
-    if (!check(scan_reply_writer_.write(**sample), "BusScanReply")) undelivered(port);
+    if (!scan_ || !check(scan_->writer.write(**sample), "BusScanReply")) undelivered(port);
   });
   if (!queued) undelivered(port);
 }
@@ -123,7 +128,7 @@ void DdsPublisher::reload_reply(const ReloadCall& call, const ReloadReport& repo
   fill_reload_reply(**sample, rack_, call, report);
   // Counted with no port's replies: a reload is the rack's.
   const bool queued = reply_out_.post([this, sample] {
-    if (!check(reload_reply_writer_.write(**sample), "ReloadReply")) undelivered({});
+    if (!reload_ || !check(reload_->writer.write(**sample), "ReloadReply")) undelivered({});
   });
   if (!queued) undelivered({});
 }
@@ -158,7 +163,9 @@ void DdsPublisher::node_removed(const std::string& port, devicenet::MacId mac) {
   }
   // Disposed: the pump is no longer the rack's, which unregistering (the
   // bridge gone) would not say. After its last samples, in the same outbox.
-  state_out_.post_always([this, port, mac] { release_node(port, mac.value(), true); });
+  const std::array<std::string, 2> keys{instance_key('P', port, mac.value()),
+                                        instance_key('N', port, mac.value())};
+  state_out_.post_always_after(keys, [this, port, mac] { release_node(port, mac.value(), true); });
 }
 
 void DdsPublisher::port_stopped(const std::string& port) {
@@ -185,7 +192,7 @@ void DdsPublisher::port_stopped(const std::string& port) {
 namespace dnbridge::daemon {
 
 void DdsPublisher::flush(Duration timeout) {
-  // One deadline for the four: a reader that died without leaving stays
+  // One deadline for them all: a reader that died without leaving stays
   // matched until its lease ends, and each wait would otherwise take all of
   // `timeout` for it.
   const TimePoint deadline = port::steady_now() + timeout;
@@ -196,7 +203,8 @@ void DdsPublisher::flush(Duration timeout) {
   (void)node_writer_.wait_for_acks(left());
   (void)port_writer_.wait_for_acks(left());
   (void)reply_writer_.wait_for_acks(left());
-  (void)scan_reply_writer_.wait_for_acks(left());
+  if (scan_) (void)scan_->writer.wait_for_acks(left());
+  if (reload_) (void)reload_->writer.wait_for_acks(left());
 }
 
 }  // namespace dnbridge::daemon

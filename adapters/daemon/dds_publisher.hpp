@@ -8,6 +8,7 @@
 // timestamp.
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -32,6 +33,35 @@ class WallClock {
  private:
   std::chrono::nanoseconds offset_;
 };
+
+// A request/reply service of the bridge besides the pumps' topics (the bus
+// scan, reload): its two topics and the reply writer.
+template <class Request, class Reply>
+struct Service {
+  Service(const dds::Participant& participant, const dds::Qos& reply_qos)
+      : requests(participant), replies(participant), writer(participant, replies, reply_qos) {}
+  dds::Topic<Request> requests;
+  dds::Topic<Reply> replies;
+  dds::Writer<Reply> writer;
+};
+
+// Makes `make()`'s entity, or nothing when DDS Security does not grant it
+// (permissions signed before the service came): the bridge then runs
+// without it, and says so once, naming `what`. Any other failure throws.
+template <class Make>
+auto unless_denied(Logger& log, std::string_view what, Make make)
+    -> std::optional<decltype(make())> {
+  try {
+    return make();
+  } catch (const dds::Error& e) {
+    if (e.code() != DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) throw;
+    log.warn(
+        "{}: not in this bridge's DDS Security permissions, so not offered (the site's "
+        "make-site-pki.sh, run again, grants it): {}",
+        what, e.what());
+    return std::nullopt;
+  }
+}
 
 class DdsPublisher final : public port::PortPublisher {
  public:
@@ -67,11 +97,12 @@ class DdsPublisher final : public port::PortPublisher {
 
   const dds::Topic<dnbridge_PumpCommand>& command_topic() const { return command_topic_; }
   const dds::Topic<dnbridge_ExplicitRequest>& request_topic() const { return request_topic_; }
-  const dds::Topic<dnbridge_BusScanRequest>& scan_request_topic() const {
-    return scan_request_topic_;
+  // Null when DDS Security does not grant the service (unless_denied).
+  const dds::Topic<dnbridge_BusScanRequest>* scan_request_topic() const {
+    return scan_ ? &scan_->requests : nullptr;
   }
-  const dds::Topic<dnbridge_ReloadRequest>& reload_request_topic() const {
-    return reload_request_topic_;
+  const dds::Topic<dnbridge_ReloadRequest>* reload_request_topic() const {
+    return reload_ ? &reload_->requests : nullptr;
   }
 
  private:
@@ -90,16 +121,12 @@ class DdsPublisher final : public port::PortPublisher {
   dds::Topic<dnbridge_PumpCommand> command_topic_;
   dds::Topic<dnbridge_ExplicitRequest> request_topic_;
   dds::Topic<dnbridge_ExplicitReply> reply_topic_;
-  dds::Topic<dnbridge_BusScanRequest> scan_request_topic_;
-  dds::Topic<dnbridge_BusScanReply> scan_reply_topic_;
-  dds::Topic<dnbridge_ReloadRequest> reload_request_topic_;
-  dds::Topic<dnbridge_ReloadReply> reload_reply_topic_;
   dds::Writer<dnbridge_PumpState> pump_writer_;
   dds::Writer<dnbridge_NodeStatus> node_writer_;
   dds::Writer<dnbridge_PortStatus> port_writer_;
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;
-  dds::Writer<dnbridge_BusScanReply> scan_reply_writer_;
-  dds::Writer<dnbridge_ReloadReply> reload_reply_writer_;
+  std::optional<Service<dnbridge_BusScanRequest, dnbridge_BusScanReply>> scan_;
+  std::optional<Service<dnbridge_ReloadRequest, dnbridge_ReloadReply>> reload_;
 
   void undelivered(const std::string& port);
 

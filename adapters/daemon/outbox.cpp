@@ -59,6 +59,15 @@ void Outbox::post_always(Job job) {
   wake_.notify_one();
 }
 
+void Outbox::post_always_after(std::span<const std::string> keys, Job job) {
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& key : keys) by_key_.erase(key);
+    push(Entry{{}, std::move(job)});
+  }
+  wake_.notify_one();
+}
+
 bool Outbox::drain(Duration timeout) {
   std::unique_lock lock(mutex_);
   const std::uint64_t last = next_seq_ - 1;
@@ -80,13 +89,15 @@ void Outbox::run() {
   for (;;) {
     wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
     if (queue_.empty()) return;  // stopping, and nothing left
+    if (queue_.front().key.empty()) {
+      --unkeyed_;
+    } else if (auto it = by_key_.find(queue_.front().key);
+               it != by_key_.end() && it->second == queue_.begin()) {
+      // (A job no longer replaceable has no entry, or another job's.)
+      by_key_.erase(it);
+    }
     Entry entry = std::move(queue_.front());
     queue_.pop_front();
-    if (entry.key.empty()) {
-      --unkeyed_;
-    } else {
-      by_key_.erase(entry.key);
-    }
     running_seq_ = entry.seq;
     lock.unlock();
     entry.job();

@@ -15,6 +15,7 @@
 #include <functional>
 #include <list>
 #include <mutex>
+#include <span>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -41,6 +42,11 @@ class Outbox {
   // Queues `job` last whatever the capacity (what must not be lost, such as
   // an unregistration, and is bounded by its caller).
   void post_always(Job job);
+  // The same, and the jobs of `keys` still waiting can no longer be
+  // replaced: they run before `job`, and one posted later with such a key
+  // queues after it (a node's instances disposed after its last sample, and
+  // before the first sample of a node added later under the same key).
+  void post_always_after(std::span<const std::string> keys, Job job);
 
   // Until every job posted before the call has run, at most `timeout`.
   bool drain(Duration timeout);

@@ -154,7 +154,7 @@ std::vector<std::string> describe(const std::string& port, const port::PortChang
     if (!macs.empty()) lines.push_back(fmt::format("port {}: {} {}", port, mac_text(macs), what));
   };
   line(c.added, "added");
-  line(c.removed, "removed: idled and released");
+  line(c.removed, "removed: idled, then released");
   line(c.reconfigured, "configured again: released, idle until a new command once back online");
   line(c.updated, "name or policies changed: applied in place");
   line(change.publish_changed, "publish policy changed");

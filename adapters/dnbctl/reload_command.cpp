@@ -125,19 +125,22 @@ Exit run_reload(const GlobalOptions& o) {
 
   const Duration wait = std::max(kReloadWait, o.timeout());
   const Deadline deadline = deadline_after(wait);
-  // A bridge that matches later gets the repeats.
-  (void)reloads.await_reader(client, deadline_after(o.timeout()));
-  auto replies = reloads.exchange(client, request, deadline, kRepeatAfter);
-  if (!replies[0]) {
+  // The bridge is there: its reader of reload requests is found with it,
+  // or it has none.
+  if (!reloads.await_reader(client, deadline_after(o.timeout()))) {
     throw CommandError(
         Exit::kNotFound,
-        reloads.reader_matched()
-            ? fmt::format("no reload reply from the bridge of rack \"{}\" within {:g} s", rack,
-                          std::chrono::duration<double>(wait).count())
-            : fmt::format("no bridge on DDS domain {} takes reload requests (none has a reader "
-                          "of dnbridge/ReloadRequest): the bridge of rack \"{}\" is of a version "
-                          "without reload, or DDS Security does not grant ReloadRequest",
-                          o.domain, rack));
+        fmt::format("no bridge on DDS domain {} takes reload requests (none has a reader of "
+                    "dnbridge/ReloadRequest within {:g} s): the bridge of rack \"{}\" is of a "
+                    "version without reload, or its DDS Security permissions do not grant "
+                    "ReloadRequest",
+                    o.domain, o.timeout_seconds, rack));
+  }
+  auto replies = reloads.exchange(client, request, deadline, kRepeatAfter);
+  if (!replies[0]) {
+    throw CommandError(Exit::kNotFound,
+                       fmt::format("no reload reply from the bridge of rack \"{}\" within {:g} s",
+                                   rack, std::chrono::duration<double>(wait).count()));
   }
 
   const dnbridge_ReloadReply& r = replies[0]->data();

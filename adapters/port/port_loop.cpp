@@ -103,6 +103,9 @@ std::future<PortChange> PortLoop::reconfigure(PortLoopConfig next) {
 void PortLoop::apply(const Reconfigure& r, TimePoint now) {
   PortLoopConfig& next = *r.config;
   PortChange change;
+  // published_ follows the rack's views, in their order: which MAC each is.
+  std::vector<MacId> published_macs;
+  for (const auto& v : rack().pumps()) published_macs.push_back(v.mac);
   try {
     change.scan_list = port_->reconfigure(next.scanner, next.pumps, now);
   } catch (const std::exception& e) {
@@ -125,9 +128,8 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
   // order: a node kept keeps its gate (a new one if its policy changed), a
   // new or re-configured one starts afresh.
   std::array<std::optional<Published>, MacId::kMax + 1> kept;
-  const auto& before = config_.pumps;
-  for (std::size_t i = 0; i < before.size(); ++i) {
-    kept[before[i].node.mac.value()] = std::move(published_[i]);
+  for (std::size_t i = 0; i < published_macs.size(); ++i) {
+    kept[published_macs[i].value()] = std::move(published_[i]);
   }
   published_.clear();
   for (const auto& v : rack().pumps()) {
@@ -159,6 +161,10 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
     for (MacId m : list) s += fmt::format("{}{}", s.empty() ? "" : " ", m.value());
     return s.empty() ? std::string("none") : s;
   };
+  if (!change.any()) {
+    r.done->set_value(std::move(change));
+    return;
+  }
   log_.info(
       "configuration applied: added {}; removed {}; configured again {}; policies changed {}; "
       "publish policies changed {}; untouched {}{}{}",

@@ -93,7 +93,7 @@ void PumpRack::replace(const PumpConfig& p) {
   v = std::move(fresh);
 }
 
-void PumpRack::update(const PumpConfig& p) {
+void PumpRack::update(const PumpConfig& p, TimePoint now) {
   PumpView* v = find(p.node.mac);
   if (!v) return;
   Slot& slot = slots_[static_cast<std::size_t>(index_[p.node.mac.value()])];
@@ -102,6 +102,10 @@ void PumpRack::update(const PumpConfig& p) {
   v->name = p.node.name;
   ++v->changes;
   ++v->status_changes;
+  // Held for a commander that has gone: the new policy applies now.
+  if (slot.held_without_commander && p.no_commander == NoCommanderPolicy::kIdle) {
+    (void)release_command(p.node.mac, now);
+  }
 }
 
 PumpView* PumpRack::find(MacId mac) {
@@ -183,6 +187,7 @@ Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, std::str
   }
   v->outputs_requested = outputs;
   v->commanded_by = std::string(issuer);
+  slots_[static_cast<std::size_t>(index_[mac.value()])].held_without_commander = false;
   ++v->commands_accepted;
   ++v->changes;
   return {};
@@ -191,8 +196,12 @@ Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, std::str
 Status PumpRack::release_command(MacId mac, TimePoint now) {
   PumpView* v = find(mac);
   if (!v || !scanner_) return Errc::kOutOfRange;
-  const auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
-  if (slot.no_commander == NoCommanderPolicy::kHoldLastOutputs) return {};
+  auto& slot = slots_[static_cast<std::size_t>(index_[mac.value()])];
+  if (slot.no_commander == NoCommanderPolicy::kHoldLastOutputs) {
+    slot.held_without_commander = v->outputs_requested.has_value();
+    return {};
+  }
+  slot.held_without_commander = false;
   if (v->outputs_requested) v->idle_cause = IdleCause::kNoCommander;
   v->outputs_requested.reset();
   v->commanded_by.clear();

@@ -146,8 +146,9 @@ class PumpRack final : public devicenet::ScannerObserver {
   // command survives.
   void replace(const PumpConfig& pump);
   // Only what the bridge itself does with the pump changed (its name, its
-  // no-commander and resume policies): view and command are kept.
-  void update(const PumpConfig& pump);
+  // no-commander and resume policies): view and command are kept, but for
+  // outputs held for a commander that has gone when the new policy is idle.
+  void update(const PumpConfig& pump, TimePoint now);
 
   const std::vector<PumpView>& pumps() const { return views_; }
   const PumpView* pump(devicenet::MacId mac) const;
@@ -169,6 +170,8 @@ class PumpRack final : public devicenet::ScannerObserver {
     profiles::cdn127::PollFormat format;
     NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
     ResumePolicy resume = ResumePolicy::kFreshCommand;
+    // The last commander went away while the policy held its outputs.
+    bool held_without_commander = false;
   };
   // The node left online, or has a device fault: with kFreshCommand (and
   // for a device fault always) its command is void, and it comes back idle.

@@ -95,7 +95,7 @@ ScanListChange RackPort::reconfigure(const devicenet::ScannerConfig& port,
     pumps_.add(*at(pumps, mac));
     (void)scanner_->add_node(node_of(mac), now);
   }
-  for (MacId mac : change.updated) pumps_.update(*at(pumps, mac));
+  for (MacId mac : change.updated) pumps_.update(*at(pumps, mac), now);
   in_force_ = pumps;
   return change;
 }

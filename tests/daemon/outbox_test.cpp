@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <future>
 #include <string>
 #include <vector>
@@ -25,6 +26,13 @@ class OutboxTest : public ::testing::Test {
     held_.get_future().wait();
   }
   void release() { release_.set_value(); }
+  // A second hold, after the first was released.
+  void hold_again() {
+    held_ = {};
+    release_ = {};
+    hold();
+  }
+  void release_again() { release(); }
   void record(std::string what) {
     std::lock_guard lock(mutex_);
     ran_.push_back(std::move(what));
@@ -55,6 +63,32 @@ TEST_F(OutboxTest, RunsJobsInOrderAndAKeyedJobOnlyInItsNewestForm) {
   EXPECT_EQ(c.replaced, 1u);
   EXPECT_EQ(c.run, 4u);  // the held job too
   EXPECT_EQ(c.waiting, 0u);
+}
+
+// A node removed (its instances disposed after its last sample) and added
+// again before the outbox caught up: the new node's samples come after the
+// disposal, not in the place of the old node's last one.
+TEST_F(OutboxTest, AJobAfterKeysRunsAfterTheirWaitingJobsAndBeforeTheirLaterOnes) {
+  hold();
+  box_.post("pump 1", [this] { record("pump 1 last"); });
+  box_.post("pump 2", [this] { record("pump 2"); });
+  const std::array<std::string, 1> keys{"pump 1"};
+  box_.post_always_after(keys, [this] { record("pump 1 disposed"); });
+  box_.post("pump 1", [this] { record("pump 1 again"); });
+  box_.post("pump 1", [this] { record("pump 1 again, newest"); });  // replaces the one after
+  box_.post("pump 2", [this] { record("pump 2 newest"); });         // in its place, before
+  release();
+  ASSERT_TRUE(box_.drain(kBound));
+  EXPECT_EQ(ran(), (std::vector<std::string>{"pump 1 last", "pump 2 newest", "pump 1 disposed",
+                                             "pump 1 again, newest"}));
+  // Keyed again from then on.
+  hold_again();
+  box_.post("pump 1", [this] { record("a"); });
+  box_.post("pump 1", [this] { record("b"); });
+  release_again();
+  ASSERT_TRUE(box_.drain(kBound));
+  EXPECT_EQ(ran().back(), "b");
+  EXPECT_EQ(ran().size(), 5u);
 }
 
 TEST_F(OutboxTest, UnkeyedJobsPastTheCapacityAreRefusedNotQueued) {

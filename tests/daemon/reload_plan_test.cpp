@@ -128,7 +128,7 @@ TEST(ReloadPlan, APortsChangeInWords) {
   c.explicit_policy_changed = true;
   EXPECT_THAT(
       describe("A", c),
-      ElementsAre("port A: node 9 added", "port A: nodes 7, 8 removed: idled and released",
+      ElementsAre("port A: node 9 added", "port A: nodes 7, 8 removed: idled, then released",
                   "port A: node 2 configured again: released, idle until a new command once back "
                   "online",
                   "port A: node 3 name or policies changed: applied in place",

@@ -78,12 +78,12 @@ TEST_F(ReloadTest, AFileWithProblemsChangesNothingAndSaysWhere) {
 
 TEST_F(ReloadTest, OnlyWhatDiffersIsAppliedAndWhatNeedsARestartIsNamed) {
   ASSERT_NO_FATAL_FAILURE(start());
-  // Node 8 out, node 9 in (the simulated device stays), node 2 with another
-  // fault action, node 3 renamed, the bit rate changed (not live).
-  const auto at8 = text_.find("  [[port.node]]\n  mac = 8\n");
-  ASSERT_NE(at8, std::string::npos);
-  const auto end8 = text_.find("[[port.node]]", at8 + 4);
-  text_.erase(at8, end8 == std::string::npos ? std::string::npos : end8 - 2 - at8);
+  // Node 4 out (from the middle of the scan list), node 9 in (the simulated
+  // device stays), node 2 with another fault action, node 3 renamed, the
+  // bit rate changed (not live).
+  const auto at4 = text_.find("  [[port.node]]\n  mac = 4\n");
+  ASSERT_NE(at4, std::string::npos);
+  text_.erase(at4, text_.find("  [[port.node]]", at4 + 4) - at4);
   ASSERT_NO_FATAL_FAILURE(replace("simulated_unconfigured = [9]\n", ""));
   text_ += "\n  [[port.node]]\n  mac = 9\n  name = \"pump-9\"\n";
   ASSERT_NO_FATAL_FAILURE(
@@ -101,7 +101,7 @@ TEST_F(ReloadTest, OnlyWhatDiffersIsAppliedAndWhatNeedsARestartIsNamed) {
   EXPECT_EQ(r.status, daemon::ReloadStatus::kApplied) << joined(r);
   EXPECT_EQ(r.file, kFile);
   EXPECT_TRUE(has_line(r.applied, "port A: node 9 added")) << joined(r);
-  EXPECT_TRUE(has_line(r.applied, "port A: node 8 removed")) << joined(r);
+  EXPECT_TRUE(has_line(r.applied, "port A: node 4 removed")) << joined(r);
   EXPECT_TRUE(has_line(r.applied, "port A: node 2 configured again")) << joined(r);
   EXPECT_TRUE(has_line(r.applied, "port A: node 3 name or policies changed")) << joined(r);
   EXPECT_EQ(r.applied.size(), 4u) << joined(r);
@@ -109,7 +109,7 @@ TEST_F(ReloadTest, OnlyWhatDiffersIsAppliedAndWhatNeedsARestartIsNamed) {
   EXPECT_EQ(r.needs_restart[0], "port A: bitrate 500000 in force, 250000 in the file");
   EXPECT_TRUE(r.problems.empty()) << joined(r);
 
-  // On DDS: 9 online, 8 disposed, 2 back online and idle, 3 renamed.
+  // On DDS: 9 online, 4 disposed, 2 back online and idle, 3 renamed.
   const auto disposed = [&](unsigned mac) {
     for (const auto& s : pumps_.history()) {
       if (s.sample->mac == mac &&
@@ -124,13 +124,13 @@ TEST_F(ReloadTest, OnlyWhatDiffersIsAppliedAndWhatNeedsARestartIsNamed) {
         const auto* nine = pumps_.latest(pump_mac(9));
         const auto* two = pumps_.latest(pump_mac(2));
         const auto* three = pumps_.latest(pump_mac(3));
-        return nine && nine->online && disposed(8) && two && two->online &&
+        return nine && nine->online && disposed(4) && two && two->online &&
                dds::view(two->idle_reason).find("after a reload") != std::string_view::npos &&
                three && dds::view(three->name) == "Pumpe drei";
       },
       seconds(10)));
   EXPECT_EQ(bridge_->port(kPort)->nodes_configured(), kPumps);
-  EXPECT_FALSE(bridge_->port(kPort)->has_node(*devicenet::MacId::from(8)));
+  EXPECT_FALSE(bridge_->port(kPort)->has_node(*devicenet::MacId::from(4)));
   // Node 1 never left online, nor did it reconnect.
   for (const auto& s : pumps_.history()) {
     if (s.sample.valid_data() && s.sample->mac == 1 && s.at >= reload_wall) {
@@ -207,6 +207,26 @@ TEST_F(ReloadTest, AReloadRequestOnDdsGetsItsReply) {
     const auto* four = pumps_.latest(pump_mac(4));
     return four && dds::view(four->name) == "pump four";
   }));
+
+  // A burst of requests: each answered once, by at most two reloads (one
+  // may start at once; the rest wait for it and its hold-off, and share
+  // the next).
+  const auto reloads_before = log_.count(LogLevel::kInfo, "reload asked by");
+  for (std::uint32_t txid = 100; txid < 120; ++txid) ask(txid, kRack);
+  ASSERT_TRUE(replies.until(
+      [&] {
+        for (std::uint32_t txid = 100; txid < 120; ++txid) {
+          if (replies_of(txid) == 0) return false;
+        }
+        return true;
+      },
+      seconds(10)));
+  for (std::uint32_t txid = 100; txid < 120; ++txid) {
+    EXPECT_EQ(replies_of(txid), 1) << txid;
+    EXPECT_EQ(reply(txid)->status, dnbridge_RELOAD_APPLIED);
+  }
+  EXPECT_LE(log_.count(LogLevel::kInfo, "reload asked by") - reloads_before, 2u);
+  EXPECT_TRUE(log_.contains(LogLevel::kInfo, "other request(s)"));
 
   // A file with problems: refused, with them.
   ASSERT_NO_FATAL_FAILURE(replace("poll_period_ms = 100", "poll_period_ms = -5"));

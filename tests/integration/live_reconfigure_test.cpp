@@ -184,6 +184,20 @@ TEST_F(LiveReconfigureTest, UntouchedNodesKeepEveryPollWhileOthersAreAddedRemove
   EXPECT_NE(rack().device(mac(7)).device().poll_state(), sim::ConnectionState::kEstablished);
   EXPECT_NE(rack().device(mac(7)).device().explicit_state(), sim::ConnectionState::kEstablished);
 
+  // 8: one idle poll, then Release, before it is allocated again.
+  const auto& polls8 = wire_.polls.at(8);
+  auto idle8 = std::find_if(polls8.begin(), polls8.end(),
+                            [&](const WireLog::Poll& p) { return p.at >= reload; });
+  ASSERT_NE(idle8, polls8.end());
+  EXPECT_EQ(idle8->size, 0u);
+  std::vector<std::uint8_t> services8;
+  for (std::size_t i = 0; i < wire_.unconnected.at(8).size(); ++i) {
+    if (wire_.unconnected.at(8)[i] > idle8->at)
+      services8.push_back(wire_.unconnected_services[8][i]);
+  }
+  ASSERT_GE(services8.size(), 2u);
+  EXPECT_EQ(services8.front(), kRelease);
+  EXPECT_NE(services8.back(), kRelease);  // allocated again
   // 8: released, configured again with the new safe state, idle until a
   // new command.
   const auto* eight = rack().pumps().pump(mac(8));
@@ -259,8 +273,109 @@ TEST_F(LiveReconfigureTest, ThePortsTimingsReachEveryNodeWithoutTouchingIt) {
   EXPECT_TRUE(change.timings_changed);
   EXPECT_EQ(change.unchanged.size(), 4u);
   EXPECT_EQ(rack().scanner().config().poll_response_timeout, milliseconds(40));
+  for (unsigned m : {5u, 6u, 7u, 8u}) {
+    EXPECT_EQ(rack().scanner().node(mac(m))->explicit_response_timeout(), milliseconds(1500));
+  }
   rack().world().run_for(seconds(3));
   for (unsigned m : {5u, 6u, 7u, 8u}) EXPECT_EQ(transitions_since(m, reload), 0u) << m;
+}
+
+// The bus lost while a node is being taken out (bus-off recovered at once):
+// once the master is back on the bus, that node is released all the same,
+// not left to its device's watchdog; a node put back at its MAC starts
+// after that.
+TEST_F(LiveReconfigureTest, ANodeTakenOutIsReleasedOnceTheMasterIsBackAfterABusLoss) {
+  auto without7 = without(7);
+  reconfigure(without7);
+  ASSERT_EQ(rack().scanner().nodes_leaving(), 1u);
+  const TimePoint lost = now();
+  rack().scanner().recheck_mac("bus-off recovered", now());
+  auto back = pumps_;
+  at(back, 7).node.poll_period = milliseconds(200);
+  at(back, 7).node.expected_packet_rate = milliseconds(800);
+  EXPECT_EQ(reconfigure(back).added, std::vector<MacId>{mac(7)});
+  ASSERT_TRUE(rack().world().run_until(
+      [&] { return rack().all_online() && rack().scanner().nodes_leaving() == 0; }, seconds(30)));
+  // After the loss: a Release first, then the new node's Allocate.
+  std::vector<std::uint8_t> since;
+  for (std::size_t i = 0; i < wire_.unconnected.at(7).size(); ++i) {
+    if (wire_.unconnected.at(7)[i] > lost) since.push_back(wire_.unconnected_services[7][i]);
+  }
+  ASSERT_GE(since.size(), 2u);
+  EXPECT_EQ(since.front(), kRelease);
+  EXPECT_NE(since.back(), kRelease);
+  EXPECT_EQ(rack().scanner().node(mac(7))->config().poll_period, milliseconds(200));
+}
+
+// A MAC's events come from one node at a time, whatever the changes: a node
+// put back while its MAC's previous one is released, then taken out again
+// before it started, goes without a word; one put back when the port stops
+// stops after the one released.
+TEST_F(LiveReconfigureTest, AMacsEventsComeFromOneNodeAtATime) {
+  // Each transition starts where the last one ended, or, after a node
+  // stopped, a node put back starts anew (absent).
+  const auto continuous = [&](unsigned m) {
+    const auto t = events_.of(mac(m));
+    for (std::size_t i = 1; i < t.size(); ++i) {
+      const bool anew = t[i - 1].to == NodeState::kStopped && t[i].from == NodeState::kAbsent;
+      if (t[i].from != t[i - 1].to && !anew) return false;
+    }
+    return true;
+  };
+  auto back = pumps_;
+  at(back, 7).node.poll_period = milliseconds(200);
+  at(back, 7).node.expected_packet_rate = milliseconds(800);
+  reconfigure(without(7));
+  reconfigure(back);
+  reconfigure(without(7));  // the one put back had not started
+  EXPECT_EQ(rack().scanner().nodes_leaving(), 1u);
+  ASSERT_TRUE(
+      rack().world().run_until([&] { return rack().scanner().nodes_leaving() == 0; }, seconds(10)));
+  EXPECT_EQ(rack().scanner().node(mac(7)), nullptr);
+  EXPECT_EQ(events_.of(mac(7)).back().to, NodeState::kStopped);
+  reconfigure(back);
+  ASSERT_TRUE(rack().world().run_until([&] { return rack().all_online(); }, seconds(10)));
+  // Put back again, then the port stops while the previous node is released.
+  reconfigure(without(7));
+  reconfigure(pumps_);
+  rack().scanner().stop(now());
+  ASSERT_TRUE(rack().world().run_until([&] { return rack().scanner().stopped(); }, seconds(10)));
+  EXPECT_EQ(rack().scanner().state(), devicenet::PortState::kStopped);
+  EXPECT_EQ(rack().scanner().node(mac(7))->state(), NodeState::kStopped);
+  for (unsigned m : {5u, 6u, 7u, 8u}) EXPECT_TRUE(continuous(m)) << m;
+  // 7: online, released, [the one put back, never started, gone without a
+  // word], put back and online, released, the one put back stopped after.
+  std::vector<NodeState> ends;
+  for (const auto& t : events_.of(mac(7))) {
+    if (t.to == NodeState::kStopped || t.to == NodeState::kOnline) ends.push_back(t.to);
+  }
+  EXPECT_EQ(ends,
+            (std::vector<NodeState>{NodeState::kOnline, NodeState::kStopped, NodeState::kOnline,
+                                    NodeState::kStopped, NodeState::kStopped}));
+}
+
+// A pump held for a commander that has gone keeps its outputs only as long
+// as its policy says so: a reload to the idle policy idles it at once.
+TEST_F(LiveReconfigureTest, OutputsHeldForAGoneCommanderGoIdleWhenThePolicyBecomesIdle) {
+  auto hold = pumps_;
+  at(hold, 6).no_commander = rack::NoCommanderPolicy::kHoldLastOutputs;
+  EXPECT_EQ(reconfigure(hold).updated, std::vector<MacId>{mac(6)});
+  ASSERT_TRUE(rack().pumps().command(mac(6), cdn127::PumpOutputs{.pump_on = true}, now()).ok());
+  ASSERT_TRUE(rack().pumps().command(mac(5), cdn127::PumpOutputs{.pump_on = true}, now()).ok());
+  rack().world().run_for(milliseconds(300));
+  ASSERT_TRUE(rack().pumps().release_command(mac(6), now()).ok());  // its commander left
+  rack().world().run_for(milliseconds(300));
+  ASSERT_TRUE(rack().device(mac(6)).device().outputs().pump_on);  // held, as configured
+
+  const TimePoint reload = now();
+  EXPECT_EQ(reconfigure(pumps_).updated, std::vector<MacId>{mac(6)});
+  rack().world().run_for(milliseconds(300));
+  EXPECT_FALSE(rack().device(mac(6)).device().outputs().pump_on);
+  EXPECT_FALSE(rack().pumps().pump(mac(6))->outputs_requested.has_value());
+  EXPECT_EQ(rack().pumps().pump(mac(6))->idle_cause, rack::IdleCause::kNoCommander);
+  EXPECT_EQ(transitions_since(6, reload), 0u);  // idle polls, the node untouched
+  // A pump whose commander is there keeps its outputs.
+  EXPECT_TRUE(rack().device(mac(5)).device().outputs().pump_on);
 }
 
 }  // namespace

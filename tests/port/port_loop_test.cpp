@@ -755,3 +755,44 @@ TEST(PortLoop, AReconfigurationIsAppliedOnThePortsThread) {
 
 }  // namespace
 }  // namespace dnbridge::port
+
+namespace dnbridge::port {
+namespace {
+
+// A node added in the middle of the file is added last to the rack; what is
+// published of each pump stays the pump's through later reloads.
+TEST(PortLoop, APumpKeepsItsPublishStateThroughReloadsWhateverTheOrder) {
+  RecordingPublisher publisher;
+  PortLoopConfig first = config_for({1, 3});
+  first.publish[0].max_period = milliseconds(500);
+  first.publish[1].max_period = milliseconds(400);
+  PortLoop loop(first,
+                std::make_unique<sim::SimBackend>(can::kBitrate500k,
+                                                  std::vector<MacId>{mac(1), mac(2), mac(3)}),
+                publisher, null_log_sink());
+  loop.start();
+  PortLoopConfig second = config_for({1, 2, 3});
+  second.publish[0].max_period = milliseconds(500);
+  second.publish[1].max_period = milliseconds(600);
+  second.publish[2].max_period = milliseconds(400);
+  const auto apply = [&](const PortLoopConfig& c) {
+    auto done = loop.reconfigure(c);
+    EXPECT_EQ(done.wait_for(std::chrono::seconds(10)), std::future_status::ready);
+    return done.get();
+  };
+  const PortChange added = apply(second);
+  EXPECT_EQ(added.scan_list.added, std::vector<MacId>{mac(2)});
+  EXPECT_TRUE(added.publish_changed.empty());
+  // The same again: nothing differs, for any pump.
+  const PortChange again = apply(second);
+  EXPECT_FALSE(again.any()) << again.publish_changed.size();
+  // One pump's policy: that pump's only.
+  second.publish[2].max_period = milliseconds(300);
+  const PortChange one = apply(second);
+  EXPECT_EQ(one.publish_changed, std::vector<MacId>{mac(3)});
+  loop.stop();
+  loop.join();
+}
+
+}  // namespace
+}  // namespace dnbridge::port

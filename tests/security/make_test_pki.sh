@@ -8,6 +8,9 @@
 #                 for 2020 only (openssl ca -startdate/-enddate)
 #   OUT/rack-before-late   the bridge's files as they were before monitor
 #                 "late" was added to test-site (a second run of the script)
+#   OUT/rack-before-services   the bridge's files with permissions as a
+#                 site signed them before the bus scan and reload came (no
+#                 BusScan*/Reload* grant), signed by test-site's permissions CA
 #   OUT/sub-ca    a CA certificate (CA:TRUE) and its key, issued by
 #                 test-site's identity CA, valid now
 #   OUT/bad-date/not_before.pem, not_after.pem   test-site's identity CA
@@ -26,6 +29,13 @@ bash "$script" --out "$out/site" --domain "$domain" --site test-site \
 cp -r "$out/site/hosts/rack" "$out/rack-before-late"
 bash "$script" --out "$out/site" --monitor late
 bash "$script" --out "$out/other" --domain "$domain" --site other-site --bridge rack
+mkdir -p "$out/rack-before-services"
+cp -r "$out/site/hosts/rack/." "$out/rack-before-services/"
+sed -E '/dnbridge\/(BusScan|Reload)(Request|Reply)/d' "$out/site/permissions.xml" \
+  >"$out/rack-before-services/permissions.xml"
+openssl smime -sign -text -in "$out/rack-before-services/permissions.xml" \
+  -out "$out/rack-before-services/permissions.p7s" \
+  -signer "$out/site/ca/permissions/ca.pem" -inkey "$out/site/ca/permissions/ca.key"
 bash "$here/issue_test_cert.sh" "$out/site" bridge rack 20200101000000Z 20210101000000Z "$out/expired"
 now=$(date -u +%Y%m%d%H%M%SZ)
 bash "$here/issue_test_cert.sh" "$out/site" bridge sub-ca "$now" "$(date -u -d '+30 days' +%Y%m%d%H%M%SZ)" \

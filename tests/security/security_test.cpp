@@ -316,6 +316,30 @@ TEST_F(SecureBridgeTest, AHostAddedLaterNeedsNoNewFilesOnTheBridge) {
   EXPECT_GE(number(p.out, "first_online_ms"), 0) << p.out;
 }
 
+// A site's permissions signed before the bus scan and reload came: the
+// bridge starts all the same, says what it does not offer and why, and
+// serves its pumps; dnbctl reload then finds no bridge taking reloads.
+TEST_F(SecureBridgeTest, PermissionsSignedBeforeTheServicesCameStillRunTheBridge) {
+  auto config = rack_config();
+  config.security = security::load_file(kPki / "rack-before-services" / "security.toml");
+  std::ifstream before(config.security->permissions);
+  const std::string permissions{std::istreambuf_iterator<char>(before), {}};
+  ASSERT_NE(permissions.find("dnbridge/PumpCommand"), std::string::npos);
+  ASSERT_EQ(permissions.find("dnbridge/Reload"), std::string::npos);
+  ASSERT_EQ(permissions.find("dnbridge/BusScan"), std::string::npos);
+  ASSERT_NO_FATAL_FAILURE(start_online(std::move(config)));
+  EXPECT_TRUE(log_.contains(LogLevel::kWarn, "the bus scan (dnbridge/BusScanRequest"));
+  EXPECT_TRUE(log_.contains(LogLevel::kWarn, "reload over DDS (dnbridge/ReloadRequest"));
+  const auto p = probe("scada", 2.0, 3);
+  ASSERT_TRUE(ran(p, 0));
+  EXPECT_EQ(device_outputs(3), kProbeCommand);
+  const auto reload =
+      dnbctl({"--domain", std::to_string(kDomain), "--security", security_file("scada").string(),
+              "--rack", e2e::kRack, "--timeout", "5", "reload"});
+  EXPECT_TRUE(ran(reload, 3));
+  EXPECT_NE(reload.err.find("takes reload requests"), std::string::npos) << reload.err;
+}
+
 // The Cyclone XML route: no [security] in the rack configuration, the
 // domain's configuration has a <Security> section with the bridge's files
 // (as CYCLONEDDS_URI would give it); the supervisor's commands work, a

@@ -183,6 +183,7 @@ void Node::halt(std::string_view reason, TimePoint now) {
 }
 
 void Node::suspend(std::string_view reason, TimePoint now) {
+  if (!started_) return;  // nothing to forget; it waits for start() anyway
   if (state_ == NodeState::kOnline) ++counters_.reconnects;
   forget_connections(Errc::kNotConnected, now);
   set_state(NodeState::kAbsent, std::string(reason), now);

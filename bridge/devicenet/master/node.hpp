@@ -47,6 +47,10 @@ class Node final : private ExplicitClient::Listener {
   // reported (the rack may already decode that MAC's data otherwise).
   // `why` ends the reasons of its last states ("taken out of the scan list").
   void retire(std::string why, TimePoint now);
+  // A retired node whose connections went with the bus (suspend()): once
+  // the master is back on the bus, a Release of both connections, which the
+  // device may still hold, then stopped.
+  void release_after_loss(TimePoint now);
   // The port's explicit response timeout changed: requests from now on use
   // it (unless the node has its own).
   void apply_port_timings();
@@ -102,8 +106,12 @@ class Node final : private ExplicitClient::Listener {
   Bytes applied_outputs() const { return applied_outputs_.view(); }
   bool applied_idle() const { return applied_idle_; }
   Duration poll_epr() const { return poll_epr_; }
+  // The wait for an explicit answer that requests from now on get.
+  Duration explicit_response_timeout() const { return client_.response_timeout(); }
   Duration explicit_epr() const { return explicit_epr_; }
   bool stopped() const { return state_ == NodeState::kStopped; }
+  // start() was called (a node never started holds no connection).
+  bool started() const { return started_; }
 
  private:
   // The life-cycle steps, in start-up order; kStartup in node_lifecycle.cpp

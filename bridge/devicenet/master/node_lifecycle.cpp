@@ -179,6 +179,13 @@ void Node::release(Step step, std::uint8_t choice, TimePoint now) {
   issue(step, r, true, now);
 }
 
+void Node::release_after_loss(TimePoint now) {
+  if (state_ == NodeState::kStopped) return;
+  shutting_down_ = true;
+  reports_data_ = false;
+  release(Step::kReleaseShutdown, allocation::kExplicit | allocation::kPoll, now);
+}
+
 void Node::attempt_allocate(TimePoint now) {
   retry_at_ = kNever;
   step_timeouts_ = 0;

@@ -133,13 +133,12 @@ Status Scanner::add_node(NodeConfig node, TimePoint now) {
   unconfigured_last_heard_[mac.value()] = kNever;
   answering_other_master_.reset(mac.value());
   Node& n = make_node(std::move(node));
-  const bool leaving =
-      std::any_of(leaving_.begin(), leaving_.end(), [&](const auto& l) { return l->mac() == mac; });
+  const bool waits = leaving(mac);
   log_.info("node {} added to the scan list{}", mac.value(),
-            leaving ? ": it starts once its MAC's previous node is released" : "");
+            waits ? ": it starts once its MAC's previous node is released" : "");
   if (state_ == PortState::kDuplicateMac) {
     n.halt("port stopped: duplicate master MAC", now);
-  } else if (state_ == PortState::kRunning && !leaving) {
+  } else if (state_ == PortState::kRunning && !waits) {
     n.set_poll_phase(now);
     n.start(now, now);
   }
@@ -157,9 +156,10 @@ Status Scanner::remove_node(MacId mac, TimePoint now) {
   auto it = std::find_if(nodes_.begin(), nodes_.end(), [&](const auto& p) { return p.get() == n; });
   std::unique_ptr<Node> node = std::move(*it);
   nodes_.erase(it);
-  if (state_ != PortState::kRunning) {
-    // No connection to give back: the node was never started, or its
-    // connections went with the bus or the master's MAC.
+  if (state_ != PortState::kRunning || !node->started()) {
+    // No connection to give back: the node was never started (a node put
+    // back while its MAC's previous one is released), or its connections
+    // went with the bus or the master's MAC.
     log_.info("node {} taken out of the scan list", mac.value());
     return {};
   }
@@ -183,6 +183,8 @@ void Scanner::reap(TimePoint now) {
     if (next && state_ == PortState::kRunning) {
       next->set_poll_phase(now);
       next->start(now, now);
+    } else if (next && state_ == PortState::kStopping) {
+      next->begin_shutdown(now);
     }
   }
 }
@@ -190,6 +192,11 @@ void Scanner::reap(TimePoint now) {
 void Scanner::drop_leaving(std::string_view reason, TimePoint now) {
   for (auto& n : leaving_) n->halt(reason, now);
   leaving_.clear();
+}
+
+bool Scanner::leaving(MacId mac) const {
+  return std::any_of(leaving_.begin(), leaving_.end(),
+                     [&](const auto& n) { return n->mac() == mac; });
 }
 
 Node* Scanner::route(MacId mac) {
@@ -227,10 +234,13 @@ void Scanner::begin_scanning(TimePoint now) {
   const auto count = static_cast<std::int64_t>(nodes_.size());
   for (std::int64_t i = 0; i < count; ++i) {
     Node& node = *nodes_[static_cast<std::size_t>(i)];
+    // A node put back where one is still to be released starts after it.
+    if (leaving(node.mac())) continue;
     const Duration period = node.config().poll_period;
     node.set_poll_phase(now + period * i / count);
     node.start(now, now + milliseconds(2) * i);
   }
+  for (auto& n : leaving_) n->release_after_loss(now);
 }
 
 void Scanner::recheck_mac(std::string_view why, TimePoint now) {
@@ -248,7 +258,11 @@ void Scanner::recheck_mac(std::string_view why, TimePoint now) {
   // Whatever the nodes had is gone with the bus: they are allocated afresh
   // once the master's MAC is checked again.
   for (auto& n : nodes_) n->suspend(fmt::format("{}: the master checks its MAC again", why), now);
-  drop_leaving(fmt::format("{}: released with the bus", why), now);
+  // Those being taken out are released once the master is back (the
+  // device may have kept their connections through a short loss).
+  for (auto& n : leaving_) {
+    n->suspend(fmt::format("{}: to be released once the master is back on the bus", why), now);
+  }
   set_state(PortState::kCheckingMac,
             fmt::format("{}: checking again that no other node has MAC {}", why,
                         config_.master_mac.value()),
@@ -259,9 +273,14 @@ void Scanner::recheck_mac(std::string_view why, TimePoint now) {
 void Scanner::stop(TimePoint now) {
   if (state_ == PortState::kRunning) {
     set_state(PortState::kStopping, "orderly shutdown: idling and releasing nodes", now);
-    for (auto& n : nodes_) n->begin_shutdown(now);
+    // A node put back where one is still released stops after it (reap):
+    // a MAC's events come from one node at a time.
+    for (auto& n : nodes_) {
+      if (!leaving(n->mac())) n->begin_shutdown(now);
+    }
     finish_stopping(now);
   } else if (state_ == PortState::kCheckingMac) {
+    drop_leaving("port stopped", now);
     for (auto& n : nodes_) n->halt("port stopped", now);
     set_state(PortState::kStopped, "stopped during the MAC check", now);
   }
@@ -317,8 +336,8 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
             fmt::format("another node (vendor {}, serial {}) has the master's MAC {}",
                         message->vendor_id, message->serial_number, config_.master_mac.value());
         log_.error("{}: port stopped", reason);
-        for (auto& n : nodes_) n->halt("port stopped: duplicate master MAC", rx_time);
         drop_leaving("port stopped: duplicate master MAC", rx_time);
+        for (auto& n : nodes_) n->halt("port stopped: duplicate master MAC", rx_time);
         set_state(PortState::kDuplicateMac, reason, rx_time);
       }
       return;

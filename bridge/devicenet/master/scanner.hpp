@@ -96,8 +96,10 @@ class Scanner {
   // then. kOutOfRange for a MAC not in the scan list, kStopped while the
   // port stops.
   Status remove_node(MacId mac, TimePoint now);
-  // Nodes taken out of the scan list and not yet released.
+  // Nodes taken out of the scan list and not yet released; whether one is
+  // at `mac`.
   std::size_t nodes_leaving() const { return leaving_.size(); }
+  bool leaving(MacId mac) const;
 
   PortState state() const { return state_; }
   const std::string& reason() const { return reason_; }
@@ -129,7 +131,8 @@ class Scanner {
   // Nodes released after remove_node() go; a node added at the same MAC
   // starts then.
   void reap(TimePoint now);
-  // Leaving nodes whose connections are gone anyway (bus lost, port halted).
+  // Leaving nodes dropped without a word (the port halted: another node has
+  // the master's MAC, or it stopped before it was back on the bus).
   void drop_leaving(std::string_view reason, TimePoint now);
   // A frame from `mac`, which is not in the scan list and not the master's.
   void heard_unconfigured(MacId mac, std::string_view how, TimePoint at);

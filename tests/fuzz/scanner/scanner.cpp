@@ -1,15 +1,19 @@
 // The master of one port driven by received frames, the passing of time and
 // the requests of the layer above, all taken from the input
 // (support/session_records.hpp). Frames it sends are checked and dropped.
-// Properties: no crash or sanitizer report; after on_timer(now) the next
-// deadline is after now (an event loop would otherwise spin); every frame sent
-// is a valid CAN 2.0A frame; events are consistent with the scan list and
-// with each other.
+// The scan list changes too (nodes taken out and put back, as a reload
+// does). Properties: no crash or sanitizer report; after on_timer(now) the
+// next deadline is after now (an event loop would otherwise spin); every
+// frame sent is a valid CAN 2.0A frame; events are consistent with the scan
+// list and with each other.
 #include "bridge/devicenet/master/scanner.hpp"
 
+#include <algorithm>
 #include <array>
+#include <bitset>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "tests/fuzz/support/fuzz_check.hpp"
 #include "tests/fuzz/support/session_records.hpp"
@@ -47,8 +51,10 @@ class CheckingObserver final : public devicenet::ScannerObserver {
     check_time(at);
     FUZZ_CHECK(find(mac) != nullptr);
     // from == to is allowed: the same state with a new reason is news too.
-    // Each transition starts where the previous one for that node ended.
-    FUZZ_CHECK(from == states_[mac.value()]);
+    // Each transition starts where the previous one for that node ended; a
+    // node put back at a MAC starts anew, absent.
+    FUZZ_CHECK(from == states_[mac.value()] ||
+               (readded_.test(mac.value()) && from == NodeState::kAbsent));
     states_[mac.value()] = to;
   }
   void on_node_identity(MacId mac, const devicenet::NodeIdentity&, TimePoint at) override {
@@ -86,11 +92,13 @@ class CheckingObserver final : public devicenet::ScannerObserver {
   void on_bus_scan(const devicenet::BusScan& scan, TimePoint at) override {
     check_time(at);
     FUZZ_CHECK(scan.started <= scan.finished && scan.finished == at);
-    FUZZ_CHECK(scan.findings.size() == MacId::kMax - config_.nodes.size());
+    // A change of the scan list ends a scan first: the list is the scan's.
+    FUZZ_CHECK(scan.findings.size() >= MacId::kMax - config_.nodes.size());
+    FUZZ_CHECK(scan.findings.size() <= MacId::kMax - scanner_->nodes().size());
     unsigned previous = 0;
     bool first = true;
     for (const auto& f : scan.findings) {
-      FUZZ_CHECK(f.mac != config_.master_mac && find(f.mac) == nullptr);
+      FUZZ_CHECK(f.mac != config_.master_mac && scanner_->node(f.mac) == nullptr);
       FUZZ_CHECK(first || f.mac.value() > previous);
       first = false;
       previous = f.mac.value();
@@ -102,6 +110,13 @@ class CheckingObserver final : public devicenet::ScannerObserver {
   }
 
   NodeState state(MacId mac) const { return states_[mac.value()]; }
+  // A node was put back at `mac`, in `state` when no node taken out from
+  // there is still being released (a node added to a port that does not
+  // scan reports nothing until it starts).
+  void readded(MacId mac, std::optional<NodeState> state) {
+    readded_.set(mac.value());
+    if (state) states_[mac.value()] = *state;
+  }
   // The scanner it observes, for what the events do not carry.
   void watch(const devicenet::Scanner& scanner) { scanner_ = &scanner; }
   std::uint64_t results() const { return results_; }
@@ -121,6 +136,7 @@ class CheckingObserver final : public devicenet::ScannerObserver {
   const devicenet::ScannerConfig& config_;
   const devicenet::Scanner* scanner_ = nullptr;
   std::array<NodeState, MacId::kMax + 1> states_{};
+  std::bitset<MacId::kMax + 1> readded_;
   TimePoint last_{};
   std::uint64_t results_ = 0;
 };
@@ -136,13 +152,19 @@ void run_timers(devicenet::Scanner& scanner, TimePoint now) {
 }
 
 void check_consistent(const devicenet::Scanner& scanner, const CheckingObserver& observer,
-                      const devicenet::ScannerConfig& config) {
-  FUZZ_CHECK(scanner.nodes().size() == config.nodes.size());
+                      const devicenet::ScannerConfig& config,
+                      const std::bitset<MacId::kMax + 1>& listed) {
+  FUZZ_CHECK(scanner.nodes().size() == listed.count());
   for (const auto& n : config.nodes) {
     const devicenet::Node* node = scanner.node(n.mac);
+    if (!listed.test(n.mac.value())) {
+      FUZZ_CHECK(node == nullptr);
+      continue;
+    }
     FUZZ_CHECK(node != nullptr);
     FUZZ_CHECK(node->mac() == n.mac);
-    FUZZ_CHECK(node->state() == observer.state(n.mac));
+    // While a node taken out is released, the events of its MAC are its own.
+    if (!scanner.leaving(n.mac)) FUZZ_CHECK(node->state() == observer.state(n.mac));
     FUZZ_CHECK(node->applied_outputs().size() <= devicenet::Node::kMaxIoSize);
     const auto& c = node->counters();
     FUZZ_CHECK(c.idle_polls <= c.polls);
@@ -176,6 +198,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   devicenet::Scanner scanner(config, sink, observer, Logger());
   observer.watch(scanner);
 
+  std::bitset<MacId::kMax + 1> listed;
+  for (const auto& n : config.nodes) listed.set(n.mac.value());
   TimePoint now = fuzz::kSessionStart;
   scanner.start(now);
   ByteReader in(Bytes(data, size));
@@ -213,10 +237,37 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         FUZZ_CHECK(scanner.scan_bus(now).ok() == can_start);
         break;
       }
+      case fuzz::Op::kToggleNode: {
+        const MacId mac = node_mac();
+        const bool stopping = scanner.state() == PortState::kStopping;
+        if (listed.test(mac.value())) {
+          const Status s = scanner.remove_node(mac, now);
+          FUZZ_CHECK(s.ok() == !stopping);
+          if (s) listed.reset(mac.value());
+        } else {
+          devicenet::NodeConfig again =
+              *std::find_if(config.nodes.begin(), config.nodes.end(),
+                            [&](const devicenet::NodeConfig& n) { return n.mac == mac; });
+          if (!rest.empty() && (rest[0] & 1) != 0) {
+            again.poll_period *= 2;
+            again.expected_packet_rate *= 2;
+          }
+          observer.readded(mac, std::nullopt);  // before: starting is an event
+          const Status s = scanner.add_node(again, now);
+          FUZZ_CHECK(s.ok() == !stopping);
+          if (s) {
+            listed.set(mac.value());
+            observer.readded(mac, scanner.leaving(mac) ? std::nullopt
+                                                       : std::optional(scanner.node(mac)->state()));
+          }
+        }
+        FUZZ_CHECK(!scanner.scanning_bus());
+        break;
+      }
     }
     // The work a received frame or request starts may be due at once.
     run_timers(scanner, now);
-    check_consistent(scanner, observer, config);
+    check_consistent(scanner, observer, config, listed);
   }
   return 0;
 }

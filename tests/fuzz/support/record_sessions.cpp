@@ -55,6 +55,9 @@ struct Scenario {
   bool stop_at_end = true;
   Duration length = seconds(6);
   bool scan_bus = false;  // a bus scan after the explicit request
+  // After the explicit request, node 2 taken out of the scan list, then put
+  // back with another poll period (a reload).
+  bool toggle_node = false;
 };
 
 void write(const std::string& path, const std::vector<std::uint8_t>& bytes) {
@@ -85,6 +88,7 @@ void run(const Scenario& s, const std::string& scanner_dir, const std::string& s
   for (auto& d : slaves) d->power_on(now);
   const TimePoint end = now + s.length;
   bool outputs_set = false, request_sent = false, scan_started = false, stopped = false;
+  int toggles = 0;
 
   const auto deliver = [&] {
     while (!queue.empty()) {
@@ -156,6 +160,19 @@ void run(const Scenario& s, const std::string& scanner_dir, const std::string& s
         scan_started = true;
         master_in.add(Op::kScanBus, now, 0, {});
         (void)scanner.scan_bus(now);
+      } else if (s.toggle_node && request_sent && toggles < 2 &&
+                 now >= fuzz::kSessionStart + seconds(5 + toggles)) {
+        const devicenet::MacId two = devicenet::MacId::from(2).value();
+        const std::vector<std::uint8_t> d{0x01, 0x01};  // node index 1; doubled period
+        master_in.add(Op::kToggleNode, now, 0, Bytes(d));
+        if (toggles++ == 0) {
+          (void)scanner.remove_node(two, now);
+        } else {
+          auto again = fuzz::fuzz_scanner_config().nodes.at(1);
+          again.poll_period *= 2;
+          again.expected_packet_rate *= 2;
+          (void)scanner.add_node(again, now);
+        }
       }
     }
   }
@@ -181,6 +198,8 @@ int main(int argc, char** argv) {
       {"startup_only", {true, true}, false, milliseconds(1500)},
       // A CDN127 at MAC 4, which the scan list does not have: found by the scan.
       {"bus_scan", {true, true, false, true}, true, seconds(15), true},
+      // Node 2 out of the scan list (idle poll, Release), then back.
+      {"reconfigure", {true, true}, true, seconds(10), false, true},
   };
   for (const auto& s : scenarios) run(s, argv[1], argv[2]);
   return 0;

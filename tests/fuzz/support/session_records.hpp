@@ -26,13 +26,17 @@
 namespace dnbridge::fuzz {
 
 enum class Op : std::uint8_t {
-  kFrame = 0,             // 0..7, 14 and 15: a received frame
+  kFrame = 0,             // 0..7 and 15: a received frame
   kTimer = 8,             // time passes, nothing else
   kSetOutputs = 9,        // scanner: set_outputs(node data[0] % n, data[1..])
   kSetIdle = 10,          // scanner: set_idle(node data[0] % n, data[1] & 1)
   kRequestExplicit = 11,  // scanner: request_explicit(node data[0] % n, request in data[1..])
   kStop = 12,             // scanner: stop(); slave: power cycle
   kScanBus = 13,          // scanner: scan_bus()
+  // scanner: node data[0] % n out of the scan list when in it (remove_node),
+  // back in when not (add_node; data[1] bit 0: its poll period and EPR
+  // doubled, a node configured again)
+  kToggleNode = 14,
 };
 
 inline constexpr Duration kStepUnit = microseconds(100);
@@ -53,7 +57,7 @@ inline std::optional<Record> next_record(ByteReader& in) noexcept {
   if (!in.ok()) return std::nullopt;
   Record r;
   const unsigned op = head >> 4;
-  r.op = op >= 8 && op <= 13 ? static_cast<Op>(op) : Op::kFrame;
+  r.op = op >= 8 && op <= 14 ? static_cast<Op>(op) : Op::kFrame;
   r.step = kStepUnit * step;
   if (r.op == Op::kFrame) r.frame.id = in.u16le();
   const std::size_t len = head & 0x0FU;
