@@ -8,6 +8,7 @@
 #include "adapters/daemon/host_identity.hpp"
 #include "adapters/port/thread_name.hpp"
 #include "adapters/socketcan/socketcan_backend.hpp"
+#include "adapters/version/version.hpp"
 
 namespace dnbridge::daemon {
 namespace {
@@ -77,7 +78,8 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends, Reloa
       offered_deadline_(offered_deadline(config_)),
       participant_(static_cast<dds_domainid_t>(config_.domain_id), config_.rack,
                    config_.security ? security::participant_properties(*config_.security)
-                                    : dds::Properties{}),
+                                    : dds::Properties{},
+                   dds::host_user_data(version::number())),
       publisher_(participant_, config_.rack, offered_deadline_, Logger(log, "dds")) {
   warn_of_policy(log_, config_.explicit_policy);
   if (config_.metrics_listen) {

@@ -30,6 +30,13 @@ Result<std::vector<DiscoveredParticipant>> DiscoveredParticipants::take() const 
         d.name = name;
         dds_free(name);
       }
+      void* data = nullptr;
+      std::size_t size = 0;
+      if (infos[i].valid_data && p->qos != nullptr && dds_qget_userdata(p->qos, &data, &size) &&
+          data != nullptr) {
+        d.user_data.assign(static_cast<const char*>(data), size);
+        dds_free(data);
+      }
       out.push_back(std::move(d));
     }
     if (n > 0) (void)dds_return_loan(handle(), samples, n);

@@ -1,5 +1,7 @@
 #include "adapters/dds/participant.hpp"
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
@@ -110,9 +112,11 @@ dds_entity_t create_bridge_domain(dds_domainid_t domain) {
 }
 
 Participant::Created create_participant(dds_domainid_t domain, const std::string& name,
-                                        const Properties& properties, bool bridge) {
+                                        const Properties& properties, bool bridge,
+                                        std::string_view user_data) {
   Qos qos;
   qos.entity_name(name);
+  if (!user_data.empty()) qos.userdata(std::as_bytes(std::span(user_data)));
   for (const auto& p : properties) qos.property(p.name, p.value);
   std::lock_guard lock(g_creating);
   Entity own_domain(bridge ? create_bridge_domain(domain) : 0);
@@ -130,11 +134,40 @@ Participant::Created create_participant(dds_domainid_t domain, const std::string
 
 }  // namespace
 
-Participant::Participant(dds_domainid_t domain, std::string_view rack, const Properties& properties)
-    : Participant(create_participant(domain, participant_name(rack), properties, true), domain) {}
+Participant::Participant(dds_domainid_t domain, std::string_view rack, const Properties& properties,
+                         std::string_view user_data)
+    : Participant(create_participant(domain, participant_name(rack), properties, true, user_data),
+                  domain) {}
 
-Participant::Participant(dds_domainid_t domain, ClientName client, const Properties& properties)
-    : Participant(create_participant(domain, std::string(client.name), properties, false), domain) {
+Participant::Participant(dds_domainid_t domain, ClientName client, const Properties& properties,
+                         std::string_view user_data)
+    : Participant(
+          create_participant(domain, std::string(client.name), properties, false, user_data),
+          domain) {}
+
+std::string host_user_data(std::string_view version) {
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+  std::string out = "host=";
+  out += host;
+  out += "\npid=" + std::to_string(getpid());
+  out += "\nversion=";
+  out += version;
+  out += '\n';
+  return out;
+}
+
+std::string user_data_field(std::string_view user_data, std::string_view key) {
+  while (!user_data.empty()) {
+    const auto end = user_data.find('\n');
+    const std::string_view line = user_data.substr(0, end);
+    if (line.size() > key.size() && line.starts_with(key) && line[key.size()] == '=') {
+      return std::string(line.substr(key.size() + 1));
+    }
+    if (end == std::string_view::npos) break;
+    user_data.remove_prefix(end + 1);
+  }
+  return {};
 }
 
 Participant::Participant(Created created, dds_domainid_t domain)

@@ -25,14 +25,18 @@ class Participant : public Entity {
   // when this process is the first in it (participant.cpp). Throws Error;
   // when Cyclone refuses the participant, the message has the reason Cyclone
   // logged (a DDS Security plugin's, for instance).
-  Participant(dds_domainid_t domain, std::string_view rack, const Properties& properties = {});
+  // `user_data`: the participant's USER_DATA QoS (host_user_data()), which
+  // discovery carries to every participant and tool.
+  Participant(dds_domainid_t domain, std::string_view rack, const Properties& properties = {},
+              std::string_view user_data = {});
 
   // A participant that is not a bridge (a client such as dnbctl), named as
   // given, so that tools never mistake it for a rack's bridge. Throws Error.
   struct ClientName {
     std::string_view name;
   };
-  Participant(dds_domainid_t domain, ClientName client, const Properties& properties = {});
+  Participant(dds_domainid_t domain, ClientName client, const Properties& properties = {},
+              std::string_view user_data = {});
 
   // Deletes the participant, and the domain it created if no other
   // participant is left in it.
@@ -57,5 +61,13 @@ class Participant : public Entity {
 
 // "dnbridge <rack>": the participant name of a rack's bridge.
 std::string participant_name(std::string_view rack);
+
+// What a participant says of where it runs, as its USER_DATA: lines
+// "host=HOST", "pid=PID" and "version=VERSION" (this host's name and this
+// process's id), so that DDS tools and Wireshark's RTPS view show which host
+// a rack's bridge is on.
+std::string host_user_data(std::string_view version);
+// A field of such user data ("host"); empty when absent.
+std::string user_data_field(std::string_view user_data, std::string_view key);
 
 }  // namespace dnbridge::dds

@@ -1,5 +1,7 @@
 #include "adapters/dnbctl/bridges.hpp"
 
+#include <algorithm>
+
 namespace dnbridge::dnbctl {
 namespace {
 
@@ -21,16 +23,21 @@ void Bridges::refresh() {
       continue;
     }
     if (auto rack = dds::bridge_rack(p.name); rack && p.alive) {
-      seen_.emplace(p.guid, Seen{std::move(*rack), true});
+      const std::string host = dds::user_data_field(p.user_data, "host");
+      const std::string pid = dds::user_data_field(p.user_data, "pid");
+      std::string where = host;
+      if (!host.empty() && !pid.empty()) where += " (pid " + pid + ")";
+      seen_.emplace(p.guid, Seen{std::move(*rack), std::move(where), true});
     }
   }
 }
 
-std::map<std::string, unsigned> Bridges::live() const {
-  std::map<std::string, unsigned> racks;
+std::map<std::string, std::vector<std::string>> Bridges::live() const {
+  std::map<std::string, std::vector<std::string>> racks;
   for (const auto& [guid, s] : seen_) {
-    if (s.alive) ++racks[s.rack];
+    if (s.alive) racks[s.rack].push_back(s.where);
   }
+  for (auto& [rack, where] : racks) std::sort(where.begin(), where.end());
   return racks;
 }
 

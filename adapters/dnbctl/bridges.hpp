@@ -4,6 +4,7 @@
 // even before anything it publishes has arrived.
 #include <map>
 #include <string>
+#include <vector>
 
 #include "adapters/dds/discovered_participants.hpp"
 #include "adapters/dds/reader.hpp"
@@ -18,12 +19,15 @@ class Bridges {
 
   // Takes what discovery reported since the last call.
   void refresh();
-  // The live bridge participants per rack name.
-  std::map<std::string, unsigned> live() const;
+  // The live bridge participants per rack name: where each runs, "HOST
+  // (pid PID)" from its user data (dds::host_user_data), or "" when it
+  // says nothing.
+  std::map<std::string, std::vector<std::string>> live() const;
 
  private:
   struct Seen {
     std::string rack;
+    std::string where;
     bool alive = true;
   };
   dds::DiscoveredParticipants reader_;

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "adapters/dds/fields.hpp"
+#include "adapters/version/version.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
@@ -66,7 +67,7 @@ bool interrupted() noexcept { return g_interrupted != 0; }
 
 Client::Client(std::uint32_t domain, const std::string& name, const dds::Properties& properties)
     : participant_(static_cast<dds_domainid_t>(domain), dds::Participant::ClientName{name},
-                   properties),
+                   properties, dds::host_user_data(version::number())),
       pump_topic_(participant_),
       node_topic_(participant_),
       port_topic_(participant_),

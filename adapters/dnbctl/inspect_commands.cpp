@@ -149,7 +149,7 @@ Exit run_racks(const GlobalOptions& o) {
   Bridges bridges(client);
   const auto bridge_racks = [&] {
     bridges.refresh();
-    std::map<std::string, unsigned> racks = bridges.live();
+    auto racks = bridges.live();
     std::erase_if(racks, [&](const auto& r) { return !o.rack.empty() && r.first != o.rack; });
     return racks;
   };

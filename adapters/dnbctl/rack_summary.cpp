@@ -131,9 +131,9 @@ std::string class_reason(const NodeRow& r) {
   }
 }
 
-std::vector<RackSummary> summarize_racks(std::span<const PortRow> ports,
-                                         std::span<const NodeRow> nodes,
-                                         const std::map<std::string, unsigned>& participants) {
+std::vector<RackSummary> summarize_racks(
+    std::span<const PortRow> ports, std::span<const NodeRow> nodes,
+    const std::map<std::string, std::vector<std::string>>& participants) {
   std::map<std::string, RackSummary, std::less<>> racks;
   const auto rack = [&racks](std::string_view name) -> RackSummary& {
     auto it = racks.find(name);
@@ -143,7 +143,11 @@ std::vector<RackSummary> summarize_racks(std::span<const PortRow> ports,
     }
     return it->second;
   };
-  for (const auto& [name, count] : participants) rack(name).participants = count;
+  for (const auto& [name, hosts] : participants) {
+    RackSummary& r = rack(name);
+    r.participants = static_cast<unsigned>(hosts.size());
+    r.hosts = hosts;
+  }
   for (const auto& p : ports) rack(view(p.port->rack)).ports.push_back(&p);
   for (const auto& n : nodes) rack(view(n.node->rack)).nodes.push_back(&n);
 
@@ -194,11 +198,22 @@ Record rack_record(const RackSummary& r) {
   for (const auto* n : r.nodes) nodes.push_back(rack_node_record(*n));
 
   std::string bridge(to_text(r.bridge));
-  if (r.participants > 1) bridge += fmt::format(" ({} bridges!)", r.participants);
+  if (r.participants > 1) {
+    // Which hosts, so that the one with the wrong rack name can be found.
+    std::string where;
+    for (const auto& h : r.hosts) {
+      where += fmt::format("{}{}", where.empty() ? "" : ", ", h.empty() ? "?" : h);
+    }
+    bridge += fmt::format(" ({} bridges!: {})", r.participants, where);
+  }
+  std::vector<Json> hosts;
+  for (const auto& h : r.hosts) hosts.emplace_back(h);
   Record rec;
   rec.add("rack", r.rack, "rack", r.rack)
       .add("bridge", std::move(bridge),
-           {{"bridge", to_text(r.bridge)}, {"participants", r.participants}})
+           {{"bridge", to_text(r.bridge)},
+            {"participants", r.participants},
+            {"bridge_hosts", Json::values(std::move(hosts))}})
       .nest("counts", std::move(counts))
       .add("ports", ports_text(r), "ports", Json::array(std::move(ports)))
       .json("nodes", Json::array(std::move(nodes)));

@@ -52,6 +52,7 @@ struct RackSummary {
   std::string rack;
   BridgeState bridge = BridgeState::kLive;
   unsigned participants = 0;          // live participants named "dnbridge <rack>"
+  std::vector<std::string> hosts;     // where each runs ("HOST (pid PID)", "" unknown)
   std::vector<const PortRow*> ports;  // by port name
   std::vector<const NodeRow*> nodes;  // by port name, then MAC
   std::array<unsigned, kNodeClasses> counts{};
@@ -59,11 +60,11 @@ struct RackSummary {
 };
 
 // One summary per rack, sorted by name. `participants`: the live bridge
-// participants per rack name (racks that publish nothing yet appear
-// through them alone).
-std::vector<RackSummary> summarize_racks(std::span<const PortRow> ports,
-                                         std::span<const NodeRow> nodes,
-                                         const std::map<std::string, unsigned>& participants);
+// participants per rack name, with where each runs (Bridges::live; racks
+// that publish nothing yet appear through them alone).
+std::vector<RackSummary> summarize_racks(
+    std::span<const PortRow> ports, std::span<const NodeRow> nodes,
+    const std::map<std::string, std::vector<std::string>>& participants);
 
 // The racks' table (counts per class), the ports that are not running on a
 // healthy bus, and every node that is not online, with its reason.

@@ -38,7 +38,7 @@ constexpr Duration kRepeatAfter = seconds(5);
 std::set<std::string> live_racks(Bridges& bridges, const Client& client) {
   bridges.refresh();
   std::set<std::string> racks;
-  for (const auto& [rack, count] : bridges.live()) racks.insert(rack);
+  for (const auto& [rack, hosts] : bridges.live()) racks.insert(rack);
   for (const auto& [key, port] : client.ports()) {
     if (port.alive) racks.insert(key.rack);
   }

@@ -7,10 +7,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
 
+#include "adapters/dds/discovered_participants.hpp"
 #include "dds_fixture.hpp"
 
 namespace dnbridge::dds::testing {
@@ -28,6 +30,33 @@ TEST_F(DdsTest, ParticipantIsNamedAfterTheRack) {
   ASSERT_TRUE(name.ok());
   EXPECT_EQ(*name, "dnbridge " + rack_);
   EXPECT_EQ(participant_.domain(), test_domain());
+}
+
+// Discovery tells every participant which rack a bridge serves (its name)
+// and where it runs (its user data): host, process, version.
+TEST(Discovery, ABridgeSaysItsRackAndHost) {
+  const std::string user_data = host_user_data("9.8.7");
+  Participant bridge(test_domain(), "rack-with-host", {}, user_data);
+  Participant client(test_domain(), Participant::ClientName{"discovery test"});
+  DiscoveredParticipants discovered(client);
+  char host[256] = {};
+  ASSERT_EQ(gethostname(host, sizeof host - 1), 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  std::optional<DiscoveredParticipant> found;
+  while (!found && std::chrono::steady_clock::now() < deadline) {
+    auto taken = discovered.take();
+    ASSERT_TRUE(taken.ok());
+    for (auto& p : *taken) {
+      if (bridge_rack(p.name) == std::optional<std::string>("rack-with-host")) found = p;
+    }
+    if (!found) (void)wait_for(client, discovered, std::chrono::milliseconds(100));
+  }
+  ASSERT_TRUE(found.has_value());
+  EXPECT_EQ(found->user_data, user_data);
+  EXPECT_EQ(user_data_field(found->user_data, "host"), host);
+  EXPECT_EQ(user_data_field(found->user_data, "pid"), std::to_string(getpid()));
+  EXPECT_EQ(user_data_field(found->user_data, "version"), "9.8.7");
+  EXPECT_EQ(user_data_field(found->user_data, "rack"), "");
 }
 
 TEST_F(DdsTest, InvalidTopicNameThrowsWithWhatWasAttempted) {

@@ -110,7 +110,8 @@ TEST(RackSummary, BridgesAreLiveSilentOrGone) {
   const std::vector<NodeRow> nodes{s.node("live", 1, dnbridge_NODE_ONLINE, "polled", false),
                                    s.node("live", 2, dnbridge_NODE_STOPPED, "orderly shutdown"),
                                    s.node("gone", 1, dnbridge_NODE_ONLINE, "polled", false, false)};
-  const auto racks = summarize_racks(ports, nodes, {{"live", 1}, {"silent", 2}});
+  const auto racks = summarize_racks(
+      ports, nodes, {{"live", {"host-a (pid 1)"}}, {"silent", {"", "host-b (pid 2)"}}});
   ASSERT_EQ(racks.size(), 3u);
   EXPECT_EQ(racks[0].rack, "gone");
   EXPECT_EQ(racks[0].bridge, BridgeState::kGone);
@@ -125,15 +126,16 @@ TEST(RackSummary, BridgesAreLiveSilentOrGone) {
 
   const std::string text = racks_text(racks);
   EXPECT_EQ(
-      text.rfind("RACK    BRIDGE                      PORTS        NODES  ONLINE  IDLE  STARTING  "
-                 "ABSENT  FAULTED  OTHER MASTER  STOPPED  UNKNOWN\n"
-                 "gone    gone                        0/1 running  1      0       0     0         "
-                 "0       0        0             0        1\n"
-                 "live    live                        1/1 running  2      1       0     0         "
-                 "0       0        0             1        0\n"
-                 "silent  no status yet (2 bridges!)  -            -      -       -     -         "
-                 "-       -        -             -        -\n",
-                 0),
+      text.rfind(
+          "RACK    BRIDGE                                         PORTS        NODES  ONLINE  "
+          "IDLE  STARTING  ABSENT  FAULTED  OTHER MASTER  STOPPED  UNKNOWN\n"
+          "gone    gone                                           0/1 running  1      0       "
+          "0     0         0       0        0             0        1\n"
+          "live    live                                           1/1 running  2      1       "
+          "0     0         0       0        0             1        0\n"
+          "silent  no status yet (2 bridges!: ?, host-b (pid 2))  -            -      -       "
+          "-     -         -       -        -             -        -\n",
+          0),
       0u)
       << text;
   // The gone bridge's port needs attention; its node and the stopped one are listed.
@@ -155,7 +157,7 @@ TEST(RackSummary, PortsOffTheirBusAreShownAndAnAllOnlineRackSaysSo) {
   const std::vector<PortRow> ports{
       s.port("r", dnbridge_PORT_RUNNING, dnbridge_BUS_OFF, "can0: bus-off")};
   const std::vector<NodeRow> nodes{s.node("r", 1, dnbridge_NODE_ONLINE, "polled", false)};
-  const auto racks = summarize_racks(ports, nodes, {{"r", 1}});
+  const auto racks = summarize_racks(ports, nodes, {{"r", {"host-a (pid 1)"}}});
   const std::string text = racks_text(racks);
   EXPECT_NE(text.find("\nRACK  PORT  STATE    BUS      REASON\n"
                       "r     A     running  bus-off  can0: bus-off\n"),
