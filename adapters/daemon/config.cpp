@@ -795,7 +795,18 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, Proble
   DaemonConfig config;
   config.source = std::string(source);
   if (const toml::node* n = root.require("rack")) {
-    if (auto v = read_name(*n, "rack", r)) config.rack = *v;
+    if (auto v = read_name(*n, "rack", r)) {
+      // The rack's DDS partition is named after it (dds::rack_partition),
+      // where these match as patterns.
+      if (v->find_first_of("*?") != std::string::npos) {
+        r.error(n->source(),
+                fmt::format("rack = \"{}\": a rack name holds no '*' or '?' (its DDS partition, "
+                            "dnbridge/RACK, would match other racks' as a pattern)",
+                            *v));
+      } else {
+        config.rack = *v;
+      }
+    }
   }
   if (const toml::node* n = root.get("domain")) {
     if (auto v = read_int_as<std::uint32_t>(

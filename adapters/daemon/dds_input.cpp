@@ -86,8 +86,9 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       publisher_(publisher),
       ports_(std::move(ports)),
       log_(std::move(log)),
-      commands_(participant, publisher.command_topic(), dds::command_reader_qos()),
-      requests_(participant, publisher.request_topic(), dds::request_reader_qos()),
+      partition_{dds::rack_partition(rack_)},
+      commands_(participant, publisher.command_topic(), dds::command_reader_qos(partition_)),
+      requests_(participant, publisher.request_topic(), dds::request_reader_qos(partition_)),
       reload_(std::move(reload)),
       command_buffer_(kBatch),
       request_buffer_(kBatch),
@@ -97,12 +98,14 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   // their topics), each as far as it grants it.
   if (const auto* topic = publisher.scan_request_topic()) {
     scan_requests_ = unless_denied(log_, "the bus scan's requests (dnbridge/BusScanRequest)", [&] {
-      return dds::Reader<dnbridge_BusScanRequest>(participant, *topic, dds::request_reader_qos());
+      return dds::Reader<dnbridge_BusScanRequest>(participant, *topic,
+                                                  dds::request_reader_qos(partition_));
     });
   }
   if (const auto* topic = publisher.reload_request_topic()) {
     reload_requests_ = unless_denied(log_, "reload requests (dnbridge/ReloadRequest)", [&] {
-      return dds::Reader<dnbridge_ReloadRequest>(participant, *topic, dds::request_reader_qos());
+      return dds::Reader<dnbridge_ReloadRequest>(participant, *topic,
+                                                 dds::request_reader_qos(partition_));
     });
   }
   // A reader's status condition stays triggered while any status in its mask

@@ -54,6 +54,9 @@ class DdsInput {
   DdsPublisher& publisher_;
   std::map<std::string, port::PortLoop*, std::less<>> ports_;
   Logger log_;
+  // The rack's partition: DDS delivers this bridge its own rack's commands
+  // and requests only (dds::rack_partition).
+  std::vector<std::string> partition_;
   dds::Reader<dnbridge_PumpCommand> commands_;
   dds::Reader<dnbridge_ExplicitRequest> requests_;
   // Absent when DDS Security does not grant the service (unless_denied).

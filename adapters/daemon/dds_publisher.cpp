@@ -26,6 +26,7 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
                            Duration state_deadline, Logger log)
     : rack_(std::move(rack)),
       log_(std::move(log)),
+      partition_{dds::rack_partition(rack_)},
       pump_topic_(participant),
       node_topic_(participant),
       port_topic_(participant),
@@ -35,16 +36,16 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
       pump_writer_(participant, pump_topic_, dds::state_writer_qos(state_deadline)),
       node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
       port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
-      reply_writer_(participant, reply_topic_, dds::reply_writer_qos()),
+      reply_writer_(participant, reply_topic_, dds::reply_writer_qos(partition_)),
       scan_(unless_denied(log_, "the bus scan (dnbridge/BusScanRequest, BusScanReply)",
                           [&] {
                             return Service<dnbridge_BusScanRequest, dnbridge_BusScanReply>(
-                                participant, dds::scan_reply_writer_qos());
+                                participant, dds::scan_reply_writer_qos(partition_));
                           })),
       reload_(unless_denied(log_, "reload over DDS (dnbridge/ReloadRequest, ReloadReply)",
                             [&] {
                               return Service<dnbridge_ReloadRequest, dnbridge_ReloadReply>(
-                                  participant, dds::scan_reply_writer_qos());
+                                  participant, dds::scan_reply_writer_qos(partition_));
                             })),
       // State samples are keyed (one waits per instance): the capacity only
       // bounds the unregistrations of a port that stops.

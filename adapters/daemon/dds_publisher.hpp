@@ -114,6 +114,8 @@ class DdsPublisher final : public port::PortPublisher {
 
   std::string rack_;
   Logger log_;
+  // The rack's partition, where its replies go (dds::rack_partition).
+  std::vector<std::string> partition_;
   WallClock clock_;
   dds::Topic<dnbridge_PumpState> pump_topic_;
   dds::Topic<dnbridge_NodeStatus> node_topic_;

@@ -2,6 +2,7 @@
 
 #include <new>
 #include <utility>
+#include <vector>
 
 namespace dnbridge::dds {
 
@@ -87,6 +88,14 @@ Qos& Qos::ownership_strength(int32_t strength) {
 Qos& Qos::destination_order_by_source_timestamp(bool by_source) {
   dds_qset_destination_order(qos_, by_source ? DDS_DESTINATIONORDER_BY_SOURCE_TIMESTAMP
                                              : DDS_DESTINATIONORDER_BY_RECEPTION_TIMESTAMP);
+  return *this;
+}
+
+Qos& Qos::partitions(std::span<const std::string> names) {
+  std::vector<const char*> c;
+  c.reserve(names.size());
+  for (const auto& n : names) c.push_back(n.c_str());
+  dds_qset_partition(qos_, static_cast<uint32_t>(c.size()), c.data());
   return *this;
 }
 

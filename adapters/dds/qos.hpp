@@ -41,6 +41,8 @@ class Qos {
   Qos& ownership_strength(int32_t strength);
   Qos& destination_order_by_source_timestamp(bool by_source = true);
   Qos& entity_name(const std::string& name);
+  // The partitions of the writer's publisher or the reader's subscriber.
+  Qos& partitions(std::span<const std::string> names);
   Qos& lifespan(Duration d);
   // Whether deleting a writer (or unregistering an instance) also disposes.
   Qos& autodispose_unregistered_instances(bool autodispose);

@@ -57,16 +57,32 @@ Qos state_reader_qos(std::optional<Duration> deadline) {
   return qos;
 }
 
-Qos command_writer_qos(int32_t strength, Duration lease) {
+std::string rack_partition(std::string_view rack) {
+  std::string name = "dnbridge/";
+  name += rack;
+  return name;
+}
+
+std::vector<std::string> rack_partitions(std::span<const std::string> racks) {
+  std::vector<std::string> out;
+  for (const auto& r : racks) out.push_back(rack_partition(r));
+  return out;
+}
+
+std::vector<std::string> rack_partitions(std::string_view rack) { return {rack_partition(rack)}; }
+
+Qos command_writer_qos(std::span<const std::string> partitions, int32_t strength, Duration lease) {
   Qos qos = command_common();
+  qos.partitions(partitions);
   qos.ownership_strength(strength)
       .liveliness(Liveliness::kAutomatic, lease)
       .autodispose_unregistered_instances(false);
   return qos;
 }
 
-Qos command_reader_qos() {
+Qos command_reader_qos(std::span<const std::string> partitions) {
   Qos qos = command_common();
+  qos.partitions(partitions);
   // Commands in the order they arrive, whatever their source timestamps:
   // ordered by those, one commander whose clock runs ahead would have every
   // later sample dropped, its own unregistration included, and hold its
@@ -78,8 +94,9 @@ Qos command_reader_qos() {
   return qos;
 }
 
-Qos request_writer_qos() {
+Qos request_writer_qos(std::span<const std::string> partitions) {
   Qos qos;
+  qos.partitions(partitions);
   qos.reliable(kMaxBlocking)
       .durability(Durability::kVolatile)
       .keep_all()
@@ -87,18 +104,28 @@ Qos request_writer_qos() {
   return qos;
 }
 
-Qos request_reader_qos() {
+Qos request_reader_qos(std::span<const std::string> partitions) {
   Qos qos;
+  qos.partitions(partitions);
   qos.reliable(kMaxBlocking).durability(Durability::kVolatile).keep_last(kExplicitHistoryDepth);
   return qos;
 }
 
-Qos reply_writer_qos() { return reply_writer_keeping(kReplyHistory); }
+Qos reply_writer_qos(std::span<const std::string> partitions) {
+  Qos qos = reply_writer_keeping(kReplyHistory);
+  qos.partitions(partitions);
+  return qos;
+}
 
-Qos scan_reply_writer_qos() { return reply_writer_keeping(kScanReplyHistory); }
+Qos scan_reply_writer_qos(std::span<const std::string> partitions) {
+  Qos qos = reply_writer_keeping(kScanReplyHistory);
+  qos.partitions(partitions);
+  return qos;
+}
 
-Qos reply_reader_qos() {
+Qos reply_reader_qos(std::span<const std::string> partitions) {
   Qos qos;
+  qos.partitions(partitions);
   qos.reliable(kMaxBlocking).durability(Durability::kTransientLocal).keep_all();
   return qos;
 }

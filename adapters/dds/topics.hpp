@@ -5,6 +5,10 @@
 // that the two sides of every topic always match.
 #include <cstdint>
 #include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/qos.hpp"
@@ -64,6 +68,24 @@ struct TopicTraits<dnbridge_ReloadReply> {
   static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_ReloadReply_desc;
 };
 
+// --- Partitions ----------------------------------------------------------------
+// What is for one rack, PumpCommand and the requests (ExplicitRequest,
+// BusScanRequest, ReloadRequest) with their replies, is published and read
+// in that rack's partition, "dnbridge/RACK": DDS delivers a bridge only its
+// own rack's commands and requests, and a command goes to the one bridge
+// that serves its pump. The state topics (PumpState, NodeStatus, PortStatus)
+// are in the default partition, so that one reader sees every rack; so are
+// readers that set no partition (a generic tool). A client of several racks
+// reads their replies with each rack's partition, or with
+// kEveryRackPartition. A rack name holds no '*' or '?' (the configuration
+// refuses them): partition names with those match as patterns.
+std::string rack_partition(std::string_view rack);
+inline constexpr std::string_view kEveryRackPartition = "dnbridge/*";
+// The partition list of a writer or reader of these racks' topics, or of
+// one rack's.
+std::vector<std::string> rack_partitions(std::span<const std::string> racks);
+std::vector<std::string> rack_partitions(std::string_view rack);
+
 // --- State topics: PumpState, NodeStatus, PortStatus -------------------------
 // Reliable, transient-local, keep-last 1: a late joiner gets each instance's
 // current state at once. Automatic liveliness (a bridge that dies is noticed
@@ -85,8 +107,9 @@ Qos state_reader_qos(std::optional<Duration> deadline = std::nullopt);
 // pass to the next strongest writer or, with none left, go NOT_ALIVE_NO_WRITERS.
 // Autodispose is off: a departing stronger writer must only unregister, so
 // that the instance stays alive while a weaker writer still commands it.
-Qos command_writer_qos(int32_t strength, Duration lease);
-Qos command_reader_qos();
+// `partitions`: rack_partitions(...) of the racks written to or read.
+Qos command_writer_qos(std::span<const std::string> partitions, int32_t strength, Duration lease);
+Qos command_reader_qos(std::span<const std::string> partitions);
 
 // --- ExplicitRequest / ExplicitReply -------------------------------------------
 // Reliable. A transaction is one instance; keep-last 4 per instance leaves
@@ -117,8 +140,8 @@ inline constexpr int32_t kExplicitHistoryDepth = 4;
 // than the bridge acknowledges waits up to the max_blocking_time and then
 // gets DDS_RETCODE_TIMEOUT, in its own process.
 inline constexpr int32_t kRequestWriterMaxSamples = 256;
-Qos request_writer_qos();
-Qos request_reader_qos();
+Qos request_writer_qos(std::span<const std::string> partitions);
+Qos request_reader_qos(std::span<const std::string> partitions);
 
 // Replies are transient-local: the bridge may answer before its reply writer
 // has discovered the requester's reply reader (discovery of the two topics is
@@ -149,8 +172,8 @@ Qos request_reader_qos();
 // The bridge's participant also fixes Cyclone's high-water mark above what
 // its bounded histories can hold (participant.hpp).
 inline constexpr int32_t kReplyHistory = 256;
-Qos reply_writer_qos();
-Qos reply_reader_qos();
+Qos reply_writer_qos(std::span<const std::string> partitions);
+Qos reply_reader_qos(std::span<const std::string> partitions);
 
 // BusScanRequest / BusScanReply (a port's bus scan) follow the same
 // contract: request_*_qos() for requests (keyed by requester and txid),
@@ -159,7 +182,7 @@ Qos reply_reader_qos();
 // last kScanReplyHistory, which bounds what it holds for a reader that
 // stopped acknowledging to well under a MiB.
 inline constexpr int32_t kScanReplyHistory = 16;
-Qos scan_reply_writer_qos();
+Qos scan_reply_writer_qos(std::span<const std::string> partitions);
 // ReloadRequest / ReloadReply (a configuration read again) follow it too,
 // with scan_reply_writer_qos() for the replies (a few KiB each at most).
 

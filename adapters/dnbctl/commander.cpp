@@ -5,9 +5,10 @@
 
 namespace dnbridge::dnbctl {
 
-Commander::Commander(Client& client, std::int32_t strength)
+Commander::Commander(Client& client, std::int32_t strength, const std::string& rack)
     : topic_(client.participant()),
-      writer_(client.participant(), topic_, dds::command_writer_qos(strength, kLease)) {}
+      writer_(client.participant(), topic_,
+              dds::command_writer_qos(std::vector{dds::rack_partition(rack)}, strength, kLease)) {}
 
 bool Commander::wait_matched(Client& client, Deadline deadline) {
   return client.wait_until(deadline, [&] {

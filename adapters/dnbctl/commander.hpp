@@ -27,7 +27,8 @@ class Commander {
   // (killed, frozen), before it takes the command as gone.
   static constexpr Duration kLease = seconds(2);
 
-  Commander(Client& client, std::int32_t strength);
+  // Commands pumps of `rack` (in its partition: only its bridge gets them).
+  Commander(Client& client, std::int32_t strength, const std::string& rack);
 
   // Until a command reader (a bridge) matched; false at the deadline.
   // Commands are volatile: one written before a bridge matched is lost.

@@ -116,7 +116,7 @@ Exit run_explicit(const GlobalOptions& o, const ExplicitArgs& args) {
   x.rack = target.rack;
   x.port = target.port;
   x.mac = target.mac;
-  Requester requester(client, requester_name());
+  Requester requester(client, requester_name(), x.rack);
   if (!requester.execute(client, x, deadline_after(o.timeout()))) {
     throw CommandError(Exit::kNotFound,
                        fmt::format("{}: no reply from the bridge of rack \"{}\" within {:g} s",

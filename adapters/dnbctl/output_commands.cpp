@@ -131,7 +131,7 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   const auto* status = client.node(key);
   const std::uint64_t refused_before = status ? status->data->counters.commands_refused : 0;
 
-  Commander commander(client, args.strength);
+  Commander commander(client, args.strength, key.rack);
   const Deadline deadline = deadline_after(o.timeout());
   if (!commander.wait_matched(client, deadline)) {
     throw CommandError(Exit::kNotFound, fmt::format("{}: no bridge took commands within {:g} s", name,

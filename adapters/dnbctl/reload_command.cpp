@@ -117,7 +117,8 @@ Exit run_reload(const GlobalOptions& o) {
   Client client = make_client(o);
   const std::string rack = choose_rack(client, o);
 
-  Transactions<dnbridge_ReloadRequest, dnbridge_ReloadReply> reloads(client, kReloadReplies);
+  Transactions<dnbridge_ReloadRequest, dnbridge_ReloadReply> reloads(client, kReloadReplies,
+                                                                     std::span(&rack, 1));
   std::array<dds::Owned<dnbridge_ReloadRequest>, 1> request;
   dds::set_string(request[0]->requester, requester_name());
   request[0]->txid = 1;

@@ -21,8 +21,8 @@ std::string requester_name() {
   return fmt::format("dnbctl@{}:{}:{:x}", host_name(), getpid(), started);
 }
 
-Requester::Requester(Client& client, std::string requester)
-    : requester_(std::move(requester)), transactions_(client, kReplies) {}
+Requester::Requester(Client& client, std::string requester, const std::string& rack)
+    : requester_(std::move(requester)), transactions_(client, kReplies, std::span(&rack, 1)) {}
 
 bool Requester::execute(Client& client, ExplicitExchange& x, Deadline deadline) {
   dds::Owned<dnbridge_ExplicitRequest> request;

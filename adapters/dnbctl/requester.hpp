@@ -39,11 +39,15 @@ template <class Request, class Reply>
 class Transactions {
  public:
   // `token`: the reply reader's in the client's waits, one per kind.
-  Transactions(Client& client, dds::WaitSet::Token token)
+  // `racks`: those the requests are for; requests and replies are in their
+  // partitions (dds::rack_partition), so that only their bridges get them.
+  Transactions(Client& client, dds::WaitSet::Token token, std::span<const std::string> racks)
       : request_topic_(client.participant()),
         reply_topic_(client.participant()),
-        writer_(client.participant(), request_topic_, dds::request_writer_qos()),
-        reader_(client.participant(), reply_topic_, dds::reply_reader_qos()),
+        writer_(client.participant(), request_topic_,
+                dds::request_writer_qos(dds::rack_partitions(racks))),
+        reader_(client.participant(), reply_topic_,
+                dds::reply_reader_qos(dds::rack_partitions(racks))),
         replies_(reader_, DDS_ANY_STATE) {
     client.attach(replies_, token);
   }
@@ -117,8 +121,9 @@ class Transactions {
 // Explicit messaging through the bridge (get, set, service).
 class Requester {
  public:
-  // `requester`: unique per client process (requester_name()).
-  Requester(Client& client, std::string requester);
+  // `requester`: unique per client process (requester_name()); `rack`: the
+  // rack whose bridge it asks.
+  Requester(Client& client, std::string requester, const std::string& rack);
 
   const std::string& name() const noexcept { return requester_; }
 

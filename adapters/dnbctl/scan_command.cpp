@@ -154,13 +154,13 @@ Exit run_scan(const GlobalOptions& o) {
   gather(
       client, o, [&] { return any_port(client, o); }, [&] { return nodes_missing(client, o); });
 
-  Transactions<dnbridge_BusScanRequest, dnbridge_BusScanReply> transactions(client, kScanReplies);
   const std::string requester = requester_name();
-
   std::vector<PortScan> scans;
   std::vector<dds::Owned<dnbridge_BusScanRequest>> requests;
+  std::vector<std::string> racks;
   for (const auto& [key, port] : client.ports()) {
     if (!o.matches(key.rack, key.port) || !port.alive) continue;
+    if (std::find(racks.begin(), racks.end(), key.rack) == racks.end()) racks.push_back(key.rack);
     scans.push_back({key, port.data->master_mac, std::nullopt});
     dds::Owned<dnbridge_BusScanRequest>& request = requests.emplace_back();
     dds::set_string(request->requester, requester);
@@ -171,6 +171,8 @@ Exit run_scan(const GlobalOptions& o) {
   if (scans.empty()) {
     throw CommandError(Exit::kNotFound, "no port with a live bridge to scan");
   }
+  Transactions<dnbridge_BusScanRequest, dnbridge_BusScanReply> transactions(client, kScanReplies,
+                                                                            racks);
 
   const Duration wait = std::max(kScanWait, o.timeout());
   const Deadline deadline = deadline_after(wait);

@@ -7,7 +7,10 @@
  * a reader of state that is reliable and transient-local with keep-last 1
  * gets the current state at once; a command writer must be reliable,
  * volatile, keep-last 1 with exclusive ownership (its strength decides who
- * commands a pump) and keeps the pump commanded only while it lives. */
+ * commands a pump) and keeps the pump commanded only while it lives. It is
+ * published in the rack's partition, "dnbridge/" followed by the rack name:
+ * the bridge of that rack reads commands there, and no other bridge gets
+ * them. State is in the default partition: one reader for every rack. */
 #include <dds/dds.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,8 +27,12 @@ static dds_qos_t* state_reader_qos(void) {
   return q;
 }
 
-static dds_qos_t* command_writer_qos(int32_t strength) {
+static dds_qos_t* command_writer_qos(const char* rack, int32_t strength) {
   dds_qos_t* q = dds_create_qos();
+  char partition[256];
+  snprintf(partition, sizeof partition, "dnbridge/%s", rack);
+  const char* partitions[] = {partition};
+  dds_qset_partition(q, 1, partitions);
   dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
   dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
   dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
@@ -91,7 +98,7 @@ int main(int argc, char** argv) {
   dds_qos_t* rq = state_reader_qos();
   dds_entity_t reader = dds_create_reader(participant, state_topic, rq, NULL);
   dds_delete_qos(rq);
-  dds_qos_t* wq = command_writer_qos(10);
+  dds_qos_t* wq = command_writer_qos(rack, 10);
   dds_entity_t writer = dds_create_writer(participant, command_topic, wq, NULL);
   dds_delete_qos(wq);
 

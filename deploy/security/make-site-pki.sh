@@ -280,22 +280,42 @@ EOF
 
 # --- permissions: one grant per identity, by role --------------------------------
 topics() { for t in "$@"; do echo "            <topic>dnbridge/$t</topic>"; done; }
+# The state topics are in the default partition; commands, requests and
+# replies in their rack's, "dnbridge/RACK" (every rack's: "dnbridge/*").
+state_topics() { topics PumpState NodeStatus PortStatus; }
 publish_of() {
   case $1 in
-    bridge) topics PumpState NodeStatus PortStatus ExplicitReply BusScanReply ReloadReply ;;
+    bridge) state_topics ;;
+  esac
+}
+publish_in_racks_of() {
+  case $1 in
+    bridge) topics ExplicitReply BusScanReply ReloadReply ;;
     supervisor) topics PumpCommand ExplicitRequest BusScanRequest ReloadRequest ;;
-    monitor) ;;
   esac
 }
 subscribe_of() {
   case $1 in
+    supervisor | monitor) state_topics ;;
+  esac
+}
+subscribe_in_racks_of() {
+  case $1 in
     bridge) topics PumpCommand ExplicitRequest BusScanRequest ReloadRequest ;;
     supervisor)
-      topics PumpState NodeStatus PortStatus ExplicitReply PumpCommand ExplicitRequest \
-        BusScanRequest BusScanReply ReloadRequest ReloadReply
+      topics ExplicitReply PumpCommand ExplicitRequest BusScanRequest BusScanReply ReloadRequest \
+        ReloadReply
       ;;
-    monitor) topics PumpState NodeStatus PortStatus ;;
   esac
+}
+# rule KIND TOPICS [PARTITION]: a <publish> or <subscribe> rule.
+rule() {
+  [ -n "$2" ] || return 0
+  printf '        <%s>\n          <topics>\n%s\n          </topics>\n' "$1" "$2"
+  if [ -n "${3:-}" ]; then
+    printf '          <partitions>\n            <partition>%s</partition>\n          </partitions>\n' "$3"
+  fi
+  printf '        </%s>\n' "$1"
 }
 # openssl prints "notBefore=Nov 22 10:00:00 2026 GMT"; a grant wants ISO 8601.
 iso_date() { date -u -d "${1#*=}" +%Y-%m-%dT%H:%M:%SZ; }
@@ -314,7 +334,9 @@ EOF
     not_before=$(iso_date "$(openssl x509 -in "$cert" -noout -startdate)")
     not_after=$(iso_date "$(openssl x509 -in "$cert" -noout -enddate)")
     pub=$(publish_of "$role")
+    pub_racks=$(publish_in_racks_of "$role")
     sub=$(subscribe_of "$role")
+    sub_racks=$(subscribe_in_racks_of "$role")
     cat <<EOF
     <grant name="$role-$name">
       <subject_name>$(subject_of "$role" "$name")</subject_name>
@@ -327,12 +349,10 @@ EOF
           <id>$domain</id>
         </domains>
 EOF
-    if [ -n "$pub" ]; then
-      printf '        <publish>\n          <topics>\n%s\n          </topics>\n        </publish>\n' "$pub"
-    fi
-    if [ -n "$sub" ]; then
-      printf '        <subscribe>\n          <topics>\n%s\n          </topics>\n        </subscribe>\n' "$sub"
-    fi
+    rule publish "$pub"
+    rule publish "$pub_racks" "dnbridge/*"
+    rule subscribe "$sub"
+    rule subscribe "$sub_racks" "dnbridge/*"
     cat <<EOF
       </allow_rule>
       <default>DENY</default>

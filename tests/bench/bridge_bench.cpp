@@ -444,8 +444,9 @@ int run_client(const ClientOptions& o) {
   dds::Topic<dnbridge_PumpState> state_topic(participant);
   dds::Topic<dnbridge_PumpCommand> command_topic(participant);
   dds::Reader<dnbridge_PumpState> reader(participant, state_topic, dds::state_reader_qos());
-  dds::Writer<dnbridge_PumpCommand> writer(participant, command_topic,
-                                           dds::command_writer_qos(10, seconds(5)));
+  dds::Writer<dnbridge_PumpCommand> writer(
+      participant, command_topic,
+      dds::command_writer_qos(dds::rack_partitions(kRack), 10, seconds(5)));
   dds::ReadCondition any(reader, DDS_ANY_STATE);
   dds::GuardCondition stop(participant);
   dds::WaitSet waitset(participant);
@@ -990,7 +991,8 @@ std::vector<double> direct_oneway(int domain, Placement cpus, double seconds, in
                                   unsigned nodes, OnReady on_ready) {
   dds::Participant participant(static_cast<dds_domainid_t>(domain), "bench-direct");
   dds::Topic<dnbridge_PumpCommand> topic(participant);
-  dds::Reader<dnbridge_PumpCommand> reader(participant, topic, dds::command_reader_qos());
+  dds::Reader<dnbridge_PumpCommand> reader(participant, topic,
+                                           dds::command_reader_qos(dds::rack_partitions(kRack)));
   if (!reader.set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
     throw std::runtime_error("setting the reader's status mask failed");
   }

@@ -731,6 +731,18 @@ TEST(ConfigErrors, EmptyNames) {
             "t.toml:8:8: name must not be empty");
 }
 
+// The rack's DDS partition is named after it: no pattern characters.
+TEST(ConfigErrors, ARackNameWithAPatternCharacter) {
+  for (const char* rack : {"rack-*", "rack?"}) {
+    EXPECT_EQ(problems(std::string("rack = \"") + rack +
+                       "\"\n[[port]]\nname = \"A\"\ninterface = \"simulated\"\n"
+                       "bitrate = 500000\n[[port.node]]\nmac = 1\nname = \"p\"\n"),
+              std::string("t.toml:1:8: rack = \"") + rack +
+                  "\": a rack name holds no '*' or '?' (its DDS partition, dnbridge/RACK, would "
+                  "match other racks' as a pattern)");
+  }
+}
+
 TEST(ConfigErrors, DuplicateNodeNamesOnAPort) {
   EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
                               "mac = 1\n"

@@ -45,15 +45,16 @@ class CommandTopicTest : public DdsTest {
   }
 
   Topic<dnbridge_PumpCommand> topic_{participant_};
-  Reader<dnbridge_PumpCommand> reader_{participant_, topic_, command_reader_qos()};
+  Reader<dnbridge_PumpCommand> reader_{participant_, topic_,
+                                       command_reader_qos(rack_partitions(rack_))};
   ReadCondition not_read_{reader_, DDS_NOT_READ_SAMPLE_STATE};
 };
 
 TEST_F(CommandTopicTest, StrongerWriterOwnsTheInstanceUntilItLeaves) {
-  auto weak = std::make_unique<Writer<dnbridge_PumpCommand>>(participant_, topic_,
-                                                             command_writer_qos(10, seconds(1)));
-  auto strong = std::make_unique<Writer<dnbridge_PumpCommand>>(participant_, topic_,
-                                                               command_writer_qos(20, seconds(1)));
+  auto weak = std::make_unique<Writer<dnbridge_PumpCommand>>(
+      participant_, topic_, command_writer_qos(rack_partitions(rack_), 10, seconds(1)));
+  auto strong = std::make_unique<Writer<dnbridge_PumpCommand>>(
+      participant_, topic_, command_writer_qos(rack_partitions(rack_), 20, seconds(1)));
   const dds_instance_handle_t strong_handle = strong->instance_handle().value();
   const dds_instance_handle_t weak_handle = weak->instance_handle().value();
 
@@ -97,11 +98,13 @@ TEST_F(CommandTopicTest, StrongerWriterOwnsTheInstanceUntilItLeaves) {
 }
 
 TEST_F(CommandTopicTest, StrongerWriterTakesOverFromAWeakerOne) {
-  Writer<dnbridge_PumpCommand> weak(participant_, topic_, command_writer_qos(10, seconds(1)));
+  Writer<dnbridge_PumpCommand> weak(participant_, topic_,
+                                    command_writer_qos(rack_partitions(rack_), 10, seconds(1)));
   ASSERT_TRUE(weak.write(*command(rack_, 1, "weak")).ok());
   ASSERT_EQ(take_next().size(), 1U);
 
-  Writer<dnbridge_PumpCommand> strong(participant_, topic_, command_writer_qos(20, seconds(1)));
+  Writer<dnbridge_PumpCommand> strong(participant_, topic_,
+                                      command_writer_qos(rack_partitions(rack_), 20, seconds(1)));
   ASSERT_TRUE(strong.write(*command(rack_, 2, "strong")).ok());
   ASSERT_TRUE(weak.write(*command(rack_, 3, "weak")).ok());
   ASSERT_TRUE(weak.wait_for_acks(kEventTimeout).ok());
@@ -113,7 +116,7 @@ TEST_F(CommandTopicTest, StrongerWriterTakesOverFromAWeakerOne) {
 TEST_F(CommandTopicTest, SharedOwnershipWriterDoesNotMatch) {
   // Ownership kind must be equal on both sides: a writer that forgot the
   // contract cannot command a pump.
-  Qos shared = command_writer_qos(10, seconds(1));
+  Qos shared = command_writer_qos(rack_partitions(rack_), 10, seconds(1));
   shared.exclusive_ownership(false);
   Writer<dnbridge_PumpCommand> writer(participant_, topic_, shared);
   ASSERT_TRUE(writer.set_status_mask(DDS_OFFERED_INCOMPATIBLE_QOS_STATUS).ok());

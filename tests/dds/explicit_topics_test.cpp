@@ -32,10 +32,12 @@ Owned<dnbridge_ExplicitReply> reply(const std::string& requester, std::uint32_t 
 
 TEST_F(DdsTest, RequestWrittenBeforeTheBridgeIsNeverDelivered) {
   Topic<dnbridge_ExplicitRequest> topic(participant_);
-  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic,
+                                          request_writer_qos(rack_partitions(rack_)));
   ASSERT_TRUE(client.write(*request(rack_, 1)).ok());
 
-  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic,
+                                          request_reader_qos(rack_partitions(rack_)));
   ASSERT_TRUE(client.write(*request(rack_, 2)).ok());
   ReadCondition any(bridge, DDS_ANY_STATE);
   ASSERT_TRUE(wait_for(participant_, any));
@@ -48,8 +50,10 @@ TEST_F(DdsTest, RequestWrittenBeforeTheBridgeIsNeverDelivered) {
 TEST_F(DdsTest, RepeatedRequestsOfOneTransactionAreAllKept) {
   // Keep-all: a repeated request is not overwritten before the bridge takes it.
   Topic<dnbridge_ExplicitRequest> topic(participant_);
-  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
-  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic,
+                                          request_reader_qos(rack_partitions(rack_)));
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic,
+                                          request_writer_qos(rack_partitions(rack_)));
   ASSERT_TRUE(client.write(*request(rack_, 1)).ok());
   ASSERT_TRUE(client.write(*request(rack_, 1)).ok());
   ASSERT_TRUE(client.write(*request(rack_, 2)).ok());
@@ -66,8 +70,10 @@ TEST_F(DdsTest, RequestReaderNeverRefusesASample) {
   // would block the writer here, and across processes the delivery thread
   // every reader of the participant shares).
   Topic<dnbridge_ExplicitRequest> topic(participant_);
-  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
-  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic,
+                                          request_reader_qos(rack_partitions(rack_)));
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic,
+                                          request_writer_qos(rack_partitions(rack_)));
   const auto r = request(rack_, 1);
   for (int32_t i = 0; i < 2 * kExplicitHistoryDepth; ++i) ASSERT_TRUE(client.write(*r).ok()) << i;
   EXPECT_EQ(bridge.take()->size(), static_cast<std::size_t>(kExplicitHistoryDepth));
@@ -87,8 +93,10 @@ TEST_F(DdsTest, ARequesterNameWithANulInsideIsSeenWhole) {
   // A client in another language can send "ab\0x": the C struct reads "ab".
   // The serialized form the bridge takes with it shows the whole name.
   Topic<dnbridge_ExplicitRequest> topic(participant_);
-  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
-  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic,
+                                          request_reader_qos(rack_partitions(rack_)));
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic,
+                                          request_writer_qos(rack_partitions(rack_)));
   ReadCondition fresh(bridge, DDS_NOT_READ_SAMPLE_STATE);
   TakeBuffer<dnbridge_ExplicitRequest> buffer(4);
   std::vector<std::vector<unsigned char>> serialized;
@@ -145,8 +153,10 @@ TEST_F(DdsTest, UnregisteredTransactionsFreeTheirInstances) {
   // no sample left: a requester unregisters each finished transaction, or
   // its instances add up in every reader.
   Topic<dnbridge_ExplicitRequest> topic(participant_);
-  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic, request_reader_qos());
-  Writer<dnbridge_ExplicitRequest> client(participant_, topic, request_writer_qos());
+  Reader<dnbridge_ExplicitRequest> bridge(participant_, topic,
+                                          request_reader_qos(rack_partitions(rack_)));
+  Writer<dnbridge_ExplicitRequest> client(participant_, topic,
+                                          request_writer_qos(rack_partitions(rack_)));
   ReadCondition not_read(bridge, DDS_NOT_READ_SAMPLE_STATE);
   int executed = 0;
   for (std::uint32_t txid = 1; txid <= 512; ++txid) {
@@ -163,11 +173,13 @@ TEST_F(DdsTest, UnregisteredTransactionsFreeTheirInstances) {
 
 TEST_F(DdsTest, ReplyReachesARequesterDiscoveredAfterIt) {
   Topic<dnbridge_ExplicitReply> topic(participant_);
-  Writer<dnbridge_ExplicitReply> bridge(participant_, topic, reply_writer_qos());
+  Writer<dnbridge_ExplicitReply> bridge(participant_, topic,
+                                        reply_writer_qos(rack_partitions(rack_)));
   ASSERT_TRUE(bridge.write(*reply(rack_, 41)).ok());
   ASSERT_TRUE(bridge.write(*reply(rack_, 42)).ok());
 
-  Reader<dnbridge_ExplicitReply> client(participant_, topic, reply_reader_qos());
+  Reader<dnbridge_ExplicitReply> client(participant_, topic,
+                                        reply_reader_qos(rack_partitions(rack_)));
   ReadCondition any(client, DDS_ANY_STATE);
   ASSERT_TRUE(wait_for(participant_, any));
   auto taken = client.take();

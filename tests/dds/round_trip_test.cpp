@@ -98,7 +98,9 @@ TEST_F(DdsTest, PumpCommandRoundTrip) {
   c->analog_output_raw = 4095;
   set_string(c->issuer, "dnbctl@host:1234");
 
-  auto got = round_trip(participant_, *c, command_writer_qos(10, seconds(1)), command_reader_qos());
+  auto got =
+      round_trip(participant_, *c, command_writer_qos(rack_partitions(rack_), 10, seconds(1)),
+                 command_reader_qos(rack_partitions(rack_)));
   const auto& d = got.data();
   EXPECT_EQ(view(d.rack), rack_);
   EXPECT_EQ(view(d.port), "port-b");
@@ -223,7 +225,8 @@ TEST_F(DdsTest, ExplicitRequestRoundTrip) {
   set_octets(r->data, data);
   set_octets(r->data, data);  // replacing frees the first copy
 
-  auto got = round_trip(participant_, *r, request_writer_qos(), request_reader_qos());
+  auto got = round_trip(participant_, *r, request_writer_qos(rack_partitions(rack_)),
+                        request_reader_qos(rack_partitions(rack_)));
   const auto& d = got.data();
   EXPECT_EQ(view(d.requester), rack_ + "@host:1");
   EXPECT_EQ(d.txid, 0xFFFFFFFFU);
@@ -252,7 +255,8 @@ TEST_F(DdsTest, ExplicitReplyRoundTrip) {
   set_octets(r->data, data);
   set_string(r->message, "ok");
 
-  auto got = round_trip(participant_, *r, reply_writer_qos(), reply_reader_qos());
+  auto got = round_trip(participant_, *r, reply_writer_qos(rack_partitions(rack_)),
+                        reply_reader_qos(rack_partitions(rack_)));
   const auto& d = got.data();
   EXPECT_EQ(view(d.requester), rack_ + "@host:1");
   EXPECT_EQ(d.txid, 7U);
@@ -268,7 +272,8 @@ TEST_F(DdsTest, EmptySequenceRoundTrip) {
   Owned<dnbridge_ExplicitReply> r;
   set_string(r->requester, rack_);
   r->status = dnbridge_STATUS_TXID_UNKNOWN;
-  auto got = round_trip(participant_, *r, reply_writer_qos(), reply_reader_qos());
+  auto got = round_trip(participant_, *r, reply_writer_qos(rack_partitions(rack_)),
+                        reply_reader_qos(rack_partitions(rack_)));
   EXPECT_EQ(got.data().status, dnbridge_STATUS_TXID_UNKNOWN);
   EXPECT_TRUE(view(got.data().data).empty());
 }
@@ -280,8 +285,10 @@ TEST_F(DdsTest, EmptySequenceRoundTrip) {
 // that the reused strings and sequences are neither leaked nor freed twice.
 TEST_F(DdsTest, TakeBufferIsReusedAcrossTakes) {
   Topic<dnbridge_ExplicitRequest> topic(participant_);
-  Reader<dnbridge_ExplicitRequest> reader(participant_, topic, request_reader_qos());
-  Writer<dnbridge_ExplicitRequest> writer(participant_, topic, request_writer_qos());
+  Reader<dnbridge_ExplicitRequest> reader(participant_, topic,
+                                          request_reader_qos(rack_partitions(rack_)));
+  Writer<dnbridge_ExplicitRequest> writer(participant_, topic,
+                                          request_writer_qos(rack_partitions(rack_)));
   ReadCondition any(reader, DDS_ANY_STATE);
   TakeBuffer<dnbridge_ExplicitRequest> buffer(2);
 

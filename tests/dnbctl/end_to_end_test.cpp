@@ -98,8 +98,8 @@ class DnbctlEndToEnd : public ::testing::Test {
     dds::Topic<dnbridge_PumpState> pump_topic{participant};
     dds::Topic<dnbridge_PumpCommand> command_topic{participant};
     dds::Reader<dnbridge_PumpState> pumps{participant, pump_topic, dds::state_reader_qos()};
-    dds::Reader<dnbridge_PumpCommand> commands{participant, command_topic,
-                                               dds::command_reader_qos()};
+    dds::Reader<dnbridge_PumpCommand> commands{
+        participant, command_topic, dds::command_reader_qos(dds::rack_partitions(kRack))};
     dds::WaitSet waitset{participant};
     std::map<unsigned, dds::Owned<dnbridge_PumpState>> latest;
     std::vector<std::uint16_t> commanded_analog;  // every command's analog_output_raw

@@ -22,6 +22,10 @@
 #include "adapters/daemon/simulated_backends.hpp"
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/participant.hpp"
+#include "adapters/dds/reader.hpp"
+#include "adapters/dds/topic.hpp"
+#include "adapters/dds/topics.hpp"
+#include "adapters/dds/writer.hpp"
 #include "adapters/dnbctl/client.hpp"
 #include "adapters/dnbctl/commander.hpp"
 #include "adapters/dnbctl/format.hpp"
@@ -185,7 +189,7 @@ TEST_F(DnbctlRacks, ShowsEachRacksNodesByClassWithTheReason) {
   ASSERT_TRUE(north_ && south_ && east_);
   // A supervisor of north's pump 1, live for the whole test.
   Client supervisor(test_domain(), "racks test supervisor");
-  Commander commander(supervisor, 10);
+  Commander commander(supervisor, 10, "rack-north");
   ASSERT_TRUE(commander.wait_matched(supervisor, deadline_after(kReady)));
   const auto state = [&](const char* rack, unsigned m) {
     const auto* n = supervisor.node({rack, "A", static_cast<std::uint8_t>(m)});
@@ -293,6 +297,47 @@ TEST_F(DnbctlRacks, ShowsEachRacksNodesByClassWithTheReason) {
       << south.out;
   EXPECT_EQ(south.out.find("rack-north"), std::string::npos) << south.out;
   EXPECT_EQ(south.out.find("rack-east"), std::string::npos) << south.out;
+}
+
+// Commands and requests travel in their rack's partition: a writer for
+// rack-south reaches south's bridge alone, one with no partition (a
+// supervisor written before partitions) reaches none; a reader of every
+// rack's replies finds both bridges' reply writers.
+TEST_F(DnbctlRacks, CommandsAndRequestsReachTheirRacksBridgeOnly) {
+  ASSERT_TRUE(north_ && south_);
+  Client supervisor(test_domain(), "partitions test");
+  dds::Topic<dnbridge_PumpCommand> commands(supervisor.participant());
+  dds::Topic<dnbridge_ExplicitRequest> requests(supervisor.participant());
+  dds::Topic<dnbridge_ExplicitReply> replies(supervisor.participant());
+  dds::Writer<dnbridge_PumpCommand> south(
+      supervisor.participant(), commands,
+      dds::command_writer_qos(dds::rack_partitions("rack-south"), 10, seconds(1)));
+  dds::Writer<dnbridge_PumpCommand> nowhere(
+      supervisor.participant(), commands,
+      dds::command_writer_qos(std::vector<std::string>{}, 10, seconds(1)));
+  dds::Writer<dnbridge_ExplicitRequest> to_north(
+      supervisor.participant(), requests,
+      dds::request_writer_qos(dds::rack_partitions("rack-north")));
+  dds::Reader<dnbridge_ExplicitReply> every(
+      supervisor.participant(), replies,
+      dds::reply_reader_qos(std::vector<std::string>{std::string(dds::kEveryRackPartition)}));
+  const auto matched = [](const auto& entity) -> std::uint32_t {
+    if constexpr (requires { entity.matched_subscriptions(); }) {
+      auto n = entity.matched_subscriptions();
+      return n.ok() ? *n : 0;
+    } else {
+      auto n = entity.matched_publications();
+      return n.ok() ? *n : 0;
+    }
+  };
+  // Discovery is local (one process): a moment at most; bounded.
+  ASSERT_TRUE(supervisor.wait_until(deadline_after(kReady), [&] {
+    return matched(south) >= 1 && matched(to_north) >= 1 && matched(every) >= 2;
+  }));
+  EXPECT_EQ(matched(south), 1u);
+  EXPECT_EQ(matched(to_north), 1u);
+  EXPECT_EQ(matched(every), 2u);
+  EXPECT_EQ(matched(nowhere), 0u);
 }
 
 }  // namespace

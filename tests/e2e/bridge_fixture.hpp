@@ -336,9 +336,10 @@ class BridgeTest : public ::testing::Test {
   Subscription<dnbridge_PumpState> pumps_{supervisor_, pump_topic_, dds::state_reader_qos()};
   Subscription<dnbridge_NodeStatus> nodes_{supervisor_, node_topic_, dds::state_reader_qos()};
   Subscription<dnbridge_PortStatus> ports_{supervisor_, port_topic_, dds::state_reader_qos()};
-  Subscription<dnbridge_ExplicitReply> replies_{supervisor_, reply_topic_, dds::reply_reader_qos()};
-  dds::Writer<dnbridge_ExplicitRequest> requests_{supervisor_, request_topic_,
-                                                  dds::request_writer_qos()};
+  Subscription<dnbridge_ExplicitReply> replies_{supervisor_, reply_topic_,
+                                                dds::reply_reader_qos(dds::rack_partitions(kRack))};
+  dds::Writer<dnbridge_ExplicitRequest> requests_{
+      supervisor_, request_topic_, dds::request_writer_qos(dds::rack_partitions(kRack))};
   const std::string requester_ = "e2e@" + std::to_string(getpid());
 
   dds::Timestamp created_wall_{};  // before the bridge was built

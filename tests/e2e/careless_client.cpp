@@ -126,7 +126,7 @@ int ahead(dds_domainid_t domain, unsigned mac, std::int32_t strength, Duration l
   dds::Participant participant(domain, dds::Participant::ClientName{issuer});
   dds::Topic<dnbridge_PumpCommand> topic(participant);
   auto writer = std::make_unique<dds::Writer<dnbridge_PumpCommand>>(
-      participant, topic, dds::command_writer_qos(strength, lease));
+      participant, topic, dds::command_writer_qos(e2e::sim_rack_partitions(), strength, lease));
   await_reader(participant, *writer, "the PumpCommand writer");
   if (!writer->write(*pump_command(mac, true, true, 4000, issuer), dds::dds_now() + ahead_by)) {
     fail("writing the command");
@@ -143,7 +143,8 @@ int ahead(dds_domainid_t domain, unsigned mac, std::int32_t strength, Duration l
 int requests(dds_domainid_t domain, const std::string& requester, std::uint32_t count) {
   dds::Participant participant(domain, dds::Participant::ClientName{requester});
   dds::Topic<dnbridge_ExplicitRequest> topic(participant);
-  dds::Writer<dnbridge_ExplicitRequest> writer(participant, topic, dds::request_writer_qos());
+  dds::Writer<dnbridge_ExplicitRequest> writer(participant, topic,
+                                               dds::request_writer_qos(e2e::sim_rack_partitions()));
   await_reader(participant, writer, "the ExplicitRequest writer");
   for (std::uint32_t txid = 1; txid <= count; ++txid) {
     // The writer's history holds kRequestWriterMaxSamples unacknowledged
@@ -171,6 +172,7 @@ int requests(dds_domainid_t domain, const std::string& requester, std::uint32_t 
 // samples: keep-all within resource limits.
 dds::Qos rejecting_reply_reader_qos() {
   dds::Qos qos;
+  qos.partitions(e2e::sim_rack_partitions());
   qos.reliable(milliseconds(100))
       .durability(dds::Durability::kTransientLocal)
       .keep_all()
@@ -186,7 +188,7 @@ int stall_replies(dds_domainid_t domain, const std::string& requester, std::uint
   dds::Reader<dnbridge_ExplicitReply> replies(participant, reply_topic,
                                               rejecting_reply_reader_qos());
   dds::Writer<dnbridge_ExplicitRequest> writer(participant, request_topic,
-                                               dds::request_writer_qos());
+                                               dds::request_writer_qos(e2e::sim_rack_partitions()));
   dds::Topic<dnbridge_PumpState> pump_topic(participant);
   dds::Topic<dnbridge_NodeStatus> node_topic(participant);
   dds::Topic<dnbridge_PortStatus> port_topic(participant);
@@ -251,7 +253,7 @@ int three_writers(dds_domainid_t domain, std::int32_t strength, Duration lease,
   };
   for (unsigned n = 1; n <= 3; ++n) {
     writers.push_back(std::make_unique<dds::Writer<dnbridge_PumpCommand>>(
-        participant, topic, dds::command_writer_qos(strength, lease)));
+        participant, topic, dds::command_writer_qos(e2e::sim_rack_partitions(), strength, lease)));
     await_reader(participant, *writers.back(), "a PumpCommand writer", readers);
     if (!write(n)) fail("writing a command");
   }

@@ -229,8 +229,9 @@ TEST_F(CarelessClientTest, CommanderWithItsClockAnHourAheadLosesThePumpWhenItsPr
   constexpr unsigned kMac = 7;
   constexpr Duration kLease = seconds(2);
   const std::string weak_issuer = "e2e weak";
-  dds::Writer<dnbridge_PumpCommand> weak(supervisor_, command_topic_,
-                                         dds::command_writer_qos(1, seconds(1)));
+  dds::Writer<dnbridge_PumpCommand> weak(
+      supervisor_, command_topic_,
+      dds::command_writer_qos(dds::rack_partitions(kRack), 1, seconds(1)));
   ASSERT_TRUE(writer_matched(weak));
   const auto off = pump_command(kMac, false, true, 123, weak_issuer);
   ASSERT_TRUE(weak.write(*off));
@@ -271,11 +272,13 @@ TEST_F(CarelessClientTest, CommanderWithItsClockAnHourAheadLosesThePumpWhenItsPr
 // each served within 1 s.
 TEST_F(CarelessClientTest, RequesterThatNeverUnregistersDelaysNeitherCommandsNorOtherRequests) {
   ASSERT_NO_FATAL_FAILURE(start_bridge());
-  dds::Writer<dnbridge_PumpCommand> commander(supervisor_, command_topic_,
-                                              dds::command_writer_qos(10, seconds(1)));
-  dds::Writer<dnbridge_ExplicitRequest> requests(supervisor_, request_topic_,
-                                                 dds::request_writer_qos());
-  Subscription<dnbridge_ExplicitReply> replies(supervisor_, reply_topic_, dds::reply_reader_qos());
+  dds::Writer<dnbridge_PumpCommand> commander(
+      supervisor_, command_topic_,
+      dds::command_writer_qos(dds::rack_partitions(kRack), 10, seconds(1)));
+  dds::Writer<dnbridge_ExplicitRequest> requests(
+      supervisor_, request_topic_, dds::request_writer_qos(dds::rack_partitions(kRack)));
+  Subscription<dnbridge_ExplicitReply> replies(supervisor_, reply_topic_,
+                                               dds::reply_reader_qos(dds::rack_partitions(kRack)));
   ASSERT_TRUE(writer_matched(commander));
   ASSERT_TRUE(writer_matched(requests));
   ASSERT_TRUE(replies.matched(1));
@@ -335,9 +338,10 @@ TEST_F(CarelessClientTest, ReplyReaderThatNeverTakesCostsNoPollAndNoNode) {
       << "the bridge's thread \"port A\" could not be put under SCHED_FIFO (CAP_SYS_NICE is "
          "needed)";
   EXPECT_TRUE(ports_.matched(1)) << "no PortStatus from the bridge";
-  dds::Writer<dnbridge_ExplicitRequest> requests(supervisor_, request_topic_,
-                                                 dds::request_writer_qos());
-  Subscription<dnbridge_ExplicitReply> replies(supervisor_, reply_topic_, dds::reply_reader_qos());
+  dds::Writer<dnbridge_ExplicitRequest> requests(
+      supervisor_, request_topic_, dds::request_writer_qos(dds::rack_partitions(kRack)));
+  Subscription<dnbridge_ExplicitReply> replies(supervisor_, reply_topic_,
+                                               dds::reply_reader_qos(dds::rack_partitions(kRack)));
   ASSERT_TRUE(writer_matched(requests));
   ASSERT_TRUE(replies.matched(1));
   // The nodes' counters before: a node that left ONLINE and came back in
@@ -394,8 +398,8 @@ TEST_F(CarelessClientTest, ReplyReaderThatNeverTakesCostsNoPollAndNoNode) {
   // acknowledged. Those writers resend them: from then on, with the stalled
   // client still matched, they count as writers that are resending data.
   Subscription<dnbridge_NodeStatus> late_nodes(supervisor_, node_topic_, dds::state_reader_qos());
-  Subscription<dnbridge_ExplicitReply> late_replies(supervisor_, reply_topic_,
-                                                    dds::reply_reader_qos());
+  Subscription<dnbridge_ExplicitReply> late_replies(
+      supervisor_, reply_topic_, dds::reply_reader_qos(dds::rack_partitions(kRack)));
   ASSERT_TRUE(late_nodes.matched(1));
   ASSERT_TRUE(late_replies.matched(1));
   watch.add(late_nodes);
@@ -516,9 +520,10 @@ TEST_F(CarelessClientTest, HundredThousandRequestsLeaveTheBridgeResidentSetFlat)
   // Built with AddressSanitizer, the bridge would hold what it frees in a
   // quarantine of up to 256 MB: without one its resident set means the same.
   ASSERT_NO_FATAL_FAILURE(start_bridge({.env = {"ASAN_OPTIONS=quarantine_size_mb=0"}}));
-  dds::Writer<dnbridge_ExplicitRequest> requests(supervisor_, request_topic_,
-                                                 dds::request_writer_qos());
-  dds::Reader<dnbridge_ExplicitReply> replies(supervisor_, reply_topic_, dds::reply_reader_qos());
+  dds::Writer<dnbridge_ExplicitRequest> requests(
+      supervisor_, request_topic_, dds::request_writer_qos(dds::rack_partitions(kRack)));
+  dds::Reader<dnbridge_ExplicitReply> replies(supervisor_, reply_topic_,
+                                              dds::reply_reader_qos(dds::rack_partitions(kRack)));
   ASSERT_TRUE(writer_matched(requests));
   {
     // Until the bridge's reply writer is matched too.
@@ -634,7 +639,7 @@ TEST_F(CarelessClientTest, HundredThousandRequestsLeaveTheBridgeResidentSetFlat)
 TEST_F(CarelessClientTest, DeletingTwoWritersOfAParticipantIdlesThePumpOfItsThirdLiveWriter) {
   ASSERT_NO_FATAL_FAILURE(start_bridge());
   Subscription<dnbridge_PumpCommand> commands(supervisor_, command_topic_,
-                                              dds::command_reader_qos());
+                                              dds::command_reader_qos(dds::rack_partitions(kRack)));
   // The bridge's reader and this one.
   auto& client = careless({"three-writers", "10", "2000", "2"});
   ASSERT_EQ(client.read_line(milliseconds(15000)), "written");

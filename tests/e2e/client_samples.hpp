@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/sample.hpp"
@@ -12,11 +13,15 @@
 
 namespace dnbridge::e2e {
 
+// The embedded default rack, and its partition of commands and requests.
+inline constexpr const char* kSimRack = "sim-rack";
+inline std::vector<std::string> sim_rack_partitions() { return dds::rack_partitions(kSimRack); }
+
 inline dds::Owned<dnbridge_PumpCommand> pump_command(unsigned mac, bool pump_on, bool n2,
                                                      std::uint16_t analog,
                                                      std::string_view issuer) {
   dds::Owned<dnbridge_PumpCommand> c;
-  dds::set_string(c->rack, "sim-rack");
+  dds::set_string(c->rack, kSimRack);
   dds::set_string(c->port, "A");
   c->mac = static_cast<std::uint8_t>(mac);
   c->pump_on = pump_on;
@@ -34,7 +39,7 @@ inline dds::Owned<dnbridge_ExplicitRequest> get_vendor(const std::string& reques
   dds::set_string(r->requester, requester);
   r->txid = txid;
   r->command = dnbridge_COMMAND_EXECUTE;
-  dds::set_string(r->rack, "sim-rack");
+  dds::set_string(r->rack, kSimRack);
   dds::set_string(r->port, "A");
   r->mac = static_cast<std::uint8_t>(mac);
   r->service = 0x0E;

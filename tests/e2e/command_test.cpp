@@ -17,7 +17,8 @@ class Commander {
       : issuer_(issuer),
         participant_(test_domain(), issuer),
         topic_(participant_),
-        writer_(participant_, topic_, dds::command_writer_qos(strength, seconds(1))) {}
+        writer_(participant_, topic_,
+                dds::command_writer_qos(dds::rack_partitions(kRack), strength, seconds(1))) {}
 
   // With the source timestamp `ahead` of this host's clock (a commander
   // whose clock is wrong).

@@ -102,7 +102,8 @@ TEST_F(ExplicitTest, ARequesterNameWithANulInsideIsRefused) {
   // NUL, and more. Read as a C string it is this requester's name; executed,
   // two such clients would take each other's transactions. Made here from
   // the serialized form of a request named with an X where the NUL goes.
-  dds::Reader<dnbridge_ExplicitRequest> tap(supervisor_, request_topic_, dds::request_reader_qos());
+  dds::Reader<dnbridge_ExplicitRequest> tap(supervisor_, request_topic_,
+                                            dds::request_reader_qos(dds::rack_partitions(kRack)));
   dds::ReadCondition fresh(tap, DDS_NOT_READ_SAMPLE_STATE);
   dds::Owned<dnbridge_ExplicitRequest> r;
   dds::set_string(r->requester, requester_ + "Xtwin");

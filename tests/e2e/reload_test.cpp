@@ -159,9 +159,10 @@ TEST_F(ReloadTest, AReloadRequestOnDdsGetsItsReply) {
   ASSERT_NO_FATAL_FAILURE(start());
   dds::Topic<dnbridge_ReloadRequest> request_topic{supervisor_};
   dds::Topic<dnbridge_ReloadReply> reply_topic{supervisor_};
-  dds::Writer<dnbridge_ReloadRequest> requests{supervisor_, request_topic,
-                                               dds::request_writer_qos()};
-  Subscription<dnbridge_ReloadReply> replies{supervisor_, reply_topic, dds::reply_reader_qos()};
+  dds::Writer<dnbridge_ReloadRequest> requests{
+      supervisor_, request_topic, dds::request_writer_qos(dds::rack_partitions(kRack))};
+  Subscription<dnbridge_ReloadReply> replies{supervisor_, reply_topic,
+                                             dds::reply_reader_qos(dds::rack_partitions(kRack))};
   ASSERT_TRUE(writer_matched(requests));
   ASSERT_TRUE(replies.matched(1));
   ASSERT_NO_FATAL_FAILURE(replace("name = \"pump-4\"", "name = \"pump four\""));

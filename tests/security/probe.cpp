@@ -147,7 +147,8 @@ int main(int argc, char** argv) {
     command_writer = attempt<dds::Writer<dnbridge_PumpCommand>>("command_writer", [&] {
       command_topic = std::make_unique<dds::Topic<dnbridge_PumpCommand>>(*participant);
       return std::make_unique<dds::Writer<dnbridge_PumpCommand>>(
-          *participant, *command_topic, dds::command_writer_qos(10, seconds(1)));
+          *participant, *command_topic,
+          dds::command_writer_qos(dds::rack_partitions("sim-rack"), 10, seconds(1)));
     });
   }
 

@@ -141,7 +141,8 @@ Supervisor::Supervisor(const std::string& rack)
       command_topic_(participant_),
       pump_reader_(participant_, pump_topic_, dds::state_reader_qos()),
       port_reader_(participant_, port_topic_, dds::state_reader_qos()),
-      command_writer_(participant_, command_topic_, dds::command_writer_qos(10, seconds(10))),
+      command_writer_(participant_, command_topic_,
+                      dds::command_writer_qos(dds::rack_partitions(rack_), 10, seconds(10))),
       pump_data_(pump_reader_, DDS_ANY_STATE),
       port_data_(port_reader_, DDS_ANY_STATE),
       waitset_(participant_) {
