@@ -798,11 +798,16 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, Proble
     if (auto v = read_name(*n, "rack", r)) {
       // The rack's DDS partition is named after it (dds::rack_partition),
       // where these match as patterns.
-      if (v->find_first_of("*?") != std::string::npos) {
-        r.error(n->source(),
-                fmt::format("rack = \"{}\": a rack name holds no '*' or '?' (its DDS partition, "
-                            "dnbridge/RACK, would match other racks' as a pattern)",
-                            *v));
+      const bool control = std::any_of(v->begin(), v->end(), [](char c) {
+        return static_cast<unsigned char>(c) < 0x20 || c == '\x7F';
+      });
+      if (control || v->find_first_of("*?") != std::string::npos) {
+        r.error(
+            n->source(),
+            fmt::format("rack = \"{}\": a rack name holds no '*', '?' or control character (its "
+                        "DDS partition, dnbridge/RACK, would match other racks' as a pattern, "
+                        "or be cut short)",
+                        control ? std::string("...") : *v));
       } else {
         config.rack = *v;
       }

@@ -26,7 +26,11 @@ void Bridges::refresh() {
       const std::string host = dds::user_data_field(p.user_data, "host");
       const std::string pid = dds::user_data_field(p.user_data, "pid");
       std::string where = host;
-      if (!host.empty() && !pid.empty()) where += " (pid " + pid + ")";
+      if (!pid.empty()) where += (host.empty() ? "? (pid " : " (pid ") + pid + ")";
+      // Another program's text: no control character reaches a table.
+      for (char& c : where) {
+        if (static_cast<unsigned char>(c) < 0x20 || c == '\x7F') c = '?';
+      }
       seen_.emplace(p.guid, Seen{std::move(*rack), std::move(where), true});
     }
   }

@@ -134,8 +134,12 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   Commander commander(client, args.strength, key.rack);
   const Deadline deadline = deadline_after(o.timeout());
   if (!commander.wait_matched(client, deadline)) {
-    throw CommandError(Exit::kNotFound, fmt::format("{}: no bridge took commands within {:g} s", name,
-                                                    o.timeout_seconds));
+    throw CommandError(
+        Exit::kNotFound,
+        fmt::format("{}: no bridge took commands in rack {}'s partition (dnbridge/{}) "
+                    "within {:g} s: a bridge of a version before partitions reads "
+                    "commands elsewhere",
+                    name, key.rack, key.rack, o.timeout_seconds));
   }
 
   // Written, then again every kRewritePeriod, until the echo shows it applied

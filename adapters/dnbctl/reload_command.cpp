@@ -132,9 +132,9 @@ Exit run_reload(const GlobalOptions& o) {
     throw CommandError(
         Exit::kNotFound,
         fmt::format("no bridge on DDS domain {} takes reload requests (none has a reader of "
-                    "dnbridge/ReloadRequest within {:g} s): the bridge of rack \"{}\" is of a "
-                    "version without reload, or its DDS Security permissions do not grant "
-                    "ReloadRequest",
+                    "dnbridge/ReloadRequest in the rack's partition within {:g} s): the bridge of "
+                    "rack \"{}\" is of a version without reload or partitions, or its DDS "
+                    "Security permissions do not grant ReloadRequest",
                     o.domain, o.timeout_seconds, rack));
   }
   auto replies = reloads.exchange(client, request, deadline, kRepeatAfter);

@@ -29,8 +29,11 @@ static dds_qos_t* state_reader_qos(void) {
 
 static dds_qos_t* command_writer_qos(const char* rack, int32_t strength) {
   dds_qos_t* q = dds_create_qos();
-  char partition[256];
-  snprintf(partition, sizeof partition, "dnbridge/%s", rack);
+  static char partition[256];
+  if (snprintf(partition, sizeof partition, "dnbridge/%s", rack) >= (int)sizeof partition) {
+    fprintf(stderr, "rack name too long\n");
+    exit(2);
+  }
   const char* partitions[] = {partition};
   dds_qset_partition(q, 1, partitions);
   dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));

@@ -281,7 +281,9 @@ EOF
 # --- permissions: one grant per identity, by role --------------------------------
 topics() { for t in "$@"; do echo "            <topic>dnbridge/$t</topic>"; done; }
 # The state topics are in the default partition; commands, requests and
-# replies in their rack's, "dnbridge/RACK" (every rack's: "dnbridge/*").
+# replies in their rack's, "dnbridge/RACK" (every rack's: "dnbridge/*"),
+# and in the default partition too, where bridges and supervisors of
+# versions before partitions have them (an upgrade goes rack by rack).
 state_topics() { topics PumpState NodeStatus PortStatus; }
 publish_of() {
   case $1 in
@@ -313,7 +315,7 @@ rule() {
   [ -n "$2" ] || return 0
   printf '        <%s>\n          <topics>\n%s\n          </topics>\n' "$1" "$2"
   if [ -n "${3:-}" ]; then
-    printf '          <partitions>\n            <partition>%s</partition>\n          </partitions>\n' "$3"
+    printf '          <partitions>\n            <partition></partition>\n            <partition>%s</partition>\n          </partitions>\n' "$3"
   fi
   printf '        </%s>\n' "$1"
 }

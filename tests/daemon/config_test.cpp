@@ -738,9 +738,14 @@ TEST(ConfigErrors, ARackNameWithAPatternCharacter) {
                        "\"\n[[port]]\nname = \"A\"\ninterface = \"simulated\"\n"
                        "bitrate = 500000\n[[port.node]]\nmac = 1\nname = \"p\"\n"),
               std::string("t.toml:1:8: rack = \"") + rack +
-                  "\": a rack name holds no '*' or '?' (its DDS partition, dnbridge/RACK, would "
-                  "match other racks' as a pattern)");
+                  "\": a rack name holds no '*', '?' or control character (its DDS partition, "
+                  "dnbridge/RACK, would match other racks' as a pattern, or be cut short)");
   }
+  EXPECT_EQ(
+      problems("rack = \"a\\u0000b\"\n[[port]]\nname = \"A\"\ninterface = \"simulated\"\n"
+               "bitrate = 500000\n[[port.node]]\nmac = 1\nname = \"p\"\n"),
+      "t.toml:1:8: rack = \"...\": a rack name holds no '*', '?' or control character (its "
+      "DDS partition, dnbridge/RACK, would match other racks' as a pattern, or be cut short)");
 }
 
 TEST(ConfigErrors, DuplicateNodeNamesOnAPort) {
