@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <tuple>
 
 #include "bridge/devicenet/wire/identifier.hpp"
 
@@ -96,26 +97,26 @@ Node& Scanner::make_node(NodeConfig config) {
   return *nodes_.back();
 }
 
+namespace {
+
+// The port's timings (Scanner::same_timings), one list for comparing and
+// for copying them.
+template <class Config>
+auto timings(Config& c) {
+  return std::tie(c.explicit_messaging.response_timeout, c.allocate_retry_min, c.allocate_retry_max,
+                  c.fault_recheck, c.max_consecutive_errors, c.poll_response_timeout,
+                  c.poll_batch_window, c.scan_response_timeout);
+}
+
+}  // namespace
+
 bool Scanner::same_timings(const ScannerConfig& a, const ScannerConfig& b) {
-  return a.explicit_messaging.response_timeout == b.explicit_messaging.response_timeout &&
-         a.allocate_retry_min == b.allocate_retry_min &&
-         a.allocate_retry_max == b.allocate_retry_max && a.fault_recheck == b.fault_recheck &&
-         a.max_consecutive_errors == b.max_consecutive_errors &&
-         a.poll_response_timeout == b.poll_response_timeout &&
-         a.poll_batch_window == b.poll_batch_window &&
-         a.scan_response_timeout == b.scan_response_timeout;
+  return timings(a) == timings(b);
 }
 
 void Scanner::retune(const ScannerConfig& next) {
   if (same_timings(config_, next)) return;
-  config_.explicit_messaging.response_timeout = next.explicit_messaging.response_timeout;
-  config_.allocate_retry_min = next.allocate_retry_min;
-  config_.allocate_retry_max = next.allocate_retry_max;
-  config_.fault_recheck = next.fault_recheck;
-  config_.max_consecutive_errors = next.max_consecutive_errors;
-  config_.poll_response_timeout = next.poll_response_timeout;
-  config_.poll_batch_window = next.poll_batch_window;
-  config_.scan_response_timeout = next.scan_response_timeout;
+  timings(config_) = timings(next);
   for (auto& n : nodes_) n->apply_port_timings();
   for (auto& n : leaving_) n->apply_port_timings();
   log_.info("port timings changed: in force for every node");
