@@ -17,6 +17,8 @@ bool Commander::wait_matched(Client& client, Deadline deadline) {
   });
 }
 
+std::uint32_t Commander::matched() const { return writer_.matched_subscriptions().value_or(0); }
+
 Status Commander::write(const NodeKey& key, const Outputs& outputs, const std::string& issuer) {
   dds::Owned<dnbridge_PumpCommand> c;
   dds::set_string(c->rack, key.rack);

@@ -33,6 +33,8 @@ class Commander {
   // Until a command reader (a bridge) matched; false at the deadline.
   // Commands are volatile: one written before a bridge matched is lost.
   bool wait_matched(Client& client, Deadline deadline);
+  // Command readers (bridges) matched now: with partitions, its rack's only.
+  std::uint32_t matched() const;
 
   Status write(const NodeKey& key, const Outputs& outputs, const std::string& issuer);
 

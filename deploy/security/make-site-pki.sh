@@ -13,7 +13,8 @@ set -euo pipefail
 
 usage() {
   cat <<'EOF'
-usage: make-site-pki.sh --out DIR [--domain ID] [options] [--bridge NAME]... [--supervisor NAME]... [--monitor NAME]...
+usage: make-site-pki.sh --out DIR [--domain ID] [options] [--bridge NAME[=RACK]]...
+                        [--supervisor NAME[=RACK,...]]... [--monitor NAME]...
 
 Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
 
@@ -23,13 +24,17 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
   --site NAME         organisation in every subject (default: dnbridge-site;
                       later runs keep the site's, which changes only with
                       --new-ca)
-  --bridge NAME       a rack's bridge: publishes PumpState, NodeStatus,
+  --bridge NAME[=RACK]
+                      a rack's bridge: publishes PumpState, NodeStatus,
                       PortStatus, ExplicitReply, BusScanReply and
                       ReloadReply, reads PumpCommand, ExplicitRequest,
-                      BusScanRequest and ReloadRequest
-  --supervisor NAME   a supervisory host: reads every dnbridge topic, writes
+                      BusScanRequest and ReloadRequest; with =RACK, the
+                      commands and requests of that rack only
+  --supervisor NAME[=RACK,...]
+                      a supervisory host: reads every dnbridge topic, writes
                       PumpCommand, ExplicitRequest, BusScanRequest and
-                      ReloadRequest
+                      ReloadRequest; with =RACK,..., commands and requests
+                      to those racks only (=* : every rack again)
   --monitor NAME      a monitoring host: reads PumpState, NodeStatus and
                       PortStatus only
   --days N            validity of new identities and of the permissions
@@ -41,7 +46,12 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
                       the site is issued again under the new CAs
   -h, --help          this text
 
-Names: letters, digits, '.', '_' and '-'. Everything else is denied: a
+Without =RACK a bridge or supervisor is granted every rack's partition
+("dnbridge/*") and the default partition, where versions before partitions
+exchange commands; with it, the partitions "dnbridge/RACK" of those racks
+only. Given again, a name keeps its racks unless new ones are given.
+
+Names and racks: letters, digits, '.', '_' and '-'. Everything else is denied: a
 participant can do only what its grant allows (default DENY), and a host
 without an identity of the site cannot join the domain.
 
@@ -60,7 +70,7 @@ site=""
 days=365
 ca_days=3650
 new_ca=0
-declare -a add_roles=() add_names=() renew=()
+declare -a add_roles=() add_names=() add_racks=() renew=()
 
 need_value() { [ $# -ge 2 ] && [ -n "$2" ] || fail "$1 needs a value (--help)"; }
 while [ $# -gt 0 ]; do
@@ -69,7 +79,9 @@ while [ $# -gt 0 ]; do
     --domain) need_value "$@"; domain=$2; shift 2 ;;
     --site) need_value "$@"; site=$2; shift 2 ;;
     --bridge | --supervisor | --monitor)
-      need_value "$@"; add_roles+=("${1#--}"); add_names+=("$2"); shift 2 ;;
+      need_value "$@"; add_roles+=("${1#--}"); add_names+=("${2%%=*}")
+      if [[ $2 == *=* ]]; then add_racks+=("=${2#*=}"); else add_racks+=(""); fi
+      shift 2 ;;
     --days) need_value "$@"; days=$2; shift 2 ;;
     --ca-days) need_value "$@"; ca_days=$2; shift 2 ;;
     --renew) need_value "$@"; renew+=("$2"); shift 2 ;;
@@ -88,6 +100,22 @@ valid_name() { [[ $1 =~ ^[A-Za-z0-9._-]{1,64}$ ]]; }
 for n in "${add_names[@]}" "${renew[@]}"; do
   valid_name "$n" || fail "'$n' is not a name: letters, digits, '.', '_', '-' (at most 64)"
 done
+# A rack scope, "=RACK,...": "*" (every rack) or rack names; a bridge has one.
+for i in "${!add_names[@]}"; do
+  scope=${add_racks[$i]}
+  [ -n "$scope" ] || continue
+  scope=${scope#=}
+  case ${add_roles[$i]} in
+    monitor) fail "--monitor ${add_names[$i]}=$scope: a monitor reads the state of every rack (no =RACK)" ;;
+    bridge) [[ $scope != *,* ]] || fail "--bridge ${add_names[$i]}=$scope: a bridge serves one rack" ;;
+  esac
+  [ "$scope" = "*" ] && continue
+  IFS=, read -r -a racks_given <<<"$scope"
+  [ "${#racks_given[@]}" -gt 0 ] || fail "--${add_roles[$i]} ${add_names[$i]}=: no rack named"
+  for r in "${racks_given[@]}"; do
+    valid_name "$r" || fail "--${add_roles[$i]} ${add_names[$i]}=$scope: '$r' is not a rack name this script grants: letters, digits, '.', '_', '-' (at most 64)"
+  done
+done
 if [ -n "$site" ]; then
   valid_name "$site" || fail "--site '$site': letters, digits, '.', '_', '-' (at most 64)"
 fi
@@ -101,7 +129,7 @@ out=$(realpath -m -- "$out")
 [ ! -e "$out" ] || [ -d "$out" ] || fail "--out $out: exists and is not a directory"
 id_ca=$out/ca/identity
 perm_ca=$out/ca/permissions
-roster=$out/roster     # "ROLE NAME" per identity of the site
+roster=$out/roster     # "ROLE NAME [RACK,...]" per identity of the site (no racks: every rack)
 site_conf=$out/site.conf
 
 # --- the site: its domain and name, kept from the first run ------------------
@@ -151,6 +179,14 @@ touch "$roster"
 for i in "${!add_names[@]}"; do
   name=${add_names[$i]}
   [ -n "$(role_of "$name")" ] || echo "${add_roles[$i]} $name" >>"$roster"
+  # New racks replace the name's racks; "*" is every rack (no third field).
+  if [ -n "${add_racks[$i]}" ]; then
+    racks=${add_racks[$i]#=}
+    [ "$racks" != "*" ] || racks=""
+    awk -v n="$name" -v r="$racks" '$2 == n { $0 = $1 " " $2 (r == "" ? "" : " " r) } { print }' \
+      "$roster" >"$roster.new"
+    mv "$roster.new" "$roster"
+  fi
 done
 printf 'site=%s\ndomain=%s\n' "$site" "$domain" >"$site_conf"
 
@@ -232,7 +268,7 @@ issue() {
   echo "issued $role $name: $host/cert.pem ($(openssl x509 -in "$host/cert.pem" -noout -enddate))"
 }
 
-while read -r role name; do
+while read -r role name _; do
   [ -n "$name" ] || continue
   host=$out/hosts/$name
   renewing=0
@@ -310,12 +346,23 @@ subscribe_in_racks_of() {
       ;;
   esac
 }
-# rule KIND TOPICS [PARTITION]: a <publish> or <subscribe> rule.
+# rule KIND TOPICS [RACKS]: a <publish> or <subscribe> rule; with RACKS
+# ("*" or RACK,...), in those racks' partitions, and for "*" in the default
+# partition too. Without, in the default partition.
 rule() {
   [ -n "$2" ] || return 0
   printf '        <%s>\n          <topics>\n%s\n          </topics>\n' "$1" "$2"
   if [ -n "${3:-}" ]; then
-    printf '          <partitions>\n            <partition></partition>\n            <partition>%s</partition>\n          </partitions>\n' "$3"
+    echo "          <partitions>"
+    if [ "$3" = "*" ]; then
+      echo "            <partition></partition>"
+      echo "            <partition>dnbridge/*</partition>"
+    else
+      local r
+      IFS=, read -r -a rule_racks <<<"$3"
+      for r in "${rule_racks[@]}"; do echo "            <partition>dnbridge/$r</partition>"; done
+    fi
+    echo "          </partitions>"
   fi
   printf '        </%s>\n' "$1"
 }
@@ -329,8 +376,9 @@ iso_date() { date -u -d "${1#*=}" +%Y-%m-%dT%H:%M:%SZ; }
      xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_permissions.xsd">
   <permissions>
 EOF
-  while read -r role name; do
+  while read -r role name racks; do
     [ -n "$name" ] || continue
+    racks=${racks:-*}
     cert=$out/hosts/$name/cert.pem
     # The grant is valid as long as the identity's certificate.
     not_before=$(iso_date "$(openssl x509 -in "$cert" -noout -startdate)")
@@ -352,9 +400,9 @@ EOF
         </domains>
 EOF
     rule publish "$pub"
-    rule publish "$pub_racks" "dnbridge/*"
+    rule publish "$pub_racks" "$racks"
     rule subscribe "$sub"
-    rule subscribe "$sub_racks" "dnbridge/*"
+    rule subscribe "$sub_racks" "$racks"
     cat <<EOF
       </allow_rule>
       <default>DENY</default>
@@ -374,14 +422,16 @@ sign governance
 sign permissions
 
 # --- what each host gets ------------------------------------------------------------
-while read -r role name; do
+while read -r role name racks; do
   [ -n "$name" ] || continue
   host=$out/hosts/$name
   cp "$id_ca/ca.pem" "$host/identity_ca.pem"
   cp "$perm_ca/ca.pem" "$host/permissions_ca.pem"
   cp "$out/governance.p7s" "$out/permissions.p7s" "$host/"
+  scope=""
+  [ "$role" = monitor ] || scope="; racks: ${racks:-every rack}"
   cat >"$host/security.toml" <<EOF
-# DDS Security of $role $name (site $site, domain $domain).
+# DDS Security of $role $name (site $site, domain $domain$scope).
 # Relative paths are relative to this file's directory.
 [security]
 identity_ca = "identity_ca.pem"

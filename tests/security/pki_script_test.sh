@@ -89,6 +89,38 @@ grep -q "<subject_name>CN=rack-B,OU=bridge,O=acme</subject_name>" "$pki/permissi
 grep -q "<id>17</id>" "$pki/permissions.xml" || fail "the domain was not kept"
 verify_all
 
+echo "== rack scopes"
+# grant ROLE-NAME: that identity's grant.
+grant_of() { sed -n "/<grant name=\"$1\">/,/<\/grant>/p" "$pki/permissions.xml"; }
+for bad in "--monitor ops-2=rack-A" "--bridge rack-C=rack-C,rack-D" "--supervisor s=rack:A" \
+  "--supervisor s=" "--supervisor s=rack-A,,rack-B"; do
+  # shellcheck disable=SC2086 # the words of each case
+  if run $bad; then fail "ran with $bad"; fi
+  [ ! -e "$pki/hosts/s" ] && [ ! -e "$pki/hosts/ops-2" ] && [ ! -e "$pki/hosts/rack-C" ] ||
+    fail "a refused $bad issued an identity"
+done
+run --bridge rack-A=rack-A --supervisor scada-2=rack-A,rack-B || fail "scopes: $(cat "$work/out")"
+[ "$(fingerprint "$pki/hosts/rack-A/cert.pem")" = "$rack_a" ] || fail "scoping rack-A reissued it"
+grep -q "^bridge rack-A rack-A$" "$pki/roster" || fail "the roster lacks rack-A's rack: $(cat "$pki/roster")"
+grant=$(grant_of supervisor-scada-2)
+grep -q "<partition>dnbridge/rack-A</partition>" <<<"$grant" || fail "scada-2 lacks rack-A's partition"
+grep -q "<partition>dnbridge/rack-B</partition>" <<<"$grant" || fail "scada-2 lacks rack-B's partition"
+if grep -q "dnbridge/\*\|<partition></partition>" <<<"$grant"; then fail "scada-2 has every rack or the default partition"; fi
+grep -q "racks: rack-A,rack-B" "$pki/hosts/scada-2/security.toml" || fail "scada-2's security.toml does not say its racks"
+grant=$(grant_of bridge-rack-A)
+grep -q "<partition>dnbridge/rack-A</partition>" <<<"$grant" || fail "rack-A lacks its partition"
+if grep -q "dnbridge/\*" <<<"$grant"; then fail "rack-A still has every rack"; fi
+# The state topics stay in the default partition (a rule without partitions).
+grep -q "<topic>dnbridge/PumpState</topic>" <<<"$grant" || fail "rack-A may not publish PumpState"
+# Given again without racks, a name keeps them; "=*" gives every rack back.
+run --supervisor scada-2 || fail "scada-2 again: $(cat "$work/out")"
+grep -q "^supervisor scada-2 rack-A,rack-B$" "$pki/roster" || fail "scada-2 lost its racks: $(cat "$pki/roster")"
+run --supervisor 'scada-2=*' || fail "scada-2=*: $(cat "$work/out")"
+grep -q "^supervisor scada-2$" "$pki/roster" || fail "scada-2=* kept racks: $(cat "$pki/roster")"
+grep_grant=$(grant_of supervisor-scada-2)
+grep -q "<partition>dnbridge/\*</partition>" <<<"$grep_grant" || fail "scada-2=* has not every rack"
+verify_all
+
 echo "== a host renewed"
 run --renew rack-A || fail "renewing rack-A: $(cat "$work/out")"
 [ "$(fingerprint "$pki/hosts/rack-A/cert.pem")" != "$rack_a" ] || fail "--renew kept the certificate"
@@ -102,7 +134,7 @@ if ls -d "$pki"/previous-* >/dev/null 2>&1; then fail "a refused --new-ca moved 
 run --new-ca --site acme-2 || fail "--new-ca: $(cat "$work/out")"
 [ "$(fingerprint "$pki/ca/identity/ca.pem")" != "$id_ca" ] || fail "--new-ca kept the identity CA"
 ls -d "$pki"/previous-*/ca/identity >/dev/null || fail "the old CAs were not kept aside"
-[ "$(ls "$pki/hosts" | wc -l)" = 4 ] || fail "not every identity was issued again: $(ls "$pki/hosts")"
+[ "$(ls "$pki/hosts" | wc -l)" = 5 ] || fail "not every identity was issued again: $(ls "$pki/hosts")"
 verify_all
 # The new site name, everywhere.
 grep -q "^site=acme-2$" "$pki/site.conf" || fail "site.conf kept the old site name"
