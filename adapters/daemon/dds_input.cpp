@@ -14,7 +14,7 @@ namespace dnbridge::daemon {
 namespace {
 
 enum Token : dds::WaitSet::Token {
-  kCommands = 1,
+  kCommandsHeld = 1,
   kRequests = 2,
   kStop = 3,
   kScanRequests = 4,
@@ -25,7 +25,8 @@ enum Token : dds::WaitSet::Token {
 constexpr Duration kClockSkewReported = seconds(1);
 
 // Commands are not taken again sooner than this after a take: under a flood
-// each pump's newest command is applied once per hold-off, at most 1 ms late.
+// each pump's newest command is applied once per hold-off, at most 1 ms late;
+// one that comes alone is taken at once, on Cyclone's thread.
 constexpr Duration kCommandHoldoff = milliseconds(1);
 
 // Samples taken at a time.
@@ -87,7 +88,10 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       ports_(std::move(ports)),
       log_(std::move(log)),
       partition_{dds::rack_partition(rack_)},
-      commands_(participant, publisher.command_topic(), dds::command_reader_qos(partition_)),
+      commands_held_(participant),
+      command_listener_([this] { on_commands_available(); }),
+      commands_(participant, publisher.command_topic(), dds::command_reader_qos(partition_),
+                command_listener_.get()),
       requests_(participant, publisher.request_topic(), dds::request_reader_qos(partition_)),
       reload_(std::move(reload)),
       command_buffer_(kBatch),
@@ -120,7 +124,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       throw std::runtime_error("setting the status mask of a DDS input reader failed");
     }
   }
-  waitset_.attach(commands_, kCommands);
+  waitset_.attach(commands_held_, kCommandsHeld);
   waitset_.attach(requests_, kRequests);
   if (scan_requests_) waitset_.attach(*scan_requests_, kScanRequests);
   if (reload_requests_) waitset_.attach(*reload_requests_, kReloadRequests);
@@ -132,9 +136,15 @@ DdsInput::~DdsInput() { stop(); }
 void DdsInput::start() {
   thread_ = std::thread([this] { run(); });
   port::name_thread(thread_, "dds input");
+  accepting_ = true;
+  commands_pending_ = true;  // any that came before
+  deliver_commands();
 }
 
 void DdsInput::stop() {
+  accepting_ = false;
+  // No listener call after this: none is handing a command to a port.
+  (void)dds::DataListener::detach(commands_);
   if (!thread_.joinable()) return;
   (void)stop_.trigger();
   thread_.join();
@@ -146,19 +156,15 @@ port::PortLoop* DdsInput::port_of(std::string_view name) {
 }
 
 void DdsInput::run() {
-  // Commands first, and again between batches of requests: a pump command
-  // never waits behind a flood of explicit requests. Commands are taken at
-  // most once per kCommandHoldoff: one that comes alone is taken at once, a
-  // flood in batches (one wake of this thread and of each port loop per
-  // batch, not per command).
+  // Requests in batches, and commands held off by a flood at the end of
+  // the hold-off (deliver_commands).
   bool requests_left = false;
-  bool commands_waiting = false;
-  TimePoint next_command_take{};
+  bool commands_held = false;
   for (;;) {
     Duration timeout = requests_left ? Duration::zero() : seconds(1);
-    if (commands_waiting) {
-      timeout =
-          std::min(timeout, std::max(Duration::zero(), next_command_take - port::steady_now()));
+    const TimePoint held_until{Duration(next_command_take_.load())};
+    if (commands_held) {
+      timeout = std::min(timeout, std::max(Duration::zero(), held_until - port::steady_now()));
     }
     auto triggered = waitset_.wait(timeout);
     if (!triggered) {
@@ -168,27 +174,48 @@ void DdsInput::run() {
     bool requests = requests_left;
     for (auto token : *triggered) {
       if (token == kStop) return;
-      commands_waiting = commands_waiting || token == kCommands;
+      if (token == kCommandsHeld) {
+        (void)commands_held_.take_triggered();
+        commands_held = true;
+      }
       requests = requests || token == kRequests;
       if (token == kScanRequests) take_scan_requests();
       if (token == kReloadRequests) take_reload_requests();
     }
-    if (commands_waiting) {
-      const TimePoint now = port::steady_now();
-      if (now >= next_command_take) {
-        (void)commands_.set_status_mask(DDS_DATA_AVAILABLE_STATUS);
-        take_commands();
-        commands_waiting = false;
-        next_command_take = now + kCommandHoldoff;
-      } else {
-        // Held off: the samples stay in the reader (keep-last 1 per pump:
-        // the newest of each pump is taken at the end), and until then
-        // more of them do not wake this thread.
-        (void)commands_.set_status_mask(0);
-      }
+    if (commands_held && port::steady_now() >= TimePoint{Duration(next_command_take_.load())}) {
+      commands_held = false;
+      held_signalled_ = false;
+      commands_pending_ = true;
+      deliver_commands();
     }
     requests_left = requests && take_requests();
   }
+}
+
+void DdsInput::on_commands_available() {
+  commands_pending_ = true;
+  deliver_commands();
+}
+
+void DdsInput::deliver_commands() {
+  do {
+    std::unique_lock lock(command_take_mutex_, std::try_to_lock);
+    if (!lock) return;  // its holder looks at commands_pending_ again after
+    while (accepting_ && commands_pending_.exchange(false)) {
+      const TimePoint now = port::steady_now();
+      if (now < TimePoint{Duration(next_command_take_.load())}) {
+        // Held off: the samples stay in the reader (keep-last 1 per pump:
+        // the newest of each is taken at the end of the hold-off, by the
+        // input thread), and meanwhile a sample costs this check only.
+        commands_pending_ = true;
+        if (!held_signalled_.exchange(true)) (void)commands_held_.trigger();
+        return;
+      }
+      take_commands();
+      next_command_take_ = (now + kCommandHoldoff).time_since_epoch().count();
+    }
+    // A thread that found the lock taken left its commands to this one.
+  } while (accepting_ && commands_pending_ && !held_signalled_);
 }
 
 void DdsInput::take_commands() {
@@ -204,10 +231,11 @@ void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& 
   port::PortLoop* loop = port_of(dds::view(c.port));
   const auto mac = devicenet::MacId::from(c.mac);
   if (!loop || !mac || !loop->has_node(*mac)) {
-    warn_limit_.warn(log_, port::steady_now(),
-                     "command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
-                     info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "",
-                     dds::view(c.port), c.mac);
+    command_warn_limit_.warn(
+        log_, port::steady_now(),
+        "command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
+        info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "", dds::view(c.port),
+        c.mac);
     return;
   }
   // No live commander left for this pump (all writers gone, or disposed):

@@ -1,18 +1,23 @@
 #pragma once
 // What reaches the bridge from DDS: pump commands, explicit requests, bus
-// scan requests and reload requests for this rack. A waitset on a thread of its own takes
-// them and hands each to its port's loop through the loop's inbox; no DDS
-// callback touches master state. Requests for other racks are left to their
-// bridges.
+// scan requests and reload requests for this rack, each handed to its port's
+// loop through the loop's inbox; nothing here touches master state.
+// Commands are taken by a listener, on the Cyclone thread that delivers
+// them, and handed over at once (take, push, wake: nothing that waits);
+// under a flood, at most once per hold-off, the rest by the input's own
+// thread at its end. Requests are taken on that thread, from a waitset.
+// Requests for other racks are left to their bridges.
 #include <atomic>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <span>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "adapters/daemon/dds_publisher.hpp"
+#include "adapters/dds/listener.hpp"
 #include "adapters/dds/reader.hpp"
 #include "adapters/dds/waitset.hpp"
 #include "adapters/port/port_loop.hpp"
@@ -32,7 +37,8 @@ class DdsInput {
   DdsInput& operator=(const DdsInput&) = delete;
 
   void start();
-  void stop();  // returns when the thread has ended
+  // Returns when the thread has ended and no command is being handed over.
+  void stop();
 
   // Samples with data for this rack taken so far (any thread).
   std::uint64_t commands_taken() const noexcept { return commands_taken_.load(); }
@@ -40,6 +46,13 @@ class DdsInput {
 
  private:
   void run();
+  // A command arrived (Cyclone's thread): hand it over now, unless within
+  // the hold-off.
+  void on_commands_available();
+  // Takes and hands over the commands waiting, unless another thread is at
+  // it (then that one does) or the hold-off is on (then the input thread
+  // does at its end). Any thread.
+  void deliver_commands();
   void take_commands();
   bool take_requests();  // true when requests may remain
   void take_scan_requests();
@@ -57,6 +70,15 @@ class DdsInput {
   // The rack's partition: DDS delivers this bridge its own rack's commands
   // and requests only (dds::rack_partition).
   std::vector<std::string> partition_;
+  // Commands: taken by one thread at a time (the mutex); a thread that finds
+  // it taken leaves `commands_pending_` set for the one that holds it.
+  std::mutex command_take_mutex_;
+  std::atomic<bool> commands_pending_{false};
+  std::atomic<bool> accepting_{false};       // between start() and stop()
+  std::atomic<bool> held_signalled_{false};  // the input thread takes them at the hold-off's end
+  std::atomic<TimePoint::rep> next_command_take_{0};  // steady clock ticks
+  dds::GuardCondition commands_held_;
+  dds::DataListener command_listener_;  // before the reader: it outlives it
   dds::Reader<dnbridge_PumpCommand> commands_;
   dds::Reader<dnbridge_ExplicitRequest> requests_;
   // Absent when DDS Security does not grant the service (unless_denied).
@@ -69,7 +91,8 @@ class DdsInput {
   dds::GuardCondition stop_;
   dds::WaitSet waitset_;
   std::thread thread_;
-  RateLimitedLog warn_limit_;
+  RateLimitedLog warn_limit_;          // the input thread's
+  RateLimitedLog command_warn_limit_;  // these two: whichever thread takes commands
   RateLimitedLog skew_limit_;
   std::atomic<std::uint64_t> commands_taken_{0};
   std::atomic<std::uint64_t> requests_taken_{0};

@@ -71,8 +71,14 @@ template <class T>
 class Reader : public Entity {
  public:
   Reader(const Participant& participant, const Topic<T>& topic, const Qos& qos)
-      : Entity(check(dds_create_reader(participant.handle(), topic.handle(), qos.get(), nullptr),
-                     std::string("creating a reader of ") + TopicTraits<T>::kDescriptor->m_typename)) {}
+      : Reader(participant, topic, qos, nullptr) {}
+  // With `listener` (DataListener::get), which must outlive the reader or be
+  // detached from it first (DataListener::detach).
+  Reader(const Participant& participant, const Topic<T>& topic, const Qos& qos,
+         const dds_listener_t* listener)
+      : Entity(check(
+            dds_create_reader(participant.handle(), topic.handle(), qos.get(), listener),
+            std::string("creating a reader of ") + TopicTraits<T>::kDescriptor->m_typename)) {}
 
   // Up to `max` samples, removed from the reader.
   Result<std::vector<Sample<T>>> take(std::size_t max = kDefaultMax) const {

@@ -5,8 +5,10 @@
 //       waitset mode, on loopback), one-way = round trip / 2, run beside each
 //       latency measurement below, over the same seconds.
 //   (0b) Cyclone alone on the path of a command: PumpCommands written by the
-//       commander process, taken here on a waitset thread, nothing behind
-//       it; one way, measured on CLOCK_MONOTONIC at both ends.
+//       commander process, taken here, nothing behind it, twice: on a
+//       waitset thread, and by a listener on Cyclone's thread (as the bridge
+//       takes them); one way, measured on CLOCK_MONOTONIC at both ends. The
+//       bridge's own addition to (2) is measured against the listener's.
 //   (1) poll response received by the master -> PumpState taken by a
 //       subscriber in another process: wall clock at take - source timestamp
 //       (the bridge stamps each sample with the CAN receive time of the poll
@@ -73,6 +75,7 @@
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/log_sink.hpp"
 #include "adapters/dds/fields.hpp"
+#include "adapters/dds/listener.hpp"
 #include "adapters/dds/loopback.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/reader.hpp"
@@ -980,58 +983,77 @@ ClientOutput read_client(Child child, double seconds, OnReady on_ready, OnEnd on
 
 std::string us(double v) { return fmt::format("{:.1f} us", v); }
 
+// How (0b) takes the commands.
+enum class Taker {
+  kWaitset,   // a waitset on a thread of its own
+  kListener,  // a DATA_AVAILABLE listener, on Cyclone's delivering thread (as the bridge does)
+};
+
 // Cyclone DDS alone on the path of a command: the commander process writes
 // PumpCommands as in (2), at the same gaps, with the same QoS, and a reader
-// in this process takes them on a waitset thread, as the bridge's DDS input
-// does, with nothing behind it. Write (CLOCK_MONOTONIC in the commander) ->
-// take (CLOCK_MONOTONIC here): one way, measured, not halved from a round
-// trip.
+// in this process takes them (`taker`), with nothing behind it. Write
+// (CLOCK_MONOTONIC in the commander) -> take (CLOCK_MONOTONIC here): one
+// way, measured, not halved from a round trip.
 template <class OnReady>
 std::vector<double> direct_oneway(int domain, Placement cpus, double seconds, int interval_us,
-                                  unsigned nodes, OnReady on_ready) {
+                                  unsigned nodes, Taker taker_kind, OnReady on_ready) {
   dds::Participant participant(static_cast<dds_domainid_t>(domain), "bench-direct");
   dds::Topic<dnbridge_PumpCommand> topic(participant);
-  dds::Reader<dnbridge_PumpCommand> reader(participant, topic,
-                                           dds::command_reader_qos(dds::rack_partitions(kRack)));
-  if (!reader.set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
+  std::map<std::pair<unsigned, unsigned>, std::int64_t> taken_at;
+  std::optional<dds::Reader<dnbridge_PumpCommand>> reader;
+  const auto take = [&] {
+    auto samples = reader->take();
+    const auto now = monotonic_ns();
+    if (!samples) return;
+    for (const auto& sample : *samples) {
+      if (!sample.info().valid_data()) continue;
+      taken_at.emplace(
+          std::make_pair(unsigned{sample.data().mac}, unsigned{sample.data().analog_output_raw}),
+          now);
+    }
+  };
+  // The listener's calls come on one Cyclone thread; detached (every call
+  // over) before taken_at is read.
+  dds::DataListener listener([&] { take(); });
+  const auto qos = dds::command_reader_qos(dds::rack_partitions(kRack));
+  if (taker_kind == Taker::kListener) {
+    reader.emplace(participant, topic, qos, listener.get());
+  } else {
+    reader.emplace(participant, topic, qos);
+  }
+  if (!reader->set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
     throw std::runtime_error("setting the reader's status mask failed");
   }
   dds::GuardCondition stop(participant);
   dds::WaitSet waitset(participant);
-  waitset.attach(reader, 1);
+  if (taker_kind == Taker::kWaitset) waitset.attach(*reader, 1);
   waitset.attach(stop, 2);
-  std::map<std::pair<unsigned, unsigned>, std::int64_t> taken_at;
   std::thread taker([&] {
     for (;;) {
       auto triggered = waitset.wait(milliseconds(200));
-      const auto now = monotonic_ns();
       if (!triggered) continue;
       for (auto t : *triggered) {
         if (t == 2) return;
       }
-      auto samples = reader.take();
-      if (!samples) continue;
-      for (const auto& sample : *samples) {
-        if (!sample.info().valid_data()) continue;
-        taken_at.emplace(std::make_pair(unsigned{sample.data().mac},
-                                        unsigned{sample.data().analog_output_raw}),
-                         now);
-      }
+      if (taker_kind == Taker::kWaitset) take();
     }
   });
   auto args = client_args("oneway", domain, {"A"}, nodes, seconds);
   args.push_back("--command-interval-us");
   args.push_back(std::to_string(interval_us));
   ClientOutput out;
+  const auto finish = [&] {
+    (void)stop.trigger();
+    taker.join();
+    (void)dds::DataListener::detach(*reader);
+  };
   try {
     out = read_client(spawn(args, true, cpus.peer), seconds, on_ready, [] {});
   } catch (...) {
-    (void)stop.trigger();
-    taker.join();
+    finish();
     throw;
   }
-  (void)stop.trigger();
-  taker.join();
+  finish();
   std::vector<double> us;
   for (const auto& c : out.commands) {
     auto it = taken_at.find({c.mac, c.value});
@@ -1039,7 +1061,6 @@ std::vector<double> direct_oneway(int domain, Placement cpus, double seconds, in
   }
   return us;
 }
-
 
 std::string verdict(bool met) { return met ? "met" : "NOT met"; }
 
@@ -1126,22 +1147,31 @@ int run_bench(const Options& o) {
     return ref;
   };
 
+  // (0b), the listener's: what the bridge's command path adds is measured
+  // against it.
+  std::optional<Summary> direct_listener;
   if (o.latency_seconds > 0 && o.direct_seconds > 0) {
-    fmt::print(
-        "(0b) Cyclone DDS alone on the path of a command: PumpCommands written as in (2) by the\n"
-        "     commander process, taken in this process by a reader on a waitset thread, as the\n"
-        "     bridge takes them, with nothing behind it; one way, measured ({} s) ...\n",
-        o.direct_seconds);
-    std::fflush(stdout);
-    std::optional<Ddsperf> ddsperf;
-    const Summary d = summarize(direct_oneway(domain, cpus, o.direct_seconds,
-                                              o.command_interval_ms * 1000, o.latency_nodes,
-                                              [&] { start_ddsperf(ddsperf); }));
-    const Reference ref = report_ddsperf(ddsperf);
-    fmt::print("(0b) write -> take, one way: samples {}  p50 {}  p99 {}  max {}\n", d.count,
-               us(d.p50), us(d.p99), us(d.max));
-    fmt::print("     ratio to ddsperf's one-way:  p50 {:.2f}  p99 {:.2f}\n\n", d.p50 / ref.p50,
-               d.p99 / ref.p99);
+    for (const Taker taker : {Taker::kWaitset, Taker::kListener}) {
+      const bool listener = taker == Taker::kListener;
+      fmt::print(
+          "(0b) Cyclone DDS alone on the path of a command: PumpCommands written as in (2) by the\n"
+          "     commander process, taken in this process {},\n"
+          "     with nothing behind it; one way, measured ({} s) ...\n",
+          listener ? "by a listener on Cyclone's thread (as the bridge takes them)"
+                   : "by a reader on a waitset thread of its own",
+          o.direct_seconds);
+      std::fflush(stdout);
+      std::optional<Ddsperf> ddsperf;
+      const Summary d =
+          summarize(direct_oneway(domain, cpus, o.direct_seconds, o.command_interval_ms * 1000,
+                                  o.latency_nodes, taker, [&] { start_ddsperf(ddsperf); }));
+      const Reference ref = report_ddsperf(ddsperf);
+      fmt::print("(0b) write -> take ({}), one way: samples {}  p50 {}  p99 {}  max {}\n",
+                 listener ? "listener" : "waitset", d.count, us(d.p50), us(d.p99), us(d.max));
+      fmt::print("     ratio to ddsperf's one-way:  p50 {:.2f}  p99 {:.2f}\n\n", d.p50 / ref.p50,
+                 d.p99 / ref.p99);
+      if (listener) direct_listener = d;
+    }
   }
 
   for (const int poll_ms : o.latency_poll_ms) {
@@ -1239,6 +1269,13 @@ int run_bench(const Options& o) {
     fmt::print(
         "    ratio to Cyclone one-way, written, no poll in flight:  p50 {:.2f}  p99 {:.2f}\n",
         cmd_write_free.p50 / cyc.p50, cmd_write_free.p99 / cyc.p99);
+    if (direct_listener) {
+      const double added = cmd_write_free.p99 - direct_listener->p99;
+      fmt::print(
+          "    the bridge's own addition, no poll in flight: p99 {} - (0b) listener's p99 {} = {}"
+          "   target <= 10 us: {}\n",
+          us(cmd_write_free.p99), us(direct_listener->p99), us(added), verdict(added <= 10.0));
+    }
     fmt::print(
         "    ratio to Cyclone one-way, start of frame:   p50 {:.2f}  p99 {:.2f}   target p99 "
         "<= 1.5: {}\n\n",

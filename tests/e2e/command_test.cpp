@@ -101,6 +101,33 @@ TEST_F(CommandTest, CommandChangesTheDeviceOutputsAndIsEchoedInPumpState) {
   }));
 }
 
+// Commands written back to back, for four pumps: most come within the
+// DDS input's hold-off of the take before them, and wait in the reader for
+// its end (each pump's newest). None is stranded there: every pump ends with
+// the last command written for it.
+TEST_F(CommandTest, AFloodEndsWithEveryPumpsNewestCommand) {
+  ASSERT_NO_FATAL_FAILURE(start_online());
+  Commander flood("flood", 10);
+  ASSERT_TRUE(flood.matched());
+  constexpr unsigned kPumps = 4;
+  for (unsigned i = 0; i < 2000; ++i) {
+    ASSERT_TRUE(flood.write(1 + i % kPumps, true, false, static_cast<std::uint16_t>(i)));
+  }
+  for (unsigned mac = 1; mac <= kPumps; ++mac) {
+    ASSERT_TRUE(flood.write(mac, true, true, static_cast<std::uint16_t>(4000 + mac)));
+  }
+  ASSERT_TRUE(pumps_.until([&] {
+    for (unsigned mac = 1; mac <= kPumps; ++mac) {
+      if (!echoes(mac, true, true, static_cast<std::uint16_t>(4000 + mac), "flood")) return false;
+    }
+    return true;
+  }));
+  for (unsigned mac = 1; mac <= kPumps; ++mac) {
+    EXPECT_EQ(device_outputs(mac),
+              (PumpOutputs{true, true, static_cast<std::uint16_t>(4000 + mac)}));
+  }
+}
+
 TEST_F(CommandTest, BadCommandIsRefusedAndReported) {
   ASSERT_NO_FATAL_FAILURE(start_online());
   Commander supervisor("supervisor-1", 10);
