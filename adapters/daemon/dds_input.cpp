@@ -19,6 +19,7 @@ enum Token : dds::WaitSet::Token {
   kStop = 3,
   kScanRequests = 4,
   kReloadRequests = 5,
+  kLogWaiting = 6,
 };
 
 // A command stamped further ahead of this host's clock is reported.
@@ -80,6 +81,40 @@ void take_all(dds::Reader<T>& reader, Logger& log, const char* what, Fn fn) {
 
 }  // namespace
 
+void HandoffLogSink::write_structured(LogLevel level, std::string_view component,
+                                      std::string_view message, std::span<const LogField> fields) {
+  {
+    std::lock_guard lock(mutex_);
+    if (lines_.size() >= kCapacity) {
+      ++dropped_;
+      return;
+    }
+    Line line{level, std::string(component), std::string(message), {}};
+    for (const auto& f : fields) line.fields.emplace_back(f.name, f.value);
+    lines_.push_back(std::move(line));
+  }
+  ready_();
+}
+
+void HandoffLogSink::drain() {
+  std::vector<Line> lines;
+  std::size_t dropped = 0;
+  {
+    std::lock_guard lock(mutex_);
+    lines.swap(lines_);
+    std::swap(dropped, dropped_);
+  }
+  for (const auto& l : lines) {
+    std::vector<LogField> fields;
+    for (const auto& [name, value] : l.fields) fields.push_back({name, value});
+    target_.write_structured(l.level, l.component, l.message, fields);
+  }
+  if (dropped > 0) {
+    target_.write(LogLevel::kWarn, "dds input",
+                  fmt::format("{} more lines of the command path not logged", dropped));
+  }
+}
+
 DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
                    std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log,
                    std::function<void(ReloadCall)> reload)
@@ -97,7 +132,10 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       command_buffer_(kBatch),
       request_buffer_(kBatch),
       stop_(participant),
-      waitset_(participant) {
+      waitset_(participant),
+      log_waiting_(participant),
+      command_sink_(log_.sink(), [this] { (void)log_waiting_.trigger(); }),
+      command_log_(log_.to(command_sink_)) {
   // Readers of the services that DDS Security grants (the publisher has
   // their topics), each as far as it grants it.
   if (const auto* topic = publisher.scan_request_topic()) {
@@ -129,6 +167,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   if (scan_requests_) waitset_.attach(*scan_requests_, kScanRequests);
   if (reload_requests_) waitset_.attach(*reload_requests_, kReloadRequests);
   waitset_.attach(stop_, kStop);
+  waitset_.attach(log_waiting_, kLogWaiting);
 }
 
 DdsInput::~DdsInput() { stop(); }
@@ -148,6 +187,7 @@ void DdsInput::stop() {
   if (!thread_.joinable()) return;
   (void)stop_.trigger();
   thread_.join();
+  command_sink_.drain();
 }
 
 port::PortLoop* DdsInput::port_of(std::string_view name) {
@@ -181,6 +221,10 @@ void DdsInput::run() {
       requests = requests || token == kRequests;
       if (token == kScanRequests) take_scan_requests();
       if (token == kReloadRequests) take_reload_requests();
+      if (token == kLogWaiting) {
+        (void)log_waiting_.take_triggered();
+        command_sink_.drain();
+      }
     }
     if (commands_held && port::steady_now() >= TimePoint{Duration(next_command_take_.load())}) {
       commands_held = false;
@@ -209,7 +253,7 @@ void DdsInput::deliver_commands() {
         // input thread), and meanwhile a sample costs this check only.
         commands_pending_ = true;
         if (!held_signalled_.exchange(true)) (void)commands_held_.trigger();
-        return;
+        break;  // to the look after unlocking: the hold-off may have ended meanwhile
       }
       take_commands();
       next_command_take_ = (now + kCommandHoldoff).time_since_epoch().count();
@@ -220,8 +264,8 @@ void DdsInput::deliver_commands() {
 
 void DdsInput::take_commands() {
   take_batches(
-      [this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0, log_,
-      "pump commands",
+      [this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0,
+      command_log_, "pump commands",
       [this](std::size_t i) { on_command(command_buffer_.data(i), command_buffer_.info(i)); });
 }
 
@@ -232,7 +276,7 @@ void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& 
   const auto mac = devicenet::MacId::from(c.mac);
   if (!loop || !mac || !loop->has_node(*mac)) {
     command_warn_limit_.warn(
-        log_, port::steady_now(),
+        command_log_, port::steady_now(),
         "command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
         info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "", dds::view(c.port),
         c.mac);
@@ -260,7 +304,7 @@ void DdsInput::note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleI
   if (ahead <= kClockSkewReported) return;
   ++commands_stamped_ahead_;
   skew_limit_.warn(
-      log_, port::steady_now(),
+      command_log_, port::steady_now(),
       "command from \"{}\" for port \"{}\" MAC {} is stamped {:.1f} s ahead of this host's "
       "clock ({} such commands so far): applied in the order received; check the commander's "
       "clock synchronisation",

@@ -25,6 +25,37 @@
 
 namespace dnbridge::daemon {
 
+// Lines written on one thread, said on another: the command path logs on
+// Cyclone's thread, where a sink that blocks (a full pipe, a slow journal)
+// would hold up delivery. At most kCapacity wait; more are counted and said.
+class HandoffLogSink : public LogSink {
+ public:
+  static constexpr std::size_t kCapacity = 32;
+  // `ready` is called (on the writing thread) when a line is waiting.
+  HandoffLogSink(LogSink& target, std::function<void()> ready)
+      : target_(target), ready_(std::move(ready)) {}
+  bool enabled(LogLevel level) const noexcept override { return target_.enabled(level); }
+  void write(LogLevel level, std::string_view component, std::string_view message) override {
+    write_structured(level, component, message, {});
+  }
+  void write_structured(LogLevel level, std::string_view component, std::string_view message,
+                        std::span<const LogField> fields) override;
+  // Writes what waits to the target (the draining thread).
+  void drain();
+
+ private:
+  struct Line {
+    LogLevel level;
+    std::string component, message;
+    std::vector<std::pair<std::string, std::string>> fields;
+  };
+  LogSink& target_;
+  std::function<void()> ready_;
+  std::mutex mutex_;
+  std::vector<Line> lines_;
+  std::size_t dropped_ = 0;
+};
+
 class DdsInput {
  public:
   // `reload`: called (on the input's thread) with each reload request for
@@ -92,8 +123,11 @@ class DdsInput {
   dds::WaitSet waitset_;
   std::thread thread_;
   RateLimitedLog warn_limit_;          // the input thread's
-  RateLimitedLog command_warn_limit_;  // these two: whichever thread takes commands
-  RateLimitedLog skew_limit_;
+  RateLimitedLog command_warn_limit_;  // these two: whichever thread takes commands,
+  RateLimitedLog skew_limit_;          // through command_log_
+  dds::GuardCondition log_waiting_;
+  HandoffLogSink command_sink_;
+  Logger command_log_;  // log_ through command_sink_
   std::atomic<std::uint64_t> commands_taken_{0};
   std::atomic<std::uint64_t> requests_taken_{0};
   std::uint64_t commands_stamped_ahead_ = 0;

@@ -9,11 +9,15 @@
 
 namespace dnbridge::dds {
 
-inline std::string loopback_config(std::string_view discovery_tag = {}) {
+// Unicast discovery reaches participants 0..max_participants-1 of the host
+// (one port each); more than that many on one domain need a larger figure.
+inline std::string loopback_config(std::string_view discovery_tag = {}, int max_participants = 50) {
   std::string xml =
       "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/>"
       "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
-      "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex>"
+      "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>" +
+      std::to_string(max_participants) +
+      "</MaxAutoParticipantIndex>"
       "<Peers><Peer address=\"127.0.0.1\"/></Peers>";
   if (!discovery_tag.empty()) {
     xml += "<Tag>";

@@ -70,6 +70,12 @@ class Logger {
     if (l.fields_.size() < kMaxFields) l.fields_.emplace_back(std::string(name), std::move(value));
     return l;
   }
+  // The same logger (component, fields) writing to `sink` instead.
+  Logger to(LogSink& sink) const {
+    Logger l = *this;
+    l.sink_ = &sink;
+    return l;
+  }
   // A logger of another component on the same sink, with these fields.
   Logger named(std::string component) const {
     Logger l = *this;

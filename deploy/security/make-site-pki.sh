@@ -110,6 +110,7 @@ for i in "${!add_names[@]}"; do
     bridge) [[ $scope != *,* ]] || fail "--bridge ${add_names[$i]}=$scope: a bridge serves one rack" ;;
   esac
   [ "$scope" = "*" ] && continue
+  [[ $scope != ,* && $scope != *, ]] || fail "--${add_roles[$i]} ${add_names[$i]}=$scope: an empty rack name"
   IFS=, read -r -a racks_given <<<"$scope"
   [ "${#racks_given[@]}" -gt 0 ] || fail "--${add_roles[$i]} ${add_names[$i]}=: no rack named"
   for r in "${racks_given[@]}"; do

@@ -1021,6 +1021,11 @@ std::vector<double> direct_oneway(int domain, Placement cpus, double seconds, in
   } else {
     reader.emplace(participant, topic, qos);
   }
+  // Detached before the listener goes, whichever way this returns.
+  struct Detach {
+    const dds::Entity& reader;
+    ~Detach() { (void)dds::DataListener::detach(reader); }
+  } detach{*reader};
   if (!reader->set_status_mask(DDS_DATA_AVAILABLE_STATUS)) {
     throw std::runtime_error("setting the reader's status mask failed");
   }
@@ -1045,7 +1050,7 @@ std::vector<double> direct_oneway(int domain, Placement cpus, double seconds, in
   const auto finish = [&] {
     (void)stop.trigger();
     taker.join();
-    (void)dds::DataListener::detach(*reader);
+    (void)dds::DataListener::detach(*reader);  // every call over before taken_at is read
   };
   try {
     out = read_client(spawn(args, true, cpus.peer), seconds, on_ready, [] {});

@@ -29,6 +29,7 @@
 //   status      status instances=I samples=S
 //        PumpState instances seen, valid samples of them taken.
 //   show RACK PORT MAC   the node line of that pump (or "node RACK PORT MAC none")
+//   wait-samples N       samples N, once N more valid PumpState samples came
 //
 // At the end of stdin it exits 0. CYCLONEDDS_URI is the test's plant-network
 // configuration.
@@ -42,6 +43,7 @@
 #include <exception>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -97,6 +99,10 @@ class PlantHost {
     for (;;) {
       client_.refresh();
       look();
+      if (samples_wanted_ && total_samples() >= *samples_wanted_) {
+        say("samples " + std::to_string(*samples_asked_));
+        samples_wanted_.reset();
+      }
       check_view();
       pollfd p{STDIN_FILENO, POLLIN, 0};
       if (::poll(&p, 1, 0) == 1) {
@@ -141,6 +147,12 @@ class PlantHost {
     }
   }
 
+  std::uint64_t total_samples() const {
+    std::uint64_t n = 0;
+    for (const auto& [k, known] : client_.pumps()) n += known.samples;
+    return n;
+  }
+
   // A change of the view is said once, when it happens.
   void check_view() {
     const auto now = Clock::now();
@@ -168,10 +180,12 @@ class PlantHost {
       in >> onoff;
       command(key, onoff == "on");
     } else if (verb == "status") {
-      std::uint64_t samples = 0;
-      for (const auto& [k, known] : client_.pumps()) samples += known.samples;
       say("status instances=" + std::to_string(client_.pumps().size()) +
-          " samples=" + std::to_string(samples));
+          " samples=" + std::to_string(total_samples()));
+    } else if (verb == "wait-samples") {
+      // The word after the verb, read as the rack.
+      samples_asked_ = std::stoull(key.rack);
+      samples_wanted_ = total_samples() + *samples_asked_;
     } else if (verb == "show") {
       const auto it = pumps_.find(key);
       say(node_line(key, it == pumps_.end() ? "none" : it->second.outputs));
@@ -206,6 +220,7 @@ class PlantHost {
   std::chrono::milliseconds fresh_;
   std::map<NodeKey, Pump> pumps_;
   bool complete_ = false;
+  std::optional<std::uint64_t> samples_wanted_, samples_asked_;
 };
 
 }  // namespace

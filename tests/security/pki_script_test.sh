@@ -93,9 +93,12 @@ echo "== rack scopes"
 # grant ROLE-NAME: that identity's grant.
 grant_of() { sed -n "/<grant name=\"$1\">/,/<\/grant>/p" "$pki/permissions.xml"; }
 for bad in "--monitor ops-2=rack-A" "--bridge rack-C=rack-C,rack-D" "--supervisor s=rack:A" \
-  "--supervisor s=" "--supervisor s=rack-A,,rack-B"; do
+  "--supervisor s=" "--supervisor s=rack-A,,rack-B" "--supervisor s=rack-A,"; do
   # shellcheck disable=SC2086 # the words of each case
+  roster_before=$(cat "$pki/roster")
   if run $bad; then fail "ran with $bad"; fi
+  grep -q "make-site-pki: --" "$work/out" || fail "no clear message for $bad: $(cat "$work/out")"
+  [ "$(cat "$pki/roster")" = "$roster_before" ] || fail "a refused $bad changed the roster"
   [ ! -e "$pki/hosts/s" ] && [ ! -e "$pki/hosts/ops-2" ] && [ ! -e "$pki/hosts/rack-C" ] ||
     fail "a refused $bad issued an identity"
 done

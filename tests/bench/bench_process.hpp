@@ -1,0 +1,273 @@
+#pragma once
+// What the benchmarks that run the bridge as a child process share: its
+// process seen from /proc (CPU time, by thread, RSS), starting and stopping
+// it, and pacing.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <poll.h>
+#include <sched.h>
+#include <signal.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "figures.hpp"
+
+namespace dnbridge::bench {
+
+// ---------------------------------------------------------------------------
+// Clocks
+
+inline void sleep_until_monotonic(std::int64_t t) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(t / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(t % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+// A duration given in microseconds, in the unit that reads best.
+inline std::string duration_text(double us) {
+  if (us >= 1e6) return fmt::format("{:.2f} s", us / 1e6);
+  if (us >= 1e3) return fmt::format("{:.2f} ms", us / 1e3);
+  return fmt::format("{:.1f} us", us);
+}
+
+// ---------------------------------------------------------------------------
+// The bridge's process, seen from /proc
+
+struct ThreadTimes {
+  std::string name;
+  std::uint64_t ticks = 0;     // utime + stime
+  std::uint64_t switches = 0;  // voluntary + involuntary context switches
+};
+
+// utime + stime (clock ticks) of a /proc/.../stat line; its name in `name`.
+inline std::optional<std::uint64_t> stat_ticks(const std::filesystem::path& stat,
+                                               std::string* name) {
+  std::ifstream f(stat);
+  std::string line;
+  if (!std::getline(f, line)) return std::nullopt;
+  const auto open = line.find('('), close = line.rfind(')');
+  if (open == std::string::npos || close == std::string::npos || close + 2 > line.size()) {
+    return std::nullopt;
+  }
+  if (name) *name = line.substr(open + 1, close - open - 1);
+  std::istringstream rest(line.substr(close + 2));
+  std::vector<std::string> fields{std::istream_iterator<std::string>(rest), {}};
+  // Fields 14 and 15 of the line (utime, stime) are 12 and 13 after the name.
+  if (fields.size() < 13) return std::nullopt;
+  return std::stoull(fields[11]) + std::stoull(fields[12]);
+}
+
+// A "Key:   value ..." line of /proc/.../status, its first number.
+inline std::uint64_t status_value(const std::filesystem::path& status, std::string_view key) {
+  std::ifstream f(status);
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.size() > key.size() && line.compare(0, key.size(), key) == 0 &&
+        line[key.size()] == ':') {
+      return std::stoull(line.substr(key.size() + 1));
+    }
+  }
+  return 0;
+}
+
+struct ProcessSample {
+  std::int64_t at = 0;       // monotonic ns
+  std::uint64_t ticks = 0;   // the whole process
+  std::uint64_t rss_kb = 0;  // VmRSS
+  std::map<pid_t, ThreadTimes> threads;
+};
+
+inline ProcessSample sample_process(pid_t pid) {
+  const std::filesystem::path dir = fmt::format("/proc/{}", pid);
+  ProcessSample s;
+  s.at = monotonic_ns();
+  s.ticks = stat_ticks(dir / "stat", nullptr).value_or(0);
+  s.rss_kb = status_value(dir / "status", "VmRSS");
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "task", ec)) {
+    ThreadTimes t;
+    const auto ticks = stat_ticks(entry.path() / "stat", &t.name);
+    if (!ticks) continue;  // ended meanwhile
+    t.ticks = *ticks;
+    t.switches = status_value(entry.path() / "status", "voluntary_ctxt_switches") +
+                 status_value(entry.path() / "status", "nonvoluntary_ctxt_switches");
+    s.threads[static_cast<pid_t>(std::stol(entry.path().filename().string()))] = t;
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------
+// The bridge as a child process
+
+inline pid_t spawn(const std::vector<std::string>& argv, int out_fd, int err_fd, int cpu) {
+  // Made before fork(): the child only calls what is safe after it.
+  std::vector<char*> args;
+  args.reserve(argv.size() + 1);
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    if (cpu >= 0) {
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      CPU_SET(static_cast<std::size_t>(cpu), &set);
+      if (sched_setaffinity(0, sizeof set, &set) != 0) _exit(126);
+    }
+    if (out_fd >= 0) dup2(out_fd, STDOUT_FILENO);
+    if (err_fd >= 0) dup2(err_fd, STDERR_FILENO);
+    execv(args[0], args.data());
+    static constexpr char kCannot[] = "dnbridge bench: cannot run the bridge\n";
+    (void)!write(STDERR_FILENO, kCannot, sizeof kCannot - 1);
+    _exit(127);
+  }
+  return pid;
+}
+
+inline std::string exit_text(int status) {
+  if (WIFEXITED(status)) return fmt::format("exit {}", WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) return fmt::format("killed by signal {}", WTERMSIG(status));
+  return "ended";
+}
+
+// `argv` run to its end: its standard output; its wait status in `status`.
+inline std::string run_capture(const std::vector<std::string>& argv, int* status) {
+  int fds[2] = {-1, -1};
+  if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  const pid_t pid = spawn(argv, fds[1], -1, -1);
+  close(fds[1]);
+  std::string out;
+  char chunk[4096];
+  for (;;) {
+    const ssize_t n = read(fds[0], chunk, sizeof chunk);
+    if (n > 0) {
+      out.append(chunk, static_cast<std::size_t>(n));
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  close(fds[0]);
+  *status = 0;
+  while (waitpid(pid, status, 0) < 0 && errno == EINTR) {
+  }
+  return out;
+}
+
+// `dnbridge --print-default-config`.
+inline std::string default_config_text(const std::string& dnbridge) {
+  int status = 0;
+  const std::string text = run_capture({dnbridge, "--print-default-config"}, &status);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || text.empty()) {
+    throw std::runtime_error(
+        fmt::format("{} --print-default-config failed ({})", dnbridge, exit_text(status)));
+  }
+  return text;
+}
+
+// The embedded default (`dnbridge --print-default-config`) on DDS domain `domain`.
+inline std::string default_config_on_domain(const std::string& dnbridge, int domain) {
+  const std::string text = default_config_text(dnbridge);
+  const std::regex domain_line(R"(^domain = \d+$)", std::regex::multiline);
+  if (!std::regex_search(text, domain_line)) {
+    throw std::runtime_error("the default configuration has no \"domain = N\" line");
+  }
+  return std::regex_replace(text, domain_line, fmt::format("domain = {}", domain));
+}
+
+// dnbridge running `config_text` (written to DIR/NAME.toml), its log
+// (standard error) in DIR/NAME.log, on CPU `cpu` (any: -1). Stopped with
+// SIGTERM, as systemd stops it.
+class BridgeProcess {
+ public:
+  BridgeProcess(const std::string& dnbridge, const std::string& config_text,
+                const std::filesystem::path& dir, const std::string& name, int cpu)
+      : config_(dir / (name + ".toml")), log_(dir / (name + ".log")) {
+    std::ofstream(config_) << config_text;
+    const int log_fd = open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (log_fd < 0) throw std::runtime_error("cannot create " + log_.string());
+    pid_ = spawn({dnbridge, "--config", config_.string()}, log_fd, log_fd, cpu);
+    close(log_fd);
+    pidfd_ = static_cast<int>(syscall(SYS_pidfd_open, pid_, 0));
+    if (pidfd_ < 0) {
+      kill(pid_, SIGKILL);
+      (void)reap();
+      throw std::runtime_error("pidfd_open failed (Linux 5.3 or later is needed)");
+    }
+  }
+  BridgeProcess(const BridgeProcess&) = delete;
+  BridgeProcess& operator=(const BridgeProcess&) = delete;
+  ~BridgeProcess() {
+    if (pid_ > 0) {
+      kill(pid_, SIGKILL);
+      (void)reap();
+    }
+    if (pidfd_ >= 0) close(pidfd_);
+  }
+
+  pid_t pid() const { return pid_; }
+  const std::filesystem::path& log_path() const { return log_; }
+  const std::filesystem::path& config_path() const { return config_; }
+
+  // Still running? Otherwise how it ended.
+  std::optional<std::string> ended() {
+    if (pid_ <= 0) return ended_;
+    pollfd p{pidfd_, POLLIN, 0};
+    if (::poll(&p, 1, 0) <= 0) return std::nullopt;
+    ended_ = exit_text(reap());
+    return ended_;
+  }
+
+  // SIGTERM (an orderly stop: nodes idled and released), then waits for the
+  // exit for at most `timeout_ms`; SIGKILL after that. How it ended.
+  std::string stop(int timeout_ms) {
+    if (pid_ <= 0) return ended_.value_or("ended");
+    kill(pid_, SIGTERM);
+    pollfd p{pidfd_, POLLIN, 0};
+    int n;
+    do {
+      n = ::poll(&p, 1, timeout_ms);
+    } while (n < 0 && errno == EINTR);
+    if (n == 0) {
+      kill(pid_, SIGKILL);
+      ended_ = exit_text(reap()) +
+               fmt::format(" (SIGKILL: not stopped {} ms after SIGTERM)", timeout_ms);
+      return *ended_;
+    }
+    ended_ = exit_text(reap());
+    return *ended_;
+  }
+
+ private:
+  int reap() {
+    int status = 0;
+    while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+    return status;
+  }
+
+  std::filesystem::path config_, log_;
+  pid_t pid_ = -1;
+  int pidfd_ = -1;
+  std::optional<std::string> ended_;
+};
+
+}  // namespace dnbridge::bench
