@@ -8,8 +8,9 @@
 //   - per bridge, over --window-seconds once all are online: CPU (utime +
 //     stime of the process, the simulated devices included) and RSS;
 //   - bytes per second on the loopback interface over the window
-//     (/proc/net/dev: all of it, which is the fleet's DDS traffic on an
-//     otherwise idle host);
+//     (/proc/net/dev, received: all of it, which is the fleet's DDS traffic
+//     on an otherwise idle host, discovery's announcements to participant
+//     indices nobody has included, and the kernel's ICMP answers to those);
 //   - `dnbctl racks --json` run once: its wall time, and how many racks it
 //     found.
 // Every participant is on the loopback interface with unicast discovery and
@@ -170,7 +171,7 @@ FleetFigures run_fleet(const Options& o, int racks, const std::string& default_t
   if (f.online_s >= 0) {
     // The window: every bridge's CPU and RSS, the loopback's bytes.
     std::vector<ProcessSample> before;
-    for (auto& b : bridges) before.push_back(sample_process(b->pid()));
+    for (auto& b : bridges) before.push_back(sample_process(b->pid(), false));
     const auto lo_before = loopback_bytes();
     const auto window_start = monotonic_ns();
     const auto window_end = window_start + static_cast<std::int64_t>(o.window_seconds * 1e9);
@@ -181,9 +182,15 @@ FleetFigures run_fleet(const Options& o, int racks, const std::string& default_t
     const auto lo_after = loopback_bytes();
     const double wall = static_cast<double>(monotonic_ns() - window_start) / 1e9;
     const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
+    for (auto& b : bridges) {
+      if (auto ended = b->ended()) throw std::runtime_error("a bridge ended: " + *ended);
+    }
     for (std::size_t i = 0; i < bridges.size(); ++i) {
-      const ProcessSample after = sample_process(bridges[i]->pid());
-      const double cpu = 100.0 * static_cast<double>(after.ticks - before[i].ticks) / tick / wall;
+      const ProcessSample after = sample_process(bridges[i]->pid(), false);
+      // Each over its own interval: the bridges are sampled one after another.
+      const double seconds = static_cast<double>(after.at - before[i].at) / 1e9;
+      const double cpu =
+          100.0 * static_cast<double>(after.ticks - before[i].ticks) / tick / seconds;
       f.cpu_mean += cpu / static_cast<double>(racks);
       f.cpu_max = std::max(f.cpu_max, cpu);
       const auto rss = static_cast<double>(after.rss_kb);
@@ -203,7 +210,10 @@ FleetFigures run_fleet(const Options& o, int racks, const std::string& default_t
     }
   }
 
-  for (auto& b : bridges) (void)kill(b->pid(), SIGTERM);
+  // All asked to stop at once (each then idles and releases its nodes).
+  for (auto& b : bridges) {
+    if (b->pid() > 0) (void)kill(b->pid(), SIGTERM);
+  }
   for (auto& b : bridges) {
     const std::string how = b->stop(20000);
     if (how != "exit 0") f.stops += (f.stops.empty() ? "" : "; ") + how;
@@ -226,6 +236,13 @@ int run(const Options& o) {
   const auto dir =
       std::filesystem::temp_directory_path() / fmt::format("dnbridge-fleet-bench-{}", getpid());
   std::filesystem::create_directories(dir);
+  struct RemoveDir {
+    std::filesystem::path dir;
+    ~RemoveDir() {
+      std::error_code ec;
+      std::filesystem::remove_all(dir, ec);
+    }
+  } remove_dir{dir};
   std::vector<FleetFigures> all;
   for (const int n : o.racks) {
     fmt::print("{} rack(s), {} pumps ...\n", n, n * static_cast<int>(kNodesPerRack));
@@ -261,7 +278,6 @@ int run(const Options& o) {
         f.cpu_max, f.rss_mean_kb, f.lo_bytes_per_s / 1e3 / f.racks, f.dnbctl_s, f.dnbctl_racks);
   }
   fmt::print("load average at end: {}\n", load_average());
-  std::filesystem::remove_all(dir);
   return 0;
 }
 

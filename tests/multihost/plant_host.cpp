@@ -28,8 +28,10 @@
 //        (it waits up to 5 s for the first).
 //   status      status instances=I samples=S
 //        PumpState instances seen, valid samples of them taken.
-//   show RACK PORT MAC   the node line of that pump (or "node RACK PORT MAC none")
-//   wait-samples N       samples N, once N more valid PumpState samples came
+//   show RACK PORT MAC   shown, then the node line of that pump as it is now
+//                        (its outputs "none" if never seen)
+//   wait-samples N       samples N, once every pump seen had N more valid
+//                        PumpState samples
 //
 // At the end of stdin it exits 0. CYCLONEDDS_URI is the test's plant-network
 // configuration.
@@ -99,9 +101,9 @@ class PlantHost {
     for (;;) {
       client_.refresh();
       look();
-      if (samples_wanted_ && total_samples() >= *samples_wanted_) {
+      if (samples_asked_ && every_pump_had(*samples_asked_)) {
         say("samples " + std::to_string(*samples_asked_));
-        samples_wanted_.reset();
+        samples_asked_.reset();
       }
       check_view();
       pollfd p{STDIN_FILENO, POLLIN, 0};
@@ -147,6 +149,15 @@ class PlantHost {
     }
   }
 
+  // Every pump seen when wait-samples was asked had `n` more samples since.
+  bool every_pump_had(std::uint64_t n) const {
+    for (const auto& [k, from] : samples_from_) {
+      const auto* known = client_.pump(k);
+      if (!known || known->samples < from + n) return false;
+    }
+    return true;
+  }
+
   std::uint64_t total_samples() const {
     std::uint64_t n = 0;
     for (const auto& [k, known] : client_.pumps()) n += known.samples;
@@ -171,27 +182,37 @@ class PlantHost {
   void answer(const std::string& line) {
     std::istringstream in(line);
     std::string verb;
-    NodeKey key;
-    unsigned mac = 0;
-    in >> verb >> key.rack >> key.port >> mac;
-    key.mac = static_cast<std::uint8_t>(mac);
-    if (verb == "command") {
-      std::string onoff;
-      in >> onoff;
-      command(key, onoff == "on");
+    in >> verb;
+    if (verb == "wait-samples") {
+      std::uint64_t n = 0;
+      if (in >> n && n > 0) {
+        samples_asked_ = n;
+        samples_from_.clear();
+        for (const auto& [k, known] : client_.pumps()) samples_from_[k] = known.samples;
+        return;
+      }
     } else if (verb == "status") {
       say("status instances=" + std::to_string(client_.pumps().size()) +
           " samples=" + std::to_string(total_samples()));
-    } else if (verb == "wait-samples") {
-      // The word after the verb, read as the rack.
-      samples_asked_ = std::stoull(key.rack);
-      samples_wanted_ = total_samples() + *samples_asked_;
-    } else if (verb == "show") {
-      const auto it = pumps_.find(key);
-      say(node_line(key, it == pumps_.end() ? "none" : it->second.outputs));
-    } else {
-      say("unknown " + line);
+      return;
     }
+    NodeKey key;
+    unsigned mac = 0;
+    if (in >> key.rack >> key.port >> mac && mac < 64) {
+      key.mac = static_cast<std::uint8_t>(mac);
+      if (verb == "command") {
+        std::string onoff;
+        in >> onoff;
+        command(key, onoff == "on");
+        return;
+      }
+      if (verb == "show") {
+        const auto it = pumps_.find(key);
+        say("shown " + node_line(key, it == pumps_.end() ? "none" : it->second.outputs));
+        return;
+      }
+    }
+    say("unknown " + line);
   }
 
   void command(const NodeKey& key, bool on) {
@@ -220,7 +241,8 @@ class PlantHost {
   std::chrono::milliseconds fresh_;
   std::map<NodeKey, Pump> pumps_;
   bool complete_ = false;
-  std::optional<std::uint64_t> samples_wanted_, samples_asked_;
+  std::optional<std::uint64_t> samples_asked_;
+  std::map<NodeKey, std::uint64_t> samples_from_;
 };
 
 }  // namespace
