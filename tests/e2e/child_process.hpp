@@ -16,6 +16,7 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 extern char** environ;
@@ -101,6 +102,25 @@ class ChildProcess {
     close(fd);
     if (n != 1) return std::nullopt;
     return wait();
+  }
+
+  // ChildOptions::capture_stderr: reads its stderr, appending to `seen`,
+  // until `text` is in `seen` (true) or `timeout` passed or stderr closed.
+  bool read_stderr_until(std::string& seen, std::string_view text,
+                         std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (seen.find(text) == std::string::npos) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          deadline - std::chrono::steady_clock::now());
+      if (stderr_ < 0 || left.count() <= 0) return false;
+      pollfd p{stderr_, POLLIN, 0};
+      if (poll(&p, 1, static_cast<int>(left.count())) != 1) return false;
+      char buf[4096];
+      const ssize_t n = read(stderr_, buf, sizeof buf);
+      if (n <= 0) return false;
+      seen.append(buf, static_cast<std::size_t>(n));
+    }
+    return true;
   }
 
   // ChildOptions::control: one line to its stdin ('\n' added).

@@ -63,25 +63,6 @@ TEST_F(BridgeTest, DnbridgeProcessServesTheSupervisorAndStopsInOrderOnSigterm) {
   std::filesystem::remove(config);
 }
 
-// What a child wrote to its standard error until `text` appeared in it, or
-// `timeout` passed (then the text is not in what is returned).
-std::string stderr_until(ChildProcess& child, std::string_view text, Duration timeout) {
-  std::string seen;
-  const auto deadline = SteadyClock::now() + timeout;
-  while (seen.find(text) == std::string::npos) {
-    const auto left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyClock::now());
-    if (left.count() <= 0) break;
-    pollfd p{child.stderr_fd(), POLLIN, 0};
-    if (::poll(&p, 1, static_cast<int>(left.count())) != 1) break;
-    char buf[1024];
-    const ssize_t n = ::read(child.stderr_fd(), buf, sizeof buf);
-    if (n <= 0) break;
-    seen.append(buf, static_cast<std::size_t>(n));
-  }
-  return seen;
-}
-
 // systemctl reload sends SIGHUP: the process reads its file again. One with
 // a problem changes nothing, says where (at error level) and the bridge
 // goes on; a good one is applied (a node renamed on DDS) without a restart.
@@ -100,7 +81,8 @@ TEST_F(BridgeTest, SighupReadsTheConfigurationFileAgain) {
   bad.replace(bad.find("poll_period_ms = 100"), 20, "poll_period_ms = -5");
   std::ofstream(config) << bad;
   ASSERT_TRUE(bridge.signal(SIGHUP));
-  const std::string log = stderr_until(bridge, "nothing changed", seconds(10));
+  std::string log;
+  bridge.read_stderr_until(log, "nothing changed", milliseconds(10000));
   EXPECT_NE(log.find("reload asked by SIGHUP"), std::string::npos) << log;
   EXPECT_NE(log.find(config.string() + ":"), std::string::npos) << log;
   EXPECT_NE(log.find("nothing changed"), std::string::npos) << log;

@@ -193,23 +193,6 @@ std::int64_t view_time(const std::string& line) {
   return t;
 }
 
-// A bridge's standard error, read until `text` appears or `timeout` passes.
-bool stderr_shows(ChildProcess& bridge, std::string& log, std::string_view text,
-                  milliseconds timeout) {
-  const auto deadline = Clock::now() + timeout;
-  while (log.find(text) == std::string::npos) {
-    const auto left = std::chrono::duration_cast<milliseconds>(deadline - Clock::now());
-    if (left.count() <= 0) return false;
-    pollfd p{bridge.stderr_fd(), POLLIN, 0};
-    if (::poll(&p, 1, static_cast<int>(left.count())) != 1) return false;
-    char buf[4096];
-    const ssize_t n = ::read(bridge.stderr_fd(), buf, sizeof buf);
-    if (n <= 0) return false;
-    log.append(buf, static_cast<std::size_t>(n));
-  }
-  return true;
-}
-
 // The plant: rack-a's and rack-b's bridges, the supervisory host sup-a and
 // the outsider, each on a host of its own; the supervisor has seen every
 // pump and rack-a's pump 1 is online.
@@ -319,7 +302,7 @@ class MultiHostTest : public ::testing::Test {
       return stale && (bridge_log || gone.size() == 2 * kPumpsPerRack);
     };
     if (bridge_log) {
-      EXPECT_TRUE(stderr_shows(*bridge_a_, log_a_, lost, milliseconds(30000))) << log_a_;
+      EXPECT_TRUE(bridge_a_->read_stderr_until(log_a_, lost, milliseconds(30000))) << log_a_;
     } else {  // `lost` only names it in the report
       EXPECT_TRUE(sup_->until(watch, milliseconds(30000))) << sup_->transcript();
     }
@@ -399,7 +382,7 @@ TEST_F(MultiHostTest, ASupervisorCommandsItsOwnRackOnly) {
                          security("sup-a").string(), "--rack", "rack-b", "pump", "1", "on"}),
       dnbctl_options);
   std::string dnbctl_says;
-  EXPECT_TRUE(stderr_shows(dnbctl, dnbctl_says, "Not Allowed By Security", milliseconds(20000)))
+  EXPECT_TRUE(dnbctl.read_stderr_until(dnbctl_says, "Not Allowed By Security", milliseconds(20000)))
       << dnbctl_says;
   EXPECT_NE(dnbctl.wait_for(milliseconds(20000)).value_or(0), 0) << dnbctl_says;
 
