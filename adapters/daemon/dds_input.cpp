@@ -96,7 +96,7 @@ void HandoffLogSink::write_structured(LogLevel level, std::string_view component
   ready_();
 }
 
-void HandoffLogSink::drain() {
+std::size_t HandoffLogSink::drain() {
   std::vector<Line> lines;
   std::size_t dropped = 0;
   {
@@ -109,10 +109,7 @@ void HandoffLogSink::drain() {
     for (const auto& [name, value] : l.fields) fields.push_back({name, value});
     target_.write_structured(l.level, l.component, l.message, fields);
   }
-  if (dropped > 0) {
-    target_.write(LogLevel::kWarn, "dds input",
-                  fmt::format("{} more lines of the command path not logged", dropped));
-  }
+  return dropped;
 }
 
 DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
@@ -187,7 +184,14 @@ void DdsInput::stop() {
   if (!thread_.joinable()) return;
   (void)stop_.trigger();
   thread_.join();
-  command_sink_.drain();
+  drain_command_log();
+}
+
+void DdsInput::drain_command_log() {
+  if (const auto dropped = command_sink_.drain(); dropped > 0) {
+    log_.warn("{} more lines of the command path not logged (more than {} waited)", dropped,
+              HandoffLogSink::kCapacity);
+  }
 }
 
 port::PortLoop* DdsInput::port_of(std::string_view name) {
@@ -223,7 +227,7 @@ void DdsInput::run() {
       if (token == kReloadRequests) take_reload_requests();
       if (token == kLogWaiting) {
         (void)log_waiting_.take_triggered();
-        command_sink_.drain();
+        drain_command_log();
       }
     }
     if (commands_held && port::steady_now() >= TimePoint{Duration(next_command_take_.load())}) {

@@ -40,8 +40,10 @@ class HandoffLogSink : public LogSink {
   }
   void write_structured(LogLevel level, std::string_view component, std::string_view message,
                         std::span<const LogField> fields) override;
-  // Writes what waits to the target (the draining thread).
-  void drain();
+  // Writes what waits to the target (the draining thread), in the order it
+  // was written; returns how many lines were dropped since the last drain,
+  // for the drainer to say with its own logger.
+  std::size_t drain();
 
  private:
   struct Line {
@@ -84,6 +86,9 @@ class DdsInput {
   // it (then that one does) or the hold-off is on (then the input thread
   // does at its end). Any thread.
   void deliver_commands();
+  // Logs the command path's waiting lines (HandoffLogSink), and how many
+  // were dropped, with this input's logger.
+  void drain_command_log();
   void take_commands();
   bool take_requests();  // true when requests may remain
   void take_scan_requests();

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "adapters/daemon/dds_input.hpp"
+
 namespace dnbridge::daemon {
 namespace {
 
@@ -105,6 +107,41 @@ TEST(Logger, FieldsAreKeptReplacedAndBounded) {
   for (int i = 0; i < 20; ++i) log = log.with("F" + std::to_string(i), "v");
   log.info("x");
   EXPECT_EQ(sink.fields.size(), Logger::kMaxFields);
+}
+
+// The command path's lines, written on Cyclone's thread, are said on the
+// input thread: in the order written, with their fields, at most kCapacity
+// between two drains; the others are counted for the drainer to say.
+TEST(HandoffLogSink, KeepsOrderAndFieldsAndCountsWhatItDrops) {
+  class Capture final : public LogSink {
+   public:
+    bool enabled(LogLevel) const noexcept override { return true; }
+    void write(LogLevel, std::string_view, std::string_view) override {}
+    void write_structured(LogLevel, std::string_view component, std::string_view message,
+                          std::span<const LogField> f) override {
+      std::string line = std::string(component) + ": " + std::string(message);
+      for (const auto& x : f) line += " " + std::string(x.name) + "=" + std::string(x.value);
+      lines.push_back(line);
+    }
+    std::vector<std::string> lines;
+  } target;
+  int signalled = 0;
+  HandoffLogSink sink(target, [&] { ++signalled; });
+  Logger log = Logger(sink, "dds input").with("RACK", "r1");
+  const std::size_t written = HandoffLogSink::kCapacity + 3;
+  for (std::size_t i = 0; i < written; ++i) log.warn("line {}", i);
+  EXPECT_TRUE(target.lines.empty());  // nothing said on the writing thread
+  EXPECT_EQ(signalled, static_cast<int>(HandoffLogSink::kCapacity));
+  EXPECT_EQ(sink.drain(), 3u);
+  ASSERT_EQ(target.lines.size(), HandoffLogSink::kCapacity);
+  for (std::size_t i = 0; i < target.lines.size(); ++i) {
+    EXPECT_EQ(target.lines[i], "dds input: line " + std::to_string(i) + " RACK=r1");
+  }
+  // The count starts again: a drain with nothing waiting drops nothing.
+  EXPECT_EQ(sink.drain(), 0u);
+  log.warn("after");
+  EXPECT_EQ(sink.drain(), 0u);
+  EXPECT_EQ(target.lines.back(), "dds input: after RACK=r1");
 }
 
 }  // namespace

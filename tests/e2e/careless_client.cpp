@@ -38,6 +38,14 @@
 //       turn), prints "sent OK FAILED" (writes that succeeded and failed);
 //       answers the line "status" with "rejected N" (replies its reader
 //       rejected); stays until the end of stdin.
+//   flood ISSUER STRENGTH COUNT
+//       a commander that writes COUNT PumpCommands back to back, with the
+//       documented command writer QoS and that strength, round robin over
+//       pumps 1..4 (pump on, analog output the command's number modulo
+//       4096), then one
+//       more for each of them (pump on, n2 ballast on, analog 4000 + MAC);
+//       prints "written" once all are acknowledged; stays until the end of
+//       stdin.
 //   three-writers STRENGTH LEASE_MS READERS
 //       three PumpCommand writers in this one participant with the documented
 //       command writer QoS, writer N commanding pump N on (analog 100 x N,
@@ -242,6 +250,33 @@ int stall_replies(dds_domainid_t domain, const std::string& requester, std::uint
   std::_Exit(0);
 }
 
+int flood(dds_domainid_t domain, const std::string& issuer, std::int32_t strength,
+          std::uint32_t count) {
+  constexpr unsigned kFloodPumps = 4;
+  dds::Participant participant(domain, dds::Participant::ClientName{"flood"});
+  dds::Topic<dnbridge_PumpCommand> topic(participant);
+  dds::Writer<dnbridge_PumpCommand> writer(
+      participant, topic,
+      dds::command_writer_qos(e2e::sim_rack_partitions(), strength, seconds(10)));
+  await_reader(participant, writer, "the PumpCommand writer");
+  const auto write = [&](const dds::Owned<dnbridge_PumpCommand>& command) {
+    if (!writer.write(*command)) fail("writing a command");
+  };
+  for (std::uint32_t i = 0; i < count; ++i) {
+    write(pump_command(1 + i % kFloodPumps, true, false, static_cast<std::uint16_t>(i % 4096),
+                       issuer));
+  }
+  for (unsigned mac = 1; mac <= kFloodPumps; ++mac) {
+    write(pump_command(mac, true, true, static_cast<std::uint16_t>(4000 + mac), issuer));
+  }
+  if (!writer.wait_for_acks(kAckTimeout)) fail("the commands were not acknowledged");
+  say("written");
+  std::string line;
+  while (next_line(line)) {
+  }
+  return 0;
+}
+
 int three_writers(dds_domainid_t domain, std::int32_t strength, Duration lease,
                   std::uint32_t readers) {
   dds::Participant participant(domain, dds::Participant::ClientName{"three writers"});
@@ -286,6 +321,7 @@ int usage() {
   std::cerr << "usage: dnbridge_careless_client DOMAIN ahead MAC STRENGTH LEASE_MS AHEAD_S ISSUER\n"
                "       dnbridge_careless_client DOMAIN requests REQUESTER COUNT\n"
                "       dnbridge_careless_client DOMAIN stall-replies REQUESTER REPEATS GETS\n"
+               "       dnbridge_careless_client DOMAIN flood ISSUER STRENGTH COUNT\n"
                "       dnbridge_careless_client DOMAIN three-writers STRENGTH LEASE_MS READERS\n";
   return 2;
 }
@@ -305,6 +341,10 @@ int run(const std::vector<std::string>& args) {
   if (mode == "stall-replies" && args.size() == 5) {
     return stall_replies(domain, args[2], static_cast<std::uint32_t>(number(3)),
                          static_cast<std::uint32_t>(number(4)));
+  }
+  if (mode == "flood" && args.size() == 5) {
+    return flood(domain, args[2], static_cast<std::int32_t>(number(3)),
+                 static_cast<std::uint32_t>(number(4)));
   }
   if (mode == "three-writers" && args.size() == 5) {
     return three_writers(domain, static_cast<std::int32_t>(number(2)), milliseconds(number(3)),

@@ -690,5 +690,22 @@ TEST_F(CarelessClientTest, DeletingTwoWritersOfAParticipantIdlesThePumpOfItsThir
   EXPECT_TRUE(idle(2));
 }
 
+// 6. A flood of commands from another process: Cyclone's receive thread there
+// hands them to the bridge's listener while the bridge's input thread may be
+// taking the ones the flood hold-off kept back. None is stranded in the
+// reader: every pump ends with the last command written for it.
+TEST_F(CarelessClientTest, AFloodFromAnotherProcessEndsWithEveryPumpsNewestCommand) {
+  ASSERT_NO_FATAL_FAILURE(start_bridge());
+  auto& client = careless({"flood", "flood", "10", "5000"});
+  ASSERT_EQ(client.read_line(milliseconds(30000)), "written");
+  ASSERT_TRUE(pumps_.until([&] {
+    for (unsigned mac = 1; mac <= 4; ++mac) {
+      if (!echoes(mac, true, true, static_cast<std::uint16_t>(4000 + mac), "flood")) return false;
+    }
+    return true;
+  })) << "a pump did not end with its newest command";
+  ASSERT_TRUE(careless_->running());
+}
+
 }  // namespace
 }  // namespace dnbridge::e2e
