@@ -2,7 +2,9 @@
 // What the benchmarks that run the bridge as a child process share: its
 // process seen from /proc (CPU time, by thread, RSS), starting and stopping
 // it, and pacing.
+#include <dds/version.h>
 #include <fcntl.h>
+#include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <poll.h>
 #include <sched.h>
@@ -12,8 +14,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -24,6 +28,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include "figures.hpp"
@@ -46,6 +51,45 @@ inline std::string duration_text(double us) {
   if (us >= 1e6) return fmt::format("{:.2f} s", us / 1e6);
   if (us >= 1e3) return fmt::format("{:.2f} ms", us / 1e3);
   return fmt::format("{:.1f} us", us);
+}
+
+// The first lines of every report: what ran, when and where, on which
+// Cyclone DDS (domain and discovery tag when given), and how busy the machine
+// was: figures are only as good as the machine is quiet.
+inline void print_run_header(std::string_view title, int domain = -1, std::string_view tag = {}) {
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  fmt::print("{}, {:%Y-%m-%d %H:%M:%S} UTC, host {}, {} CPU(s)\n", title,
+             fmt::gmtime(std::time(nullptr)), host, std::thread::hardware_concurrency());
+  fmt::print("DDS: Cyclone DDS {}, loopback only (lo, unicast discovery){}\n", DDS_VERSION,
+             domain >= 0 ? fmt::format(", domain {}, tag {}", domain, tag) : std::string());
+  fmt::print("load average at start: {}\n", load_average());
+}
+
+// Keeps the calling thread, and the threads and processes it starts after,
+// on one CPU (none: -1).
+inline bool pin_to_cpu(int cpu) {
+  if (cpu < 0) return true;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(static_cast<std::size_t>(cpu), &set);
+  return sched_setaffinity(0, sizeof set, &set) == 0;
+}
+
+// Asks the kernel to keep every CPU out of idle states that take longer than
+// 0 us to leave, for as long as the returned descriptor is open (the PM QoS
+// interface that latency tools such as cyclictest use): a CPU woken from a
+// halt, on a virtual machine above all, adds tens of microseconds to a
+// hand-over between threads, whatever the software. -1 when refused.
+inline int hold_cpus_awake() {
+  const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  const std::int32_t zero = 0;
+  if (write(fd, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
+    close(fd);
+    return -1;
+  }
+  return fd;
 }
 
 // ---------------------------------------------------------------------------
@@ -125,6 +169,7 @@ inline pid_t spawn(const std::vector<std::string>& argv, int out_fd, int err_fd,
   args.reserve(argv.size() + 1);
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
+  const std::string cannot = "dnbridge bench: cannot run " + argv.at(0) + "\n";
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
@@ -136,13 +181,95 @@ inline pid_t spawn(const std::vector<std::string>& argv, int out_fd, int err_fd,
     }
     if (out_fd >= 0) dup2(out_fd, STDOUT_FILENO);
     if (err_fd >= 0) dup2(err_fd, STDERR_FILENO);
-    execv(args[0], args.data());
-    static constexpr char kCannot[] = "dnbridge bench: cannot run the bridge\n";
-    (void)!write(STDERR_FILENO, kCannot, sizeof kCannot - 1);
+    execvp(args[0], args.data());
+    (void)!write(STDERR_FILENO, cannot.data(), cannot.size());
     _exit(127);
   }
   return pid;
 }
+
+// A child process; its standard output when captured.
+struct Child {
+  pid_t pid = -1;
+  int out = -1;
+};
+
+// Runs `argv` (a path, or a name looked up in PATH) on CPU `cpu` (any: -1)
+// with standard output to a pipe (capture) or /dev/null, standard error
+// inherited. Throws on failure to start.
+inline Child spawn_child(const std::vector<std::string>& argv, bool capture, int cpu) {
+  int fds[2] = {-1, -1};
+  if (capture) {
+    if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  } else {
+    fds[1] = open("/dev/null", O_WRONLY | O_CLOEXEC);
+  }
+  Child c;
+  try {
+    c.pid = spawn(argv, fds[1], -1, cpu);
+  } catch (...) {
+    if (fds[0] >= 0) close(fds[0]);
+    if (fds[1] >= 0) close(fds[1]);
+    throw;
+  }
+  if (fds[1] >= 0) close(fds[1]);
+  c.out = fds[0];
+  return c;
+}
+
+// Exit status of a child (-1 when killed by a signal).
+inline int wait_child(pid_t pid) {
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Reads a child's output line by line, each read bounded by a deadline.
+class LineReader {
+ public:
+  explicit LineReader(int fd) : fd_(fd) {}
+  // The next line; nullopt at end of file or when `deadline` (monotonic ns)
+  // passes first (timed_out() tells which).
+  std::optional<std::string> next(std::int64_t deadline) {
+    for (;;) {
+      if (auto pos = buffer_.find('\n', start_); pos != std::string::npos) {
+        std::string line = buffer_.substr(start_, pos - start_);
+        start_ = pos + 1;
+        return line;
+      }
+      // What was returned goes before more is read: a long output is not
+      // moved once per line.
+      buffer_.erase(0, start_);
+      start_ = 0;
+      if (eof_) return std::nullopt;
+      const auto left = deadline - monotonic_ns();
+      if (left <= 0) {
+        timed_out_ = true;
+        return std::nullopt;
+      }
+      pollfd p{fd_, POLLIN, 0};
+      const int n =
+          ::poll(&p, 1, static_cast<int>(std::min<std::int64_t>(left / 1'000'000 + 1, 1000)));
+      if (n <= 0) continue;
+      char chunk[65536];
+      const ssize_t got = ::read(fd_, chunk, sizeof chunk);
+      if (got <= 0) {
+        eof_ = true;
+        continue;
+      }
+      buffer_.append(chunk, static_cast<std::size_t>(got));
+    }
+  }
+  bool timed_out() const { return timed_out_; }
+
+ private:
+  int fd_;
+  std::string buffer_;
+  std::size_t start_ = 0;  // where the next line begins in buffer_
+  bool eof_ = false;
+  bool timed_out_ = false;
+};
 
 inline std::string exit_text(int status) {
   if (WIFEXITED(status)) return fmt::format("exit {}", WEXITSTATUS(status));

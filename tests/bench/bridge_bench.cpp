@@ -2,13 +2,18 @@
 // DDS itself costs on the same machine in the same run.
 //
 //   (0) Cyclone's own one-way latency: ddsperf ping and pong (two processes,
-//       waitset mode, on loopback), one-way = round trip / 2, run beside each
-//       latency measurement below, over the same seconds.
+//       waitset mode, on loopback), one-way = round trip / 2 (ddsperf prints
+//       its round trips halved already), run beside each latency
+//       measurement below, over the same seconds.
 //   (0b) Cyclone alone on the path of a command: PumpCommands written by the
 //       commander process, taken here, nothing behind it, twice: on a
 //       waitset thread, and by a listener on Cyclone's thread (as the bridge
 //       takes them); one way, measured on CLOCK_MONOTONIC at both ends. The
 //       bridge's own addition to (2) is measured against the listener's.
+//   (0c) Cyclone alone on the state path: PumpStates written in this process
+//       with the bridge's QoS, in the pattern of (1)'s poll responses, taken
+//       by the subscriber process as in (1); the bridge's own addition to (1)
+//       is measured against it.
 //   (1) poll response received by the master -> PumpState taken by a
 //       subscriber in another process: wall clock at take - source timestamp
 //       (the bridge stamps each sample with the CAN receive time of the poll
@@ -19,9 +24,14 @@
 //       and arbitration): both ends on CLOCK_MONOTONIC, which the two
 //       processes share. Commands come at random gaps, so that they meet the
 //       poll schedule at every phase. (1) and (2) are measured with polls
-//       every 10 ms and every 100 ms (the shipped default).
+//       every 10 ms and every 100 ms (the shipped default). Commands that
+//       meet a poll in flight: from its response to the new poll written.
 //   (3) CPU time of the bridge per second of wall time, 4 ports x 63 nodes
-//       polled every 10 ms, the simulated devices' threads left out.
+//       polled every 10 ms, the simulated devices' threads left out; (3b)
+//       the same with a PumpState per poll; (3c) Cyclone alone writing (3b)'s
+//       samples, CPU per sample, which splits (3b)'s cost per sample into
+//       Cyclone's write and the bridge's own work; (3d) (3c) with Cyclone's
+//       write batching.
 //
 // The bridge runs in this process (daemon::Daemon, configuration built here,
 // each port on a ThreadedSimBackend: the simulated bus and devices on a
@@ -84,10 +94,12 @@
 #include "adapters/dds/waitset.hpp"
 #include "adapters/dds/writer.hpp"
 #include "adapters/sim/world/threaded_sim_backend.hpp"
+#include "bench_process.hpp"
 #include "bridge/can/can_timing.hpp"
 #include "bridge/devicenet/wire/identifier.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
+#include "ddsperf.hpp"
 #include "figures.hpp"
 
 namespace dnbridge::bench {
@@ -117,14 +129,6 @@ bool steady_clock_is_monotonic() {
     if (s < a || s > b) return false;
   }
   return true;
-}
-
-void sleep_until_monotonic(std::int64_t t) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(t / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(t % 1'000'000'000);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
 }
 
 // Where the process's CPU time goes, thread by thread (/proc: clock ticks,
@@ -168,266 +172,9 @@ std::map<pid_t, ThreadSample> snapshot_threads() {
 pid_t this_thread_id() { return static_cast<pid_t>(gettid()); }
 
 // ---------------------------------------------------------------------------
-// Child processes
-
-struct Child {
-  pid_t pid = -1;
-  int out = -1;  // its standard output, when captured
-};
-
-// Keeps the calling thread, and the threads and processes it starts after,
-// on one CPU (none: -1).
-bool pin_to_cpu(int cpu) {
-  if (cpu < 0) return true;
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(static_cast<std::size_t>(cpu), &set);
-  return sched_setaffinity(0, sizeof set, &set) == 0;
-}
-
-// Asks the kernel to keep every CPU out of idle states that take longer than
-// 0 us to leave, for as long as the returned descriptor is open (the PM QoS
-// interface that latency tools such as cyclictest use): a CPU woken from a
-// halt, on a virtual machine above all, adds tens of microseconds to a
-// hand-over between threads, whatever the software. -1 when refused.
-int hold_cpus_awake() {
-  const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
-  if (fd < 0) return -1;
-  const std::int32_t zero = 0;
-  if (write(fd, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
-    close(fd);
-    return -1;
-  }
-  return fd;
-}
-
-// Runs `argv` on CPU `cpu` (any: -1) with standard output to a pipe (capture)
-// or /dev/null, standard error inherited. Throws on failure to start.
-Child spawn(const std::vector<std::string>& argv, bool capture, int cpu) {
-  int fds[2] = {-1, -1};
-  if (capture && pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
-  if (pid == 0) {
-    if (!pin_to_cpu(cpu)) _exit(126);
-    if (capture) {
-      dup2(fds[1], STDOUT_FILENO);
-    } else {
-      const int null = open("/dev/null", O_WRONLY);
-      if (null >= 0) dup2(null, STDOUT_FILENO);
-    }
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    execvp(args[0], args.data());
-    std::fprintf(stderr, "dnbridge-bench: cannot run %s\n", argv[0].c_str());
-    _exit(127);
-  }
-  Child c;
-  c.pid = pid;
-  if (capture) {
-    close(fds[1]);
-    c.out = fds[0];
-  }
-  return c;
-}
-
-// Exit status of a child (-1 when killed by a signal).
-int wait_child(pid_t pid) {
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-// Reads a child's output line by line, each read bounded by a deadline.
-class LineReader {
- public:
-  explicit LineReader(int fd) : fd_(fd) {}
-  // The next line; nullopt at end of file or when `deadline` (monotonic ns)
-  // passes first (timed_out() tells which).
-  std::optional<std::string> next(std::int64_t deadline) {
-    for (;;) {
-      if (auto pos = buffer_.find('\n'); pos != std::string::npos) {
-        std::string line = buffer_.substr(0, pos);
-        buffer_.erase(0, pos + 1);
-        return line;
-      }
-      if (eof_) return std::nullopt;
-      const auto left = deadline - monotonic_ns();
-      if (left <= 0) {
-        timed_out_ = true;
-        return std::nullopt;
-      }
-      pollfd p{fd_, POLLIN, 0};
-      const int n =
-          ::poll(&p, 1, static_cast<int>(std::min<std::int64_t>(left / 1'000'000 + 1, 1000)));
-      if (n <= 0) continue;
-      char chunk[65536];
-      const ssize_t got = ::read(fd_, chunk, sizeof chunk);
-      if (got <= 0) {
-        eof_ = true;
-        continue;
-      }
-      buffer_.append(chunk, static_cast<std::size_t>(got));
-    }
-  }
-  bool timed_out() const { return timed_out_; }
-
- private:
-  int fd_;
-  std::string buffer_;
-  bool eof_ = false;
-  bool timed_out_ = false;
-};
-
-// ---------------------------------------------------------------------------
 // DDS set-up shared by every process of the run
 
 constexpr const char* kRack = "bench";
-
-// ---------------------------------------------------------------------------
-// (0) Cyclone's own latency: ddsperf
-
-struct DdsperfWindow {
-  double min, p50, p90, p99, max;  // round trip, us
-  double count;
-};
-
-struct DdsperfResult {
-  std::vector<DdsperfWindow> windows;  // the first (warm-up) window left out
-  double rtt_p50 = 0, rtt_p99 = 0, rtt_max = 0;
-  double samples = 0;
-  std::string command;
-};
-
-// ddsperf prints, once a second, the round trips of that second: mean, min,
-// 50 %, 90 %, 99 %, max and count; it prints no figure over the whole run.
-// The run's percentiles are computed from the windows: each window's
-// distribution is taken as piecewise linear between its reported quantiles,
-// the windows are pooled weighted by their counts, and the pooled
-// distribution is inverted.
-double pooled_quantile(const std::vector<DdsperfWindow>& ws, double q) {
-  auto window_cdf = [](const DdsperfWindow& w, double x) {
-    const std::array<double, 5> xs{w.min, w.p50, w.p90, w.p99, w.max};
-    const std::array<double, 5> qs{0.0, 0.5, 0.9, 0.99, 1.0};
-    if (x < xs[0]) return 0.0;
-    if (x >= xs[4]) return 1.0;
-    for (std::size_t i = 1; i < xs.size(); ++i) {
-      if (x < xs[i]) {
-        const double span = xs[i] - xs[i - 1];
-        return span > 0 ? qs[i - 1] + (qs[i] - qs[i - 1]) * (x - xs[i - 1]) / span : qs[i];
-      }
-    }
-    return 1.0;
-  };
-  double lo = ws.front().min, hi = ws.front().max, total = 0;
-  for (const auto& w : ws) {
-    lo = std::min(lo, w.min);
-    hi = std::max(hi, w.max);
-    total += w.count;
-  }
-  for (int i = 0; i < 100; ++i) {
-    const double mid = (lo + hi) / 2;
-    double f = 0;
-    for (const auto& w : ws) f += w.count * window_cdf(w, mid);
-    (f / total < q ? lo : hi) = mid;
-  }
-  return hi;
-}
-
-// Which CPU the measured process (the bridge; ddsperf pong) and its peer (the
-// subscriber and commander; ddsperf ping) run on; -1: wherever the kernel
-// puts them.
-struct Placement {
-  int tested = -1;
-  int peer = -1;
-};
-
-// ddsperf ping and pong, run beside a measurement of the bridge: started when
-// the measurement starts, read when it ends, so that both see the same
-// machine at the same time.
-class Ddsperf {
- public:
-  Ddsperf(int domain, double seconds, int rate_hz, int size, Placement cpus) {
-    const std::string d = std::to_string(domain);
-    const auto run_s = static_cast<int>(std::ceil(seconds)) + 2;
-    // pong outlives ping; ping waits (initwait) for its pong before it starts.
-    pong_ = spawn({"ddsperf", "-i", d, "-D", std::to_string(run_s + 15), "pong", "waitset"}, false,
-                  cpus.tested);
-    std::vector<std::string> ping_args{"ddsperf",
-                                       "-i",
-                                       d,
-                                       "-Qminmatch:1",
-                                       "-Qinitwait:10",
-                                       "-D",
-                                       std::to_string(run_s),
-                                       "ping",
-                                       std::to_string(rate_hz) + "Hz",
-                                       "size",
-                                       std::to_string(size),
-                                       "waitset"};
-    for (std::size_t i = 1; i < ping_args.size(); ++i) command_ += ping_args[i] + " ";
-    ping_ = spawn(ping_args, true, cpus.peer);
-    deadline_ = monotonic_ns() + static_cast<std::int64_t>((run_s + 30) * 1e9);
-  }
-  Ddsperf(const Ddsperf&) = delete;
-  Ddsperf& operator=(const Ddsperf&) = delete;
-  ~Ddsperf() {
-    if (ping_.pid > 0) {
-      kill(ping_.pid, SIGKILL);
-      (void)wait_child(ping_.pid);
-      close(ping_.out);
-    }
-    if (pong_.pid > 0) {
-      kill(pong_.pid, SIGKILL);
-      (void)wait_child(pong_.pid);
-    }
-  }
-
-  // Reads ping's report to its end (the run's length) and stops pong.
-  DdsperfResult finish() {
-    DdsperfResult r;
-    r.command = command_;
-    LineReader lines(ping_.out);
-    const std::regex re(
-        R"(size \d+ mean [\d.]+us min ([\d.]+)us 50% ([\d.]+)us 90% ([\d.]+)us 99% ([\d.]+)us max ([\d.]+)us cnt (\d+))");
-    bool first = true;
-    while (auto line = lines.next(deadline_)) {
-      std::smatch m;
-      if (!std::regex_search(*line, m, re)) continue;
-      if (first) {  // discovery and warm-up
-        first = false;
-        continue;
-      }
-      r.windows.push_back({std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]),
-                           std::stod(m[5]), std::stod(m[6])});
-    }
-    close(ping_.out);
-    if (lines.timed_out()) kill(ping_.pid, SIGKILL);
-    const int ping_status = wait_child(ping_.pid);
-    ping_.pid = -1;
-    kill(pong_.pid, SIGTERM);
-    (void)wait_child(pong_.pid);
-    pong_.pid = -1;
-    if (ping_status != 0 || r.windows.empty()) {
-      throw std::runtime_error(
-          fmt::format("ddsperf ping failed (exit {}, {} windows)", ping_status, r.windows.size()));
-    }
-    for (const auto& w : r.windows) {
-      r.samples += w.count;
-      r.rtt_max = std::max(r.rtt_max, w.max);
-    }
-    r.rtt_p50 = pooled_quantile(r.windows, 0.50);
-    r.rtt_p99 = pooled_quantile(r.windows, 0.99);
-    return r;
-  }
-
- private:
-  Child pong_, ping_;
-  std::string command_;
-  std::int64_t deadline_ = 0;
-};
 
 // ---------------------------------------------------------------------------
 // The client process: subscriber and commander
@@ -456,8 +203,12 @@ int run_client(const ClientOptions& o) {
   waitset.attach(any, 1);
   waitset.attach(stop, 2);
 
-  // "oneway": no bridge, only a reader of the commands to match.
+  // "oneway": no bridge, only a reader of the commands to match. "state": no
+  // bridge, PumpStates written by the benchmark with the bridge's QoS, and
+  // no command reader to match.
   const bool commanding = o.mode == "latency" || o.mode == "oneway";
+  const bool state_latency = o.mode == "latency" || o.mode == "state";
+  const bool command_reader = o.mode != "state";
   const std::size_t expected = o.mode == "oneway" ? 0 : o.ports.size() * o.nodes;
   auto key_of = [&](const dnbridge_PumpState& s) -> std::optional<std::size_t> {
     for (std::size_t p = 0; p < o.ports.size(); ++p) {
@@ -507,7 +258,7 @@ int run_client(const ClientOptions& o) {
         if (!counting) continue;
         taken.fetch_add(1, std::memory_order_relaxed);
         // A new analog value: the sample of a new poll response.
-        if (o.mode == "latency" && is_ready && fresh) {
+        if (state_latency && is_ready && fresh) {
           latencies.push_back((now - s.info().source_timestamp()).count());
         }
       }
@@ -523,7 +274,8 @@ int run_client(const ClientOptions& o) {
 
   // Every node online and its inputs read, and the bridge's command reader matched.
   const auto online_deadline = monotonic_ns() + 90'000'000'000;
-  while (ready_count.load() < expected || writer.matched_subscriptions().value_or(0) == 0) {
+  while (ready_count.load() < expected ||
+         (command_reader && writer.matched_subscriptions().value_or(0) == 0)) {
     if (monotonic_ns() > online_deadline) return fail("not every node came online within 90 s");
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
@@ -591,13 +343,15 @@ int run_client(const ClientOptions& o) {
   (void)stop.trigger();
   taker.join();
 
+  // "taken" first: the benchmark ends a CPU window on it, before it reads
+  // the rest.
   std::string out;
   out.reserve(latencies.size() * 12 + written.size() * 32 + 256);
+  out += fmt::format("taken {} {}\n", taken.load(), elapsed);
   for (auto l : latencies) out += fmt::format("state {}\n", l);
   if (commanding) {
     for (const auto& w : written) out += fmt::format("cmd {} {} {}\n", w.mac, w.value, w.at);
   }
-  out += fmt::format("taken {} {}\n", taken.load(), elapsed);
   out += "done\n";
   std::fwrite(out.data(), 1, out.size(), stdout);
   std::fflush(stdout);
@@ -633,6 +387,7 @@ struct PortWire {
     // outputs waited for the poll in flight (a poll connection carries one
     // poll at a time).
     bool after_response;
+    std::int64_t response_rx;  // then: that response's receive time, steady clock
   };
   std::mutex mutex;
   std::vector<OutputFrame> output_frames;
@@ -653,27 +408,32 @@ struct PortWire {
   }
 
   // On the port's thread: the first poll frame of each new output value, as
-  // the master writes it.
-  void on_written(const can::CanFrame& frame, TimePoint at) {
+  // the master writes it, stamped when it is written (the time the master
+  // hands with it is its loop's time, which can be earlier).
+  void on_written(const can::CanFrame& frame) {
     if (!record_outputs) return;
+    const auto at = steady_ns();
     const auto out = output_of(frame);
     if (!out || static_cast<int>(out->second) == last_written[out->first]) return;
     last_written[out->first] = static_cast<int>(out->second);
     std::lock_guard lock(mutex);
-    written_frames.push_back({out->first, out->second, at.time_since_epoch().count(),
-                              static_cast<int>(out->first) == answering_mac});
+    const bool after_response = static_cast<int>(out->first) == answering_mac;
+    written_frames.push_back(
+        {out->first, out->second, at, after_response, after_response ? answering_rx : 0});
   }
 
   // On the port's thread: the MAC whose poll response the master is being
   // handed, while it is (-1 otherwise). A frame written then was sent in
   // answer to it.
   int answering_mac = -1;
-  void on_receiving(const can::CanFrame& frame) {
+  std::int64_t answering_rx = 0;
+  void on_receiving(const can::CanFrame& frame, TimePoint rx_time) {
     const auto id = devicenet::decode_identifier(frame.id);
     const bool response =
         id && id->group == devicenet::MessageGroup::k1 &&
         id->message_id == static_cast<std::uint8_t>(devicenet::Group1Message::kSlavePollResponse);
     answering_mac = response ? id->mac.value() : -1;
+    answering_rx = rx_time.time_since_epoch().count();
   }
   void on_received() { answering_mac = -1; }
 
@@ -733,7 +493,7 @@ class WrittenFramesBackend final : public port::CanBackend {
    public:
     Sink(can::FrameSink& inner, PortWire& wire) : inner_(inner), wire_(wire) {}
     void send(const can::CanFrame& frame, TimePoint now) override {
-      wire_.on_written(frame, now);
+      wire_.on_written(frame);
       inner_.send(frame, now);
     }
 
@@ -745,7 +505,7 @@ class WrittenFramesBackend final : public port::CanBackend {
    public:
     Receiver(port::FrameReceiver& inner, PortWire& wire) : inner_(inner), wire_(wire) {}
     void on_frame(const can::CanFrame& frame, TimePoint rx_time) override {
-      wire_.on_receiving(frame);
+      wire_.on_receiving(frame, rx_time);
       inner_.on_frame(frame, rx_time);
       wire_.on_received();
     }
@@ -1053,7 +813,7 @@ std::vector<double> direct_oneway(int domain, Placement cpus, double seconds, in
     (void)dds::DataListener::detach(*reader);  // every call over before taken_at is read
   };
   try {
-    out = read_client(spawn(args, true, cpus.peer), seconds, on_ready, [] {});
+    out = read_client(spawn_child(args, true, cpus.peer), seconds, on_ready, [] {});
   } catch (...) {
     finish();
     throw;
@@ -1069,20 +829,126 @@ std::vector<double> direct_oneway(int domain, Placement cpus, double seconds, in
 
 std::string verdict(bool met) { return met ? "met" : "NOT met"; }
 
+// Cyclone DDS alone on the state path: PumpStates written by this process
+// with the bridge's participant and QoS (the bridge's default partition,
+// state_writer_qos), each with a new analog input value, and taken by the
+// subscriber process as in (1). Every `period`, every instance (ports x
+// nodes) once, in `batches` batches `spacing` apart, from a thread of its
+// own, from the client's "ready" until its window ends.
+struct StatePattern {
+  std::vector<std::string> ports;
+  unsigned nodes = 0;
+  Duration period{};
+  unsigned batches = 1;
+  Duration spacing{};
+  // Cyclone's write batching (dds_write_set_batch, process-wide): a batch's
+  // samples go out together at its end (dds_write_flush), not one datagram
+  // per write.
+  bool batched = false;
+};
+
+struct DirectStateResult {
+  std::vector<double> latency_us;  // wall clock at take - source timestamp, as (1)
+  std::uint64_t written = 0;       // within the window
+  std::uint64_t taken = 0;
+  double window_s = 0;
+  double process_cpu_s = 0;  // this process over the window (Cyclone's threads included)
+  double write_cpu_s = 0;    // the writing thread, inside its batches of writes
+};
+
+template <class OnReady, class OnEnd>
+DirectStateResult direct_state(int domain, Placement cpus, double window_seconds,
+                               const StatePattern& p, OnReady on_ready, OnEnd on_end) {
+  dds::Participant participant(static_cast<dds_domainid_t>(domain), kRack);
+  dds::Topic<dnbridge_PumpState> topic(participant);
+  dds::Writer<dnbridge_PumpState> writer(participant, topic, dds::state_writer_qos(seconds(2)));
+  struct Batching {
+    explicit Batching(bool enable) : on(enable) {
+      if (on) dds_write_set_batch(true);
+    }
+    ~Batching() {
+      if (on) dds_write_set_batch(false);
+    }
+    bool on;
+  } batching(p.batched);
+  std::vector<dds::Owned<dnbridge_PumpState>> states(p.ports.size() * p.nodes);
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    auto& st = states[i];
+    dds::set_string(st->rack, kRack);
+    dds::set_string(st->port, p.ports[i / p.nodes]);
+    st->mac = static_cast<std::uint8_t>(1 + i % p.nodes);
+    dds::set_string(st->name, fmt::format("pump-{}-{}", p.ports[i / p.nodes], st->mac));
+    dds::set_string(st->idle_reason, "");
+    st->online = st->inputs_valid = true;
+    st->analog_input_count = 1;
+    if (!writer.write(*st)) throw std::runtime_error("writing a PumpState failed");
+  }
+  DirectStateResult r;
+  std::atomic<bool> stop{false};
+  std::atomic<std::int64_t> write_cpu_ns{0};
+  std::atomic<std::uint64_t> written{0};
+  std::thread pace;
+  std::int64_t cpu0 = 0, wall0 = 0;
+  const auto per_batch = (states.size() + p.batches - 1) / p.batches;
+  const auto ns = [](Duration d) {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
+  };
+  auto start = [&] {
+    wall0 = monotonic_ns();
+    cpu0 = process_cpu_ns();
+    pace = std::thread([&] {
+      std::int64_t cycle = monotonic_ns();
+      while (!stop.load(std::memory_order_relaxed)) {
+        for (unsigned b = 0; b < p.batches; ++b) {
+          sleep_until_monotonic(cycle + b * ns(p.spacing));
+          const auto t0 = clock_ns(CLOCK_THREAD_CPUTIME_ID);
+          const auto first = b * per_batch;
+          for (auto i = first; i < std::min(first + per_batch, states.size()); ++i) {
+            auto& st = *states[i];
+            st.analog_input_raw[0] =
+                static_cast<std::uint16_t>((st.analog_input_raw[0] + 1) % 4096);
+            (void)writer.write(st);
+            written.fetch_add(1, std::memory_order_relaxed);
+          }
+          if (p.batched) (void)dds_write_flush(writer.handle());
+          write_cpu_ns.fetch_add(clock_ns(CLOCK_THREAD_CPUTIME_ID) - t0, std::memory_order_relaxed);
+        }
+        cycle += ns(p.period);
+      }
+    });
+    on_ready();
+  };
+  auto end = [&] {
+    r.window_s = static_cast<double>(monotonic_ns() - wall0) / 1e9;
+    r.process_cpu_s = static_cast<double>(process_cpu_ns() - cpu0) / 1e9;
+    r.write_cpu_s = static_cast<double>(write_cpu_ns.load()) / 1e9;
+    r.written = written.load();
+    stop = true;
+    on_end();
+  };
+  auto args = client_args("state", domain, p.ports, p.nodes, window_seconds);
+  ClientOutput out;
+  try {
+    out = read_client(spawn_child(args, true, cpus.peer), window_seconds, start, end);
+  } catch (...) {
+    stop = true;
+    if (pace.joinable()) pace.join();
+    throw;
+  }
+  stop = true;
+  if (pace.joinable()) pace.join();
+  r.latency_us = std::move(out.state_us);
+  r.taken = out.taken;
+  return r;
+}
+
 int run_bench(const Options& o) {
   const int domain = o.domain >= 0 ? o.domain : 200 + static_cast<int>(getpid() % 30);
   const std::string tag = fmt::format("dnbridge-bench-{}", getpid());
   setenv("CYCLONEDDS_URI", dds::loopback_config(tag).c_str(), 1);
   daemon::StderrLogSink log(LogLevel::kWarn);
 
-  char host[256] = {};
-  gethostname(host, sizeof host - 1);
-  fmt::print("dnbridge benchmark, {:%Y-%m-%d %H:%M:%S} UTC, host {}, {} CPU(s)\n",
-             fmt::gmtime(std::time(nullptr)), host, std::thread::hardware_concurrency());
-  fmt::print("DDS: Cyclone DDS {}, loopback only (lo, unicast discovery), domain {}, tag {}\n",
-             DDS_VERSION, domain, tag);
-  // Latencies are only as good as the machine is quiet: say how busy it was.
-  fmt::print("load average at start: {}\n", load_average());
+  print_run_header("dnbridge benchmark", domain, tag);
 
   const int awake = o.hold_awake ? hold_cpus_awake() : -1;
   if (awake >= 0) {
@@ -1125,8 +991,9 @@ int run_bench(const Options& o) {
   // (0), (1), (2) -------------------------------------------------------------
   // Each measurement has ddsperf running beside it: Cyclone's own latency and
   // the bridge's are taken over the same seconds, on the same CPUs.
-  auto start_ddsperf = [&](std::optional<Ddsperf>& d) {
-    d.emplace(domain, o.latency_seconds, o.ddsperf_rate, o.ddsperf_size, cpus);
+  // ddsperf for as long as the measurement beside it.
+  auto start_ddsperf = [&](std::optional<Ddsperf>& d, double seconds) {
+    d.emplace(domain, seconds, o.ddsperf_rate, o.ddsperf_size, cpus);
   };
   struct Reference {
     double p50 = 0, p99 = 0;  // one-way, us
@@ -1143,13 +1010,12 @@ int run_bench(const Options& o) {
     fmt::print("(0) Cyclone DDS, beside it: ddsperf {}(and ddsperf pong waitset)\n",
                cyc.command);
     fmt::print(
-        "    round trips {:.0f} in {} one-second windows (the first left out)  p50 {}  p99 {}  "
-        "max {}\n    (p99 of single windows {:.1f}..{:.1f} us)\n",
-        cyc.samples, cyc.windows.size(), us(cyc.rtt_p50), us(cyc.rtt_p99), us(cyc.rtt_max),
-        window_p99_lo, window_p99_hi);
-    const Reference ref{cyc.rtt_p50 / 2, cyc.rtt_p99 / 2};
-    fmt::print("    one-way = round trip / 2:  p50 {}  p99 {}\n", us(ref.p50), us(ref.p99));
-    return ref;
+        "    one-way = round trip / 2 (as ddsperf prints it), {:.0f} round trips in {} one-second\n"
+        "    windows (the first left out):  p50 {}  p99 {}  max {}\n"
+        "    (p99 of single windows {:.1f}..{:.1f} us)\n",
+        cyc.samples, cyc.windows.size(), us(cyc.half_rtt_p50), us(cyc.half_rtt_p99),
+        us(cyc.half_rtt_max), window_p99_lo, window_p99_hi);
+    return Reference{cyc.half_rtt_p50, cyc.half_rtt_p99};
   };
 
   // (0b), the listener's: what the bridge's command path adds is measured
@@ -1167,9 +1033,9 @@ int run_bench(const Options& o) {
           o.direct_seconds);
       std::fflush(stdout);
       std::optional<Ddsperf> ddsperf;
-      const Summary d =
-          summarize(direct_oneway(domain, cpus, o.direct_seconds, o.command_interval_ms * 1000,
-                                  o.latency_nodes, taker, [&] { start_ddsperf(ddsperf); }));
+      const Summary d = summarize(
+          direct_oneway(domain, cpus, o.direct_seconds, o.command_interval_ms * 1000,
+                        o.latency_nodes, taker, [&] { start_ddsperf(ddsperf, o.direct_seconds); }));
       const Reference ref = report_ddsperf(ddsperf);
       fmt::print("(0b) write -> take ({}), one way: samples {}  p50 {}  p99 {}  max {}\n",
                  listener ? "listener" : "waitset", d.count, us(d.p50), us(d.p99), us(d.max));
@@ -1181,6 +1047,33 @@ int run_bench(const Options& o) {
 
   for (const int poll_ms : o.latency_poll_ms) {
     if (o.latency_seconds <= 0) break;
+    // (0c): Cyclone alone on the state path, in the pattern of this run's
+    // poll responses (each node once per poll period, one response frame
+    // time, about 250 us at 500 kbit/s, apart).
+    std::optional<Summary> direct_state_summary;
+    if (o.direct_seconds > 0) {
+      fmt::print(
+          "(0c) Cyclone DDS alone on the state path: PumpStates written in this process with "
+          "the\n     bridge's QoS, {} instances every {} ms 250 us apart, each a new analog "
+          "value, taken by\n     the subscriber process as in (1); wall clock at take - source "
+          "timestamp ({} s) ...\n",
+          o.latency_nodes, poll_ms, o.direct_seconds);
+      std::fflush(stdout);
+      std::optional<Ddsperf> ddsperf;
+      const StatePattern pattern{
+          {"A"}, o.latency_nodes, milliseconds(poll_ms), o.latency_nodes, microseconds(250)};
+      const auto r = direct_state(
+          domain, cpus, o.direct_seconds, pattern,
+          [&] { start_ddsperf(ddsperf, o.direct_seconds); }, [] {});
+      const Reference ref = report_ddsperf(ddsperf);
+      const Summary d = summarize(r.latency_us);
+      fmt::print("(0c) write -> take, one way: samples {}  p50 {}  p99 {}  max {}\n", d.count,
+                 us(d.p50), us(d.p99), us(d.max));
+      fmt::print("     ratio to ddsperf's one-way:  p50 {:.2f}  p99 {:.2f}\n\n", d.p50 / ref.p50,
+                 d.p99 / ref.p99);
+      if (d.count > 0) direct_state_summary = d;
+    }
+
     BridgeSetup s;
     s.ports = {"A"};
     s.nodes = o.latency_nodes;
@@ -1205,8 +1098,8 @@ int run_bench(const Options& o) {
     args.push_back(std::to_string(o.command_interval_ms * 1000));
     std::optional<Ddsperf> ddsperf;
     ClientOutput out = read_client(
-        spawn(args, true, cpus.peer), o.latency_seconds, [&] { start_ddsperf(ddsperf); },
-        [] {});
+        spawn_child(args, true, cpus.peer), o.latency_seconds,
+        [&] { start_ddsperf(ddsperf, o.latency_seconds); }, [] {});
     bridge.stop();
     const auto offset_after = realtime_ns() - monotonic_ns();
     const auto drift_us = static_cast<double>(offset_after - offset_before) / 1e3;
@@ -1222,6 +1115,12 @@ int run_bench(const Options& o) {
         drift_us);
     fmt::print("    ratio to Cyclone one-way:  p50 {:.2f}  p99 {:.2f}   target p99 <= 1.5: {}\n",
                state.p50 / cyc.p50, state.p99 / cyc.p99, verdict(state.p99 <= 1.5 * cyc.p99));
+    if (direct_state_summary) {
+      const double added = state.p99 - direct_state_summary->p99;
+      fmt::print(
+          "    the bridge's own addition: p99 {} - (0c)'s p99 {} = {}   target <= 10 us: {}\n",
+          us(state.p99), us(direct_state_summary->p99), us(added), verdict(added <= 10.0));
+    }
 
     std::map<std::pair<unsigned, unsigned>, PortWire::OutputFrame> frames;
     for (const auto& f : bridge.output_frames()) frames.emplace(std::make_pair(f.mac, f.value), f);
@@ -1229,6 +1128,10 @@ int run_bench(const Options& o) {
     for (const auto& f : bridge.written_frames())
       written.emplace(std::make_pair(f.mac, f.value), f);
     std::vector<double> to_write, to_start, to_end, to_write_free;
+    // Commands that met a poll in flight: from that poll's response received
+    // to the next poll frame written, and that frame's time on the wire.
+    std::vector<double> after_response_us;
+    double frame_us = 0;
     std::size_t waited = 0;
     for (const auto& c : out.commands) {
       auto it = frames.find({c.mac, c.value});
@@ -1236,8 +1139,11 @@ int run_bench(const Options& o) {
       if (it == frames.end() || wr == written.end()) continue;
       const double write_us = static_cast<double>(wr->second.at - c.at) / 1e3;
       to_write.push_back(write_us);
+      frame_us = std::max(frame_us, static_cast<double>(it->second.end - it->second.start) / 1e3);
       if (wr->second.after_response) {
         ++waited;
+        after_response_us.push_back(static_cast<double>(wr->second.at - wr->second.response_rx) /
+                                    1e3);
       } else {
         to_write_free.push_back(write_us);
       }
@@ -1261,6 +1167,19 @@ int run_bench(const Options& o) {
         "                                                p50 {}  p99 {}  max {}\n",
         waited, 100.0 * static_cast<double>(waited) / static_cast<double>(to_write.size()),
         us(cmd_write_free.p50), us(cmd_write_free.p99), us(cmd_write_free.max));
+    if (!after_response_us.empty()) {
+      // Such a command waits for the remaining transaction of the poll in
+      // flight, then for the master to write the next poll: that last part
+      // is to take no longer than one frame time.
+      const Summary after = summarize(after_response_us);
+      fmt::print(
+          "    those {}: from the response of the poll in flight received to the new poll "
+          "written\n"
+          "                                                p50 {}  p99 {}  max {}\n"
+          "      target p99 <= one frame time ({}, the poll frame at 500 kbit/s): {}\n",
+          waited, us(after.p50), us(after.p99), us(after.max), us(frame_us),
+          verdict(after.p99 <= frame_us));
+    }
     fmt::print(
         "    to its start of frame on the bus:           p50 {}  p99 {}  max {}  min {}\n"
         "      (adds waiting for a frame already on the 500 kbit/s wire, and arbitration)\n",
@@ -1290,6 +1209,10 @@ int run_bench(const Options& o) {
   }
 
   // (3) ---------------------------------------------------------------------
+  struct CpuFigures {
+    double bridge_pct;     // of one core
+    double samples_per_s;  // PumpState taken by the subscriber
+  };
   auto cpu_run = [&](const char* title, double window, bool every_poll) {
     BridgeSetup s;
     s.ports = {"P1", "P2", "P3", "P4"};
@@ -1332,7 +1255,7 @@ int run_bench(const Options& o) {
       bits = static_cast<double>(bridge.bus_bits() - bits0);
       threads1 = snapshot_threads();
     };
-    ClientOutput out = read_client(spawn(args, true, cpus.peer), window, start, end);
+    ClientOutput out = read_client(spawn_child(args, true, cpus.peer), window, start, end);
     bridge.stop();
     if (wall <= 0) throw std::runtime_error("the CPU window was not measured");
     const double bridge_pct = 100.0 * (cpu - sim_cpu) / wall;
@@ -1356,15 +1279,28 @@ int run_bench(const Options& o) {
       double switches = 0;
       unsigned threads = 0;
     };
-    std::array<Group, 4> groups{
-        {{"port loops"}, {"DDS input + main"}, {"Cyclone DDS's own"}, {"simulated devices"}}};
+    // The bridge's threads by their names (adapters/daemon: the outboxes
+    // that write to DDS, the DDS input); Cyclone's by elimination.
+    std::array<Group, 6> groups{{{"port loops"},
+                                 {"DDS writes (state, reply outboxes)"},
+                                 {"DDS input"},
+                                 {"main and other"},
+                                 {"Cyclone DDS's own"},
+                                 {"simulated devices"}}};
+    const auto group_of = [&](pid_t tid, const std::string& name) -> Group& {
+      if (port_tids.count(tid)) return groups[0];
+      if (sim_tids.count(tid)) return groups[5];
+      if (name == "dds state out" || name == "dds reply out") return groups[1];
+      if (name == "dds input") return groups[2];
+      if (name.rfind("dnbridge-ben", 0) == 0 || name == "reload" || name == "sd_notify") {
+        return groups[3];
+      }
+      return groups[4];
+    };
     for (const auto& [tid, t1] : threads1) {
       auto it = threads0.find(tid);
       if (it == threads0.end()) continue;
-      Group& g = port_tids.count(tid)                                        ? groups[0]
-                 : sim_tids.count(tid)                                       ? groups[3]
-                 : t1.name != "dnbridge-benc" && t1.name != "dnbridge-bench" ? groups[2]
-                                                                             : groups[1];
+      Group& g = group_of(tid, t1.name);
       g.cpu_s += t1.cpu_s - it->second.cpu_s;
       g.switches += static_cast<double>(t1.switches - it->second.switches);
       ++g.threads;
@@ -1375,21 +1311,62 @@ int run_bench(const Options& o) {
                  g.switches / wall);
     }
     fmt::print("\n");
-    return bridge_pct;
+    return CpuFigures{bridge_pct, static_cast<double>(out.taken) / out.window_s};
   };
 
-  const double pct = cpu_run(
+  const CpuFigures shipped = cpu_run(
       "(3) CPU: 4 ports x 63 CDN127s, each polled every 10 ms, on an ideal bus (no bit timing);\n"
       "    publish policy as shipped (on change, 0.05 V deadband, at least once a second); a\n"
       "    subscriber in another process takes every PumpState; one PumpCommand per pump at the "
       "start ...",
       o.cpu_seconds, false);
-  fmt::print("    target < 10 % of one core: {}\n\n", verdict(pct < 10.0));
+  fmt::print("    target < 10 % of one core: {}\n\n", verdict(shipped.bridge_pct < 10.0));
   if (o.busy_seconds > 0) {
-    (void)cpu_run(
+    const CpuFigures busy = cpu_run(
         "(3b) the same, but every poll response a new analog input and deadband 0: a PumpState "
         "per poll ...",
         o.busy_seconds, true);
+    fmt::print("\n");
+    // (3c): what Cyclone's writes of (3b)'s samples cost, alone.
+    fmt::print(
+        "(3c) Cyclone DDS alone writing (3b)'s samples: PumpStates of 4 x 63 instances, each "
+        "every\n     10 ms, in batches every 1 ms, written in this process with the bridge's "
+        "QoS, taken by\n     the subscriber process ...\n");
+    std::fflush(stdout);
+    StatePattern pattern{{"P1", "P2", "P3", "P4"}, 63, milliseconds(10), 10, milliseconds(1)};
+    // CPU per sample written: in the write calls, and of the process.
+    const auto write_cost = [&](const StatePattern& p) {
+      const auto r = direct_state(
+          domain, cpus, o.busy_seconds, p, [] {}, [] {});
+      if (r.written == 0 || r.window_s <= 0) throw std::runtime_error("(3c) wrote nothing");
+      const double n = static_cast<double>(r.written);
+      const double write_us = r.write_cpu_s / n * 1e6;
+      const double process_us = r.process_cpu_s / n * 1e6;
+      fmt::print(
+          "    written {:.0f}/s, taken {:.0f}/s; CPU per sample: {:.2f} us in the write calls{}, "
+          "{:.2f} us\n     for this process in all (Cyclone's own threads included; {:.1f} % of "
+          "one core)\n",
+          n / r.window_s, static_cast<double>(r.taken) / r.window_s, write_us,
+          p.batched ? " and flushes" : "", process_us, 100.0 * r.process_cpu_s / r.window_s);
+      return process_us;
+    };
+    const double process_us = write_cost(pattern);
+    // (3b) against (3): the CPU each further published sample costs the
+    // bridge, and Cyclone's share of it.
+    const double extra = busy.samples_per_s - shipped.samples_per_s;
+    if (extra > 0) {
+      const double per_sample_us = (busy.bridge_pct - shipped.bridge_pct) / 100.0 / extra * 1e6;
+      fmt::print(
+          "    (3b) - (3): {:.2f} us of the bridge's CPU per further PumpState published; of "
+          "it Cyclone's\n     write {:.2f} us (3c), the bridge's own work {:.2f} us\n",
+          per_sample_us, process_us, per_sample_us - process_us);
+    }
+    fmt::print(
+        "(3d) the same as (3c) with Cyclone's write batching (dds_write_set_batch; a flush after "
+        "each\n     batch: its samples leave together) ...\n");
+    std::fflush(stdout);
+    pattern.batched = true;
+    (void)write_cost(pattern);
     fmt::print("\n");
   }
   fmt::print("load average at end: {}\n", load_average());
@@ -1409,14 +1386,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--latency-seconds", o.latency_seconds, "(1) and (2), each run; 0 to skip")
       ->capture_default_str();
-  app.add_option("--direct-seconds", o.direct_seconds, "(0b); 0 to skip")->capture_default_str();
+  app.add_option("--direct-seconds", o.direct_seconds, "(0b) and (0c), each run; 0 to skip")
+      ->capture_default_str();
   app.add_option("--latency-poll-ms", o.latency_poll_ms, "a run of (1) and (2) per poll period")
       ->capture_default_str();
   app.add_option("--latency-nodes", o.latency_nodes, "nodes for (1) and (2)")
       ->capture_default_str();
   app.add_option("--command-interval-ms", o.command_interval_ms, "(2)")->capture_default_str();
   app.add_option("--cpu-seconds", o.cpu_seconds, "(3) measurement window")->capture_default_str();
-  app.add_option("--busy-seconds", o.busy_seconds, "(3b) window, 0 to skip")->capture_default_str();
+  app.add_option("--busy-seconds", o.busy_seconds, "(3b), (3c) and (3d) windows, 0 to skip")
+      ->capture_default_str();
   app.add_option("--domain", o.domain, "DDS domain (default: from the process id)");
   app.add_option("--bridge-cpu", o.bridge_cpu, "CPU of the bridge and of ddsperf pong")
       ->capture_default_str();

@@ -222,12 +222,7 @@ FleetFigures run_fleet(const Options& o, int racks, const std::string& default_t
 }
 
 int run(const Options& o) {
-  char host[256] = {};
-  gethostname(host, sizeof host - 1);
-  fmt::print("dnbridge fleet benchmark, {:%Y-%m-%d %H:%M:%S} UTC, host {}, {} CPU(s)\n",
-             fmt::gmtime(std::time(nullptr)), host, std::thread::hardware_concurrency());
-  fmt::print("DDS: Cyclone DDS {}, loopback only (lo, unicast discovery)\n", DDS_VERSION);
-  fmt::print("load average at start: {}\n", load_average());
+  print_run_header("dnbridge fleet benchmark");
   fmt::print(
       "each rack: {} simulated CDN127s on one port, polled every {} ms, publish policy as shipped\n"
       "(a PumpState per pump at least once a second); its bridge a dnbridge-sim process\n\n",

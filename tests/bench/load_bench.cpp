@@ -799,13 +799,9 @@ int run(const Options& o) {
   if (!mkdtemp(dir_template)) throw std::runtime_error("mkdtemp failed");
   const std::filesystem::path dir = dir_template;
 
+  print_run_header("dnbridge load benchmark", domain, tag);
   char host[256] = {};
   gethostname(host, sizeof host - 1);
-  fmt::print("dnbridge load benchmark, {:%Y-%m-%d %H:%M:%S} UTC, host {}, {} CPU(s)\n",
-             fmt::gmtime(std::time(nullptr)), host, std::thread::hardware_concurrency());
-  fmt::print("load average at start: {}\n", load_average());
-  fmt::print("DDS: Cyclone DDS {}, loopback only (lo, unicast discovery), domain {}, tag {}\n",
-             DDS_VERSION, domain, tag);
 
   std::size_t max_requests = 16;
   for (int rate : o.request_rates) {
