@@ -100,7 +100,9 @@ class PlantNetwork {
   PlantNetwork& operator=(const PlantNetwork&) = delete;
 
   // Namespaces a killed test process left behind (its pid is gone, or is
-  // this process's now).
+  // this process's now), with the processes it had started in them (its
+  // bridges and hosts, which outlive it): killed first, as a namespace that
+  // still holds a process lives on after its name is deleted.
   static void remove_stale() {
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator("/run/netns", ec)) {
@@ -109,7 +111,9 @@ class PlantNetwork {
       const auto pid = static_cast<pid_t>(std::atol(name.c_str() + 5));
       // Also this process's: left by an earlier process with the same pid.
       if (pid > 0 && (pid == getpid() || (::kill(pid, 0) != 0 && errno == ESRCH))) {
-        std::system((std::string(DNBRIDGE_IP) + " netns del " + name + " 2>/dev/null").c_str());
+        const std::string ip = DNBRIDGE_IP;
+        std::system((ip + " netns pids " + name + " 2>/dev/null | xargs -r kill -KILL").c_str());
+        std::system((ip + " netns del " + name + " 2>/dev/null").c_str());
       }
     }
   }
