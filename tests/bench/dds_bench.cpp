@@ -19,15 +19,12 @@
 // no bus.
 //
 // It reports figures; it exits non-zero only when the run itself fails.
-#include <dds/version.h>
-#include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <cstdio>
-#include <ctime>
 #include <functional>
 #include <map>
 #include <memory>
@@ -811,26 +808,27 @@ int main(int argc, char** argv) {
   CLI::App app{
       "dnbridge-dds-bench: what the product's type, QoS and way of taking cost Cyclone DDS, "
       "one change at a time from ddsperf's set-up"};
-  app.add_option("--seconds", o.seconds, "length of one path's slot")->capture_default_str();
-  app.add_option("--rounds", o.rounds, "times every path is measured")->capture_default_str();
+  app.add_option("--seconds", o.seconds, "length of one path's slot")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
+  app.add_option("--rounds", o.rounds, "times every path is measured")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   app.add_option("--command-interval-us", o.command_interval_us,
                  "mean gap between two commands (or states)")
+      ->check(CLI::Range(2, 10'000'000))
       ->capture_default_str();
   app.add_option("--bridge-cpu", o.bridge_cpu, "CPU of this process and ddsperf pong")
       ->capture_default_str();
   app.add_option("--peer-cpu", o.peer_cpu, "CPU of the peer process and ddsperf ping")
       ->capture_default_str();
-  bool no_pin = false, allow_idle = false, no_ddsperf = false;
-  app.add_flag("--no-pin", no_pin, "let the kernel place every process");
-  app.add_flag("--allow-idle", allow_idle, "let CPUs halt when idle");
-  app.add_flag("--no-ddsperf", no_ddsperf, "leave ddsperf out");
+  app.add_flag("!--no-pin", o.pin, "let the kernel place every process");
+  app.add_flag("!--allow-idle", o.hold_awake, "let CPUs halt when idle");
+  app.add_flag("!--no-ddsperf", o.ddsperf, "leave ddsperf out");
   app.add_option("--domain", o.domain, "DDS domain (default: from the process id)");
   app.add_flag("--peer", o.peer)->group("");  // the re-executed peer
   app.add_option("--t0", o.t0)->group("");
   CLI11_PARSE(app, argc, argv);
-  o.pin = !no_pin;
-  o.hold_awake = !allow_idle;
-  o.ddsperf = !no_ddsperf;
   try {
     return o.peer ? run_peer(o) : run_bench(o);
   } catch (const std::exception& e) {

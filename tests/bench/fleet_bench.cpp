@@ -16,14 +16,11 @@
 // Every participant is on the loopback interface with unicast discovery and
 // a discovery tag of the run's own. It reports figures; it exits non-zero
 // only when the run itself fails.
-#include <dds/version.h>
-#include <fmt/chrono.h>
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <set>

@@ -26,9 +26,7 @@
 // loopback interface only. Load is paced with clock_nanosleep; everything
 // else waits for events (DDS waitsets, the bridge's exit through a pidfd).
 // It reports figures; it exits non-zero only when the run itself fails.
-#include <dds/version.h>
 #include <fcntl.h>
-#include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <poll.h>
 #include <sched.h>
@@ -48,7 +46,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
