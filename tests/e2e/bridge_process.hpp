@@ -9,27 +9,19 @@
 #include <fstream>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
-#include "adapters/daemon/config.hpp"
 #include "child_process.hpp"
 #include "dds/dds_fixture.hpp"
+#include "support/simulated_rack.hpp"
 
 namespace dnbridge::e2e {
 
 // `dnbridge-sim --simulate`'s configuration, on `domain`, logging warnings only.
 inline std::filesystem::path write_simulated_rack_config(dds_domainid_t domain) {
-  std::string text(daemon::embedded_default_config_text());
-  const auto replace = [&](std::string_view from, const std::string& to) {
-    const auto at = text.find(from);
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-  };
-  replace("domain = 0", "domain = " + std::to_string(domain));
-  replace("log_level = \"info\"", "log_level = \"warn\"");
   const auto path = std::filesystem::temp_directory_path() /
                     ("dnbridge-e2e-" + std::to_string(getpid()) + ".toml");
-  std::ofstream(path) << text;
+  std::ofstream(path) << support::simulated_rack_config(domain, "sim-rack", "warn");
   return path;
 }
 

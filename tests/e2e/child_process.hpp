@@ -123,6 +123,8 @@ class ChildProcess {
     return true;
   }
 
+  // ChildOptions::control: the end of its stdin (its stdout stays open).
+  bool close_input() const { return control_ >= 0 && shutdown(control_, SHUT_WR) == 0; }
   // ChildOptions::control: one line to its stdin ('\n' added).
   bool send_line(const std::string& line) const {
     const std::string text = line + "\n";

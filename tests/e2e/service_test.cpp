@@ -29,9 +29,9 @@
 #include <string>
 #include <vector>
 
-#include "adapters/daemon/config.hpp"
 #include "child_process.hpp"
 #include "dds/dds_fixture.hpp"
+#include "support/simulated_rack.hpp"
 
 namespace dnbridge::e2e {
 namespace {
@@ -348,9 +348,7 @@ TEST(ServiceNotify, AStalledPortLoopStarvesTheWatchdogUntilItAdvancesAgain) {
 // whose kernel has no SocketCAN at all, or has it without a can7): the port
 // says so, the service is ready, and the other port runs.
 TEST(ServiceNotify, AnAbsentCanInterfaceIsReportedAndDoesNotHoldReadinessBack) {
-  std::string text(daemon::embedded_default_config_text());
-  const std::string domain = "domain = " + std::to_string(dds::testing::test_domain());
-  text.replace(text.find("domain = 0"), std::strlen("domain = 0"), domain);
+  std::string text = support::simulated_rack_config(dds::testing::test_domain());
   text +=
       "\n[[port]]\nname = \"B\"\ninterface = \"can7\"\nbitrate = 500000\n"
       "  [[port.node]]\n  mac = 9\n  name = \"pump-9\"\n";

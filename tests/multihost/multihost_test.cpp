@@ -10,18 +10,14 @@
 // DDS Security permissions cover rack-a only, and a host without a
 // certificate of the site. The PKI is made by deploy/security/make-site-pki.sh.
 #include <gtest/gtest.h>
-#include <poll.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
-#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -29,8 +25,9 @@
 #include <string_view>
 #include <vector>
 
-#include "adapters/daemon/config.hpp"
 #include "e2e/child_process.hpp"
+#include "support/plant_network.hpp"
+#include "support/simulated_rack.hpp"
 
 namespace dnbridge::multihost_test {
 namespace {
@@ -38,9 +35,9 @@ namespace {
 namespace fs = std::filesystem;
 using e2e::ChildOptions;
 using e2e::ChildProcess;
+using plant::PlantNetwork;
+using plant::sh;
 using std::chrono::milliseconds;
-using std::chrono::seconds;
-using Clock = std::chrono::steady_clock;
 
 constexpr int kDomain = 42;
 // Each rack is the simulated rack of `dnbridge-sim --simulate`: 8 pumps.
@@ -61,131 +58,17 @@ std::int64_t monotonic_ns() {
   return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
 }
 
-// Runs `command` through the shell; false (and says so) when it fails.
-bool sh(std::string command) {
-  if (command.rfind("ip ", 0) == 0) command.replace(0, 2, DNBRIDGE_IP);
-  const int rc = std::system((command + " 2>&1").c_str());
-  if (rc != 0) ADD_FAILURE() << "failed (" << rc << "): " << command;
-  return rc == 0;
-}
-
-// The plant network: a switch (a Linux bridge in namespace PREFIX-plant)
-// and one host namespace per name, PREFIX-NAME, with eth0 cabled to the
-// switch's port NAME at 10.99.0.N/24. Removed at destruction.
-class PlantNetwork {
- public:
-  explicit PlantNetwork(std::vector<std::string> hosts)
-      : prefix_("dnbmh" + std::to_string(getpid())), hosts_(std::move(hosts)) {
-    remove_stale();
-    const std::string plant = prefix_ + "-plant";
-    ok_ = sh("ip netns add " + plant) && sh("ip -n " + plant + " link set lo up") &&
-          sh("ip -n " + plant + " link add switch type bridge") &&
-          sh("ip -n " + plant + " link set switch up");
-    for (std::size_t i = 0; ok_ && i < hosts_.size(); ++i) {
-      const std::string ns = name_space(hosts_[i]);
-      ok_ = sh("ip netns add " + ns) && sh("ip -n " + ns + " link set lo up") &&
-            sh("ip -n " + plant + " link add " + hosts_[i] + " type veth peer name eth0 netns " +
-               ns) &&
-            sh("ip -n " + plant + " link set " + hosts_[i] + " master switch up") &&
-            sh("ip -n " + ns + " addr add 10.99.0." + std::to_string(i + 1) + "/24 dev eth0") &&
-            sh("ip -n " + ns + " link set eth0 up");
-    }
-  }
-  ~PlantNetwork() {
-    for (const auto& h : hosts_)
-      std::system(("ip netns del " + name_space(h) + " 2>/dev/null").c_str());
-    std::system(("ip netns del " + prefix_ + "-plant 2>/dev/null").c_str());
-  }
-  PlantNetwork(const PlantNetwork&) = delete;
-  PlantNetwork& operator=(const PlantNetwork&) = delete;
-
-  // Namespaces a killed test process left behind (its pid is gone, or is
-  // this process's now), with the processes it had started in them (its
-  // bridges and hosts, which outlive it): killed first, as a namespace that
-  // still holds a process lives on after its name is deleted.
-  static void remove_stale() {
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator("/run/netns", ec)) {
-      const std::string name = entry.path().filename().string();
-      if (name.rfind("dnbmh", 0) != 0) continue;
-      const auto pid = static_cast<pid_t>(std::atol(name.c_str() + 5));
-      // Also this process's: left by an earlier process with the same pid.
-      if (pid > 0 && (pid == getpid() || (::kill(pid, 0) != 0 && errno == ESRCH))) {
-        const std::string ip = DNBRIDGE_IP;
-        std::system((ip + " netns pids " + name + " 2>/dev/null | xargs -r kill -KILL").c_str());
-        std::system((ip + " netns del " + name + " 2>/dev/null").c_str());
-      }
-    }
-  }
-
-  bool ok() const { return ok_; }
-  std::string name_space(const std::string& host) const { return prefix_ + "-" + host; }
-
-  // `host`'s cable, at the switch.
-  bool cut(const std::string& host) {
-    return sh("ip -n " + prefix_ + "-plant link set " + host + " down");
-  }
-  bool mend(const std::string& host) {
-    return sh("ip -n " + prefix_ + "-plant link set " + host + " up");
-  }
-
-  // `args` run on `host`.
-  std::vector<std::string> on(const std::string& host, std::vector<std::string> args) const {
-    args.insert(args.begin(), {DNBRIDGE_IP, "netns", "exec", name_space(host)});
-    return args;
-  }
-
- private:
-  std::string prefix_;
-  std::vector<std::string> hosts_;
-  bool ok_ = false;
-};
-
-// A program on a plant host, as deploy/ ships Cyclone for a plant network.
-ChildOptions plant_options(bool control) {
-  ChildOptions o;
-  o.env = {"CYCLONEDDS_URI=file://" DNBRIDGE_SOURCE_DIR "/deploy/cyclonedds/cyclonedds.xml"};
-  o.control = control;
-  o.capture_stderr = !control;
-  return o;
-}
-
-// dnbridge_plant_host on a plant host; every line it printed is kept.
-class PlantHost {
+// dnbridge_plant_host on a plant host.
+class PlantHost : public plant::HostProgram {
  public:
   PlantHost(const PlantNetwork& net, const std::string& host, std::vector<std::string> args)
-      : child_(net.on(host,
-                      [&] {
-                        args.insert(args.begin(), DNBRIDGE_PLANT_HOST);
-                        return args;
-                      }()),
-               plant_options(true)) {}
-
-  bool send(const std::string& line) { return child_.send_line(line); }
-
-  // Its lines, read until one satisfies `wanted`; nullopt at the timeout.
-  std::optional<std::string> until(const std::function<bool(const std::string&)>& wanted,
-                                   milliseconds timeout = milliseconds(10000)) {
-    const auto deadline = Clock::now() + timeout;
-    for (;;) {
-      const auto left = std::chrono::duration_cast<milliseconds>(deadline - Clock::now());
-      if (left.count() < 0) return std::nullopt;
-      auto line = child_.read_line(left);
-      if (!line) return std::nullopt;
-      transcript_ += *line + "\n";
-      if (wanted(*line)) return line;
-    }
-  }
-  std::optional<std::string> until(const std::string& prefix,
-                                   milliseconds timeout = milliseconds(10000)) {
-    return until([&](const std::string& l) { return l.rfind(prefix, 0) == 0; }, timeout);
-  }
-
-  const std::string& transcript() const { return transcript_; }
-
- private:
-  ChildProcess child_;
-  std::string transcript_;
+      : HostProgram(
+            net, host,
+            [&] {
+              args.insert(args.begin(), DNBRIDGE_PLANT_HOST);
+              return args;
+            }(),
+            plant::deployed_cyclone(true)) {}
 };
 
 // The time in a "view complete T" or "view incomplete T N" line.
@@ -216,10 +99,10 @@ class MultiHostTest : public ::testing::Test {
     ASSERT_TRUE(net_->ok());
     bridge_a_.emplace(
         net_->on("rack-a", {DNBRIDGE_BINARY, "--config", rack_config("rack-a", "bridge-a")}),
-        plant_options(false));
+        plant::deployed_cyclone(false));
     bridge_b_.emplace(
         net_->on("rack-b", {DNBRIDGE_BINARY, "--config", rack_config("rack-b", "bridge-b")}),
-        plant_options(false));
+        plant::deployed_cyclone(false));
     const std::vector<std::string> view{std::to_string(kDomain), std::to_string(2 * kPumpsPerRack),
                                         std::to_string(kFreshMs)};
     const auto started = monotonic_ns();
@@ -262,17 +145,10 @@ class MultiHostTest : public ::testing::Test {
   // bridge identity `identity` of the site: written beside that identity's
   // files, which its [security] table names relative to itself.
   std::string rack_config(const std::string& rack, const std::string& identity) const {
-    std::string text(daemon::embedded_default_config_text());
-    const auto replace = [&](std::string_view from, const std::string& to) {
-      const auto at = text.find(from);
-      EXPECT_NE(at, std::string::npos) << from;
-      if (at != std::string::npos) text.replace(at, from.size(), to);
-    };
-    replace("rack = \"sim-rack\"", "rack = \"" + rack + "\"");
-    replace("domain = 0", "domain = " + std::to_string(kDomain));
     // Rack-a's log is read (its commander's loss); rack-b's is not, and
     // says little at warn.
-    if (rack != "rack-a") replace("log_level = \"info\"", "log_level = \"warn\"");
+    const std::string text =
+        support::simulated_rack_config(kDomain, rack, rack == "rack-a" ? "info" : "warn");
     std::stringstream table;
     table << std::ifstream(security(identity)).rdbuf();
     const fs::path path = security(identity).parent_path() / (rack + ".toml");
@@ -380,7 +256,7 @@ TEST_F(MultiHostTest, ASupervisorCommandsItsOwnRackOnly) {
   ASSERT_TRUE(refused);
   EXPECT_EQ(refused->rfind("refused rack-b", 0), 0u) << *refused;
   // dnbctl on the supervisor's host, with its identity, says why.
-  ChildOptions dnbctl_options = plant_options(false);
+  ChildOptions dnbctl_options = plant::deployed_cyclone(false);
   ChildProcess dnbctl(
       net_->on("sup-a", {DNBCTL_BIN, "--domain", std::to_string(kDomain), "--security",
                          security("sup-a").string(), "--rack", "rack-b", "pump", "1", "on"}),

@@ -25,7 +25,11 @@
 //        dnbctl's lease) in RACK's partition; a writer per rack, made at
 //        its first command (refused: DDS Security denied it); READERS is how
 //        many command readers (bridges) its writer had matched when it wrote
-//        (it waits up to 5 s for the first).
+//        (it waits up to 5 s for the first). As dnbctl does, it writes the
+//        command again every second until the pump's PumpState shows it
+//        applied (a sample written as soon as the writer matched can reach
+//        the bridge before the bridge has discovered the writer, and be
+//        dropped there), and not after that.
 //   status      status instances=I samples=S
 //        PumpState instances seen, valid samples of them taken.
 //   show RACK PORT MAC   shown, then the node line of that pump as it is now
@@ -101,6 +105,7 @@ class PlantHost {
     for (;;) {
       client_.refresh();
       look();
+      rewrite();
       if (samples_asked_ && every_pump_had(*samples_asked_)) {
         say("samples " + std::to_string(*samples_asked_));
         samples_asked_.reset();
@@ -145,6 +150,11 @@ class PlantHost {
       if (auto outputs = outputs_of(*known.data); outputs != pump.outputs) {
         pump.outputs = std::move(outputs);
         say(node_line(key, pump.outputs));
+      }
+      if (const auto it = unapplied_.find(key);
+          it != unapplied_.end() && !known.data->outputs_idle &&
+          known.data->pump_on == it->second.on && dds::view(known.data->commanded_by) == kIssuer) {
+        unapplied_.erase(it);
       }
     }
   }
@@ -228,15 +238,33 @@ class PlantHost {
     }
     // The first bridge's reader, within 5 s; any matched later is not waited for.
     (void)commander->wait_matched(client_, Clock::now() + std::chrono::seconds(5));
-    if (!commander->write(key, dnbctl::Outputs{.pump_on = on}, "plant host").ok()) {
+    if (!commander->write(key, dnbctl::Outputs{.pump_on = on}, kIssuer).ok()) {
       say("refused " + key.rack + " write failed");
       return;
     }
     say("written " + key.rack + " " + std::to_string(commander->matched()));
+    unapplied_[key] = Unapplied{on, Clock::now()};
   }
+
+  // Each command not yet seen applied, written again a second after the last time.
+  void rewrite() {
+    const auto now = Clock::now();
+    for (auto& [key, command] : unapplied_) {
+      if (now - command.written < std::chrono::seconds(1)) continue;
+      (void)commanders_[key.rack]->write(key, dnbctl::Outputs{.pump_on = command.on}, kIssuer);
+      command.written = now;
+    }
+  }
+
+  static constexpr const char* kIssuer = "plant host";
+  struct Unapplied {
+    bool on = false;
+    Clock::time_point written;
+  };
 
   dnbctl::Client client_;
   std::map<std::string, std::unique_ptr<dnbctl::Commander>> commanders_;
+  std::map<NodeKey, Unapplied> unapplied_;
   std::size_t expected_;
   std::chrono::milliseconds fresh_;
   std::map<NodeKey, Pump> pumps_;

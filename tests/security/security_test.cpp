@@ -31,6 +31,7 @@
 #include "bridge/profiles/cdn127/io_data.hpp"
 #include "dnbctl/subprocess.hpp"
 #include "e2e/bridge_fixture.hpp"
+#include "support/simulated_rack.hpp"
 
 namespace dnbridge::security_test {
 namespace {
@@ -65,9 +66,7 @@ std::string security_table(const security::Settings& s) {
 // `dnbridge-sim --simulate`'s rack on the PKI's domain, as a file, with `security`.
 fs::path write_rack_config(const std::string& name, const std::string& security,
                            int domain = kDomain) {
-  std::string text(daemon::embedded_default_config_text());
-  const auto at = text.find("domain = 0");
-  text.replace(at, 10, "domain = " + std::to_string(domain));
+  const std::string text = support::simulated_rack_config(domain);
   const auto path = fs::temp_directory_path() /
                     ("dnbridge-security-" + std::to_string(getpid()) + "-" + name + ".toml");
   std::ofstream(path) << text << security;
