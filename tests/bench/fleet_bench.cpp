@@ -12,7 +12,15 @@
 //     on an otherwise idle host, discovery's announcements to participant
 //     indices nobody has included, and the kernel's ICMP answers to those);
 //   - `dnbctl racks --json` run once: its wall time, and how many racks it
-//     found.
+//     found;
+//   - the supervisor commanding pumps, --command-rate commands per second
+//     in all, round-robin over every rack's pumps, over a window each way:
+//     with a writer per rack in its rack's partition (as shipped), and with
+//     one writer in every rack's partition ("dnbridge/*": each bridge then
+//     receives every rack's commands and drops the others', as all bridges
+//     did before racks had partitions). Per bridge CPU, the loopback's
+//     bytes, the supervisor's own CPU, and the CPU of the bridges and the
+//     supervisor together (how near the machine is to saturation), each way.
 // Every participant is on the loopback interface with unicast discovery and
 // a discovery tag of the run's own. It reports figures; it exits non-zero
 // only when the run itself fails.
@@ -22,19 +30,23 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
 #include <thread>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "adapters/dds/fields.hpp"
 #include "adapters/dds/loopback.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/reader.hpp"
+#include "adapters/dds/sample.hpp"
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/waitset.hpp"
+#include "adapters/dds/writer.hpp"
 #include "bench_process.hpp"
 #include "figures.hpp"
 
@@ -49,6 +61,7 @@ struct Options {
   std::vector<int> racks{1, 10, 50, 100};
   int poll_ms = 1000;
   double window_seconds = 10;
+  int command_rate = 200;
   double online_timeout_seconds = 180;
   int domain = -1;
 };
@@ -100,17 +113,140 @@ std::uint64_t loopback_bytes() {
   return 0;
 }
 
+// A window's figures.
+struct WindowFigures {
+  double cpu_mean = 0, cpu_max = 0;  // % of one core, per bridge
+  double cpu_all = 0;                // % of one core, every bridge and the supervisor
+  double rss_mean_kb = 0, rss_max_kb = 0;
+  double lo_bytes_per_s = 0;
+  double own_cpu = 0;  // this process (the supervisor), % of one core
+};
+
+// Every bridge's CPU and RSS, the loopback's bytes and this process's CPU,
+// over `seconds`, while `during(end)` runs until monotonic_ns() `end`.
+WindowFigures measure_window(const std::vector<std::unique_ptr<BridgeProcess>>& bridges,
+                             double seconds, const std::function<void(std::int64_t)>& during) {
+  WindowFigures w;
+  std::vector<ProcessSample> before;
+  for (const auto& b : bridges) before.push_back(sample_process(b->pid(), false));
+  const ProcessSample own_before = sample_process(getpid(), false);
+  const auto lo_before = loopback_bytes();
+  const auto start = monotonic_ns();
+  during(start + static_cast<std::int64_t>(seconds * 1e9));
+  const auto lo_after = loopback_bytes();
+  const ProcessSample own_after = sample_process(getpid(), false);
+  const double wall = static_cast<double>(monotonic_ns() - start) / 1e9;
+  const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
+  for (const auto& b : bridges) {
+    if (auto ended = b->ended()) throw std::runtime_error("a bridge ended: " + *ended);
+  }
+  const auto racks = static_cast<double>(bridges.size());
+  const auto cpu_of = [&](const ProcessSample& from, const ProcessSample& to) {
+    // Each over its own interval: the bridges are sampled one after another.
+    const double interval = static_cast<double>(to.at - from.at) / 1e9;
+    return 100.0 * static_cast<double>(to.ticks - from.ticks) / tick / interval;
+  };
+  for (std::size_t i = 0; i < bridges.size(); ++i) {
+    const ProcessSample after = sample_process(bridges[i]->pid(), false);
+    const double cpu = cpu_of(before[i], after);
+    w.cpu_mean += cpu / racks;
+    w.cpu_max = std::max(w.cpu_max, cpu);
+    w.cpu_all += cpu;
+    const auto rss = static_cast<double>(after.rss_kb);
+    w.rss_mean_kb += rss / racks;
+    w.rss_max_kb = std::max(w.rss_max_kb, rss);
+  }
+  w.own_cpu = cpu_of(own_before, own_after);
+  w.cpu_all += w.own_cpu;
+  w.lo_bytes_per_s = static_cast<double>(lo_after - lo_before) / wall;
+  return w;
+}
+
+// The supervisor's commands over a window, one way of reaching the bridges.
+struct CommandFigures {
+  WindowFigures window;
+  std::uint64_t written = 0, failed = 0;
+  double matched_s = -1;  // until every writer had matched its bridge(s)
+};
+
 struct FleetFigures {
   int racks = 0;
   double seen_s = -1, online_s = -1;
-  double cpu_mean = 0, cpu_max = 0;  // % of one core, per bridge
-  double rss_mean_kb = 0, rss_max_kb = 0;
-  double lo_bytes_per_s = 0;
+  WindowFigures state;
   double dnbctl_s = 0;
   std::size_t dnbctl_racks = 0;
   int dnbctl_status = 0;
   std::string stops;  // how the bridges ended, if not all with exit 0
+  CommandFigures partitioned, everywhere;
 };
+
+// Commands at o.command_rate per second in all, round-robin over every
+// rack's pumps, each toggling its pump, for o.window_seconds: with a writer
+// per rack in its rack's partition, or (`everywhere`) one writer in every
+// rack's partition. `wait_take(until)` waits for PumpState samples until
+// `until` and takes them.
+CommandFigures command_window(const Options& o, const dds::Participant& participant, int racks,
+                              bool everywhere,
+                              const std::vector<std::unique_ptr<BridgeProcess>>& bridges,
+                              const std::function<void(std::int64_t)>& wait_take) {
+  CommandFigures c;
+  dds::Topic<dnbridge_PumpCommand> topic(participant);
+  std::vector<std::unique_ptr<dds::Writer<dnbridge_PumpCommand>>> writers;
+  const auto writer_in = [&](const std::string& partition) {
+    writers.push_back(std::make_unique<dds::Writer<dnbridge_PumpCommand>>(
+        participant, topic,
+        dds::command_writer_qos(std::vector{partition}, 10, std::chrono::seconds(2))));
+  };
+  if (everywhere) {
+    writer_in(dds::rack_partition("*"));
+  } else {
+    for (int k = 1; k <= racks; ++k) writer_in(dds::rack_partition(fmt::format("fleet-{}", k)));
+  }
+  // Every bridge matched: each rack's writer its bridge, the one writer all.
+  const auto start = monotonic_ns();
+  const auto matched = [&] {
+    for (const auto& w : writers) {
+      const auto want = everywhere ? static_cast<std::uint32_t>(racks) : 1u;
+      if (w->matched_subscriptions().value_or(0) < want) return false;
+    }
+    return true;
+  };
+  while (!matched() && monotonic_ns() - start < 30'000'000'000) {
+    wait_take(monotonic_ns() + 100'000'000);
+  }
+  if (!matched())
+    throw std::runtime_error("the command writers did not match every bridge in 30 s");
+  c.matched_s = static_cast<double>(monotonic_ns() - start) / 1e9;
+
+  std::vector<std::string> rack_names;
+  for (int k = 1; k <= racks; ++k) rack_names.push_back(fmt::format("fleet-{}", k));
+  std::vector<bool> on(static_cast<std::size_t>(racks) * kNodesPerRack, false);
+  const auto period = static_cast<std::int64_t>(1e9 / o.command_rate);
+  c.window = measure_window(bridges, o.window_seconds, [&](std::int64_t end) {
+    std::size_t i = 0;
+    for (auto next = monotonic_ns(); next < end; next += period) {
+      while (monotonic_ns() < next) wait_take(next);
+      const std::size_t rack = (i / kNodesPerRack) % static_cast<std::size_t>(racks);
+      const auto mac = static_cast<std::uint8_t>(1 + i % kNodesPerRack);
+      const std::size_t pump = rack * kNodesPerRack + (mac - 1);
+      on[pump] = !on[pump];
+      dds::Owned<dnbridge_PumpCommand> cmd;
+      dds::set_string(cmd->rack, rack_names[rack]);
+      dds::set_string(cmd->port, "A");
+      cmd->mac = mac;
+      cmd->pump_on = on[pump];
+      dds::set_string(cmd->issuer, "fleet supervisor");
+      const auto& w = everywhere ? *writers.front() : *writers[rack];
+      if (w.write(*cmd).ok()) {
+        ++c.written;
+      } else {
+        ++c.failed;
+      }
+      ++i;
+    }
+  });
+  return c;
+}
 
 FleetFigures run_fleet(const Options& o, int racks, const std::string& default_text,
                        const std::filesystem::path& dir) {
@@ -166,35 +302,13 @@ FleetFigures run_fleet(const Options& o, int racks, const std::string& default_t
   }
 
   if (f.online_s >= 0) {
-    // The window: every bridge's CPU and RSS, the loopback's bytes.
-    std::vector<ProcessSample> before;
-    for (auto& b : bridges) before.push_back(sample_process(b->pid(), false));
-    const auto lo_before = loopback_bytes();
-    const auto window_start = monotonic_ns();
-    const auto window_end = window_start + static_cast<std::int64_t>(o.window_seconds * 1e9);
-    while (monotonic_ns() < window_end) {
-      (void)waitset.wait(milliseconds(100));
-      take();
-    }
-    const auto lo_after = loopback_bytes();
-    const double wall = static_cast<double>(monotonic_ns() - window_start) / 1e9;
-    const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
-    for (auto& b : bridges) {
-      if (auto ended = b->ended()) throw std::runtime_error("a bridge ended: " + *ended);
-    }
-    for (std::size_t i = 0; i < bridges.size(); ++i) {
-      const ProcessSample after = sample_process(bridges[i]->pid(), false);
-      // Each over its own interval: the bridges are sampled one after another.
-      const double seconds = static_cast<double>(after.at - before[i].at) / 1e9;
-      const double cpu =
-          100.0 * static_cast<double>(after.ticks - before[i].ticks) / tick / seconds;
-      f.cpu_mean += cpu / static_cast<double>(racks);
-      f.cpu_max = std::max(f.cpu_max, cpu);
-      const auto rss = static_cast<double>(after.rss_kb);
-      f.rss_mean_kb += rss / static_cast<double>(racks);
-      f.rss_max_kb = std::max(f.rss_max_kb, rss);
-    }
-    f.lo_bytes_per_s = static_cast<double>(lo_after - lo_before) / wall;
+    // The window: the supervisor only reads.
+    f.state = measure_window(bridges, o.window_seconds, [&](std::int64_t end) {
+      while (monotonic_ns() < end) {
+        (void)waitset.wait(milliseconds(100));
+        take();
+      }
+    });
 
     // dnbctl racks, as an operator runs it.
     const auto t = monotonic_ns();
@@ -205,6 +319,23 @@ FleetFigures run_fleet(const Options& o, int racks, const std::string& default_t
          at = out.find("\"bridge_hosts\"", at + 1)) {
       ++f.dnbctl_racks;
     }
+
+    const auto settle = [&] {
+      // The pumps go idle when the writers go: not in the next window.
+      const auto end = monotonic_ns() + 3'000'000'000;
+      while (monotonic_ns() < end) {
+        (void)waitset.wait(milliseconds(100));
+        take();
+      }
+    };
+    const auto wait_take = [&](std::int64_t until) {
+      (void)waitset.wait(
+          std::chrono::nanoseconds(std::max<std::int64_t>(0, until - monotonic_ns())));
+      take();
+    };
+    f.partitioned = command_window(o, participant, racks, false, bridges, wait_take);
+    settle();
+    f.everywhere = command_window(o, participant, racks, true, bridges, wait_take);
   }
 
   // All asked to stop at once (each then idles and releases its nodes).
@@ -251,9 +382,20 @@ int run(const Options& o) {
           "devices included); RSS mean {:.0f} kB max {:.0f} kB\n"
           "    loopback: {:.0f} kB/s in all, {:.1f} kB/s per rack\n"
           "    dnbctl racks --json: {:.2f} s, {} rack(s) found (exit {})\n",
-          f.seen_s, f.online_s, o.window_seconds, f.cpu_mean, f.cpu_max, f.rss_mean_kb,
-          f.rss_max_kb, f.lo_bytes_per_s / 1e3, f.lo_bytes_per_s / 1e3 / f.racks, f.dnbctl_s,
-          f.dnbctl_racks, f.dnbctl_status);
+          f.seen_s, f.online_s, o.window_seconds, f.state.cpu_mean, f.state.cpu_max,
+          f.state.rss_mean_kb, f.state.rss_max_kb, f.state.lo_bytes_per_s / 1e3,
+          f.state.lo_bytes_per_s / 1e3 / f.racks, f.dnbctl_s, f.dnbctl_racks, f.dnbctl_status);
+      for (const auto& [c, how] :
+           {std::pair{&f.partitioned, "a writer per rack, its partition"},
+            std::pair{&f.everywhere, "one writer, every rack's partition"}}) {
+        fmt::print(
+            "    {} commands/s ({}; matched in {:.2f} s): {} written, {} failed; per bridge CPU "
+            "mean {:.2f} % max {:.2f} %; loopback {:.0f} kB/s; supervisor CPU {:.1f} %; bridges "
+            "and supervisor {:.0f} % in all\n",
+            o.command_rate, how, c->matched_s, c->written, c->failed, c->window.cpu_mean,
+            c->window.cpu_max, c->window.lo_bytes_per_s / 1e3, c->window.own_cpu,
+            c->window.cpu_all);
+      }
     }
     if (!f.stops.empty()) fmt::print("    bridges that did not stop with exit 0: {}\n", f.stops);
     std::fflush(stdout);
@@ -266,8 +408,25 @@ int run(const Options& o) {
     fmt::print(
         "  {:5}  {:5}  {:7.2f} s  {:9.2f} s  {:8.2f} % ({:.2f} %)  {:10.0f} kB  {:16.1f}  "
         "{:.2f} s ({} found)\n",
-        f.racks, f.racks * static_cast<int>(kNodesPerRack), f.seen_s, f.online_s, f.cpu_mean,
-        f.cpu_max, f.rss_mean_kb, f.lo_bytes_per_s / 1e3 / f.racks, f.dnbctl_s, f.dnbctl_racks);
+        f.racks, f.racks * static_cast<int>(kNodesPerRack), f.seen_s, f.online_s, f.state.cpu_mean,
+        f.state.cpu_max, f.state.rss_mean_kb, f.state.lo_bytes_per_s / 1e3 / f.racks, f.dnbctl_s,
+        f.dnbctl_racks);
+  }
+  fmt::print(
+      "\ncommands, {}/s in all: per bridge CPU mean (max), loopback, supervisor CPU, CPU of the\n"
+      "bridges and the supervisor together (2 CPUs: 200 %)\n"
+      "  racks  a writer per rack, its partition              one writer, every rack's "
+      "partition\n",
+      o.command_rate);
+  for (const auto& f : all) {
+    if (f.online_s < 0) continue;
+    fmt::print("  {:5}", f.racks);
+    for (const auto* c : {&f.partitioned, &f.everywhere}) {
+      fmt::print("  {:5.2f} % ({:5.2f} %) {:6.0f} kB/s {:5.1f} % {:4.0f} %", c->window.cpu_mean,
+                 c->window.cpu_max, c->window.lo_bytes_per_s / 1e3, c->window.own_cpu,
+                 c->window.cpu_all);
+    }
+    fmt::print("\n");
   }
   fmt::print("load average at end: {}\n", load_average());
   return 0;
@@ -285,6 +444,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--poll-ms", o.poll_ms, "poll period of every node")->capture_default_str();
   app.add_option("--window-seconds", o.window_seconds, "CPU, RSS and traffic window")
+      ->capture_default_str();
+  app.add_option("--command-rate", o.command_rate,
+                 "the supervisor's commands per second, in all, in the command windows")
+      ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   app.add_option("--online-timeout-seconds", o.online_timeout_seconds,
                  "how long every pump may take to be online")
