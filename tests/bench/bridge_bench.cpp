@@ -956,22 +956,9 @@ int run_bench(const Options& o) {
   // for ddsperf: a hand-over between threads of one process then stays on
   // its CPU (on a virtual machine waking another, idle, CPU can cost tens of
   // microseconds), and each pair is measured in the same layout.
-  Placement cpus;
-  const int online = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
-  if (o.pin && o.bridge_cpu != o.peer_cpu && std::max(o.bridge_cpu, o.peer_cpu) < online &&
-      std::min(o.bridge_cpu, o.peer_cpu) >= 0) {
-    cpus = {o.bridge_cpu, o.peer_cpu};
-    if (!pin_to_cpu(cpus.tested)) {
-      throw std::runtime_error(fmt::format("cannot keep the benchmark on CPU {}", cpus.tested));
-    }
-    fmt::print(
-        "CPUs: the bridge (this process, every thread) and ddsperf pong on CPU {}; the "
-        "subscriber/commander\n      process and ddsperf ping on CPU {}\n\n",
-        cpus.tested, cpus.peer);
-  } else {
-    fmt::print("CPUs: every process and thread where the kernel puts it{}\n\n",
-               o.pin ? " (two distinct online CPUs are needed to pin)" : "");
-  }
+  const Placement cpus =
+      place_processes(o.pin, o.bridge_cpu, o.peer_cpu, "the bridge (this process, every thread)",
+                      "the subscriber/commander process");
 
   if (!steady_clock_is_monotonic()) {
     fmt::print(stderr,

@@ -654,18 +654,8 @@ int run_bench(const Options& o) {
   const int awake = o.hold_awake ? hold_cpus_awake() : -1;
   fmt::print("CPU idle: {}\n", awake >= 0 ? "/dev/cpu_dma_latency held at 0 us (no CPU halts)"
                                           : "CPUs halt when idle");
-  Placement cpus;
-  if (o.pin && o.bridge_cpu != o.peer_cpu &&
-      std::max(o.bridge_cpu, o.peer_cpu) < static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN))) {
-    cpus = {o.bridge_cpu, o.peer_cpu};
-    if (!pin_to_cpu(cpus.tested)) throw std::runtime_error("cannot pin to the bridge's CPU");
-    fmt::print(
-        "CPUs: the bridge's side and ddsperf pong on CPU {}, the supervisor's side and "
-        "ddsperf ping on CPU {}\n",
-        cpus.tested, cpus.peer);
-  } else {
-    fmt::print("CPUs: where the kernel puts them\n");
-  }
+  const Placement cpus = place_processes(o.pin, o.bridge_cpu, o.peer_cpu, "the bridge's side",
+                                         "the supervisor's side");
   fmt::print(
       "{} rounds of {} paths, {:.1f} s each; commands and states every {} us on average "
       "(gaps 0.5..1.5 x), round robin over {} instances\n\n",

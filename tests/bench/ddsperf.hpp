@@ -12,6 +12,7 @@
 #include <regex>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bench_process.hpp"
@@ -76,6 +77,27 @@ struct Placement {
   int tested = -1;
   int peer = -1;
 };
+
+// With `pin`, this process (every thread it starts later too) on CPU
+// `tested_cpu`, and the returned Placement names `peer_cpu` for the peer;
+// without, or when the two are not distinct online CPUs, no placement.
+// Prints which; throws when this process cannot be pinned.
+inline Placement place_processes(bool pin, int tested_cpu, int peer_cpu, std::string_view tested,
+                                 std::string_view peer) {
+  const int online = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
+  if (!pin || tested_cpu == peer_cpu || std::max(tested_cpu, peer_cpu) >= online ||
+      std::min(tested_cpu, peer_cpu) < 0) {
+    fmt::print("CPUs: every process and thread where the kernel puts it{}\n\n",
+               pin ? " (two distinct online CPUs are needed to pin)" : "");
+    return {};
+  }
+  if (!pin_to_cpu(tested_cpu)) {
+    throw std::runtime_error(fmt::format("cannot keep the benchmark on CPU {}", tested_cpu));
+  }
+  fmt::print("CPUs: {} and ddsperf pong on CPU {}; {} and ddsperf ping on CPU {}\n\n", tested,
+             tested_cpu, peer, peer_cpu);
+  return {tested_cpu, peer_cpu};
+}
 
 // ddsperf ping and pong, run beside a measurement of the bridge: started when
 // the measurement starts, read when it ends, so that both see the same
