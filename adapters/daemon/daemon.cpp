@@ -119,6 +119,7 @@ metrics::ProcessCounters Daemon::process_counters() const {
   if (input_) {
     c.commands_taken = input_->commands_taken();
     c.requests_taken = input_->requests_taken();
+    c.command_holdoffs = input_->command_holdoffs();
   }
   return c;
 }

@@ -91,9 +91,11 @@ class Daemon {
   const metrics::MetricsServer* metrics_server() const {
     return metrics_server_ ? &*metrics_server_ : nullptr;
   }
+  // The process's own counters: its DDS queues, the samples it took, the
+  // command hold-offs (the metrics endpoint's process series).
+  metrics::ProcessCounters process_counters() const;
 
  private:
-  metrics::ProcessCounters process_counters() const;
   void run_reloads();
   void log_report(const ReloadReport& report, const std::vector<ReloadCall>& asked_by);
 

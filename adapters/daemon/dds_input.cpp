@@ -256,7 +256,10 @@ void DdsInput::deliver_commands() {
         // the newest of each is taken at the end of the hold-off, by the
         // input thread), and meanwhile a sample costs this check only.
         commands_pending_ = true;
-        if (!held_signalled_.exchange(true)) (void)commands_held_.trigger();
+        if (!held_signalled_.exchange(true)) {
+          ++command_holdoffs_;
+          (void)commands_held_.trigger();
+        }
         break;  // to the look after unlocking: the hold-off may have ended meanwhile
       }
       take_commands();

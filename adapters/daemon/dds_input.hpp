@@ -75,6 +75,9 @@ class DdsInput {
 
   // Samples with data for this rack taken so far (any thread).
   std::uint64_t commands_taken() const noexcept { return commands_taken_.load(); }
+  // Times commands came within the hold-off after a take (a flood) and were
+  // left in the reader for the input thread to take at its end.
+  std::uint64_t command_holdoffs() const noexcept { return command_holdoffs_.load(); }
   std::uint64_t requests_taken() const noexcept { return requests_taken_.load(); }
 
  private:
@@ -134,6 +137,7 @@ class DdsInput {
   HandoffLogSink command_sink_;
   Logger command_log_;  // log_ through command_sink_
   std::atomic<std::uint64_t> commands_taken_{0};
+  std::atomic<std::uint64_t> command_holdoffs_{0};
   std::atomic<std::uint64_t> requests_taken_{0};
   std::uint64_t commands_stamped_ahead_ = 0;
   std::uint64_t requests_refused_for_names_ = 0;

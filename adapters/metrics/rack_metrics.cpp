@@ -213,6 +213,10 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
               with(rack, "topic", "PumpCommand"), static_cast<double>(p.commands_taken));
     f.counter("dnbridge_dds_samples_taken_total", "DDS samples taken by the bridge",
               with(rack, "topic", "ExplicitRequest"), static_cast<double>(p.requests_taken));
+    f.counter("dnbridge_dds_command_holdoffs_total",
+              "Times PumpCommand samples came within 1 ms of the take before them (a flood) and "
+              "waited in the reader for the next take, which takes each pump's newest",
+              rack, static_cast<double>(p.command_holdoffs));
   }
   return f.take();
 }

@@ -21,7 +21,7 @@
 //   process    dnbridge_dds_samples_written_total{queue},
 //   dnbridge_dds_samples_replaced_total{queue},
 //              dnbridge_dds_samples_refused_total{queue}, dnbridge_dds_queue_depth{queue},
-//              dnbridge_dds_samples_taken_total{topic}
+//              dnbridge_dds_samples_taken_total{topic}, dnbridge_dds_command_holdoffs_total
 //
 // Labels: rack and port on every port and node series, mac and name on a
 // node's. Units in the names (seconds, ratio), counters end in _total.
@@ -55,6 +55,7 @@ struct ProcessCounters {
   std::vector<Queue> queues;
   std::uint64_t commands_taken = 0;  // PumpCommand samples
   std::uint64_t requests_taken = 0;  // ExplicitRequest samples
+  std::uint64_t command_holdoffs = 0;  // DdsInput::command_holdoffs
 };
 
 class RackMetrics final : public port::PortPublisher, public prometheus::Collectable {

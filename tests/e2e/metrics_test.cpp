@@ -85,7 +85,8 @@ TEST_F(BridgeTest, MetricsAreServedAndPassPromtool) {
         "dnbridge_can_bus_state{rack=\"sim-rack\",port=\"A\",state=\"error-active\"} 1\n",
         "# TYPE dnbridge_node_polls_total counter\n", "# TYPE dnbridge_can_frames_total counter\n",
         "# TYPE dnbridge_dds_queue_depth gauge\n",
-        "dnbridge_dds_samples_taken_total{rack=\"sim-rack\",topic=\"PumpCommand\"} 0\n"}) {
+        "dnbridge_dds_samples_taken_total{rack=\"sim-rack\",topic=\"PumpCommand\"} 0\n",
+        "dnbridge_dds_command_holdoffs_total{rack=\"sim-rack\"} 0\n"}) {
     EXPECT_NE(text.find(line), std::string::npos) << line << "in:\n" << text;
   }
   const auto [status, said] = promtool(text);
