@@ -112,6 +112,19 @@ std::size_t HandoffLogSink::drain() {
   return dropped;
 }
 
+thread_local bool DrainFirstLogSink::in_before_ = false;
+
+void DrainFirstLogSink::write_structured(LogLevel level, std::string_view component,
+                                         std::string_view message,
+                                         std::span<const LogField> fields) {
+  if (!in_before_) {
+    in_before_ = true;
+    before_();
+    in_before_ = false;
+  }
+  target_.write_structured(level, component, message, fields);
+}
+
 DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
                    std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log,
                    std::function<void(ReloadCall)> reload)
@@ -132,7 +145,9 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       waitset_(participant),
       log_waiting_(participant),
       command_sink_(log_.sink(), [this] { (void)log_waiting_.trigger(); }),
-      command_log_(log_.to(command_sink_)) {
+      command_log_(log_.to(command_sink_)),
+      own_sink_(log_.sink(), [this] { drain_command_log(); }) {
+  log_ = log_.to(own_sink_);
   // Readers of the services that DDS Security grants (the publisher has
   // their topics), each as far as it grants it.
   if (const auto* topic = publisher.scan_request_topic()) {

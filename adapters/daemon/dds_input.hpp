@@ -58,6 +58,27 @@ class HandoffLogSink : public LogSink {
   std::size_t dropped_ = 0;
 };
 
+// A thread's own lines after the lines handed off before them: before each
+// line it writes, `before` writes out what a HandoffLogSink holds (and may
+// log through this sink itself: it is not called again from within), so the
+// log keeps the order in which the lines were written.
+class DrainFirstLogSink : public LogSink {
+ public:
+  DrainFirstLogSink(LogSink& target, std::function<void()> before)
+      : target_(target), before_(std::move(before)) {}
+  bool enabled(LogLevel level) const noexcept override { return target_.enabled(level); }
+  void write(LogLevel level, std::string_view component, std::string_view message) override {
+    write_structured(level, component, message, {});
+  }
+  void write_structured(LogLevel level, std::string_view component, std::string_view message,
+                        std::span<const LogField> fields) override;
+
+ private:
+  LogSink& target_;
+  std::function<void()> before_;
+  static thread_local bool in_before_;
+};
+
 class DdsInput {
  public:
   // `reload`: called (on the input's thread) with each reload request for
@@ -136,6 +157,9 @@ class DdsInput {
   dds::GuardCondition log_waiting_;
   HandoffLogSink command_sink_;
   Logger command_log_;  // log_ through command_sink_
+  // log_'s sink once constructed: the input's own lines come after the
+  // command path's lines handed off before them.
+  DrainFirstLogSink own_sink_;
   std::atomic<std::uint64_t> commands_taken_{0};
   std::atomic<std::uint64_t> command_holdoffs_{0};
   std::atomic<std::uint64_t> requests_taken_{0};

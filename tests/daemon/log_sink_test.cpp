@@ -144,5 +144,43 @@ TEST(HandoffLogSink, KeepsOrderAndFieldsAndCountsWhatItDrops) {
   EXPECT_EQ(target.lines.back(), "dds input: after RACK=r1");
 }
 
+// The input thread's own lines (DdsInput's logger) come after the command
+// path's lines handed off before them, not before, though those wait for the
+// next drain.
+TEST(DrainFirstLogSink, AThreadsOwnLinesComeAfterTheLinesHandedOffBeforeThem) {
+  class Capture final : public LogSink {
+   public:
+    bool enabled(LogLevel) const noexcept override { return true; }
+    void write(LogLevel, std::string_view component, std::string_view message) override {
+      lines.push_back(std::string(component) + ": " + std::string(message));
+    }
+    std::vector<std::string> lines;
+  } target;
+  HandoffLogSink handoff(target, [] {});
+  int drains = 0;
+  DrainFirstLogSink own(target, [&] {
+    ++drains;
+    if (handoff.drain() > 0) Logger(own, "input").warn("lines dropped");
+  });
+  const Logger commands(handoff, "commands");
+  const Logger input(own, "input");
+  commands.info("one");
+  input.info("two");
+  commands.info("three");
+  commands.info("four");
+  input.info("five");
+  EXPECT_EQ(target.lines,
+            (std::vector<std::string>{"commands: one", "input: two", "commands: three",
+                                      "commands: four", "input: five"}));
+  EXPECT_EQ(drains, 2);
+  // What `before` logs itself is not preceded by another drain.
+  for (std::size_t i = 0; i < HandoffLogSink::kCapacity + 1; ++i) commands.info("flood");
+  input.info("six");
+  EXPECT_EQ(drains, 3);
+  ASSERT_GE(target.lines.size(), 2u);
+  EXPECT_EQ(target.lines[target.lines.size() - 2], "input: lines dropped");
+  EXPECT_EQ(target.lines.back(), "input: six");
+}
+
 }  // namespace
 }  // namespace dnbridge::daemon
