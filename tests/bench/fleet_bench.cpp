@@ -14,13 +14,15 @@
 //   - `dnbctl racks --json` run once: its wall time, and how many racks it
 //     found;
 //   - the supervisor commanding pumps, --command-rate commands per second
-//     in all, round-robin over every rack's pumps, over a window each way:
+//     in all, round robin over the racks (each command toggling its pump),
+//     over a window each way, opened 2 s after its writers matched:
 //     with a writer per rack in its rack's partition (as shipped), and with
 //     one writer in every rack's partition ("dnbridge/*": each bridge then
 //     receives every rack's commands and drops the others', as all bridges
 //     did before racks had partitions). Per bridge CPU, the loopback's
 //     bytes, the supervisor's own CPU, and the CPU of the bridges and the
-//     supervisor together (how near the machine is to saturation), each way.
+//     supervisor together (how near the machine is to saturation), and how
+//     many of the pumps commanded PumpState showed applied, each way.
 // Every participant is on the loopback interface with unicast discovery and
 // a discovery tag of the run's own. It reports figures; it exits non-zero
 // only when the run itself fails.
@@ -167,7 +169,13 @@ struct CommandFigures {
   WindowFigures window;
   std::uint64_t written = 0, failed = 0;
   double matched_s = -1;  // until every writer had matched its bridge(s)
+  // Pumps commanded in the window, and how many of them PumpState showed
+  // commanded by the supervisor by the end of the window and 2 s more.
+  std::size_t pumps_commanded = 0, pumps_seen_applied = 0;
 };
+
+using PumpKey = std::tuple<std::string, unsigned>;
+constexpr const char* kIssuer = "fleet supervisor";
 
 struct FleetFigures {
   int racks = 0;
@@ -180,15 +188,19 @@ struct FleetFigures {
   CommandFigures partitioned, everywhere;
 };
 
-// Commands at o.command_rate per second in all, round-robin over every
-// rack's pumps, each toggling its pump, for o.window_seconds: with a writer
-// per rack in its rack's partition, or (`everywhere`) one writer in every
-// rack's partition. `wait_take(until)` waits for PumpState samples until
-// `until` and takes them.
+// Commands at o.command_rate per second in all for o.window_seconds, round
+// robin over the racks (rack 1 pump 1, rack 2 pump 1, ..., rack 1 pump 2,
+// ...), each toggling its pump: with a writer per rack in its rack's
+// partition, or (`everywhere`) one writer in every rack's partition. The
+// window opens 2 s after the writers matched, so that the bridges' discovery
+// of them is not in it. `wait_take(until)` waits for PumpState samples until
+// `until` and takes them; `applied` is what they showed commanded by the
+// supervisor (cleared here).
 CommandFigures command_window(const Options& o, const dds::Participant& participant, int racks,
                               bool everywhere,
                               const std::vector<std::unique_ptr<BridgeProcess>>& bridges,
-                              const std::function<void(std::int64_t)>& wait_take) {
+                              const std::function<void(std::int64_t)>& wait_take,
+                              std::set<PumpKey>& applied) {
   CommandFigures c;
   dds::Topic<dnbridge_PumpCommand> topic(participant);
   std::vector<std::unique_ptr<dds::Writer<dnbridge_PumpCommand>>> writers;
@@ -217,17 +229,23 @@ CommandFigures command_window(const Options& o, const dds::Participant& particip
   if (!matched())
     throw std::runtime_error("the command writers did not match every bridge in 30 s");
   c.matched_s = static_cast<double>(monotonic_ns() - start) / 1e9;
+  for (const auto settled = monotonic_ns() + 2'000'000'000; monotonic_ns() < settled;) {
+    wait_take(settled);
+  }
+  applied.clear();
 
   std::vector<std::string> rack_names;
   for (int k = 1; k <= racks; ++k) rack_names.push_back(fmt::format("fleet-{}", k));
   std::vector<bool> on(static_cast<std::size_t>(racks) * kNodesPerRack, false);
+  std::set<PumpKey> commanded;
   const auto period = static_cast<std::int64_t>(1e9 / o.command_rate);
   c.window = measure_window(bridges, o.window_seconds, [&](std::int64_t end) {
     std::size_t i = 0;
     for (auto next = monotonic_ns(); next < end; next += period) {
       while (monotonic_ns() < next) wait_take(next);
-      const std::size_t rack = (i / kNodesPerRack) % static_cast<std::size_t>(racks);
-      const auto mac = static_cast<std::uint8_t>(1 + i % kNodesPerRack);
+      const std::size_t rack = i % static_cast<std::size_t>(racks);
+      const auto mac =
+          static_cast<std::uint8_t>(1 + (i / static_cast<std::size_t>(racks)) % kNodesPerRack);
       const std::size_t pump = rack * kNodesPerRack + (mac - 1);
       on[pump] = !on[pump];
       dds::Owned<dnbridge_PumpCommand> cmd;
@@ -235,16 +253,20 @@ CommandFigures command_window(const Options& o, const dds::Participant& particip
       dds::set_string(cmd->port, "A");
       cmd->mac = mac;
       cmd->pump_on = on[pump];
-      dds::set_string(cmd->issuer, "fleet supervisor");
+      dds::set_string(cmd->issuer, kIssuer);
       const auto& w = everywhere ? *writers.front() : *writers[rack];
       if (w.write(*cmd).ok()) {
         ++c.written;
+        commanded.insert({rack_names[rack], mac});
       } else {
         ++c.failed;
       }
       ++i;
     }
   });
+  for (const auto grace = monotonic_ns() + 2'000'000'000; monotonic_ns() < grace;) wait_take(grace);
+  c.pumps_commanded = commanded.size();
+  for (const auto& k : commanded) c.pumps_seen_applied += applied.count(k);
   return c;
 }
 
@@ -273,15 +295,16 @@ FleetFigures run_fleet(const Options& o, int racks, const std::string& default_t
   dds::ReadCondition data(reader, DDS_ANY_STATE);
   dds::WaitSet waitset(participant);
   waitset.attach(data, 1);
-  std::set<std::tuple<std::string, unsigned>> seen, online;
+  std::set<PumpKey> seen, online, applied;
   const std::size_t all = static_cast<std::size_t>(racks) * kNodesPerRack;
   const auto take = [&] {
     auto samples = reader.take();
     if (!samples) return;
     for (const auto& s : *samples) {
       if (!s.valid_data()) continue;
-      std::tuple<std::string, unsigned> key{std::string(dds::view(s->rack)), s->mac};
+      PumpKey key{std::string(dds::view(s->rack)), s->mac};
       seen.insert(key);
+      if (!s->outputs_idle && dds::view(s->commanded_by) == kIssuer) applied.insert(key);
       if (s->online) {
         online.insert(key);
       } else {
@@ -333,9 +356,9 @@ FleetFigures run_fleet(const Options& o, int racks, const std::string& default_t
           std::chrono::nanoseconds(std::max<std::int64_t>(0, until - monotonic_ns())));
       take();
     };
-    f.partitioned = command_window(o, participant, racks, false, bridges, wait_take);
+    f.partitioned = command_window(o, participant, racks, false, bridges, wait_take, applied);
     settle();
-    f.everywhere = command_window(o, participant, racks, true, bridges, wait_take);
+    f.everywhere = command_window(o, participant, racks, true, bridges, wait_take, applied);
   }
 
   // All asked to stop at once (each then idles and releases its nodes).
@@ -389,12 +412,14 @@ int run(const Options& o) {
            {std::pair{&f.partitioned, "a writer per rack, its partition"},
             std::pair{&f.everywhere, "one writer, every rack's partition"}}) {
         fmt::print(
-            "    {} commands/s ({}; matched in {:.2f} s): {} written, {} failed; per bridge CPU "
+            "    {} commands/s ({}; matched in {:.2f} s): {} written, {} failed, {} of the {} "
+            "pumps "
+            "commanded seen applied; per bridge CPU "
             "mean {:.2f} % max {:.2f} %; loopback {:.0f} kB/s; supervisor CPU {:.1f} %; bridges "
             "and supervisor {:.0f} % in all\n",
-            o.command_rate, how, c->matched_s, c->written, c->failed, c->window.cpu_mean,
-            c->window.cpu_max, c->window.lo_bytes_per_s / 1e3, c->window.own_cpu,
-            c->window.cpu_all);
+            o.command_rate, how, c->matched_s, c->written, c->failed, c->pumps_seen_applied,
+            c->pumps_commanded, c->window.cpu_mean, c->window.cpu_max,
+            c->window.lo_bytes_per_s / 1e3, c->window.own_cpu, c->window.cpu_all);
       }
     }
     if (!f.stops.empty()) fmt::print("    bridges that did not stop with exit 0: {}\n", f.stops);
