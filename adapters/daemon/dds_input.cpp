@@ -119,8 +119,10 @@ void DrainFirstLogSink::write_structured(LogLevel level, std::string_view compon
                                          std::span<const LogField> fields) {
   if (!in_before_) {
     in_before_ = true;
+    struct Reset {
+      ~Reset() { in_before_ = false; }
+    } reset;
     before_();
-    in_before_ = false;
   }
   target_.write_structured(level, component, message, fields);
 }
@@ -204,7 +206,10 @@ void DdsInput::stop() {
 
 void DdsInput::drain_command_log() {
   if (const auto dropped = command_sink_.drain(); dropped > 0) {
-    log_.warn("{} more lines of the command path not logged (more than {} waited)", dropped,
+    // Straight to the target: through log_, newer handed-off lines would
+    // be drained before this one.
+    log_.to(own_sink_.target())
+        .warn("{} more lines of the command path not logged (more than {} waited)", dropped,
               HandoffLogSink::kCapacity);
   }
 }

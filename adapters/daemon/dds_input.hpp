@@ -59,9 +59,11 @@ class HandoffLogSink : public LogSink {
 };
 
 // A thread's own lines after the lines handed off before them: before each
-// line it writes, `before` writes out what a HandoffLogSink holds (and may
-// log through this sink itself: it is not called again from within), so the
-// log keeps the order in which the lines were written.
+// line it writes, `before` writes out what a HandoffLogSink holds, so the log
+// keeps the order in which the lines were written. For one writing thread at
+// a time (two that drain at once may interleave what they write). `before`
+// may log through this sink: it is not called again from within, nor, on
+// that thread, is any DrainFirstLogSink's.
 class DrainFirstLogSink : public LogSink {
  public:
   DrainFirstLogSink(LogSink& target, std::function<void()> before)
@@ -72,6 +74,7 @@ class DrainFirstLogSink : public LogSink {
   }
   void write_structured(LogLevel level, std::string_view component, std::string_view message,
                         std::span<const LogField> fields) override;
+  LogSink& target() const noexcept { return target_; }
 
  private:
   LogSink& target_;

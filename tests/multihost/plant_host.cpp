@@ -29,7 +29,10 @@
 //        command again every second until the pump's PumpState shows it
 //        applied (a sample written as soon as the writer matched can reach
 //        the bridge before the bridge has discovered the writer, and be
-//        dropped there), and not after that.
+//        dropped there), and not after that; after 30 s without, it gives
+//        up and says "gave up RACK PORT MAC". (Applied is looked at when a
+//        PumpState sample comes: every pump publishes at least once a
+//        second.)
 //   status      status instances=I samples=S
 //        PumpState instances seen, valid samples of them taken.
 //   show RACK PORT MAC   shown, then the node line of that pump as it is now
@@ -243,13 +246,21 @@ class PlantHost {
       return;
     }
     say("written " + key.rack + " " + std::to_string(commander->matched()));
-    unapplied_[key] = Unapplied{on, Clock::now()};
+    unapplied_[key] = Unapplied{on, Clock::now(), Clock::now()};
   }
 
-  // Each command not yet seen applied, written again a second after the last time.
+  // Each command not yet seen applied, written again a second after the
+  // last time, for 30 s.
   void rewrite() {
     const auto now = Clock::now();
-    for (auto& [key, command] : unapplied_) {
+    for (auto it = unapplied_.begin(); it != unapplied_.end();) {
+      if (now - it->second.first > std::chrono::seconds(30)) {
+        say("gave up " + it->first.rack + " " + it->first.port + " " +
+            std::to_string(it->first.mac));
+        it = unapplied_.erase(it);
+        continue;
+      }
+      auto& [key, command] = *it++;
       if (now - command.written < std::chrono::seconds(1)) continue;
       (void)commanders_[key.rack]->write(key, dnbctl::Outputs{.pump_on = command.on}, kIssuer);
       command.written = now;
@@ -259,7 +270,7 @@ class PlantHost {
   static constexpr const char* kIssuer = "plant host";
   struct Unapplied {
     bool on = false;
-    Clock::time_point written;
+    Clock::time_point first, written;
   };
 
   dnbctl::Client client_;
