@@ -42,8 +42,6 @@
 //
 // At the end of stdin it exits 0. CYCLONEDDS_URI is the test's plant-network
 // configuration.
-#include <poll.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdint>
@@ -62,6 +60,7 @@
 #include "adapters/dnbctl/commander.hpp"
 #include "adapters/security/check.hpp"
 #include "adapters/security/toml_settings.hpp"
+#include "support/stdin_lines.hpp"
 
 namespace {
 
@@ -104,7 +103,7 @@ class PlantHost {
 
   // Until the end of stdin.
   void run() {
-    std::string input;
+    support::StdinLines input;
     for (;;) {
       client_.refresh();
       look();
@@ -114,17 +113,7 @@ class PlantHost {
         samples_asked_.reset();
       }
       check_view();
-      pollfd p{STDIN_FILENO, POLLIN, 0};
-      if (::poll(&p, 1, 0) == 1) {
-        char buf[512];
-        const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
-        if (n <= 0) return;
-        input.append(buf, static_cast<std::size_t>(n));
-        for (auto end = input.find('\n'); end != std::string::npos; end = input.find('\n')) {
-          answer(input.substr(0, end));
-          input.erase(0, end + 1);
-        }
-      }
+      if (!input.read(0, [this](const std::string& line) { answer(line); })) return;
       // Woken by state, or in 20 ms to look at stdin and staleness again.
       client_.wait(milliseconds(20));
     }
