@@ -112,10 +112,9 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends, Reloa
 
 metrics::ProcessCounters Daemon::process_counters() const {
   metrics::ProcessCounters c;
-  for (const auto& [name, q] : {std::pair{"state", publisher_.state_queue()},
-                                std::pair{"replies", publisher_.reply_queue()}}) {
-    c.queues.push_back({name, q.run, q.replaced, q.refused, q.waiting});
-  }
+  // State samples are written on the ports' threads: replies alone queue.
+  const auto replies = publisher_.reply_queue();
+  c.queues.push_back({"replies", replies.run, replies.refused, replies.waiting});
   if (input_) {
     c.commands_taken = input_->commands_taken();
     c.requests_taken = input_->requests_taken();

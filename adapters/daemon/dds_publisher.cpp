@@ -1,7 +1,6 @@
 #include "adapters/daemon/dds_publisher.hpp"
 
 #include <algorithm>
-#include <array>
 #include <memory>
 
 #include "adapters/daemon/samples.hpp"
@@ -47,9 +46,6 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
                               return Service<dnbridge_ReloadRequest, dnbridge_ReloadReply>(
                                   participant, dds::scan_reply_writer_qos(partition_));
                             })),
-      // State samples are keyed (one waits per instance): the capacity only
-      // bounds the unregistrations of a port that stops.
-      state_out_("dds state out", 64),
       reply_out_("dds reply out", kReplyBacklog) {}
 
 bool DdsPublisher::check(Status s, const char* what) {
@@ -60,10 +56,6 @@ bool DdsPublisher::check(Status s, const char* what) {
 }
 
 namespace {
-
-std::string instance_key(char topic, const std::string& port, std::uint8_t mac = 0) {
-  return fmt::format("{}{}/{}", topic, mac, port);
-}
 
 // A node's instance of a state topic.
 template <class T>
@@ -79,31 +71,27 @@ dds::Owned<T> key_of(const std::string& rack, const std::string& port, std::uint
 
 void DdsPublisher::pump_state(const std::string& port, const rack::PumpView& pump,
                               TimePoint source_time) {
-  auto sample = std::make_shared<dds::Owned<dnbridge_PumpState>>();
-  fill_pump_state(**sample, rack_, port, pump);
-  const auto at = clock_.to_wall(source_time);
-  state_out_.post(instance_key('P', port, pump.mac.value()),
-                  [this, sample, at] { check(pump_writer_.write(**sample, at), "PumpState"); });
-  std::lock_guard lock(mutex_);
-  written_[port].insert(pump.mac.value());
+  {
+    std::lock_guard lock(mutex_);
+    written_[port].insert(pump.mac.value());
+  }
+  dds::Owned<dnbridge_PumpState> sample;
+  fill_pump_state(*sample, rack_, port, pump);
+  check(pump_writer_.write(*sample, clock_.to_wall(source_time)), "PumpState");
 }
 
 void DdsPublisher::node_status(const std::string& port, const rack::PumpView& pump,
                                const port::NodeStatusView& node, TimePoint source_time) {
-  auto sample = std::make_shared<dds::Owned<dnbridge_NodeStatus>>();
-  fill_node_status(**sample, rack_, port, pump, node);
-  const auto at = clock_.to_wall(source_time);
-  state_out_.post(instance_key('N', port, pump.mac.value()),
-                  [this, sample, at] { check(node_writer_.write(**sample, at), "NodeStatus"); });
+  dds::Owned<dnbridge_NodeStatus> sample;
+  fill_node_status(*sample, rack_, port, pump, node);
+  check(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
 }
 
 void DdsPublisher::port_status(const port::PortStatusView& status, TimePoint source_time) {
-  auto sample = std::make_shared<dds::Owned<dnbridge_PortStatus>>();
-  fill_port_status(**sample, rack_, status);
-  (*sample)->replies_undelivered = replies_undelivered(status.port);
-  const auto at = clock_.to_wall(source_time);
-  state_out_.post(instance_key('S', status.port),
-                  [this, sample, at] { check(port_writer_.write(**sample, at), "PortStatus"); });
+  dds::Owned<dnbridge_PortStatus> sample;
+  fill_port_status(*sample, rack_, status);
+  sample->replies_undelivered = replies_undelivered(status.port);
+  check(port_writer_.write(*sample, clock_.to_wall(source_time)), "PortStatus");
 }
 
 void DdsPublisher::explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) {
@@ -163,29 +151,24 @@ void DdsPublisher::node_removed(const std::string& port, devicenet::MacId mac) {
     written_[port].erase(mac.value());
   }
   // Disposed: the pump is no longer the rack's, which unregistering (the
-  // bridge gone) would not say. After its last samples, in the same outbox.
-  const std::array<std::string, 2> keys{instance_key('P', port, mac.value()),
-                                        instance_key('N', port, mac.value())};
-  state_out_.post_always_after(keys, [this, port, mac] { release_node(port, mac.value(), true); });
+  // bridge gone) would not say.
+  release_node(port, mac.value(), true);
 }
 
 void DdsPublisher::port_stopped(const std::string& port) {
   // Unregister, never dispose: the last samples (online false, stopped) stay
-  // what late readers see until the bridge is back. After the port's last
-  // samples, which wait in the same outbox.
+  // what late readers see until the bridge is back.
   std::set<std::uint8_t> macs;
   {
     std::lock_guard lock(mutex_);
-    macs = written_[port];
+    macs = std::move(written_[port]);
+    written_.erase(port);
   }
-  state_out_.post_always([this, port, macs] {
-    for (std::uint8_t mac : macs) release_node(port, mac, false);
-    const auto now = dds::dds_now();
-    dds::Owned<dnbridge_PortStatus> port_key;
-    dds::set_string(port_key->rack, rack_);
-    dds::set_string(port_key->port, port);
-    check(port_writer_.unregister_instance(*port_key, now), "PortStatus unregistration");
-  });
+  for (std::uint8_t mac : macs) release_node(port, mac, false);
+  dds::Owned<dnbridge_PortStatus> port_key;
+  dds::set_string(port_key->rack, rack_);
+  dds::set_string(port_key->port, port);
+  check(port_writer_.unregister_instance(*port_key, dds::dds_now()), "PortStatus unregistration");
 }
 
 }  // namespace dnbridge::daemon
@@ -198,7 +181,6 @@ void DdsPublisher::flush(Duration timeout) {
   // `timeout` for it.
   const TimePoint deadline = port::steady_now() + timeout;
   auto left = [&] { return std::max(Duration::zero(), deadline - port::steady_now()); };
-  (void)state_out_.drain(left());
   (void)reply_out_.drain(left());
   (void)pump_writer_.wait_for_acks(left());
   (void)node_writer_.wait_for_acks(left());

@@ -1,11 +1,18 @@
 #pragma once
 // The DDS face of the ports: writes PumpState, NodeStatus, PortStatus and
-// ExplicitReply samples. Called from every port's thread, it fills the
-// sample there and hands it to an outbox (adapters/daemon/outbox.hpp): state
-// samples to one thread, replies to another, so that a reader that does not
-// acknowledge can delay neither a poll nor the state topics. Each sample
-// carries the monotonic event time mapped to the wall clock as its source
-// timestamp.
+// ExplicitReply samples. Called from every port's thread, it fills each
+// sample there. State samples (and their instances' disposal and
+// unregistration) are written there too: their writers are keep-last, and
+// Cyclone DDS never holds a keep-last write back for readers that have not
+// acknowledged (0.10.2 gives such a writer no history watermarks:
+// src/core/ddsi/src/ddsi_endpoint.c, "aggressive keep last"), so a reader
+// that stops acknowledging delays no poll (tests/e2e/careless_client_test.cpp
+// shows it). Their max blocking time is zero besides: should a write still
+// have to wait, it fails at once and is logged, and the next sample of the
+// instance follows. Replies are handed to an outbox
+// (adapters/daemon/outbox.hpp) and written on its thread, at most
+// kReplyBacklog waiting. Each sample carries the monotonic event time mapped
+// to the wall clock as its source timestamp.
 #include <map>
 #include <mutex>
 #include <optional>
@@ -15,6 +22,7 @@
 #include "adapters/daemon/outbox.hpp"
 #include "adapters/daemon/reload.hpp"
 #include "adapters/dds/participant.hpp"
+#include "adapters/dds/sample.hpp"
 #include "adapters/dds/time.hpp"
 #include "adapters/dds/topic.hpp"
 #include "adapters/dds/topics.hpp"
@@ -89,8 +97,7 @@ class DdsPublisher final : public port::PortPublisher {
 
   // Replies not written (the outbox full, or the write failed) for `port`.
   std::uint64_t replies_undelivered(const std::string& port) const;
-  // The outboxes' counters: the state samples' and the replies'.
-  Outbox::Counters state_queue() const { return state_out_.counters(); }
+  // The reply outbox's counters.
   Outbox::Counters reply_queue() const { return reply_out_.counters(); }
   // Replies handed over at most this many at a time; more are undelivered.
   static constexpr std::size_t kReplyBacklog = 1024;
@@ -109,7 +116,7 @@ class DdsPublisher final : public port::PortPublisher {
   // Logs a failed write (rate-limited); true when it succeeded.
   bool check(Status s, const char* what);
   // A node's PumpState and NodeStatus instances unregistered, after being
-  // disposed when `dispose` (on the state outbox's thread).
+  // disposed when `dispose`.
   void release_node(const std::string& port, std::uint8_t mac, bool dispose);
 
   std::string rack_;
@@ -137,8 +144,7 @@ class DdsPublisher final : public port::PortPublisher {
   std::map<std::string, std::uint64_t> undelivered_;  // per port
   std::mutex log_mutex_;
   RateLimitedLog error_limit_;
-  // Last: their threads end, after writing what waits, before the writers go.
-  Outbox state_out_;
+  // Last: its thread ends, after writing what waits, before the writers go.
   Outbox reply_out_;
 };
 

@@ -18,54 +18,17 @@ Outbox::~Outbox() {
   thread_.join();
 }
 
-void Outbox::push(Entry entry) {
-  entry.seq = next_seq_++;
-  if (entry.key.empty()) ++unkeyed_;
-  queue_.push_back(std::move(entry));
-  if (!queue_.back().key.empty()) by_key_.emplace(queue_.back().key, std::prev(queue_.end()));
-}
-
-void Outbox::post(std::string key, Job job) {
-  {
-    std::lock_guard lock(mutex_);
-    if (auto it = by_key_.find(key); it != by_key_.end()) {
-      it->second->job = std::move(job);
-      ++counters_.replaced;
-      return;
-    }
-    push(Entry{std::move(key), std::move(job)});
-  }
-  wake_.notify_one();
-}
-
 bool Outbox::post(Job job) {
   {
     std::lock_guard lock(mutex_);
-    if (unkeyed_ >= capacity_) {
+    if (queue_.size() >= capacity_) {
       ++counters_.refused;
       return false;
     }
-    push(Entry{{}, std::move(job)});
+    queue_.push_back(Entry{std::move(job), next_seq_++});
   }
   wake_.notify_one();
   return true;
-}
-
-void Outbox::post_always(Job job) {
-  {
-    std::lock_guard lock(mutex_);
-    push(Entry{{}, std::move(job)});
-  }
-  wake_.notify_one();
-}
-
-void Outbox::post_always_after(std::span<const std::string> keys, Job job) {
-  {
-    std::lock_guard lock(mutex_);
-    for (const auto& key : keys) by_key_.erase(key);
-    push(Entry{{}, std::move(job)});
-  }
-  wake_.notify_one();
 }
 
 bool Outbox::drain(Duration timeout) {
@@ -89,13 +52,6 @@ void Outbox::run() {
   for (;;) {
     wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
     if (queue_.empty()) return;  // stopping, and nothing left
-    if (queue_.front().key.empty()) {
-      --unkeyed_;
-    } else if (auto it = by_key_.find(queue_.front().key);
-               it != by_key_.end() && it->second == queue_.begin()) {
-      // (A job no longer replaceable has no entry, or another job's.)
-      by_key_.erase(it);
-    }
     Entry entry = std::move(queue_.front());
     queue_.pop_front();
     running_seq_ = entry.seq;

@@ -47,6 +47,8 @@ Qos reply_writer_keeping(int32_t history) {
 
 Qos state_writer_qos(Duration deadline) {
   Qos qos = state_common();
+  // Written from the port loops: a write must fail rather than wait.
+  qos.reliable(Duration::zero());
   qos.deadline(deadline).autodispose_unregistered_instances(false);
   return qos;
 }

@@ -201,9 +201,6 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
       const Labels labels = with(rack, "queue", q.name);
       f.counter("dnbridge_dds_samples_written_total", "DDS samples written (or unregistrations)",
                 labels, static_cast<double>(q.written));
-      f.counter("dnbridge_dds_samples_replaced_total",
-                "State samples superseded by a newer one of the same instance before written",
-                labels, static_cast<double>(q.replaced));
       f.counter("dnbridge_dds_samples_refused_total", "Samples not queued: the queue was full",
                 labels, static_cast<double>(q.refused));
       f.gauge("dnbridge_dds_queue_depth", "Samples waiting to be written", labels,

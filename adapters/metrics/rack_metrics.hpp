@@ -19,7 +19,6 @@
 //              dnbridge_node_commands_refused_total, dnbridge_node_explicit_requests_total,
 //              dnbridge_node_explicit_timeouts_total
 //   process    dnbridge_dds_samples_written_total{queue},
-//   dnbridge_dds_samples_replaced_total{queue},
 //              dnbridge_dds_samples_refused_total{queue}, dnbridge_dds_queue_depth{queue},
 //              dnbridge_dds_samples_taken_total{topic}, dnbridge_dds_command_holdoffs_total
 //
@@ -46,9 +45,8 @@ namespace dnbridge::metrics {
 // The process's DDS side, read at each scrape.
 struct ProcessCounters {
   struct Queue {
-    std::string name;  // "state", "replies"
+    std::string name;  // "replies"
     std::uint64_t written = 0;
-    std::uint64_t replaced = 0;  // superseded by a newer sample before written
     std::uint64_t refused = 0;   // not queued: the queue was full
     std::uint64_t depth = 0;     // waiting now
   };

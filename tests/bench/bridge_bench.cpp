@@ -1259,10 +1259,11 @@ int run_bench(const Options& o) {
       double switches = 0;
       unsigned threads = 0;
     };
-    // The bridge's threads by their names (adapters/daemon: the outboxes
-    // that write to DDS, the DDS input); Cyclone's by elimination.
+    // The bridge's threads by their names (adapters/daemon: the reply
+    // outbox, the DDS input; the port loops write the state samples);
+    // Cyclone's by elimination.
     std::array<Group, 6> groups{{{"port loops"},
-                                 {"DDS writes (state, reply outboxes)"},
+                                 {"reply outbox"},
                                  {"DDS input"},
                                  {"main and other"},
                                  {"Cyclone DDS's own"},
@@ -1270,7 +1271,7 @@ int run_bench(const Options& o) {
     const auto group_of = [&](pid_t tid, const std::string& name) -> Group& {
       if (port_tids.count(tid)) return groups[0];
       if (sim_tids.count(tid)) return groups[5];
-      if (name == "dds state out" || name == "dds reply out") return groups[1];
+      if (name == "dds reply out") return groups[1];
       if (name == "dds input") return groups[2];
       if (name.rfind("dnbridge-ben", 0) == 0 || name == "reload" || name == "sd_notify") {
         return groups[3];

@@ -54,6 +54,10 @@
 //       back and prints "deleted"; on "write N" writes writer N's command
 //       again and prints "written"; the writers left live until the end of
 //       stdin.
+//   state-reader
+//       a PumpState reader with the documented state QoS, never taken from;
+//       prints "receiving" once it holds a sample; stays until the end of
+//       stdin. Stopped (SIGSTOP), it is a reader that acknowledges nothing.
 #include <unistd.h>
 
 #include <cstdint>
@@ -174,6 +178,28 @@ int requests(dds_domainid_t domain, const std::string& requester, std::uint32_t 
   // Ends without deleting anything: whatever the bridge holds of this client
   // it holds until the client's lease ends.
   std::_Exit(0);
+}
+
+int state_reader(dds_domainid_t domain) {
+  dds::Participant participant(domain, dds::Participant::ClientName{"state-reader"});
+  dds::Topic<dnbridge_PumpState> topic(participant);
+  dds::Reader<dnbridge_PumpState> reader(participant, topic, dds::state_reader_qos());
+  dds::ReadCondition any(reader, DDS_ANY_STATE);
+  dds::WaitSet waitset(participant);
+  waitset.attach(any, 1);
+  const auto deadline = std::chrono::steady_clock::now() + kMatchTimeout;
+  for (;;) {
+    auto held = reader.read();
+    if (held.ok() && !held->empty()) break;
+    const auto left = deadline - std::chrono::steady_clock::now();
+    if (left <= Duration::zero()) fail("no PumpState sample");
+    (void)waitset.wait(std::chrono::duration_cast<Duration>(left));
+  }
+  say("receiving");
+  std::string line;
+  while (next_line(line)) {
+  }
+  return 0;
 }
 
 // The reply reader's QoS before the bridge's readers stopped refusing
@@ -322,7 +348,8 @@ int usage() {
                "       dnbridge_careless_client DOMAIN requests REQUESTER COUNT\n"
                "       dnbridge_careless_client DOMAIN stall-replies REQUESTER REPEATS GETS\n"
                "       dnbridge_careless_client DOMAIN flood ISSUER STRENGTH COUNT\n"
-               "       dnbridge_careless_client DOMAIN three-writers STRENGTH LEASE_MS READERS\n";
+               "       dnbridge_careless_client DOMAIN three-writers STRENGTH LEASE_MS READERS\n"
+               "       dnbridge_careless_client DOMAIN state-reader\n";
   return 2;
 }
 
@@ -350,6 +377,7 @@ int run(const std::vector<std::string>& args) {
     return three_writers(domain, static_cast<std::int32_t>(number(2)), milliseconds(number(3)),
                          static_cast<std::uint32_t>(number(4)));
   }
+  if (mode == "state-reader" && args.size() == 2) return state_reader(domain);
   return usage();
 }
 

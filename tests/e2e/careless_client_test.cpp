@@ -7,6 +7,7 @@
 // Every wait is for an event and bounded: a DDS waitset, a line from the
 // careless client on its control socket, or its exit on a pidfd.
 #include <sched.h>
+#include <signal.h>
 
 #include <algorithm>
 #include <chrono>
@@ -21,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "adapters/daemon/dds_publisher.hpp"
+#include "adapters/port/steady_time.hpp"
 #include "bridge_fixture.hpp"
 #include "bridge_process.hpp"
 #include "child_process.hpp"
@@ -705,6 +708,83 @@ TEST_F(CarelessClientTest, AFloodFromAnotherProcessEndsWithEveryPumpsNewestComma
     return true;
   })) << "a pump did not end with its newest command";
   ASSERT_TRUE(careless_->running());
+}
+
+// 7. A reader that acknowledges nothing (a client process stopped with
+// SIGSTOP, once it has a sample of the writer) while the state writers keep
+// more unacknowledged data than Cyclone lets a keep-all writer keep (its
+// high-water mark, 500 kB at most): 64 ports of 63 pumps, about 800 kB of
+// PumpState. The port threads write state samples themselves (DdsPublisher),
+// so no such write may wait: each call returns within 50 ms (a write held
+// back would take the QoS's max blocking time, and the next pump's the
+// same). The reader resumes, every instance is published again as the ports
+// do each period, and every instance's newest sample is delivered.
+TEST_F(CarelessClientTest, AStateReaderThatAcknowledgesNothingNeverHoldsThePortThreads) {
+  constexpr unsigned kPorts = 64;
+  constexpr unsigned kMacs = 63;
+  daemon::DdsPublisher publisher(supervisor_, "stalled-rack", seconds(5), Logger{});
+  auto& client = careless({"state-reader"});
+
+  const auto port_name = [](unsigned p) { return "port-" + std::to_string(p); };
+  // Every instance once, named `round` (padded: about 200 bytes a sample);
+  // the longest call.
+  const auto publish_all = [&](const std::string& round) {
+    Duration longest{};
+    rack::PumpView view;
+    view.name = round + std::string(100, '.');
+    for (unsigned p = 0; p < kPorts; ++p) {
+      for (unsigned mac = 1; mac <= kMacs; ++mac) {
+        view.mac = devicenet::MacId::from_bits(mac);
+        const auto start = SteadyClock::now();
+        publisher.pump_state(port_name(p), view, port::steady_now());
+        longest = std::max<Duration>(longest, SteadyClock::now() - start);
+      }
+    }
+    return longest;
+  };
+  const auto as_ms = [](Duration d) {
+    return std::chrono::duration<double, std::milli>(d).count();
+  };
+
+  // The client's reader has a sample: the writer has matched it.
+  rack::PumpView first;
+  first.mac = devicenet::MacId::from_bits(1);
+  first.name = "first";
+  const auto receiving = [&] {
+    std::optional<std::string> line;
+    const auto deadline = SteadyClock::now() + seconds(30);
+    while (!line && SteadyClock::now() < deadline) {
+      publisher.pump_state(port_name(0), first, port::steady_now());
+      line = client.read_line(milliseconds(100));
+    }
+    return line;
+  };
+  ASSERT_EQ(receiving(), std::optional<std::string>("receiving"))
+      << "the client's state reader got no sample";
+
+  ASSERT_EQ(kill(client.pid(), SIGSTOP), 0);
+  const Duration stalled_longest = publish_all("stalled");
+  ASSERT_EQ(kill(client.pid(), SIGCONT), 0);
+  report("longest PumpState call, a reader stopped (4032 instances)", as_ms(stalled_longest));
+  EXPECT_LT(stalled_longest, milliseconds(50));
+
+  publisher.flush(seconds(10));
+  const Duration resumed_longest = publish_all("resumed");
+  report("longest PumpState call, the reader resumed", as_ms(resumed_longest));
+  EXPECT_LT(resumed_longest, milliseconds(50));
+  const auto newest_everywhere = [&] {
+    std::set<std::pair<std::string, unsigned>> seen;
+    for (const auto& r : pumps_.history()) {
+      if (r.sample.valid_data() && dds::view(r.sample->rack) == "stalled-rack" &&
+          dds::view(r.sample->name).starts_with("resumed")) {
+        seen.emplace(std::string(dds::view(r.sample->port)), r.sample->mac);
+      }
+    }
+    return seen.size() == kPorts * kMacs;
+  };
+  EXPECT_TRUE(pumps_.until(newest_everywhere, seconds(10)))
+      << "not every instance's newest sample was delivered after the reader resumed";
+  ASSERT_TRUE(client.running());
 }
 
 }  // namespace
