@@ -15,6 +15,8 @@
 #   /usr/share/doc/dnbridge       operations.md (deploy/README.md), security.md
 #                                 (deploy/security/README.md), data-model.md
 #                                 (idl/README.md), copyright, changelog.gz
+#   /usr/share/doc/dnbridge/eds   example EDS files of devices the simulator
+#                                 can play (deploy/eds)
 #   systemd's unit directory      dnbridge@.service (a template: nothing starts
 #                                 until an instance is enabled)
 #   /usr/lib/sysusers.d           the dedicated user dnbridge
@@ -121,6 +123,8 @@ install(FILES ${PROJECT_SOURCE_DIR}/deploy/security/README.md DESTINATION ${CMAK
         RENAME security.md COMPONENT bridge)
 install(FILES ${PROJECT_SOURCE_DIR}/idl/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR}
         RENAME data-model.md COMPONENT bridge)
+file(GLOB DNBRIDGE_EDS_EXAMPLES ${PROJECT_SOURCE_DIR}/deploy/eds/*.eds)
+install(FILES ${DNBRIDGE_EDS_EXAMPLES} DESTINATION ${CMAKE_INSTALL_DOCDIR}/eds COMPONENT bridge)
 
 # dnbridge-sim
 install(TARGETS dnbridge-sim cdn127-sim dnbridge-demo RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}

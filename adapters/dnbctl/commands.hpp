@@ -98,4 +98,12 @@ Exit run_scan(const GlobalOptions& options);
 CLI::App* add_reload(CLI::App& app);
 Exit run_reload(const GlobalOptions& options);
 
+// --- eds_command.cpp: eds check ---------------------------------------------------------
+// Needs no bridge: reads a file (--json for the result as one document).
+struct EdsArgs {
+  std::string file;
+};
+CLI::App* add_eds(CLI::App& app, EdsArgs& args);
+Exit run_eds(const GlobalOptions& options, const EdsArgs& args);
+
 }  // namespace dnbridge::dnbctl

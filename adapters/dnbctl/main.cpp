@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
   ExplicitArgs get;
   ExplicitArgs set;
   ExplicitArgs service;
+  EdsArgs eds;
   auto* list_cmd = add_list(app, list);
   auto* racks_cmd = add_racks(app);
   auto* watch_cmd = add_watch(app, watch);
@@ -79,6 +80,7 @@ int main(int argc, char** argv) {
   auto* show_cmd = add_show(app, show);
   auto* scan_cmd = add_scan(app);
   auto* reload_cmd = add_reload(app);
+  auto* eds_cmd = add_eds(app, eds);
 
   try {
     app.parse(argc, argv);
@@ -120,6 +122,7 @@ int main(int argc, char** argv) {
     if (service_cmd->parsed()) rc = run_explicit(options, service);
     if (scan_cmd->parsed()) rc = run_scan(options);
     if (reload_cmd->parsed()) rc = run_reload(options);
+    if (eds_cmd->parsed()) rc = run_eds(options, eds);
     return code(rc);
   } catch (const CommandError& e) {
     std::fprintf(stderr, "dnbctl: %s\n", e.what());
