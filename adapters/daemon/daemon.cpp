@@ -115,6 +115,7 @@ metrics::ProcessCounters Daemon::process_counters() const {
   // State samples are written on the ports' threads: replies alone queue.
   const auto replies = publisher_.reply_queue();
   c.queues.push_back({"replies", replies.run, replies.refused, replies.waiting});
+  c.state_write_failures = publisher_.state_write_failures();
   if (input_) {
     c.commands_taken = input_->commands_taken();
     c.requests_taken = input_->requests_taken();

@@ -48,6 +48,10 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
                             })),
       reply_out_("dds reply out", kReplyBacklog) {}
 
+void DdsPublisher::check_state(Status s, const char* what) {
+  if (!check(s, what)) state_write_failures_.fetch_add(1, std::memory_order_relaxed);
+}
+
 bool DdsPublisher::check(Status s, const char* what) {
   if (s) return true;
   std::lock_guard lock(log_mutex_);
@@ -77,21 +81,21 @@ void DdsPublisher::pump_state(const std::string& port, const rack::PumpView& pum
   }
   dds::Owned<dnbridge_PumpState> sample;
   fill_pump_state(*sample, rack_, port, pump);
-  check(pump_writer_.write(*sample, clock_.to_wall(source_time)), "PumpState");
+  check_state(pump_writer_.write(*sample, clock_.to_wall(source_time)), "PumpState");
 }
 
 void DdsPublisher::node_status(const std::string& port, const rack::PumpView& pump,
                                const port::NodeStatusView& node, TimePoint source_time) {
   dds::Owned<dnbridge_NodeStatus> sample;
   fill_node_status(*sample, rack_, port, pump, node);
-  check(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
+  check_state(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
 }
 
 void DdsPublisher::port_status(const port::PortStatusView& status, TimePoint source_time) {
   dds::Owned<dnbridge_PortStatus> sample;
   fill_port_status(*sample, rack_, status);
   sample->replies_undelivered = replies_undelivered(status.port);
-  check(port_writer_.write(*sample, clock_.to_wall(source_time)), "PortStatus");
+  check_state(port_writer_.write(*sample, clock_.to_wall(source_time)), "PortStatus");
 }
 
 void DdsPublisher::explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) {
@@ -138,11 +142,11 @@ void DdsPublisher::release_node(const std::string& port, std::uint8_t mac, bool 
   const auto pump_key = key_of<dnbridge_PumpState>(rack_, port, mac);
   const auto node_key = key_of<dnbridge_NodeStatus>(rack_, port, mac);
   if (dispose) {
-    check(pump_writer_.dispose(*pump_key, now), "PumpState disposal");
-    check(node_writer_.dispose(*node_key, now), "NodeStatus disposal");
+    check_state(pump_writer_.dispose(*pump_key, now), "PumpState disposal");
+    check_state(node_writer_.dispose(*node_key, now), "NodeStatus disposal");
   }
-  check(pump_writer_.unregister_instance(*pump_key, now), "PumpState unregistration");
-  check(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
+  check_state(pump_writer_.unregister_instance(*pump_key, now), "PumpState unregistration");
+  check_state(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
 }
 
 void DdsPublisher::node_removed(const std::string& port, devicenet::MacId mac) {
@@ -168,7 +172,8 @@ void DdsPublisher::port_stopped(const std::string& port) {
   dds::Owned<dnbridge_PortStatus> port_key;
   dds::set_string(port_key->rack, rack_);
   dds::set_string(port_key->port, port);
-  check(port_writer_.unregister_instance(*port_key, dds::dds_now()), "PortStatus unregistration");
+  check_state(port_writer_.unregister_instance(*port_key, dds::dds_now()),
+              "PortStatus unregistration");
 }
 
 }  // namespace dnbridge::daemon

@@ -8,11 +8,15 @@
 // src/core/ddsi/src/ddsi_endpoint.c, "aggressive keep last"), so a reader
 // that stops acknowledging delays no poll (tests/e2e/careless_client_test.cpp
 // shows it). Their max blocking time is zero besides: should a write still
-// have to wait, it fails at once and is logged, and the next sample of the
-// instance follows. Replies are handed to an outbox
+// have to wait for room, it fails at once, is logged and counted
+// (state_write_failures), and the next sample of the instance follows. What
+// a write can still wait for is short and not bounded by DDS: the writer's
+// lock, shared with the other ports and Cyclone's acknowledgment handling,
+// and the socket's send buffer. Replies are handed to an outbox
 // (adapters/daemon/outbox.hpp) and written on its thread, at most
 // kReplyBacklog waiting. Each sample carries the monotonic event time mapped
 // to the wall clock as its source timestamp.
+#include <atomic>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -99,6 +103,10 @@ class DdsPublisher final : public port::PortPublisher {
   std::uint64_t replies_undelivered(const std::string& port) const;
   // The reply outbox's counters.
   Outbox::Counters reply_queue() const { return reply_out_.counters(); }
+  // State samples, disposals and unregistrations whose write failed.
+  std::uint64_t state_write_failures() const {
+    return state_write_failures_.load(std::memory_order_relaxed);
+  }
   // Replies handed over at most this many at a time; more are undelivered.
   static constexpr std::size_t kReplyBacklog = 1024;
 
@@ -115,6 +123,8 @@ class DdsPublisher final : public port::PortPublisher {
  private:
   // Logs a failed write (rate-limited); true when it succeeded.
   bool check(Status s, const char* what);
+  // The same for a state topic's write, disposal or unregistration, counted.
+  void check_state(Status s, const char* what);
   // A node's PumpState and NodeStatus instances unregistered, after being
   // disposed when `dispose`.
   void release_node(const std::string& port, std::uint8_t mac, bool dispose);
@@ -144,6 +154,7 @@ class DdsPublisher final : public port::PortPublisher {
   std::map<std::string, std::uint64_t> undelivered_;  // per port
   std::mutex log_mutex_;
   RateLimitedLog error_limit_;
+  std::atomic<std::uint64_t> state_write_failures_{0};
   // Last: its thread ends, after writing what waits, before the writers go.
   Outbox reply_out_;
 };

@@ -79,11 +79,11 @@ dds_entity_t checked(dds_entity_t created, const std::string& errors,
 // fall to 1 KiB. A reader that acknowledges nothing any more (topics.hpp)
 // keeps them above that for good, and after any resend (a late reader's
 // history, a lost packet) the mark stops growing: from then on every write
-// of that writer waited and failed, for every reader. The bridge's writers
-// all keep a bounded history (keep-last: a sample per state instance, 256
-// replies of at most a few KiB, as requests over 2 KiB are not answered),
-// which bounds what they hold unacknowledged whatever their readers do;
-// fixed at 4 MiB, above those bounds, the mark is not reached. The operator's CYCLONEDDS_URI (files
+// of that writer waited and failed, for every reader (seen with a keep-all
+// reply writer). The bridge's writers are all keep-last now, and Cyclone
+// 0.10.2 gives keep-last writers no mark at all (src/core/ddsi/src/
+// ddsi_endpoint.c): this fixed mark, 4 MiB, is for a keep-all writer, should
+// one be added. The operator's CYCLONEDDS_URI (files
 // and fragments, as Cyclone reads it) comes after and may override these.
 constexpr const char* kBridgeDomainConfig =
     "<CycloneDDS><Domain id=\"any\"><Internal><Watermarks>"

@@ -94,14 +94,11 @@ std::vector<std::string> rack_partitions(std::string_view rack);
 // `online` member says "offline", so deleting the writer must not dispose.
 
 // `deadline`: the longest gap the bridge promises between two samples of an
-// instance, derived from the node's publish period. A write never waits: when
-// readers have not acknowledged enough of what was written, it fails at once
-// with DDS_RETCODE_TIMEOUT (the writer's caller decides how long to try
-// again: kStateWriteRetryFor).
+// instance, derived from the node's publish period. Keep-last, which Cyclone
+// DDS 0.10.2 never holds back for readers that have not acknowledged; its max
+// blocking time is 0, so that a write that would have to wait for room (a
+// full reader history in the same process) fails at once instead.
 Qos state_writer_qos(Duration deadline);
-// How long a state sample is tried again while readers do not acknowledge,
-// before it is given up (the newer sample of its instance follows).
-inline constexpr Duration kStateWriteRetryFor = milliseconds(100);
 // `deadline`: what the reader asks for; it must be at least the writer's
 // (DDS matches only offered <= requested); none to match any writer.
 Qos state_reader_qos(std::optional<Duration> deadline = std::nullopt);

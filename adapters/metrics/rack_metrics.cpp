@@ -199,8 +199,8 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
     const Labels rack{{"rack", rack_}};
     for (const auto& q : p.queues) {
       const Labels labels = with(rack, "queue", q.name);
-      f.counter("dnbridge_dds_samples_written_total", "DDS samples written (or unregistrations)",
-                labels, static_cast<double>(q.written));
+      f.counter("dnbridge_dds_samples_written_total", "DDS samples written from the queue", labels,
+                static_cast<double>(q.written));
       f.counter("dnbridge_dds_samples_refused_total", "Samples not queued: the queue was full",
                 labels, static_cast<double>(q.refused));
       f.gauge("dnbridge_dds_queue_depth", "Samples waiting to be written", labels,
@@ -214,6 +214,10 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
               "Times PumpCommand samples came within 1 ms of the take before them (a flood) and "
               "waited in the reader for the next take, which takes each pump's newest",
               rack, static_cast<double>(p.command_holdoffs));
+    f.counter("dnbridge_dds_state_write_failures_total",
+              "PumpState, NodeStatus and PortStatus writes, disposals and unregistrations that "
+              "failed (logged; the instance's next sample follows)",
+              rack, static_cast<double>(p.state_write_failures));
   }
   return f.take();
 }

@@ -20,7 +20,8 @@
 //              dnbridge_node_explicit_timeouts_total
 //   process    dnbridge_dds_samples_written_total{queue},
 //              dnbridge_dds_samples_refused_total{queue}, dnbridge_dds_queue_depth{queue},
-//              dnbridge_dds_samples_taken_total{topic}, dnbridge_dds_command_holdoffs_total
+//              dnbridge_dds_samples_taken_total{topic}, dnbridge_dds_command_holdoffs_total,
+//              dnbridge_dds_state_write_failures_total
 //
 // Labels: rack and port on every port and node series, mac and name on a
 // node's. Units in the names (seconds, ratio), counters end in _total.
@@ -54,6 +55,7 @@ struct ProcessCounters {
   std::uint64_t commands_taken = 0;  // PumpCommand samples
   std::uint64_t requests_taken = 0;  // ExplicitRequest samples
   std::uint64_t command_holdoffs = 0;  // DdsInput::command_holdoffs
+  std::uint64_t state_write_failures = 0;  // DdsPublisher::state_write_failures
 };
 
 class RackMetrics final : public port::PortPublisher, public prometheus::Collectable {

@@ -715,10 +715,13 @@ TEST_F(CarelessClientTest, AFloodFromAnotherProcessEndsWithEveryPumpsNewestComma
 // more unacknowledged data than Cyclone lets a keep-all writer keep (its
 // high-water mark, 500 kB at most): 64 ports of 63 pumps, about 800 kB of
 // PumpState. The port threads write state samples themselves (DdsPublisher),
-// so no such write may wait: each call returns within 50 ms (a write held
-// back would take the QoS's max blocking time, and the next pump's the
-// same). The reader resumes, every instance is published again as the ports
-// do each period, and every instance's newest sample is delivered.
+// so no such write may wait, nor fail: each call returns within 50 ms (a
+// write held back would take the QoS's max blocking time, and the next
+// pump's the same), no write failed, and every sample reached this
+// process's reader (Cyclone delivers to a reader in the writer's process
+// only what it could write). The reader resumes, every instance is
+// published again as the ports do each period, and every instance's newest
+// sample is delivered.
 TEST_F(CarelessClientTest, AStateReaderThatAcknowledgesNothingNeverHoldsThePortThreads) {
   constexpr unsigned kPorts = 64;
   constexpr unsigned kMacs = 63;
@@ -741,6 +744,19 @@ TEST_F(CarelessClientTest, AStateReaderThatAcknowledgesNothingNeverHoldsThePortT
       }
     }
     return longest;
+  };
+  // Every instance's sample of round `round`, here.
+  const auto every_instance = [&](std::string_view round) {
+    return [&, round] {
+      std::set<std::pair<std::string, unsigned>> seen;
+      for (const auto& r : pumps_.history()) {
+        if (r.sample.valid_data() && dds::view(r.sample->rack) == "stalled-rack" &&
+            dds::view(r.sample->name).starts_with(round)) {
+          seen.emplace(std::string(dds::view(r.sample->port)), r.sample->mac);
+        }
+      }
+      return seen.size() == kPorts * kMacs;
+    };
   };
   const auto as_ms = [](Duration d) {
     return std::chrono::duration<double, std::milli>(d).count();
@@ -767,21 +783,15 @@ TEST_F(CarelessClientTest, AStateReaderThatAcknowledgesNothingNeverHoldsThePortT
   ASSERT_EQ(kill(client.pid(), SIGCONT), 0);
   report("longest PumpState call, a reader stopped (4032 instances)", as_ms(stalled_longest));
   EXPECT_LT(stalled_longest, milliseconds(50));
+  EXPECT_EQ(publisher.state_write_failures(), 0u);
+  EXPECT_TRUE(pumps_.until(every_instance("stalled"), seconds(10)))
+      << "a sample written while the reader was stopped did not reach this process's reader";
 
   publisher.flush(seconds(10));
   const Duration resumed_longest = publish_all("resumed");
   report("longest PumpState call, the reader resumed", as_ms(resumed_longest));
   EXPECT_LT(resumed_longest, milliseconds(50));
-  const auto newest_everywhere = [&] {
-    std::set<std::pair<std::string, unsigned>> seen;
-    for (const auto& r : pumps_.history()) {
-      if (r.sample.valid_data() && dds::view(r.sample->rack) == "stalled-rack" &&
-          dds::view(r.sample->name).starts_with("resumed")) {
-        seen.emplace(std::string(dds::view(r.sample->port)), r.sample->mac);
-      }
-    }
-    return seen.size() == kPorts * kMacs;
-  };
+  const auto newest_everywhere = every_instance("resumed");
   EXPECT_TRUE(pumps_.until(newest_everywhere, seconds(10)))
       << "not every instance's newest sample was delivered after the reader resumed";
   ASSERT_TRUE(client.running());

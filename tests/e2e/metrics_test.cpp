@@ -86,7 +86,8 @@ TEST_F(BridgeTest, MetricsAreServedAndPassPromtool) {
         "# TYPE dnbridge_node_polls_total counter\n", "# TYPE dnbridge_can_frames_total counter\n",
         "# TYPE dnbridge_dds_queue_depth gauge\n",
         "dnbridge_dds_samples_taken_total{rack=\"sim-rack\",topic=\"PumpCommand\"} 0\n",
-        "dnbridge_dds_command_holdoffs_total{rack=\"sim-rack\"} 0\n"}) {
+        "dnbridge_dds_command_holdoffs_total{rack=\"sim-rack\"} 0\n",
+        "dnbridge_dds_state_write_failures_total{rack=\"sim-rack\"} 0\n"}) {
     EXPECT_NE(text.find(line), std::string::npos) << line << "in:\n" << text;
   }
   const auto [status, said] = promtool(text);
