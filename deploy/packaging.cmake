@@ -12,11 +12,10 @@
 #   /usr/share/dnbridge/security  make-site-pki.sh: a site's DDS Security PKI
 #   /usr/share/dnbridge/networkd  systemd-networkd examples for the CAN interfaces
 #   /usr/share/dnbridge/prometheus  a scrape configuration and alert rules
+#   /usr/share/dnbridge/eds       example EDS files (deploy/eds)
 #   /usr/share/doc/dnbridge       operations.md (deploy/README.md), security.md
 #                                 (deploy/security/README.md), data-model.md
 #                                 (idl/README.md), copyright, changelog.gz
-#   /usr/share/doc/dnbridge/eds   example EDS files of devices the simulator
-#                                 can play (deploy/eds)
 #   systemd's unit directory      dnbridge@.service (a template: nothing starts
 #                                 until an instance is enabled)
 #   /usr/lib/sysusers.d           the dedicated user dnbridge
@@ -124,7 +123,8 @@ install(FILES ${PROJECT_SOURCE_DIR}/deploy/security/README.md DESTINATION ${CMAK
 install(FILES ${PROJECT_SOURCE_DIR}/idl/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR}
         RENAME data-model.md COMPONENT bridge)
 file(GLOB DNBRIDGE_EDS_EXAMPLES ${PROJECT_SOURCE_DIR}/deploy/eds/*.eds)
-install(FILES ${DNBRIDGE_EDS_EXAMPLES} DESTINATION ${CMAKE_INSTALL_DOCDIR}/eds COMPONENT bridge)
+install(FILES ${DNBRIDGE_EDS_EXAMPLES} DESTINATION ${CMAKE_INSTALL_DATADIR}/dnbridge/eds
+        COMPONENT bridge)
 
 # dnbridge-sim
 install(TARGETS dnbridge-sim cdn127-sim dnbridge-demo RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}

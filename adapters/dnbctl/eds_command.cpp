@@ -4,11 +4,13 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "adapters/dnbctl/commands.hpp"
 #include "adapters/dnbctl/json.hpp"
+#include "bridge/cip/assembly.hpp"
 #include "bridge/profiles/eds/eds_file.hpp"
 
 namespace dnbridge::dnbctl {
@@ -20,52 +22,47 @@ using eds::Member;
 using eds::Problem;
 
 std::string read_text(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw CommandError(Exit::kUsage, fmt::format("cannot read {}: it is a directory", path));
+  }
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    throw CommandError(Exit::kUsage, fmt::format("cannot read {}: {}", path, std::strerror(errno)));
+    const int error = errno;
+    throw CommandError(Exit::kUsage,
+                       fmt::format("cannot read {}: {}", path,
+                                   error != 0 ? std::strerror(error) : "cannot be opened"));
   }
   std::stringstream text;
   text << in.rdbuf();
   return text.str();
 }
 
-std::string describe(const cip::EPath& p) {
-  if (p.empty()) return "(no path)";
-  std::string out;
-  const auto part = [&](std::string_view name, const std::optional<std::uint32_t>& v) {
-    if (!v) return;
-    if (!out.empty()) out += ' ';
-    out += fmt::format("{} 0x{:02X}", name, *v);
-  };
-  part("class", p.class_id);
-  part("instance", p.instance_id);
-  part("connection point", p.connection_point);
-  part("attribute", p.attribute);
-  return out;
-}
-
 std::string io_data_text(const EdsFile& f, const eds::IoData& d, const char* what) {
-  std::string text = fmt::format("{} {} ({} bytes, \"{}\"", what, d.number, d.size, d.name);
+  std::string text = fmt::format("{} {} ({} byte{}, \"{}\"", what, d.number, d.size,
+                                 d.size == 1 ? "" : "s", d.name);
   if (const eds::Assembly* a = f.assembly_at(d.path)) {
     text += fmt::format(", assembly {}", a->number);
   } else {
-    text += ", " + describe(d.path);
+    text += ", " + cip::describe(d.path);
   }
   return text + ")";
 }
 
 std::string member_text(const EdsFile& f, const Member& m) {
+  const std::string bits = fmt::format("{} bit{}", m.bits, m.bits == 1 ? "" : "s");
   switch (m.kind) {
     case Member::Kind::kPadding:
-      return fmt::format("{} bits padding", m.bits);
+      return bits + " padding";
     case Member::Kind::kPath:
-      return fmt::format("{} bits {}", m.bits, describe(m.path));
+      return bits + " " + cip::describe(m.path);
     case Member::Kind::kParam: {
       const eds::Param* p = f.param(m.number);
-      return fmt::format("{} bits Param{} ({})", m.bits, m.number, p ? p->name : "?");
+      return fmt::format("{} Param{} ({})", bits, m.number, p ? p->name : "?");
     }
     case Member::Kind::kAssembly:
-      return fmt::format("{} bits Assem{}", m.bits, m.number);
+      return fmt::format("{} Assem{}", bits, m.number);
   }
   return "?";
 }
@@ -127,6 +124,8 @@ std::string json(const std::string& path, const eds::Parsed& parsed) {
         .end_object();
   }
   w.end_array();
+  w.field("errors", static_cast<std::uint64_t>(parsed.errors));
+  w.field("problems_not_shown", static_cast<std::uint64_t>(parsed.not_shown));
   if (parsed.file) {
     const EdsFile& f = *parsed.file;
     const auto& d = f.device;
@@ -202,13 +201,15 @@ Exit run_eds(const GlobalOptions& options, const EdsArgs& args) {
     for (const Problem& p : parsed.problems) {
       std::fprintf(stderr, "%s\n", eds::format_problem(args.file, p).c_str());
     }
+    if (parsed.not_shown > 0) {
+      std::fprintf(stderr, "%s: %zu more problems not shown\n", args.file.c_str(),
+                   parsed.not_shown);
+    }
     if (parsed.file) print(summary(args.file, *parsed.file));
   }
   if (!parsed.file) {
-    std::size_t errors = 0;
-    for (const Problem& p : parsed.problems) errors += p.severity == Problem::Severity::kError;
-    throw CommandError(Exit::kFailed, fmt::format("{}: not usable, {} error{}", args.file, errors,
-                                                  errors == 1 ? "" : "s"));
+    throw CommandError(Exit::kFailed, fmt::format("{}: not usable, {} error{}", args.file,
+                                                  parsed.errors, parsed.errors == 1 ? "" : "s"));
   }
   return Exit::kOk;
 }

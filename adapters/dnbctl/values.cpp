@@ -8,32 +8,16 @@
 #include <cmath>
 
 #include "bridge/cip/data_types.hpp"
+#include "bridge/common/text.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
-  return s;
-}
-
 std::string lower(std::string_view s) {
   std::string out(s);
   for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return out;
-}
-
-bool has_hex_prefix(std::string_view s) {
-  return s.size() >= 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
-}
-
-int hex_digit(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
 }
 
 // Digits of one number as parse_unsigned reads it: decimal, or hex with 0x
@@ -137,33 +121,18 @@ Parsed<AnalogValue> parse_analog(std::string_view text) {
 Parsed<std::vector<std::uint8_t>> parse_hex_bytes(std::string_view text) {
   std::string_view t = trim(text);
   if (has_hex_prefix(t)) t.remove_prefix(2);
-  std::vector<std::uint8_t> out;
-  int high = -1;  // the first digit of a byte, while waiting for the second
-  for (char c : t) {
-    if (c == ' ' || c == ':' || c == '-' || c == ',') {
-      if (high >= 0) {
-        return Parsed<std::vector<std::uint8_t>>::failure(fmt::format(
-            "hex bytes \"{}\": every byte needs two hex digits", text));
-      }
-      continue;
-    }
-    const int d = hex_digit(c);
-    if (d < 0) {
+  HexBytes parsed = dnbridge::parse_hex_bytes(t, " :-,");
+  switch (parsed.error) {
+    case HexBytes::Error::kNone:
+      return std::move(parsed.bytes);
+    case HexBytes::Error::kOneDigit:
       return Parsed<std::vector<std::uint8_t>>::failure(
-          fmt::format("hex bytes \"{}\": '{}' is not a hex digit", text, c));
-    }
-    if (high < 0) {
-      high = d;
-    } else {
-      out.push_back(static_cast<std::uint8_t>(high * 16 + d));
-      high = -1;
-    }
+          fmt::format("hex bytes \"{}\": every byte needs two hex digits", text));
+    case HexBytes::Error::kNotHexDigit:
+      break;
   }
-  if (high >= 0) {
-    return Parsed<std::vector<std::uint8_t>>::failure(
-        fmt::format("hex bytes \"{}\": every byte needs two hex digits", text));
-  }
-  return out;
+  return Parsed<std::vector<std::uint8_t>>::failure(
+      fmt::format("hex bytes \"{}\": '{}' is not a hex digit", text, parsed.bad));
 }
 
 std::string hex_bytes(std::span<const std::uint8_t> data) {

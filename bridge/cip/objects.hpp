@@ -87,9 +87,10 @@ namespace class_attr {
 inline constexpr std::uint8_t kRevision = 1, kMaxInstance = 2, kMaxClassId = 6,
                               kMaxInstanceAttribute = 7;
 }
-// The Assembly object's data.
+// The Assembly object's instance attributes (its class attributes are
+// class_attr's 1 and 2): the member list and the data (cip/assembly.hpp).
 namespace assembly_attr {
-inline constexpr std::uint8_t kData = 3;
+inline constexpr std::uint8_t kMemberCount = 1, kMemberList = 2, kData = 3;
 }
 
 namespace identity {

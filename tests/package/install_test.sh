@@ -180,12 +180,12 @@ for f in /usr/bin/dnbridge /usr/bin/dnbctl \
          /usr/share/bash-completion/completions/dnbctl \
          /usr/share/dnbridge/prometheus/prometheus.yml \
          /usr/share/dnbridge/prometheus/dnbridge-alerts.yml \
-         /usr/share/doc/dnbridge/eds/dnbridge-example-io-block.eds \
-         /usr/share/doc/dnbridge/eds/dnbridge-example-valve-manifold.eds; do
+         /usr/share/dnbridge/eds/dnbridge-example-io-block.eds \
+         /usr/share/dnbridge/eds/dnbridge-example-valve-manifold.eds; do
   [ -f "$f" ] || fail "$f not installed"
 done
 # The installed dnbctl reads the installed examples.
-for f in /usr/share/doc/dnbridge/eds/*.eds; do
+for f in /usr/share/dnbridge/eds/*.eds; do
   dnbctl eds check "$f" >/dev/null || fail "dnbctl eds check $f"
 done
 for d in /lib/systemd/system /usr/lib/systemd/system; do

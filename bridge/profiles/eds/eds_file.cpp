@@ -6,7 +6,9 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
-#include <map>
+#include <set>
+
+#include "bridge/common/text.hpp"
 
 namespace dnbridge::eds {
 
@@ -82,7 +84,7 @@ const Param* EdsFile::param(unsigned number) const noexcept {
 
 const Param* EdsFile::param(std::string_view name) const noexcept {
   for (const auto& p : params) {
-    if (same_name(p.name, name)) return &p;
+    if (iequals(p.name, name)) return &p;
   }
   return nullptr;
 }
@@ -106,7 +108,7 @@ namespace {
 // "Input12" with prefix "Input": 12. Nothing when the keyword is not the
 // prefix followed by a number from 1.
 std::optional<unsigned> number_after(std::string_view keyword, std::string_view prefix) {
-  if (keyword.size() <= prefix.size() || !same_name(keyword.substr(0, prefix.size()), prefix)) {
+  if (keyword.size() <= prefix.size() || !iequals(keyword.substr(0, prefix.size()), prefix)) {
     return std::nullopt;
   }
   const std::string_view digits = keyword.substr(prefix.size());
@@ -116,15 +118,30 @@ std::optional<unsigned> number_after(std::string_view keyword, std::string_view 
   return n;
 }
 
+std::string lowered(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) {
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c + 32);
+  }
+  return out;
+}
+
 class Reader {
  public:
-  explicit Reader(std::vector<Problem>& problems) : problems_(problems) {}
+  explicit Reader(Parsed& out) : out_(out) {}
 
   std::optional<EdsFile> read(const Text& text) {
     EdsFile file;
     if (const Section* s = text.find("File")) {
       if (const Entry* e = s->find("DescText")) file.description = string(*e, 0);
       if (const Entry* e = s->find("Revision")) file.revision = string(*e, 0);
+    }
+    std::set<std::string> seen;
+    for (const Section& section : text.sections) {
+      if (!seen.insert(lowered(section.name)).second) {
+        warning(section.line,
+                fmt::format("[{}] is given again: only the first is read", section.name));
+      }
     }
     const Section* device_section = text.find("Device");
     if (device_section == nullptr) {
@@ -136,9 +153,7 @@ class Reader {
     if (const Section* s = text.find("Params")) params(*s, file.params);
     if (const Section* s = text.find("Assembly")) assemblies(*s, file.assemblies);
     cross_check(file);
-    for (const auto& p : problems_) {
-      if (p.severity == Problem::Severity::kError) return std::nullopt;
-    }
+    if (out_.errors > 0) return std::nullopt;
     return file;
   }
 
@@ -150,8 +165,16 @@ class Reader {
     add(line, Problem::Severity::kWarning, std::move(message));
   }
   void add(std::uint32_t line, Problem::Severity severity, std::string message) {
-    if (problems_.size() < kMaxProblems) problems_.push_back({line, severity, std::move(message)});
+    if (severity == Problem::Severity::kError) ++out_.errors;
+    if (out_.problems.size() < kMaxProblems) {
+      out_.problems.push_back({line, severity, std::move(message)});
+    } else {
+      ++out_.not_shown;
+    }
   }
+  // An entry found wrong (said already): what refers to it says nothing more.
+  void failed(const Entry& e) { failed_.insert(lowered(e.keyword)); }
+  bool has_failed(std::string_view keyword) const { return failed_.count(lowered(keyword)) != 0; }
 
   // Field `i` of `e`, or an error naming `what` and nullptr.
   const Field* field(const Entry& e, std::size_t i, std::string_view what) {
@@ -180,15 +203,21 @@ class Reader {
       t.remove_prefix(1);
     }
     int base = 10;
-    if (t.size() > 2 && t[0] == '0' && (t[1] == 'x' || t[1] == 'X')) {
+    if (has_hex_prefix(t)) {
       base = 16;
       t.remove_prefix(2);
     }
     std::uint64_t magnitude = 0;
     const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), magnitude, base);
-    if (f->quoted || t.empty() || ec != std::errc{} || end != t.data() + t.size() ||
-        magnitude > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
+    if (f->quoted || t.empty() || end != t.data() + t.size() ||
+        (ec != std::errc{} && ec != std::errc::result_out_of_range)) {
       error(f->line, fmt::format("{}: {} \"{}\" is not a number", e.keyword, what, f->text));
+      return std::nullopt;
+    }
+    if (ec == std::errc::result_out_of_range ||
+        magnitude > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
+      error(f->line,
+            fmt::format("{}: {} {} is out of range ({}..{})", e.keyword, what, f->text, lo, hi));
       return std::nullopt;
     }
     const auto value =
@@ -207,8 +236,11 @@ class Reader {
     const Field* f = given(e, i);
     if (f == nullptr) return std::nullopt;
     std::string_view t = f->text;
-    if (t.size() > 2 && t[0] == '0' && (t[1] == 'x' || t[1] == 'X')) {
-      if (auto v = integer(e, i, what, 0, std::numeric_limits<std::int64_t>::max())) {
+    const std::string_view digits =
+        !t.empty() && (t.front() == '-' || t.front() == '+') ? t.substr(1) : t;
+    if (has_hex_prefix(digits)) {
+      if (auto v = integer(e, i, what, -std::numeric_limits<std::int64_t>::max(),
+                           std::numeric_limits<std::int64_t>::max())) {
         return static_cast<double>(*v);
       }
       return std::nullopt;
@@ -230,37 +262,17 @@ class Reader {
                                  std::optional<std::int64_t> size = std::nullopt) {
     const Field* f = field(e, i, what);
     if (f == nullptr) return std::nullopt;
-    std::vector<std::uint8_t> bytes;
-    int high = -1;
-    for (char c : f->text) {
-      if (c == ' ' || c == '\t') {
-        if (high >= 0) {
-          error(f->line,
-                fmt::format("{}: {} \"{}\": a byte of one hex digit", e.keyword, what, f->text));
-          return std::nullopt;
-        }
-        continue;
-      }
-      int digit = -1;
-      if (c >= '0' && c <= '9') digit = c - '0';
-      if (c >= 'a' && c <= 'f') digit = c - 'a' + 10;
-      if (c >= 'A' && c <= 'F') digit = c - 'A' + 10;
-      if (digit < 0) {
-        error(f->line, fmt::format("{}: {} \"{}\" is not hex bytes", e.keyword, what, f->text));
-        return std::nullopt;
-      }
-      if (high < 0) {
-        high = digit;
-      } else {
-        bytes.push_back(static_cast<std::uint8_t>(high << 4 | digit));
-        high = -1;
-      }
+    const HexBytes hex = parse_hex_bytes(f->text, " \t");
+    if (hex.error == HexBytes::Error::kNotHexDigit) {
+      error(f->line, fmt::format("{}: {} \"{}\" is not hex bytes", e.keyword, what, f->text));
+      return std::nullopt;
     }
-    if (high >= 0) {
+    if (hex.error == HexBytes::Error::kOneDigit) {
       error(f->line,
             fmt::format("{}: {} \"{}\": a byte of one hex digit", e.keyword, what, f->text));
       return std::nullopt;
     }
+    const std::vector<std::uint8_t>& bytes = hex.bytes;
     if (size && *size != static_cast<std::int64_t>(bytes.size())) {
       error(f->line, fmt::format("{}: {} has {} bytes, its size field says {}", e.keyword, what,
                                  bytes.size(), *size));
@@ -283,10 +295,17 @@ class Reader {
         error(s.line, fmt::format("[Device] has no {}", keyword));
         return;
       }
-      if (auto v = integer(*e, 0, keyword, 0, hi)) {
+      if (auto v = integer(*e, 0, "value", 0, hi)) {
         out = static_cast<std::remove_reference_t<decltype(out)>>(*v);
       }
     };
+    std::set<std::string> seen;
+    for (const Entry& e : s.entries) {
+      if (!seen.insert(lowered(e.keyword)).second) {
+        warning(e.line,
+                fmt::format("[Device] {} is given again: only the first is read", e.keyword));
+      }
+    }
     required("VendCode", 0xFFFF, d.vendor_code);
     required("ProdType", 0xFFFF, d.product_type);
     required("ProdCode", 0xFFFF, d.product_code);
@@ -317,14 +336,18 @@ class Reader {
         {"COSInfo", ConnectionKind::kChangeOfState},
         {"CyclicInfo", ConnectionKind::kCyclic}};
     for (const Entry& e : s.entries) {
-      if (same_name(e.keyword, "Default")) {
+      if (iequals(e.keyword, "Default")) {
+        if (defaults_line_ != 0) {
+          error(e.line, "Default is given twice");
+          continue;
+        }
         defaults_line_ = e.line;
         if (auto k = kinds(e, 0, "default connections")) io.defaults = *k;
         continue;
       }
       bool known = false;
       for (const auto& [keyword, kind] : kInfos) {
-        if (!same_name(e.keyword, keyword)) continue;
+        if (!iequals(e.keyword, keyword)) continue;
         known = true;
         if (io.connection(kind) != nullptr) {
           error(e.line, fmt::format("{} is given twice", e.keyword));
@@ -364,10 +387,14 @@ class Reader {
     std::optional<cip::EPath> p;
     if (path_size) p = path(e, 5, "path", *path_size);
     d.help = string(e, 6);
-    if (!size || !bits || !carried || !p) return;
+    if (!size || !bits || !carried || !p) {
+      failed(e);
+      return;
+    }
     if (*bits > *size * 8) {
       error(e.line,
             fmt::format("{}: {} bits used do not fit in {} bytes", e.keyword, *bits, *size));
+      failed(e);
       return;
     }
     d.size = static_cast<std::uint16_t>(*size);
@@ -385,7 +412,11 @@ class Reader {
         error(e.line, fmt::format("{} is given twice", e.keyword));
         continue;
       }
-      if (auto p = param(e, *n)) out.push_back(std::move(*p));
+      if (auto p = param(e, *n)) {
+        out.push_back(std::move(*p));
+      } else {
+        failed(e);
+      }
     }
   }
 
@@ -433,9 +464,9 @@ class Reader {
     p.size = static_cast<std::uint16_t>(*size);
     const DataType* type = data_type(static_cast<std::uint8_t>(*type_code));
     if (type == nullptr) {
-      error(e.line, fmt::format("{} ({}): data type 0x{:02X} is not a CIP elementary type "
-                                "dnbridge knows",
-                                e.keyword, p.name, *type_code));
+      warning(e.line, fmt::format("{} ({}): data type 0x{:02X} is not one dnbridge reads; the "
+                                  "parameter is left out",
+                                  e.keyword, p.name, *type_code));
       return std::nullopt;
     }
     p.type = *type;
@@ -484,7 +515,11 @@ class Reader {
         error(e.line, fmt::format("{} is given twice", e.keyword));
         continue;
       }
-      if (auto a = assembly(e, *n)) out.push_back(std::move(*a));
+      if (auto a = assembly(e, *n)) {
+        out.push_back(std::move(*a));
+      } else {
+        failed(e);
+      }
     }
   }
 
@@ -553,11 +588,13 @@ class Reader {
 
   void cross_check(const EdsFile& f) {
     for (const auto& c : f.io.connections) {
-      if (c.input != 0 && f.io.input(c.input) == nullptr) {
+      if (c.input != 0 && f.io.input(c.input) == nullptr &&
+          !has_failed(fmt::format("Input{}", c.input))) {
         error(c.line, fmt::format("{} connection: Input{} is not in [IO_Info]", to_string(c.kind),
                                   c.input));
       }
-      if (c.output != 0 && f.io.output(c.output) == nullptr) {
+      if (c.output != 0 && f.io.output(c.output) == nullptr &&
+          !has_failed(fmt::format("Output{}", c.output))) {
         error(c.line, fmt::format("{} connection: Output{} is not in [IO_Info]", to_string(c.kind),
                                   c.output));
       }
@@ -586,7 +623,9 @@ class Reader {
       for (const Member& m : a.members) {
         if (m.kind == Member::Kind::kParam) {
           const Param* p = f.param(m.number);
-          if (p == nullptr) {
+          if (p == nullptr && has_failed(fmt::format("Param{}", m.number))) {
+            // Said where the parameter is.
+          } else if (p == nullptr) {
             error(a.line, fmt::format("Assem{} ({}): member Param{} is not in [Params]", a.number,
                                       a.name, m.number));
           } else if (p->type.size != 0 && m.bits > p->size * 8u) {
@@ -596,6 +635,7 @@ class Reader {
                                       p->size * 8u));
           }
         } else if (m.kind == Member::Kind::kAssembly &&
+                   !has_failed(fmt::format("Assem{}", m.number)) &&
                    std::none_of(f.assemblies.begin(), f.assemblies.end(),
                                 [&](const Assembly& b) { return b.number == m.number; })) {
           error(a.line, fmt::format("Assem{} ({}): member Assem{} is not in [Assembly]", a.number,
@@ -605,7 +645,8 @@ class Reader {
     }
   }
 
-  std::vector<Problem>& problems_;
+  Parsed& out_;
+  std::set<std::string> failed_;
   std::uint32_t defaults_line_ = 0;
 };
 
@@ -615,7 +656,9 @@ Parsed parse(std::string_view text) {
   Lexed lexed = lex(text);
   Parsed out;
   out.problems = std::move(lexed.problems);
-  Reader reader(out.problems);
+  out.errors = lexed.errors;
+  out.not_shown = lexed.not_shown;
+  Reader reader(out);
   auto file = reader.read(lexed.text);
   std::stable_sort(out.problems.begin(), out.problems.end(),
                    [](const Problem& a, const Problem& b) { return a.line < b.line; });

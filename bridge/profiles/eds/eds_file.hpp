@@ -22,6 +22,7 @@
 // object's instances): 0x01 poll, 0x02 bit-strobe, 0x04 change of state,
 // 0x08 cyclic. Other sections and keywords are ignored. Everything found
 // wrong is a Problem on its line; an error makes the file unusable.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -162,8 +163,10 @@ struct EdsFile {
 };
 
 struct Parsed {
-  std::optional<EdsFile> file;  // absent when there is an error
-  std::vector<Problem> problems;
+  std::optional<EdsFile> file;    // absent when there is an error
+  std::vector<Problem> problems;  // the first kMaxProblems, in line order
+  std::size_t errors = 0;         // all of them, shown or not
+  std::size_t not_shown = 0;      // problems past kMaxProblems
 };
 
 // Reads `text` (the whole file).

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "bridge/common/text.hpp"
+
 namespace dnbridge::eds {
 namespace {
 
@@ -14,15 +16,11 @@ bool is_control(char c) noexcept {
   return (u < 0x20 && !is_blank(c) && c != '\n') || u == 0x7F;
 }
 
-std::string_view trim(std::string_view s) noexcept {
-  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
-  return s;
-}
-
 class Lexer {
  public:
-  explicit Lexer(std::string_view in) : in_(in) {}
+  explicit Lexer(std::string_view in) : in_(in) {
+    if (in_.starts_with("\xEF\xBB\xBF")) i_ = 3;  // a UTF-8 byte order mark
+  }
 
   Lexed run() {
     while (!at_end()) {
@@ -56,8 +54,11 @@ class Lexer {
     while (!at_end() && peek() != '\n') advance();
   }
   void problem(std::uint32_t line, std::string message) {
+    ++out_.errors;
     if (out_.problems.size() < kMaxProblems) {
       out_.problems.push_back({line, Problem::Severity::kError, std::move(message)});
+    } else {
+      ++out_.not_shown;
     }
   }
   // Reports a control character once per line.
@@ -72,10 +73,13 @@ class Lexer {
     const std::uint32_t line = line_;
     advance();  // '['
     const std::size_t start = i_;
-    while (!at_end() && peek() != ']' && peek() != '\n') advance();
+    while (!at_end() && peek() != ']' && peek() != '\n') {
+      if (is_control(peek())) control(peek());
+      advance();
+    }
     if (at_end() || peek() != ']') {
-      problem(line, "a section header without its closing ']'");
-      section_ = kNone;  // what follows belongs to no section we know
+      problem(line, "a section header without its closing ']' (its entries are not read)");
+      section_ = kLost;
       skip_line();
       return;
     }
@@ -97,42 +101,26 @@ class Lexer {
     }
   }
 
-  // To the end of the entry: past its ';', or before a section header.
-  void skip_entry() {
-    bool in_string = false;
-    while (!at_end()) {
-      const char c = peek();
-      if (c == '\n') in_string = false;
-      if (!in_string && c == '$') {
-        skip_line();
-        continue;
-      }
-      if (!in_string && c == '[' && line_start_) return;
-      if (c == '"') in_string = !in_string;
-      advance();
-      if (!in_string && c == ';') return;
-    }
-  }
-
   void entry() {
     const std::uint32_t line = line_;
     const std::size_t start = i_;
     while (!at_end() && peek() != '=' && peek() != '\n' && peek() != ';' && peek() != '$') {
+      if (is_control(peek())) control(peek());
       advance();
     }
     const std::string_view keyword = trim(in_.substr(start, i_ - start));
     if (at_end() || peek() != '=') {
+      // A stray line: only it is passed over.
       problem(line, fmt::format("\"{}\" is not an entry (Keyword = value;)", keyword));
-      skip_entry();
+      if (!at_end() && peek() == ';') advance();
+      skip_line();
       return;
     }
     advance();  // '='
     if (keyword.empty()) problem(line, "an entry with no keyword before its '='");
     Entry e{std::string(keyword), line, {}};
-    const bool ended = fields(e);
-    if (!ended) {
-      problem(line, fmt::format("entry {} is not ended by ';'", e.keyword));
-    }
+    if (!fields(e)) problem(line, fmt::format("entry {} is not ended by ';'", e.keyword));
+    if (section_ == kLost) return;
     if (section_ == kNone) {
       problem(line, fmt::format("entry {} is not in a section", e.keyword));
       return;
@@ -140,29 +128,26 @@ class Lexer {
     out_.text.sections[section_].entries.push_back(std::move(e));
   }
 
-  // The fields of an entry, up to its ';' (true) or a section header or the
-  // end of the input (false).
+  // The fields of an entry, up to its ';' or a string left open (true), or a
+  // section header or the end of the input (false).
   bool fields(Entry& e) {
     Field f;
     f.line = line_;
     std::string bare;
-    bool bare_after_string = false;
+    bool has_bare = false;         // bare text other than blanks
+    std::uint32_t stray_line = 0;  // of text after a string
     const auto finish = [&] {
-      const std::string_view t = trim(bare);
-      if (f.quoted) {
-        if (!t.empty()) bare_after_string = true;
-      } else {
-        f.text = std::string(t);
+      if (stray_line != 0) {
+        problem(stray_line, fmt::format("entry {}: text after a string in field {}", e.keyword,
+                                        e.fields.size() + 1));
       }
-      if (bare_after_string) {
-        problem(f.line, fmt::format("entry {}: text after a string in field {}", e.keyword,
-                                    e.fields.size() + 1));
-      }
+      if (!f.quoted) f.text = std::string(trim(bare));
       e.fields.push_back(std::move(f));
       f = Field{};
       f.line = line_;
       bare.clear();
-      bare_after_string = false;
+      has_bare = false;
+      stray_line = 0;
     };
     while (!at_end()) {
       const char c = peek();
@@ -170,7 +155,7 @@ class Lexer {
         skip_line();
       } else if (c == '\n') {
         advance();
-        if (!f.quoted && !trim(bare).empty()) bare += ' ';
+        if (has_bare) bare += ' ';
       } else if (c == '[' && line_start_) {
         finish();
         return false;
@@ -179,19 +164,27 @@ class Lexer {
         finish();
         if (c == ';') return true;
       } else if (c == '"') {
-        if (!f.quoted && !trim(bare).empty()) {
+        if (has_bare) {
           problem(line_, fmt::format("entry {}: a string after text in field {}", e.keyword,
                                      e.fields.size() + 1));
+          bare.clear();
+          has_bare = false;
         }
         if (!f.quoted) f.line = line_;
         f.quoted = true;
-        string(f.text);
+        if (!string(f.text)) {
+          finish();
+          return true;  // said already; the entry ends with its line
+        }
       } else {
         if (is_control(c)) control(c);
         if (f.quoted) {
-          if (!is_blank(c)) bare_after_string = true;
+          if (!is_blank(c) && stray_line == 0) stray_line = line_;
         } else {
-          if (trim(bare).empty() && !is_blank(c)) f.line = line_;
+          if (!has_bare && !is_blank(c)) {
+            f.line = line_;
+            has_bare = true;
+          }
           bare += c;
         }
         advance();
@@ -201,14 +194,14 @@ class Lexer {
     return false;
   }
 
-  // A quoted string, appended to `out`; it ends on its line.
-  void string(std::string& out) {
+  // A quoted string, appended to `out`; false when its line ended first.
+  bool string(std::string& out) {
     const std::uint32_t line = line_;
     advance();  // '"'
     while (!at_end() && peek() != '\n') {
       char c = peek();
       advance();
-      if (c == '"') return;
+      if (c == '"') return true;
       if (c == '\\' && !at_end() && (peek() == '"' || peek() == '\\')) {
         c = peek();
         advance();
@@ -217,7 +210,8 @@ class Lexer {
       }
       out += c;
     }
-    problem(line, "a string not closed on its line");
+    problem(line, "a string not closed on its line (its entry ends there)");
+    return false;
   }
 
   std::string_view in_;
@@ -226,31 +220,25 @@ class Lexer {
   bool line_start_ = true;  // nothing but blanks since the line began
   std::uint32_t control_line_ = 0;
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-  std::size_t section_ = kNone;  // index of the section entries go to
+  static constexpr std::size_t kLost = static_cast<std::size_t>(-2);
+  // Where entries go: a section's index; kNone before the first section,
+  // kLost after a header that could not be read.
+  std::size_t section_ = kNone;
   Lexed out_;
 };
 
 }  // namespace
 
-bool same_name(std::string_view a, std::string_view b) noexcept {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c + 32) : c; };
-    if (lower(a[i]) != lower(b[i])) return false;
-  }
-  return true;
-}
-
 const Entry* Section::find(std::string_view keyword) const noexcept {
   for (const auto& e : entries) {
-    if (same_name(e.keyword, keyword)) return &e;
+    if (iequals(e.keyword, keyword)) return &e;
   }
   return nullptr;
 }
 
 const Section* Text::find(std::string_view name) const noexcept {
   for (const auto& s : sections) {
-    if (same_name(s.name, name)) return &s;
+    if (iequals(s.name, name)) return &s;
   }
   return nullptr;
 }

@@ -63,16 +63,16 @@ inline constexpr std::size_t kMaxProblems = 50;
 
 struct Lexed {
   Text text;
-  std::vector<Problem> problems;
+  std::vector<Problem> problems;  // the first kMaxProblems
+  std::size_t errors = 0;         // all of them, shown or not
+  std::size_t not_shown = 0;      // problems past kMaxProblems
 };
 
-// Problems found here: a string not closed on its line, an entry with no '='
-// or not ended by ';' before the next section or the end, an entry before
-// the first section, a section header without its ']', a character that is
-// not text (a NUL, a control character).
+// Problems found here: a string not closed on its line (its entry ends
+// there), a line with no '=' (passed over), an entry not ended by ';' before
+// the next section or the end, an entry before the first section, a section
+// header without its ']' (its entries are passed over), a control character.
+// A UTF-8 byte order mark at the start is skipped.
 Lexed lex(std::string_view input);
-
-// ASCII case-insensitive equality, as EDS names are compared.
-bool same_name(std::string_view a, std::string_view b) noexcept;
 
 }  // namespace dnbridge::eds

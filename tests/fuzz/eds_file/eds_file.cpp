@@ -1,6 +1,6 @@
 // EDS files (bridge/profiles/eds). Input: the file's text.
 // Properties: reading never fails hard; a file comes back exactly when no
-// problem is an error; every problem has a line within the text, in line
+// problem is an error, shown or not; every problem has a line within the text, in line
 // order, at most kMaxProblems of them; what a file gives refers only to what
 // it holds (each connection's input and output, each member's parameter).
 #include "bridge/profiles/eds/eds_file.hpp"
@@ -19,7 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   const Parsed parsed = parse(text);
   const auto lines = static_cast<std::uint32_t>(std::count(text.begin(), text.end(), '\n')) + 1;
-  bool error = false;
+  std::size_t errors = 0;
   std::uint32_t last = 0;
   FUZZ_CHECK(parsed.problems.size() <= kMaxProblems);
   for (const Problem& p : parsed.problems) {
@@ -27,13 +27,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(p.line >= last);
     FUZZ_CHECK(!p.message.empty());
     last = p.line;
-    error = error || p.severity == Problem::Severity::kError;
+    errors += p.severity == Problem::Severity::kError ? 1 : 0;
   }
-  if (!parsed.file) {
-    FUZZ_CHECK(error || parsed.problems.size() == kMaxProblems);
-    return 0;
-  }
-  FUZZ_CHECK(!error);
+  FUZZ_CHECK(errors <= parsed.errors);
+  FUZZ_CHECK(parsed.not_shown == 0 || parsed.problems.size() == kMaxProblems);
+  FUZZ_CHECK(parsed.file.has_value() == (parsed.errors == 0));
+  if (!parsed.file) return 0;
   const EdsFile& f = *parsed.file;
   for (const ConnectionInfo& c : f.io.connections) {
     FUZZ_CHECK(c.input == 0 || f.io.input(c.input) != nullptr);

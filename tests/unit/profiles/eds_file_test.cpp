@@ -72,7 +72,7 @@ TEST(EdsFile, TheIoBlockExampleReadsAsItShips) {
   ASSERT_NE(f.io.output(1), nullptr);
   EXPECT_EQ(f.io.output(1)->size, 2);
 
-  ASSERT_EQ(f.params.size(), 4u);
+  ASSERT_EQ(f.params.size(), 5u);
   const Param* ai = f.param("analog input 1");
   ASSERT_NE(ai, nullptr);
   EXPECT_EQ(ai->number, 2u);
@@ -92,8 +92,8 @@ TEST(EdsFile, TheIoBlockExampleReadsAsItShips) {
   ASSERT_EQ(a->members.size(), 3u);
   EXPECT_EQ(a->members[0].kind, Member::Kind::kParam);
   EXPECT_EQ(a->members[0].number, 3u);
-  EXPECT_EQ(a->members[1].kind, Member::Kind::kPath);
-  EXPECT_EQ(a->members[1].path, (cip::EPath{0x08, 1, std::nullopt, 3}));
+  EXPECT_EQ(a->members[1].kind, Member::Kind::kParam);
+  EXPECT_EQ(a->members[1].number, 5u);
   EXPECT_EQ(a->members[2].bits, 16);
   const Assembly* out = f.assembly_at(f.io.output(1)->path);
   ASSERT_NE(out, nullptr);
@@ -115,7 +115,10 @@ TEST(EdsFile, TheValveManifoldExampleReadsAsItShips) {
   EXPECT_EQ(f.io.input(2)->size, 1);
   EXPECT_EQ(f.io.connection(ConnectionKind::kChangeOfState), nullptr);
   ASSERT_EQ(f.assemblies.size(), 3u);
-  EXPECT_EQ(f.assemblies[1].members.size(), 3u);  // two 1-bit members and 6 bits of padding
+  ASSERT_EQ(f.assemblies[1].members.size(), 3u);  // two 1-bit members and 6 bits of padding
+  EXPECT_EQ(f.assemblies[1].members[0].kind, Member::Kind::kPath);
+  EXPECT_EQ(f.assemblies[1].members[0].path, (cip::EPath{0x08, 1, std::nullopt, 3}));
+  EXPECT_EQ(f.assemblies[1].members[2].kind, Member::Kind::kPadding);
   EXPECT_EQ(f.param("Low pressure limit")->default_value, 400.0);
 }
 
@@ -243,9 +246,9 @@ INSTANTIATE_TEST_SUITE_P(
                   minimal("[Params]\nParam1 = 0, 0, , 0, 0xC7, 4, \"speed\", \"\", \"\", 0, 10, "
                           "1, 1, 1, 1, 0, , , , , 0;\n"),
                   4, "data size 4 is not that of UINT (2)"},
-        Malformed{"a parameter of an unknown type",
-                  minimal("[Params]\nParam1 = 0, 0, , 0, 0xEE, 4, \"x\";\n"), 4,
-                  "data type 0xEE is not a CIP elementary type"},
+        Malformed{"a default given twice",
+                  minimal("[IO_Info]\nDefault = 0x0001;\nPollInfo = 1, 0, 0;\nDefault = 1;\n"), 6,
+                  "Default is given twice"},
         Malformed{"a default outside the limits",
                   minimal("[Params]\nParam1 = 0, 0, , 0, 0xC6, 1, \"x\", \"\", \"\", 0, 10, "
                           "11;\n"),
@@ -275,8 +278,8 @@ TEST(EdsFile, ANumberThatIsNotOneIsAnErrorOnItsLine) {
       "MajRev = 1; MinRev = 300;\n");
   EXPECT_FALSE(parsed.file.has_value());
   const std::string text = all(parsed);
-  EXPECT_THAT(text, HasSubstr("t.eds:2: error: VendCode: VendCode \"12x\" is not a number"));
-  EXPECT_THAT(text, HasSubstr("t.eds:4: error: MinRev: MinRev 300 is out of range (0..255)"));
+  EXPECT_THAT(text, HasSubstr("t.eds:2: error: VendCode: value \"12x\" is not a number"));
+  EXPECT_THAT(text, HasSubstr("t.eds:4: error: MinRev: value 300 is out of range (0..255)"));
 }
 
 TEST(EdsFile, EveryProblemIsReportedInOnePassInLineOrder) {
@@ -288,6 +291,48 @@ TEST(EdsFile, EveryProblemIsReportedInOnePassInLineOrder) {
   for (std::size_t i = 1; i < parsed.problems.size(); ++i) {
     EXPECT_LE(parsed.problems[i - 1].line, parsed.problems[i].line) << all(parsed);
   }
+}
+
+TEST(EdsFile, AParameterOfATypeNotReadIsLeftOutWithAWarning) {
+  const Parsed parsed =
+      parse(minimal("[Params]\nParam1 = 0, 0, , 0, 0xDB, 4, \"when\";\n"
+                    "[Assembly]\nAssem1 = \"a\", , 32, 0, , , 32, Param1;\n"));
+  ASSERT_TRUE(parsed.file.has_value()) << all(parsed);
+  EXPECT_TRUE(parsed.file->params.empty());
+  ASSERT_EQ(parsed.problems.size(), 1u) << all(parsed);
+  EXPECT_EQ(parsed.problems[0].severity, Problem::Severity::kWarning);
+  EXPECT_EQ(parsed.problems[0].line, 4u);
+  EXPECT_THAT(parsed.problems[0].message, HasSubstr("data type 0xDB is not one dnbridge reads"));
+}
+
+TEST(EdsFile, WhatRefersToAnEntryFoundWrongSaysNothingMore) {
+  const Parsed parsed = parse(minimal(
+      "[IO_Info]\nPollInfo = 1, 1, 0;\nInput1 = 4, 0, 1, \"in\", 6, \"20 04 zz\", \"\";\n"));
+  EXPECT_FALSE(parsed.file.has_value());
+  ASSERT_EQ(parsed.problems.size(), 1u) << all(parsed);
+  EXPECT_EQ(parsed.problems[0].line, 5u);
+}
+
+TEST(EdsFile, AnErrorPastTheProblemsShownStillMakesTheFileUnusable) {
+  std::string text = minimal("[IO_Info]\n");
+  for (int i = 0; i < 60; ++i)
+    text += "Input" + std::to_string(i + 1) + " = 1, 0, 0x10, \"\", 0, , \"\";\n";
+  text += "PollInfo = 1, 99, 0;\n";
+  const Parsed parsed = parse(text);
+  EXPECT_FALSE(parsed.file.has_value());
+  EXPECT_EQ(parsed.problems.size(), kMaxProblems);
+  EXPECT_EQ(parsed.errors, 1u);
+  EXPECT_EQ(parsed.not_shown, 11u);
+}
+
+TEST(EdsFile, AByteOrderMarkDuplicateSectionsAndALostHeaderAreHandled) {
+  const Parsed parsed =
+      parse("\xEF\xBB\xBF" + minimal("[Device]\nVendCode = 9;\n[Params\nParam1 = x;\n"));
+  EXPECT_FALSE(parsed.file.has_value());
+  const std::string text = all(parsed);
+  EXPECT_THAT(text, HasSubstr("t.eds:3: warning: [Device] is given again"));
+  EXPECT_THAT(text, HasSubstr("t.eds:5: error: a section header without its closing ']'"));
+  EXPECT_EQ(parsed.errors, 1u) << text;  // nothing about the entry in the lost section
 }
 
 TEST(EdsFile, AProblemIsWrittenAsCompilersWriteThem) {
