@@ -1,0 +1,64 @@
+#include "adapters/sim/generic/cos_producer.hpp"
+
+#include <algorithm>
+
+namespace dnbridge::sim {
+
+CosProducer::CosProducer(CosProduction settings, Bytes data, TimePoint established)
+    : settings_(settings), data_(data.begin(), data.end()), last_production_(established) {}
+
+std::vector<std::uint8_t> CosProducer::produce(TimePoint now) {
+  last_production_ = now;
+  change_pending_ = false;
+  ++counters_.produced;
+  if (!settings_.ack_suppressed) {
+    awaiting_ack_ = true;  // a message still waiting is superseded
+    retries_left_ = settings_.retry_limit;
+    ack_deadline_ = now + settings_.ack_timer;
+  }
+  return data_;
+}
+
+std::optional<std::vector<std::uint8_t>> CosProducer::set_data(Bytes data, TimePoint now) {
+  if (std::equal(data.begin(), data.end(), data_.begin(), data_.end())) return std::nullopt;
+  data_.assign(data.begin(), data.end());
+  if (settings_.cyclic) return std::nullopt;  // sent at the next cycle
+  if (now < last_production_ + settings_.inhibit) {
+    change_pending_ = true;
+    return std::nullopt;
+  }
+  return produce(now);
+}
+
+void CosProducer::on_ack() {
+  if (!awaiting_ack_) return;
+  awaiting_ack_ = false;
+  ++counters_.acks_received;
+}
+
+TimePoint CosProducer::next_deadline() const noexcept {
+  TimePoint next = last_production_ + settings_.expected_packet_rate;
+  if (change_pending_) next = std::min(next, last_production_ + settings_.inhibit);
+  if (awaiting_ack_) next = std::min(next, ack_deadline_);
+  return next;
+}
+
+std::optional<std::vector<std::uint8_t>> CosProducer::on_timer(TimePoint now) {
+  if (change_pending_ && now >= last_production_ + settings_.inhibit) return produce(now);
+  if (now >= last_production_ + settings_.expected_packet_rate) return produce(now);
+  if (awaiting_ack_ && now >= ack_deadline_) {
+    if (retries_left_ == 0) {
+      awaiting_ack_ = false;
+      ++counters_.given_up;
+      return std::nullopt;
+    }
+    --retries_left_;
+    ++counters_.retries;
+    ++counters_.produced;
+    ack_deadline_ = now + settings_.ack_timer;
+    return data_;
+  }
+  return std::nullopt;
+}
+
+}  // namespace dnbridge::sim

@@ -1,0 +1,45 @@
+#include "bridge/devicenet/master/cos_consumer.hpp"
+
+#include <algorithm>
+
+#include "bridge/devicenet/wire/identifier.hpp"
+
+namespace dnbridge::devicenet {
+
+CosConsumer::CosConsumer(MacId slave, CosSettings settings, TimePoint established)
+    : slave_(slave), settings_(settings), last_(established) {}
+
+CosConsumer::Taken CosConsumer::on_message(Bytes data, TimePoint now) {
+  Taken taken;
+  const bool same = have_data_ && std::equal(data.begin(), data.end(), data_.begin(), data_.end());
+  const bool soon = now - last_ <= settings_.ack_timer + settings_.ack_slack;
+  taken.repeat = same && soon && repeats_in_a_row_ < settings_.retry_limit;
+  repeats_in_a_row_ = taken.repeat ? static_cast<std::uint8_t>(repeats_in_a_row_ + 1) : 0;
+  ++counters_.messages;
+  if (taken.repeat) ++counters_.repeats;
+  if (!settings_.ack_suppressed) {
+    taken.acknowledge = true;
+    ++counters_.acks_sent;
+  }
+  data_.assign(data.begin(), data.end());
+  have_data_ = true;
+  last_ = now;
+  lost_ = false;
+  return taken;
+}
+
+bool CosConsumer::check_watchdog(TimePoint now) {
+  if (lost_ || now < watchdog_deadline()) return false;
+  lost_ = true;
+  ++counters_.losses;
+  return true;
+}
+
+can::CanFrame CosConsumer::ack_frame() const noexcept {
+  can::CanFrame f;
+  f.id = group2_id(slave_, Group2Message::kMasterCosCyclicAck);
+  f.len = 0;
+  return f;
+}
+
+}  // namespace dnbridge::devicenet
