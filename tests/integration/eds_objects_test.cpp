@@ -1,0 +1,142 @@
+// The objects of a simulated device described by an EDS file (the io-block
+// example), request by request: Identity from [Device]; the Assembly
+// object's member lists, which agree with the EDS they come from, and data
+// packed from the parameters; the Parameter object within its limits; the
+// Acknowledge Handler's defaults and limits; CIP errors for the rest.
+#include "adapters/sim/generic/eds_objects.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "bridge/cip/assembly.hpp"
+#include "bridge/profiles/eds/member_check.hpp"
+
+namespace dnbridge::sim {
+namespace {
+
+constexpr std::uint8_t kGet = 0x0E;
+constexpr std::uint8_t kSet = 0x10;
+
+eds::EdsFile io_block() {
+  std::ifstream in(std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-io-block.eds");
+  std::stringstream text;
+  text << in.rdbuf();
+  auto parsed = eds::parse(text.str());
+  EXPECT_TRUE(parsed.file.has_value());
+  return parsed.file.value_or(eds::EdsFile{});
+}
+
+class EdsObjectsTest : public ::testing::Test {
+ protected:
+  // The response message: service byte first.
+  std::vector<std::uint8_t> call(std::uint8_t service, std::uint16_t class_id,
+                                 std::uint16_t instance, std::uint8_t attribute,
+                                 std::vector<std::uint8_t> data = {}) {
+    devicenet::RequestMessage r;
+    r.service = service;
+    r.class_id = class_id;
+    r.instance_id = instance;
+    r.attribute = attribute;
+    r.data = Bytes(data.data(), data.size());
+    std::array<std::uint8_t, devicenet::kMaxExplicitMessage> out{};
+    const std::size_t n = objects_.execute(r, MutableBytes(out));
+    return {out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n)};
+  }
+  std::vector<std::uint8_t> get(std::uint16_t c, std::uint16_t i, std::uint8_t a) {
+    auto r = call(kGet, c, i, a);
+    EXPECT_FALSE(r.empty());
+    if (r.empty() || r[0] != (kGet | 0x80)) {
+      ADD_FAILURE() << "Get " << c << "/" << i << "/" << int{a} << " failed";
+      return {};
+    }
+    return {r.begin() + 1, r.end()};
+  }
+  // The general status of an error response; 0 for success.
+  std::uint8_t status(const std::vector<std::uint8_t>& response) {
+    return !response.empty() && response[0] == 0x94 && response.size() >= 2 ? response[1] : 0;
+  }
+
+  EdsObjects objects_{io_block(), 0x12345678};
+};
+
+TEST_F(EdsObjectsTest, IdentityIsTheEdsDevice) {
+  EXPECT_EQ(get(1, 1, 1), (std::vector<std::uint8_t>{0xE9, 0xFD}));  // 65001
+  EXPECT_EQ(get(1, 1, 3), (std::vector<std::uint8_t>{0x01, 0x00}));
+  EXPECT_EQ(get(1, 1, 4), (std::vector<std::uint8_t>{1, 3}));
+  EXPECT_EQ(get(1, 1, 6), (std::vector<std::uint8_t>{0x78, 0x56, 0x34, 0x12}));
+  const auto name = get(1, 1, 7);
+  ASSERT_FALSE(name.empty());
+  EXPECT_EQ(std::string(name.begin() + 1, name.end()), "Example IO block 8DI/8DO/1AI");
+  EXPECT_EQ(name[0], name.size() - 1);
+}
+
+TEST_F(EdsObjectsTest, AssemblyMemberListsAgreeWithTheirEds) {
+  EXPECT_EQ(get(4, 0, 2), (std::vector<std::uint8_t>{150, 0}));  // max instance
+  EXPECT_EQ(get(4, 100, 1), (std::vector<std::uint8_t>{3, 0}));
+  const auto list = get(4, 100, 2);
+  auto members = cip::decode_member_list(Bytes(list.data(), list.size()));
+  ASSERT_TRUE(members.ok());
+  ASSERT_EQ(members->size(), 3u);
+  EXPECT_EQ(cip::describe((*members)[1]), "8 bits: class 0x0F instance 0x05 attribute 0x01");
+  const eds::EdsFile& f = objects_.file();
+  EXPECT_TRUE(eds::member_differences(f, *f.assembly_at(f.io.input(1)->path), *members).empty());
+  const auto outputs = get(4, 150, 2);
+  auto out_members = cip::decode_member_list(Bytes(outputs.data(), outputs.size()));
+  ASSERT_TRUE(out_members.ok());
+  ASSERT_EQ(out_members->size(), 2u);
+  EXPECT_TRUE((*out_members)[1].padding());
+  EXPECT_EQ(status(call(kGet, 4, 101, 1)), 0x16);
+}
+
+TEST_F(EdsObjectsTest, AssemblyDataPacksTheParameters) {
+  const std::array<std::uint8_t, 1> inputs{0xA5};
+  const std::array<std::uint8_t, 1> module{0x01};
+  const std::array<std::uint8_t, 2> analog{0xFE, 0xFF};  // -2 mV
+  ASSERT_TRUE(objects_.set_param_value(3, Bytes(inputs.data(), 1)));
+  ASSERT_TRUE(objects_.set_param_value(5, Bytes(module.data(), 1)));
+  ASSERT_TRUE(objects_.set_param_value(2, Bytes(analog.data(), 2)));
+  EXPECT_EQ(get(4, 100, 3), (std::vector<std::uint8_t>{0xA5, 0x01, 0xFE, 0xFF}));
+  EXPECT_EQ(objects_.assembly_data(100), (std::vector<std::uint8_t>{0xA5, 0x01, 0xFE, 0xFF}));
+  EXPECT_EQ(status(call(kSet, 4, 100, 3, {0, 0, 0, 0})), 0x0E);  // set through a connection only
+}
+
+TEST_F(EdsObjectsTest, ParametersAreSetWithinTheirLimits) {
+  EXPECT_EQ(get(0x0F, 1, 1), (std::vector<std::uint8_t>{3, 0}));  // its default
+  EXPECT_EQ(status(call(kSet, 0x0F, 1, 1, {50, 0})), 0);
+  EXPECT_EQ(get(0x0F, 1, 1), (std::vector<std::uint8_t>{50, 0}));
+  EXPECT_EQ(status(call(kSet, 0x0F, 1, 1, {101, 0})), 0x09);  // above 100
+  EXPECT_EQ(status(call(kSet, 0x0F, 1, 1, {50})), 0x13);
+  EXPECT_EQ(status(call(kSet, 0x0F, 1, 1, {50, 0, 0})), 0x15);
+  EXPECT_EQ(status(call(kSet, 0x0F, 2, 1, {0, 0})), 0x0E);  // read only
+  EXPECT_EQ(status(call(kSet, 0x0F, 9, 1, {0})), 0x16);
+  EXPECT_EQ(get(0x0F, 0, 2), (std::vector<std::uint8_t>{5, 0}));
+}
+
+TEST_F(EdsObjectsTest, TheAcknowledgeHandlerHasTheSeedsDefaultsAndLimits) {
+  EXPECT_EQ(get(0x2B, 1, 1), (std::vector<std::uint8_t>{20, 0}));
+  EXPECT_EQ(get(0x2B, 1, 2), (std::vector<std::uint8_t>{1}));
+  EXPECT_EQ(get(0x2B, 1, 3), (std::vector<std::uint8_t>{4, 0}));
+  EXPECT_EQ(get(0x2B, 1, 4), (std::vector<std::uint8_t>{1}));
+  EXPECT_EQ(get(0x2B, 1, 5), (std::vector<std::uint8_t>{0}));  // an empty list
+  EXPECT_EQ(status(call(kSet, 0x2B, 1, 1, {50, 0})), 0);
+  EXPECT_EQ(objects_.ack_handler().ack_timer_ms, 50);
+  EXPECT_EQ(status(call(kSet, 0x2B, 1, 1, {0, 0})), 0x09);  // 1..65535
+  EXPECT_EQ(status(call(kSet, 0x2B, 1, 5, {1, 4})), 0x0E);
+  objects_.ack_handler().cos_acknowledged = true;
+  EXPECT_EQ(get(0x2B, 1, 5), (std::vector<std::uint8_t>{1, 4}));
+  EXPECT_EQ(get(0x2B, 0, 1), (std::vector<std::uint8_t>{1, 0}));
+}
+
+TEST_F(EdsObjectsTest, WhatIsNotThereIsAnsweredWithItsError) {
+  EXPECT_EQ(status(call(0x05, 1, 1, 0)), 0x08);          // Reset: not a service here
+  EXPECT_EQ(status(call(kGet, 0x64, 1, 1)), 0x16);       // no such class
+  EXPECT_EQ(status(call(kGet, 1, 1, 99)), 0x14);         // no such attribute
+  EXPECT_EQ(status(call(kSet, 1, 1, 1, {0, 0})), 0x0E);  // Identity: read only
+}
+
+}  // namespace
+}  // namespace dnbridge::sim
