@@ -103,7 +103,7 @@ std::string summary(const std::string& path, const EdsFile& f) {
   }
   out += fmt::format("assemblies: {}\n", f.assemblies.size());
   for (const auto& a : f.assemblies) {
-    out += fmt::format("  {:>3} \"{}\": {} bits", a.number, a.name, a.bits.value_or(0));
+    out += fmt::format("  {:>3} \"{}\": {} bits", a.number, a.name, a.size_bits());
     for (std::size_t i = 0; i < a.members.size(); ++i) {
       out += (i == 0 ? ": " : ", ") + member_text(f, a.members[i]);
     }
@@ -169,7 +169,7 @@ std::string json(const std::string& path, const eds::Parsed& parsed) {
       w.begin_object()
           .field("number", a.number)
           .field("name", a.name)
-          .field("bits", static_cast<std::uint64_t>(a.bits.value_or(0)));
+          .field("bits", static_cast<std::uint64_t>(a.size_bits()));
       w.key("members").begin_array();
       for (const auto& m : a.members) w.value(member_text(f, m));
       w.end_array().end_object();

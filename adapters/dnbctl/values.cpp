@@ -14,12 +14,6 @@
 namespace dnbridge::dnbctl {
 namespace {
 
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
-
 // Digits of one number as parse_unsigned reads it: decimal, or hex with 0x
 // (whether it fits is parse_unsigned's to say).
 bool is_number(std::string_view s) {
@@ -75,7 +69,7 @@ Parsed<NodeRef> parse_node(std::string_view text) {
 }
 
 Parsed<bool> parse_on_off(std::string_view text) {
-  const std::string t = lower(trim(text));
+  const std::string t = to_lower(trim(text));
   if (t == "on" || t == "1" || t == "true") return true;
   if (t == "off" || t == "0" || t == "false") return false;
   return Parsed<bool>::failure(fmt::format("\"{}\" is neither on nor off", text));
@@ -146,7 +140,7 @@ std::string hex_bytes(std::span<const std::uint8_t> data) {
 }
 
 Parsed<Decoding> parse_decoding(std::string_view text) {
-  const std::string t = lower(trim(text));
+  const std::string t = to_lower(trim(text));
   if (t == "string") return Decoding::kString;
   if (t == "uint") return Decoding::kUint;
   if (t == "int") return Decoding::kInt;

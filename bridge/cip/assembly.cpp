@@ -1,6 +1,7 @@
 #include "bridge/cip/assembly.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 namespace dnbridge::cip {
 
@@ -57,11 +58,15 @@ std::string describe(const EPath& path) {
   return out;
 }
 
+std::string describe_path(const AssemblyMember& member) {
+  if (member.padding()) return "padding";
+  if (member.path) return describe(*member.path);
+  return fmt::format("path {:02X}", fmt::join(member.path_bytes, " "));
+}
+
 std::string describe(const AssemblyMember& member) {
-  const char* bits = member.bits == 1 ? "bit" : "bits";
-  if (member.padding()) return fmt::format("{} {}: padding", member.bits, bits);
-  if (member.path) return fmt::format("{} {}: {}", member.bits, bits, describe(*member.path));
-  return fmt::format("{} {}: path {:02X}", member.bits, bits, fmt::join(member.path_bytes, " "));
+  return fmt::format("{} {}: {}", member.bits, member.bits == 1 ? "bit" : "bits",
+                     describe_path(member));
 }
 
 }  // namespace dnbridge::cip

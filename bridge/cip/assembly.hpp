@@ -45,8 +45,10 @@ std::uint32_t member_bits(const std::vector<AssemblyMember>& members) noexcept;
 
 // "class 0x0F instance 0x02 attribute 0x01" (a logical path), "(empty)".
 std::string describe(const EPath& path);
-// "16 bits: class 0x0F instance 0x02 attribute 0x01", "8 bits: padding",
-// "8 bits: path 91 03 41 42 43 00" (one that is not a logical path).
+// What a member is: "class 0x0F instance 0x02 attribute 0x01", "padding",
+// "path 91 03 41 42 43 00" (one that is not a logical path).
+std::string describe_path(const AssemblyMember& member);
+// With its size: "16 bits: class 0x0F instance 0x02 attribute 0x01".
 std::string describe(const AssemblyMember& member);
 
 }  // namespace dnbridge::cip

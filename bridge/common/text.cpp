@@ -25,6 +25,12 @@ bool iequals(std::string_view a, std::string_view b) noexcept {
   return true;
 }
 
+std::string to_lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = lower(c);
+  return out;
+}
+
 bool has_hex_prefix(std::string_view s) noexcept {
   return s.size() >= 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
 }

@@ -2,6 +2,7 @@
 // Small text helpers for what people write: configuration values, command
 // arguments, EDS files. ASCII only (case, digits, blanks).
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -12,6 +13,8 @@ std::string_view trim(std::string_view s) noexcept;
 
 // Equal ignoring ASCII case.
 bool iequals(std::string_view a, std::string_view b) noexcept;
+// `s` with ASCII letters in lower case.
+std::string to_lower(std::string_view s);
 
 // "0x" or "0X" first.
 bool has_hex_prefix(std::string_view s) noexcept;

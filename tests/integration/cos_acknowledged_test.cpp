@@ -141,7 +141,9 @@ TEST(CosAcknowledged, ACyclicDeviceProducesEveryEprOnly) {
   link.run_until(t0 + milliseconds(650));
   ASSERT_EQ(link.sent_at.size(), 3u);
   EXPECT_EQ(link.sent_at[0], t0 + milliseconds(200));
+  EXPECT_EQ(link.sent_at[1], t0 + milliseconds(400));
   EXPECT_EQ(link.sent_at[2], t0 + milliseconds(600));
+  EXPECT_EQ(link.consumer().counters().repeats, 0u);
   EXPECT_EQ(link.consumer().last_data(), (std::vector<std::uint8_t>{4, 0}));
 }
 
@@ -153,6 +155,56 @@ TEST(CosAcknowledged, ADeviceThatFallsSilentIsLostAfterFourEprs) {
   EXPECT_FALSE(link.consumer().check_watchdog(t0 + milliseconds(1199)));
   EXPECT_TRUE(link.consumer().check_watchdog(t0 + milliseconds(1200)));
   EXPECT_EQ(link.consumer().counters().losses, 1u);
+}
+
+TEST(CosAcknowledged, ARetryResendsTheMessageAwaitedNotAChangeHeldBack) {
+  sim::CosProduction p = production();
+  p.inhibit = milliseconds(30);
+  CosLink link(p, consumption());
+  link.drop_acks = true;
+  link.run_until(t0 + milliseconds(30));
+  link.set_data({1, 0});  // sent at 30 ms
+  link.run_until(t0 + milliseconds(35));
+  link.set_data({2, 0});  // held back by the inhibit time until 60 ms
+  link.run_until(t0 + milliseconds(55));
+  // The retry at 50 ms is the message awaited, {1, 0}: the master sees a repeat.
+  ASSERT_EQ(link.sent_at.size(), 2u);
+  EXPECT_EQ(link.sent_at[1], t0 + milliseconds(50));
+  EXPECT_EQ(link.consumer().last_data(), (std::vector<std::uint8_t>{1, 0}));
+  EXPECT_EQ(link.consumer().counters().repeats, 1u);
+  link.run_until(t0 + milliseconds(61));
+  ASSERT_EQ(link.sent_at.size(), 3u);
+  EXPECT_EQ(link.sent_at[2], t0 + milliseconds(60));
+  EXPECT_EQ(link.consumer().last_data(), (std::vector<std::uint8_t>{2, 0}));
+  EXPECT_EQ(link.consumer().counters().repeats, 1u);
+}
+
+TEST(CosAcknowledged, CyclesFasterThanTheAckTimerAreNeverTakenForRetries) {
+  sim::CosProduction p = production();
+  p.cyclic = true;
+  p.expected_packet_rate = milliseconds(10);
+  devicenet::CosSettings s = consumption();
+  s.expected_packet_rate = milliseconds(10);
+  CosLink link(p, s);
+  link.drop_acks = true;
+  link.run_until(t0 + milliseconds(105));
+  EXPECT_EQ(link.sent_at.size(), 10u);
+  EXPECT_EQ(link.producer().counters().retries, 0u);  // each cycle supersedes the wait
+  EXPECT_EQ(link.consumer().counters().repeats, 0u);
+}
+
+TEST(CosAcknowledged, AnEprOfZeroMeansNoHeartbeatAndNoWatchdog) {
+  sim::CosProduction p = production();
+  p.expected_packet_rate = Duration::zero();
+  devicenet::CosSettings s = consumption();
+  s.expected_packet_rate = Duration::zero();
+  CosLink link(p, s);
+  link.run_until(t0 + seconds(5));
+  EXPECT_TRUE(link.sent_at.empty());
+  link.set_data({5, 0});
+  link.run_until(t0 + seconds(10));
+  EXPECT_EQ(link.sent_at.size(), 1u);
+  EXPECT_FALSE(link.consumer().check_watchdog(t0 + seconds(3600)));
 }
 
 }  // namespace

@@ -13,10 +13,20 @@ std::vector<std::uint8_t> CosProducer::produce(TimePoint now) {
   ++counters_.produced;
   if (!settings_.ack_suppressed) {
     awaiting_ack_ = true;  // a message still waiting is superseded
+    awaiting_ = data_;
     retries_left_ = settings_.retry_limit;
-    ack_deadline_ = now + settings_.ack_timer;
+    ack_deadline_ = now + ack_timer();
   }
   return data_;
+}
+
+Duration CosProducer::ack_timer() const noexcept {
+  return std::max<Duration>(settings_.ack_timer, milliseconds(1));
+}
+
+std::optional<TimePoint> CosProducer::next_production() const noexcept {
+  if (settings_.expected_packet_rate <= Duration::zero()) return std::nullopt;
+  return last_production_ + settings_.expected_packet_rate;
 }
 
 std::optional<std::vector<std::uint8_t>> CosProducer::set_data(Bytes data, TimePoint now) {
@@ -37,7 +47,7 @@ void CosProducer::on_ack() {
 }
 
 TimePoint CosProducer::next_deadline() const noexcept {
-  TimePoint next = last_production_ + settings_.expected_packet_rate;
+  TimePoint next = next_production().value_or(kNever);
   if (change_pending_) next = std::min(next, last_production_ + settings_.inhibit);
   if (awaiting_ack_) next = std::min(next, ack_deadline_);
   return next;
@@ -45,7 +55,7 @@ TimePoint CosProducer::next_deadline() const noexcept {
 
 std::optional<std::vector<std::uint8_t>> CosProducer::on_timer(TimePoint now) {
   if (change_pending_ && now >= last_production_ + settings_.inhibit) return produce(now);
-  if (now >= last_production_ + settings_.expected_packet_rate) return produce(now);
+  if (const auto due = next_production(); due && now >= *due) return produce(now);
   if (awaiting_ack_ && now >= ack_deadline_) {
     if (retries_left_ == 0) {
       awaiting_ack_ = false;
@@ -55,8 +65,8 @@ std::optional<std::vector<std::uint8_t>> CosProducer::on_timer(TimePoint now) {
     --retries_left_;
     ++counters_.retries;
     ++counters_.produced;
-    ack_deadline_ = now + settings_.ack_timer;
-    return data_;
+    ack_deadline_ = now + ack_timer();
+    return awaiting_;
   }
   return std::nullopt;
 }

@@ -11,7 +11,11 @@
 //   master's acknowledgment; none within the acknowledge timer (attribute
 //   1, default 20 ms), the message is sent again, at most the retry limit
 //   (attribute 2, default 1) times in a row; then the device gives it up.
-//   A new message supersedes one still waiting.
+//   A new message supersedes one still waiting; a change held back by the
+//   inhibit time waits for its own turn, never rides on a retry.
+// An EPR of 0 means no heartbeat (nor, cyclic, any production), as the
+// Connection object's 0 is read (UNVERIFIED); an acknowledge timer of 0,
+// outside the object's 1..65535, is taken as 1 ms.
 //
 // Sans-IO: time comes in as arguments; what to send comes back, the caller
 // puts it on the bus (Group 1 message 0xD).
@@ -57,9 +61,13 @@ class CosProducer {
 
  private:
   std::vector<std::uint8_t> produce(TimePoint now);
+  Duration ack_timer() const noexcept;
+  // When the next heartbeat or cycle is due; none with an EPR of 0.
+  std::optional<TimePoint> next_production() const noexcept;
 
   CosProduction settings_;
   std::vector<std::uint8_t> data_;
+  std::vector<std::uint8_t> awaiting_;  // the message waiting for its acknowledgment
   TimePoint last_production_;
   bool change_pending_ = false;  // a change held back by the inhibit time
   bool awaiting_ack_ = false;

@@ -98,7 +98,7 @@ const eds::Assembly* EdsObjects::assembly(unsigned number) const noexcept {
 std::vector<std::uint8_t> EdsObjects::assembly_data(unsigned number) const {
   const eds::Assembly* a = assembly(number);
   if (a == nullptr) return {};
-  const std::uint32_t total = a->bits.value_or(0);
+  const std::uint32_t total = a->size_bits();
   std::vector<std::uint8_t> out((total + 7) / 8, 0);
   std::uint32_t at = 0;
   const auto put = [&](const std::vector<std::uint8_t>& from, std::uint32_t bits) {

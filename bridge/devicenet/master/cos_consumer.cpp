@@ -12,8 +12,12 @@ CosConsumer::CosConsumer(MacId slave, CosSettings settings, TimePoint establishe
 CosConsumer::Taken CosConsumer::on_message(Bytes data, TimePoint now) {
   Taken taken;
   const bool same = have_data_ && std::equal(data.begin(), data.end(), data_.begin(), data_.end());
-  const bool soon = now - last_ <= settings_.ack_timer + settings_.ack_slack;
-  taken.repeat = same && soon && repeats_in_a_row_ < settings_.retry_limit;
+  const Duration gap = now - last_;
+  const bool soon =
+      gap <= settings_.ack_timer + settings_.ack_slack &&
+      (settings_.expected_packet_rate <= Duration::zero() || gap < settings_.expected_packet_rate);
+  taken.repeat =
+      same && soon && !settings_.ack_suppressed && repeats_in_a_row_ < settings_.retry_limit;
   repeats_in_a_row_ = taken.repeat ? static_cast<std::uint8_t>(repeats_in_a_row_ + 1) : 0;
   ++counters_.messages;
   if (taken.repeat) ++counters_.repeats;

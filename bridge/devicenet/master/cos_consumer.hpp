@@ -16,9 +16,14 @@
 //   handled as a poll timeout is.
 //
 // What the master sees of the device's retries: the same data again within
-// the acknowledge timer (plus `ack_slack`) of the message before, which a
-// change of state cannot be (it needs a change) and a heartbeat is not (it
-// comes an EPR apart). Counted as repeats, acknowledged as any message.
+// the acknowledge timer (plus `ack_slack`) of the message before, and sooner
+// than an EPR after it, which a change of state cannot be (it needs a
+// change) and a heartbeat or cycle is not (it comes an EPR apart). With an
+// EPR no longer than the acknowledge timer, a heartbeat supersedes a retry
+// before it is due, and nothing counts. Counted as repeats, acknowledged as
+// any message; none with acknowledgment suppressed (nothing is retried).
+// An EPR of 0 means no watchdog (as the Connection object's 0 is read;
+// UNVERIFIED).
 //
 // Sans-IO and clockless: time comes in as arguments.
 #include <cstdint>
@@ -58,8 +63,10 @@ class CosConsumer {
   // A message of the connection, its data as reassembled.
   Taken on_message(Bytes data, TimePoint now);
 
-  // When nothing has come for 4 × EPR; after it, lost() until a message.
+  // When nothing has come for 4 × EPR (never with an EPR of 0); after it,
+  // lost() until a message.
   TimePoint watchdog_deadline() const noexcept {
+    if (settings_.expected_packet_rate <= Duration::zero()) return kNever;
     return last_ + 4 * settings_.expected_packet_rate;
   }
   // Call when now >= watchdog_deadline(): true (once per loss) when the

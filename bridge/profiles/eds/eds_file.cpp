@@ -118,12 +118,13 @@ std::optional<unsigned> number_after(std::string_view keyword, std::string_view 
   return n;
 }
 
-std::string lowered(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) {
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c + 32);
+// An entry's identity: "param5" for Param5 or PARAM05 (the numbered
+// keywords by their number), the keyword in lower case for the others.
+std::string entry_key(std::string_view keyword) {
+  for (std::string_view prefix : {"Input", "Output", "Param", "Assem"}) {
+    if (auto n = number_after(keyword, prefix)) return fmt::format("{}{}", to_lower(prefix), *n);
   }
-  return out;
+  return to_lower(keyword);
 }
 
 class Reader {
@@ -138,7 +139,7 @@ class Reader {
     }
     std::set<std::string> seen;
     for (const Section& section : text.sections) {
-      if (!seen.insert(lowered(section.name)).second) {
+      if (!seen.insert(to_lower(section.name)).second) {
         warning(section.line,
                 fmt::format("[{}] is given again: only the first is read", section.name));
       }
@@ -166,15 +167,15 @@ class Reader {
   }
   void add(std::uint32_t line, Problem::Severity severity, std::string message) {
     if (severity == Problem::Severity::kError) ++out_.errors;
-    if (out_.problems.size() < kMaxProblems) {
+    if (out_.problems.size() < kMaxProblemsKept) {
       out_.problems.push_back({line, severity, std::move(message)});
     } else {
       ++out_.not_shown;
     }
   }
   // An entry found wrong (said already): what refers to it says nothing more.
-  void failed(const Entry& e) { failed_.insert(lowered(e.keyword)); }
-  bool has_failed(std::string_view keyword) const { return failed_.count(lowered(keyword)) != 0; }
+  void failed(const Entry& e) { failed_.insert(entry_key(e.keyword)); }
+  bool has_failed(std::string_view keyword) const { return failed_.count(entry_key(keyword)) != 0; }
 
   // Field `i` of `e`, or an error naming `what` and nullptr.
   const Field* field(const Entry& e, std::size_t i, std::string_view what) {
@@ -301,7 +302,7 @@ class Reader {
     };
     std::set<std::string> seen;
     for (const Entry& e : s.entries) {
-      if (!seen.insert(lowered(e.keyword)).second) {
+      if (!seen.insert(to_lower(e.keyword)).second) {
         warning(e.line,
                 fmt::format("[Device] {} is given again: only the first is read", e.keyword));
       }
@@ -359,6 +360,8 @@ class Reader {
         if (combines && input && output) {
           io.connections.push_back({kind, *combines, static_cast<unsigned>(*input),
                                     static_cast<unsigned>(*output), e.line});
+        } else {
+          failed(e);
         }
       }
       if (known) continue;
@@ -408,7 +411,7 @@ class Reader {
     for (const Entry& e : s.entries) {
       auto n = number_after(e.keyword, "Param");
       if (!n) continue;  // Enum, Group and vendors' entries are not read
-      if (std::any_of(out.begin(), out.end(), [&](const Param& p) { return p.number == *n; })) {
+      if (!seen_params_.insert(*n).second) {
         error(e.line, fmt::format("{} is given twice", e.keyword));
         continue;
       }
@@ -582,7 +585,6 @@ class Reader {
                                 a.name, total, *a.bits));
       return std::nullopt;
     }
-    if (!a.bits) a.bits = total;
     return a;
   }
 
@@ -600,22 +602,22 @@ class Reader {
       }
     }
     for (ConnectionKind k : kConnectionKinds) {
-      if (f.io.defaults.has(k) && f.io.connection(k) == nullptr) {
-        error(defaults_line_,
-              fmt::format("[IO_Info] Default names {}, which no {} entry describes", to_string(k),
-                          k == ConnectionKind::kPoll     ? "PollInfo"
-                          : k == ConnectionKind::kStrobe ? "StrobeInfo"
-                          : k == ConnectionKind::kCyclic ? "CyclicInfo"
-                                                         : "COSInfo"));
+      const std::string_view info = k == ConnectionKind::kPoll     ? "PollInfo"
+                                    : k == ConnectionKind::kStrobe ? "StrobeInfo"
+                                    : k == ConnectionKind::kCyclic ? "CyclicInfo"
+                                                                   : "COSInfo";
+      if (f.io.defaults.has(k) && f.io.connection(k) == nullptr && !has_failed(info)) {
+        error(defaults_line_, fmt::format("[IO_Info] Default names {}, which no {} entry describes",
+                                          to_string(k), info));
       }
     }
     for (const auto* list : {&f.io.inputs, &f.io.outputs}) {
       for (const IoData& d : *list) {
         const Assembly* a = f.assembly_at(d.path);
-        if (a != nullptr && a->bits && *a->bits != d.size * 8u) {
+        if (a != nullptr && (a->bits || !a->members.empty()) && a->size_bits() != d.size * 8u) {
           error(d.line, fmt::format("{} ({}) is {} bytes, the Assem{} it names is {} bits",
                                     list == &f.io.inputs ? "an input" : "an output", d.name, d.size,
-                                    a->number, *a->bits));
+                                    a->number, a->size_bits()));
         }
       }
     }
@@ -647,6 +649,7 @@ class Reader {
 
   Parsed& out_;
   std::set<std::string> failed_;
+  std::set<unsigned> seen_params_;
   std::uint32_t defaults_line_ = 0;
 };
 
@@ -657,9 +660,18 @@ Parsed parse(std::string_view text) {
   Parsed out;
   out.problems = std::move(lexed.problems);
   out.errors = lexed.errors;
-  out.not_shown = lexed.not_shown;
+  out.not_shown = lexed.not_kept;
   Reader reader(out);
   auto file = reader.read(lexed.text);
+  // Errors first, then warnings, kMaxProblems of them, in line order.
+  std::stable_sort(
+      out.problems.begin(), out.problems.end(), [](const Problem& a, const Problem& b) {
+        return a.severity == Problem::Severity::kError && b.severity != Problem::Severity::kError;
+      });
+  if (out.problems.size() > kMaxProblems) {
+    out.not_shown += out.problems.size() - kMaxProblems;
+    out.problems.resize(kMaxProblems);
+  }
   std::stable_sort(out.problems.begin(), out.problems.end(),
                    [](const Problem& a, const Problem& b) { return a.line < b.line; });
   out.file = std::move(file);

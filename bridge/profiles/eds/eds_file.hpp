@@ -142,10 +142,18 @@ struct Assembly {
   unsigned number = 0;  // AssemN's N (by convention its instance)
   std::string name;
   cip::EPath path;
-  std::optional<std::uint32_t> bits;  // the size given; absent: the members'
+  std::optional<std::uint32_t> bits;  // the size given
   std::uint16_t descriptor = 0;
   std::vector<Member> members;
   std::uint32_t line = 0;
+
+  // The size given, or its members' when none is.
+  std::uint32_t size_bits() const noexcept {
+    if (bits) return *bits;
+    std::uint32_t total = 0;
+    for (const auto& m : members) total += m.bits;
+    return total;
+  }
 };
 
 struct EdsFile {
@@ -163,8 +171,9 @@ struct EdsFile {
 };
 
 struct Parsed {
-  std::optional<EdsFile> file;    // absent when there is an error
-  std::vector<Problem> problems;  // the first kMaxProblems, in line order
+  std::optional<EdsFile> file;  // absent when there is an error
+                                // At most kMaxProblems, errors before warnings, in line order.
+  std::vector<Problem> problems;
   std::size_t errors = 0;         // all of them, shown or not
   std::size_t not_shown = 0;      // problems past kMaxProblems
 };

@@ -7,13 +7,14 @@
 namespace dnbridge::eds {
 namespace {
 
-bool is_blank(char c) noexcept {
+// A blank within a line (a newline ends one).
+bool is_line_blank(char c) noexcept {
   return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
 }
 
 bool is_control(char c) noexcept {
   const auto u = static_cast<unsigned char>(c);
-  return (u < 0x20 && !is_blank(c) && c != '\n') || u == 0x7F;
+  return (u < 0x20 && !is_line_blank(c) && c != '\n') || u == 0x7F;
 }
 
 class Lexer {
@@ -25,7 +26,7 @@ class Lexer {
   Lexed run() {
     while (!at_end()) {
       const char c = peek();
-      if (c == '\n' || is_blank(c)) {
+      if (c == '\n' || is_line_blank(c)) {
         advance();
       } else if (c == '$') {
         skip_line();
@@ -45,7 +46,7 @@ class Lexer {
     if (in_[i_] == '\n') {
       ++line_;
       line_start_ = true;
-    } else if (!is_blank(in_[i_])) {
+    } else if (!is_line_blank(in_[i_])) {
       line_start_ = false;
     }
     ++i_;
@@ -55,10 +56,10 @@ class Lexer {
   }
   void problem(std::uint32_t line, std::string message) {
     ++out_.errors;
-    if (out_.problems.size() < kMaxProblems) {
+    if (out_.problems.size() < kMaxProblemsKept) {
       out_.problems.push_back({line, Problem::Severity::kError, std::move(message)});
     } else {
-      ++out_.not_shown;
+      ++out_.not_kept;
     }
   }
   // Reports a control character once per line.
@@ -92,7 +93,7 @@ class Lexer {
     while (!at_end() && peek() != '\n') {
       if (peek() == '$') {
         skip_line();
-      } else if (is_blank(peek())) {
+      } else if (is_line_blank(peek())) {
         advance();
       } else {
         problem(line, "text after a section header");
@@ -172,16 +173,13 @@ class Lexer {
         }
         if (!f.quoted) f.line = line_;
         f.quoted = true;
-        if (!string(f.text)) {
-          finish();
-          return true;  // said already; the entry ends with its line
-        }
+        string(f.text);
       } else {
         if (is_control(c)) control(c);
         if (f.quoted) {
-          if (!is_blank(c) && stray_line == 0) stray_line = line_;
+          if (!is_line_blank(c) && stray_line == 0) stray_line = line_;
         } else {
-          if (!has_bare && !is_blank(c)) {
+          if (!has_bare && !is_line_blank(c)) {
             f.line = line_;
             has_bare = true;
           }
@@ -194,14 +192,14 @@ class Lexer {
     return false;
   }
 
-  // A quoted string, appended to `out`; false when its line ended first.
-  bool string(std::string& out) {
+  // A quoted string, appended to `out`; it ends with its line at the latest.
+  void string(std::string& out) {
     const std::uint32_t line = line_;
     advance();  // '"'
     while (!at_end() && peek() != '\n') {
       char c = peek();
       advance();
-      if (c == '"') return true;
+      if (c == '"') return;
       if (c == '\\' && !at_end() && (peek() == '"' || peek() == '\\')) {
         c = peek();
         advance();
@@ -210,8 +208,7 @@ class Lexer {
       }
       out += c;
     }
-    problem(line, "a string not closed on its line (its entry ends there)");
-    return false;
+    problem(line, "a string not closed on its line");
   }
 
   std::string_view in_;

@@ -58,18 +58,20 @@ struct Text {
 };
 
 // Reading goes on after a problem (from the next entry or section), so that
-// one pass reports every one, up to kMaxProblems.
+// one pass finds every one; at most kMaxProblems are shown (errors first),
+// and at most kMaxProblemsKept are kept while reading.
 inline constexpr std::size_t kMaxProblems = 50;
+inline constexpr std::size_t kMaxProblemsKept = 10000;
 
 struct Lexed {
   Text text;
-  std::vector<Problem> problems;  // the first kMaxProblems
-  std::size_t errors = 0;         // all of them, shown or not
-  std::size_t not_shown = 0;      // problems past kMaxProblems
+  std::vector<Problem> problems;  // the first kMaxProblemsKept
+  std::size_t errors = 0;         // all of them, kept or not
+  std::size_t not_kept = 0;       // problems past kMaxProblemsKept
 };
 
-// Problems found here: a string not closed on its line (its entry ends
-// there), a line with no '=' (passed over), an entry not ended by ';' before
+// Problems found here: a string not closed on its line (it ends there, its
+// entry goes on), a line with no '=' (passed over), an entry not ended by ';' before
 // the next section or the end, an entry before the first section, a section
 // header without its ']' (its entries are passed over), a control character.
 // A UTF-8 byte order mark at the start is skipped.

@@ -36,18 +36,13 @@ Expected expected_of(const EdsFile& file, const Member& m) {
   return {};
 }
 
-std::string reported_text(const cip::AssemblyMember& m) {
-  if (m.padding()) return "padding";
-  if (m.path) return cip::describe(*m.path);
-  return fmt::format("path {:02X}", fmt::join(m.path_bytes, " "));
-}
-
 }  // namespace
 
 std::vector<std::string> member_differences(const EdsFile& file, const Assembly& expected,
                                             const std::vector<cip::AssemblyMember>& reported) {
   std::vector<std::string> out;
-  const std::uint32_t expected_bits = expected.bits.value_or(0);
+  if (!expected.bits && expected.members.empty()) return out;  // the EDS says nothing of it
+  const std::uint32_t expected_bits = expected.size_bits();
   const std::uint32_t reported_bits = cip::member_bits(reported);
   if (expected_bits != reported_bits) {
     out.push_back(fmt::format("{} bits in all on the device, {} in the EDS (Assem{})",
@@ -71,7 +66,7 @@ std::vector<std::string> member_differences(const EdsFile& file, const Assembly&
     const bool same_path = !want.path || (r.path && *r.path == *want.path);
     if (!same_kind || !same_path) {
       out.push_back(fmt::format("member {}: {} on the device, {} in the EDS", i + 1,
-                                reported_text(r), want.text));
+                                cip::describe_path(r), want.text));
     }
   }
   return out;

@@ -31,6 +31,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   FUZZ_CHECK(errors <= parsed.errors);
   FUZZ_CHECK(parsed.not_shown == 0 || parsed.problems.size() == kMaxProblems);
+  // Errors are shown before any warning is.
+  const bool warning_shown =
+      std::any_of(parsed.problems.begin(), parsed.problems.end(),
+                  [](const Problem& p) { return p.severity == Problem::Severity::kWarning; });
+  FUZZ_CHECK(!warning_shown || errors == parsed.errors);
   FUZZ_CHECK(parsed.file.has_value() == (parsed.errors == 0));
   if (!parsed.file) return 0;
   const EdsFile& f = *parsed.file;
@@ -44,7 +49,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       bits += m.bits;
       if (m.kind == Member::Kind::kParam) FUZZ_CHECK(f.param(m.number) != nullptr);
     }
-    FUZZ_CHECK(a.members.empty() || a.bits == bits);
+    FUZZ_CHECK(!a.bits || a.members.empty() || *a.bits == bits);
+    FUZZ_CHECK(a.size_bits() == (a.bits ? *a.bits : bits));
   }
   for (const Param& p : f.params) {
     FUZZ_CHECK(p.divisor != 0);

@@ -40,8 +40,10 @@ TEST(CosConsumer, WithAcknowledgmentSuppressedNothingIsAcknowledged) {
   CosConsumer c(kSlave, s, t0);
   const std::array<std::uint8_t, 2> a{0x01, 0x00};
   EXPECT_FALSE(c.on_message(bytes(a), t0).acknowledge);
+  // Nothing is retried without acknowledgment: the same data soon is no repeat.
+  EXPECT_FALSE(c.on_message(bytes(a), t0 + milliseconds(15)).repeat);
   EXPECT_EQ(c.counters().acks_sent, 0u);
-  EXPECT_EQ(c.counters().messages, 1u);
+  EXPECT_EQ(c.counters().messages, 2u);
 }
 
 TEST(CosConsumer, TheSameDataWithinTheAckTimerIsTheDevicesRetry) {

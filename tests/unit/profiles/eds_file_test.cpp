@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <fstream>
 #include <ostream>
@@ -88,7 +89,7 @@ TEST(EdsFile, TheIoBlockExampleReadsAsItShips) {
   const Assembly* a = f.assembly_at(in->path);
   ASSERT_NE(a, nullptr);
   EXPECT_EQ(a->number, 100u);
-  EXPECT_EQ(a->bits, 32u);
+  EXPECT_EQ(a->size_bits(), 32u);
   ASSERT_EQ(a->members.size(), 3u);
   EXPECT_EQ(a->members[0].kind, Member::Kind::kParam);
   EXPECT_EQ(a->members[0].number, 3u);
@@ -272,14 +273,22 @@ INSTANTIATE_TEST_SUITE_P(
                   "member 1 \"Widget\" is neither a path, ParamN nor AssemN"}),
     case_name);
 
+TEST(EdsFile, AStringLeftOpenIsOneErrorAndItsEntryGoesOn) {
+  const Parsed parsed = parse(minimal("[File]\nDescText = \"open\n  ;\nRevision = 1.0;\n"));
+  EXPECT_EQ(parsed.errors, 1u) << all(parsed);
+  EXPECT_FALSE(parsed.file.has_value());
+}
+
 TEST(EdsFile, ANumberThatIsNotOneIsAnErrorOnItsLine) {
   const Parsed parsed = parse(
-      "[Device]\nVendCode = 12x;\nProdType = 0; ProdCode = 1;\n"
-      "MajRev = 1; MinRev = 300;\n");
+      "[Device]\nVendCode = 12x;\nProdType = 99999999999999999999;"
+      " ProdCode = 1;\nMajRev = 1; MinRev = 300;\n");
   EXPECT_FALSE(parsed.file.has_value());
   const std::string text = all(parsed);
   EXPECT_THAT(text, HasSubstr("t.eds:2: error: VendCode: value \"12x\" is not a number"));
   EXPECT_THAT(text, HasSubstr("t.eds:4: error: MinRev: value 300 is out of range (0..255)"));
+  EXPECT_THAT(text, HasSubstr("t.eds:3: error: ProdType: value 99999999999999999999 is out of "
+                              "range (0..65535)"));
 }
 
 TEST(EdsFile, EveryProblemIsReportedInOnePassInLineOrder) {
@@ -311,6 +320,19 @@ TEST(EdsFile, WhatRefersToAnEntryFoundWrongSaysNothingMore) {
   EXPECT_FALSE(parsed.file.has_value());
   ASSERT_EQ(parsed.problems.size(), 1u) << all(parsed);
   EXPECT_EQ(parsed.problems[0].line, 5u);
+  // Nor what refers to a parameter written another way, or to a failed PollInfo.
+  const Parsed param =
+      parse(minimal("[IO_Info]\nDefault = 1;\nPollInfo = x, 0, 0;\n[Params]\n"
+                    "Param05 = 0, 0, , 0, 0xC6, 9, \"p\";\n[Assembly]\n"
+                    "Assem1 = \"a\", , 8, 0, , , 8, Param5;\n"));
+  EXPECT_EQ(param.errors, 2u) << all(param);  // PollInfo's field, Param05's size
+}
+
+TEST(EdsFile, AParameterGivenTwiceIsAnErrorEvenWhenTheFirstWasLeftOut) {
+  const Parsed parsed =
+      parse(minimal("[Params]\nParam1 = 0, 0, , 0, 0xDB, 4, \"when\";\n"
+                    "Param1 = 0, 0, , 0, 0xC6, 1, \"again\";\n"));
+  EXPECT_THAT(all(parsed), HasSubstr("t.eds:5: error: Param1 is given twice"));
 }
 
 TEST(EdsFile, AnErrorPastTheProblemsShownStillMakesTheFileUnusable) {
@@ -323,6 +345,10 @@ TEST(EdsFile, AnErrorPastTheProblemsShownStillMakesTheFileUnusable) {
   EXPECT_EQ(parsed.problems.size(), kMaxProblems);
   EXPECT_EQ(parsed.errors, 1u);
   EXPECT_EQ(parsed.not_shown, 11u);
+  // The error is among those shown, warnings making up the rest.
+  EXPECT_EQ(std::count_if(parsed.problems.begin(), parsed.problems.end(),
+                          [](const Problem& p) { return p.severity == Problem::Severity::kError; }),
+            1);
 }
 
 TEST(EdsFile, AByteOrderMarkDuplicateSectionsAndALostHeaderAreHandled) {
