@@ -207,5 +207,33 @@ TEST(CosAcknowledged, AnEprOfZeroMeansNoHeartbeatAndNoWatchdog) {
   EXPECT_FALSE(link.consumer().check_watchdog(t0 + seconds(3600)));
 }
 
+TEST(CosAcknowledged, AHeartbeatSoonAfterARetryIsNoRepeatAndAZeroAckTimerIsOneMs) {
+  sim::CosProduction p = production();
+  p.expected_packet_rate = milliseconds(30);
+  p.retry_limit = 2;
+  devicenet::CosSettings s = consumption();
+  s.expected_packet_rate = milliseconds(30);
+  s.retry_limit = 2;
+  CosLink link(p, s);
+  link.drop_acks = true;
+  // Heartbeats at 30 ms apart; the first one's retry at 50 ms, then the
+  // heartbeat at 60 ms, 10 ms after that retry: not a repeat.
+  link.run_until(t0 + milliseconds(65));
+  ASSERT_EQ(link.sent_at.size(), 3u);
+  EXPECT_EQ(link.sent_at[1], t0 + milliseconds(50));
+  EXPECT_EQ(link.sent_at[2], t0 + milliseconds(60));
+  EXPECT_EQ(link.consumer().counters().repeats, 1u);
+
+  sim::CosProduction zero = production();
+  zero.ack_timer = Duration::zero();
+  CosLink fast(zero, consumption());
+  fast.drop_acks = true;
+  fast.run_until(t0 + milliseconds(20));
+  fast.set_data({1, 0});
+  fast.run_until(t0 + milliseconds(25));
+  ASSERT_EQ(fast.sent_at.size(), 2u);
+  EXPECT_EQ(fast.sent_at[1], t0 + milliseconds(21));
+}
+
 }  // namespace
 }  // namespace dnbridge

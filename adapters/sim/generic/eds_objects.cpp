@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <optional>
 
 #include "bridge/cip/assembly.hpp"
@@ -25,7 +26,9 @@ std::vector<std::uint8_t> encode_value(const eds::Param& p, double v) {
   std::vector<std::uint8_t> out(p.size, 0);
   if (p.type.is_float) {
     if (p.size == 4) {
-      const auto bits = std::bit_cast<std::uint32_t>(static_cast<float>(v));
+      const float f =
+          std::abs(v) <= std::numeric_limits<float>::max() ? static_cast<float>(v) : 0.0f;
+      const auto bits = std::bit_cast<std::uint32_t>(f);
       for (std::size_t i = 0; i < 4; ++i) out[i] = static_cast<std::uint8_t>(bits >> (8 * i));
     } else if (p.size == 8) {
       const auto bits = std::bit_cast<std::uint64_t>(v);
@@ -34,7 +37,13 @@ std::vector<std::uint8_t> encode_value(const eds::Param& p, double v) {
     return out;
   }
   if (p.type.size == 0) return out;  // strings: no value kept
-  const auto bits = static_cast<std::uint64_t>(static_cast<std::int64_t>(v));
+  // In the type's range (the EDS reader checked the limits; a default of
+  // 2^64 - 1 reads as 2^64 in a double).
+  const double lo = p.type.is_signed ? -std::ldexp(1.0, 8 * p.size - 1) : 0.0;
+  const double hi = std::ldexp(1.0, 8 * p.size - (p.type.is_signed ? 1 : 0));
+  const double clamped = std::isfinite(v) ? std::clamp(v, lo, std::nextafter(hi, 0.0)) : 0.0;
+  const auto bits = clamped < 0 ? static_cast<std::uint64_t>(static_cast<std::int64_t>(clamped))
+                                : static_cast<std::uint64_t>(clamped);
   for (std::size_t i = 0; i < out.size() && i < 8; ++i) {
     out[i] = static_cast<std::uint8_t>(bits >> (8 * i));
   }
@@ -81,6 +90,13 @@ std::vector<std::uint8_t> EdsObjects::param_value(unsigned number) const {
   return it == values_.end() ? std::vector<std::uint8_t>{} : it->second;
 }
 
+std::optional<double> EdsObjects::param_number(unsigned number) const {
+  const eds::Param* p = file_.param(number);
+  if (p == nullptr) return std::nullopt;
+  const auto value = param_value(number);
+  return decode_value(*p, Bytes(value.data(), value.size()));
+}
+
 bool EdsObjects::set_param_value(unsigned number, Bytes value) {
   auto it = values_.find(number);
   if (it == values_.end() || it->second.size() != value.size()) return false;
@@ -88,16 +104,24 @@ bool EdsObjects::set_param_value(unsigned number, Bytes value) {
   return true;
 }
 
-const eds::Assembly* EdsObjects::assembly(unsigned number) const noexcept {
+const eds::Assembly* EdsObjects::assembly(unsigned instance) const noexcept {
+  return file_.assembly_at(cip::EPath{cip::class_id::kAssembly, instance, std::nullopt, 3});
+}
+
+const eds::Assembly* EdsObjects::assembly_numbered(unsigned number) const noexcept {
   for (const auto& a : file_.assemblies) {
     if (a.number == number) return &a;
   }
   return nullptr;
 }
 
-std::vector<std::uint8_t> EdsObjects::assembly_data(unsigned number) const {
-  const eds::Assembly* a = assembly(number);
-  if (a == nullptr) return {};
+std::vector<std::uint8_t> EdsObjects::assembly_data(unsigned instance) const {
+  const eds::Assembly* a = assembly(instance);
+  return a == nullptr ? std::vector<std::uint8_t>{} : packed(*a, 0);
+}
+
+std::vector<std::uint8_t> EdsObjects::packed(const eds::Assembly& assembly, unsigned depth) const {
+  const eds::Assembly* a = &assembly;
   const std::uint32_t total = a->size_bits();
   std::vector<std::uint8_t> out((total + 7) / 8, 0);
   std::uint32_t at = 0;
@@ -110,9 +134,11 @@ std::vector<std::uint8_t> EdsObjects::assembly_data(unsigned number) const {
   };
   for (const auto& m : a->members) {
     if (m.kind == eds::Member::Kind::kParam) put(param_value(m.number), m.bits);
-    // A nested assembly once (an assembly naming itself reads as zeros).
-    if (m.kind == eds::Member::Kind::kAssembly && m.number != number) {
-      put(assembly_data(m.number), m.bits);
+    // Nested assemblies, kMaxNesting deep (the EDS reader refuses cycles).
+    if (m.kind == eds::Member::Kind::kAssembly && depth < kMaxNesting) {
+      if (const eds::Assembly* nested = assembly_numbered(m.number)) {
+        put(packed(*nested, depth + 1), m.bits);
+      }
     }
     at += m.bits;
   }
@@ -139,7 +165,7 @@ std::vector<cip::AssemblyMember> EdsObjects::member_list(const eds::Assembly& a)
         break;
       }
       case eds::Member::Kind::kAssembly: {
-        const eds::Assembly* nested = assembly(m.number);
+        const eds::Assembly* nested = assembly_numbered(m.number);
         if (nested != nullptr) path = nested->path;
         break;
       }
@@ -176,7 +202,8 @@ EdsObjects::Outcome EdsObjects::get_identity(std::uint8_t attribute, ByteWriter&
       out.u32le(serial_number_);
       break;
     case cip::identity_attr::kProductName: {
-      const std::string_view name = std::string_view(d.product_name).substr(0, 255);
+      const std::string_view name = d.product_name;
+      if (name.size() > cip::kMaxShortStringLength) return {GeneralStatus::kReplyDataTooLarge};
       out.u8(static_cast<std::uint8_t>(name.size()));
       out.bytes(Bytes(reinterpret_cast<const std::uint8_t*>(name.data()), name.size()));
       break;
@@ -190,10 +217,10 @@ EdsObjects::Outcome EdsObjects::get_identity(std::uint8_t attribute, ByteWriter&
 EdsObjects::Outcome EdsObjects::get_assembly(std::uint16_t instance, std::uint8_t attribute,
                                              ByteWriter& out) const {
   if (instance == 0) {
-    unsigned max = 0;
-    for (const auto& a : file_.assemblies) max = std::max(max, a.number);
+    std::uint32_t max = 0;
+    for (const auto& a : file_.assemblies) max = std::max(max, a.path.instance_id.value_or(0));
     if (attribute == cip::class_attr::kRevision) {
-      out.u16le(2);
+      out.u16le(1);
     } else if (attribute == cip::class_attr::kMaxInstance) {
       out.u16le(static_cast<std::uint16_t>(max));
     } else {
@@ -232,8 +259,17 @@ EdsObjects::Outcome EdsObjects::get_parameter(std::uint16_t instance, std::uint8
     out.u16le(static_cast<std::uint16_t>(max));
     return {};
   }
-  if (file_.param(instance) == nullptr) return {GeneralStatus::kObjectDoesNotExist};
+  const eds::Param* p = file_.param(instance);
+  if (p == nullptr) return {GeneralStatus::kObjectDoesNotExist};
   if (attribute != 1) return {GeneralStatus::kAttributeNotSupported};
+  if (p->type.size == 0) {
+    // A string parameter is kept empty: its length alone.
+    if (p->type.code == 0xD0)
+      out.u16le(0);
+    else
+      out.u8(0);
+    return {};
+  }
   const auto value = param_value(instance);
   out.bytes(Bytes(value.data(), value.size()));
   return {};
@@ -277,10 +313,16 @@ EdsObjects::Outcome EdsObjects::get_ack_handler(std::uint16_t instance, std::uin
 }
 
 EdsObjects::Outcome EdsObjects::get(const devicenet::RequestMessage& r, ByteWriter& out) const {
-  const std::uint8_t attribute = r.attribute.value_or(0);
+  const std::uint8_t attribute = *r.attribute;
   switch (r.class_id) {
     case cip::class_id::kIdentity:
-      if (r.instance_id != 1) return {GeneralStatus::kObjectDoesNotExist};
+      if (r.instance_id == 0) {
+        if (attribute != cip::class_attr::kRevision && attribute != cip::class_attr::kMaxInstance) {
+          return {GeneralStatus::kAttributeNotSupported};
+        }
+        out.u16le(1);
+        return {};
+      }
       return get_identity(attribute, out);
     case cip::class_id::kAssembly:
       return get_assembly(r.instance_id, attribute, out);
@@ -293,27 +335,52 @@ EdsObjects::Outcome EdsObjects::get(const devicenet::RequestMessage& r, ByteWrit
   }
 }
 
+bool EdsObjects::exists(std::uint16_t class_id, std::uint16_t instance) const noexcept {
+  if (instance == 0) {
+    return class_id == cip::class_id::kIdentity || class_id == cip::class_id::kAssembly ||
+           class_id == kParameterClass || class_id == kAckHandlerClass;
+  }
+  switch (class_id) {
+    case cip::class_id::kIdentity:
+    case kAckHandlerClass:
+      return instance == 1;
+    case cip::class_id::kAssembly:
+      return assembly(instance) != nullptr;
+    case kParameterClass:
+      return file_.param(instance) != nullptr;
+    default:
+      return false;
+  }
+}
+
 EdsObjects::Outcome EdsObjects::set(const devicenet::RequestMessage& r) {
-  const std::uint8_t attribute = r.attribute.value_or(0);
+  const std::uint8_t attribute = *r.attribute;
   const auto size_check = [&](std::size_t want) -> std::optional<Outcome> {
     if (r.data.size() < want) return Outcome{GeneralStatus::kNotEnoughData};
     if (r.data.size() > want) return Outcome{GeneralStatus::kTooMuchData};
     return std::nullopt;
   };
-  if (r.class_id == kParameterClass && r.instance_id != 0) {
+  // Supported at all (as a Get would answer), then settable.
+  ByteWriter probe(MutableBytes{});
+  const Outcome supported = get(r, probe);
+  if (supported.status == GeneralStatus::kAttributeNotSupported) return supported;
+  if (r.class_id == kParameterClass && attribute == 1) {
     const eds::Param* p = file_.param(r.instance_id);
-    if (p == nullptr) return {GeneralStatus::kObjectDoesNotExist};
-    if (attribute != 1) return {GeneralStatus::kAttributeNotSettable};
-    if (p->read_only()) return {GeneralStatus::kAttributeNotSettable};
+    if (p->read_only() || p->type.size == 0) return {GeneralStatus::kAttributeNotSettable};
     if (auto bad = size_check(p->size)) return *bad;
     const auto v = decode_value(*p, r.data);
-    if (!v || (p->minimum && *v < *p->minimum) || (p->maximum && *v > *p->maximum)) {
+    if (!v || !std::isfinite(*v)) return {GeneralStatus::kInvalidAttributeValue};
+    // A REAL is compared with its limits as REALs.
+    const auto limit = [&](double l) {
+      return p->size == 4 && p->type.is_float ? double{static_cast<float>(l)} : l;
+    };
+    if ((p->minimum && *v < limit(*p->minimum)) || (p->maximum && *v > limit(*p->maximum))) {
       return {GeneralStatus::kInvalidAttributeValue};
     }
     values_[p->number].assign(r.data.begin(), r.data.end());
     return {};
   }
-  if (r.class_id == kAckHandlerClass && r.instance_id == 1) {
+  if (r.class_id == kAckHandlerClass) {
     switch (attribute) {
       case 1: {
         if (auto bad = size_check(2)) return *bad;
@@ -326,23 +393,17 @@ EdsObjects::Outcome EdsObjects::set(const devicenet::RequestMessage& r) {
         if (auto bad = size_check(1)) return *bad;
         ack_.retry_limit = r.data[0];
         return {};
-      case 3:
+      case 3: {
         if (auto bad = size_check(2)) return *bad;
-        ack_.cos_producing_instance = static_cast<std::uint16_t>(r.data[0] | r.data[1] << 8);
+        const auto v = static_cast<std::uint16_t>(r.data[0] | r.data[1] << 8);
+        // The ack list holds USINT instances.
+        if (v == 0 || v > 0xFF) return {GeneralStatus::kInvalidAttributeValue};
+        ack_.cos_producing_instance = v;
         return {};
-      case 4:
-      case 5:
-        return {GeneralStatus::kAttributeNotSettable};
+      }
       default:
-        return {GeneralStatus::kAttributeNotSupported};
+        break;
     }
-  }
-  // Identity, Assembly and the class attributes: read only here.
-  ByteWriter probe(MutableBytes{});
-  const Outcome exists = get(r, probe);
-  if (exists.status == GeneralStatus::kObjectDoesNotExist ||
-      exists.status == GeneralStatus::kAttributeNotSupported) {
-    return exists;
   }
   return {GeneralStatus::kAttributeNotSettable};
 }
@@ -351,13 +412,22 @@ std::size_t EdsObjects::execute(const devicenet::RequestMessage& request, Mutabl
   std::array<std::uint8_t, devicenet::kMaxExplicitMessage> data{};
   ByteWriter w{MutableBytes(data)};
   Outcome o;
+  // In the order the CDN127 simulator checks (cdn127_objects.cpp, dispatch).
   const auto service = static_cast<cip::Service>(request.service);
-  if (service == cip::Service::kGetAttributeSingle) {
-    o = get(request, w);
-  } else if (service == cip::Service::kSetAttributeSingle) {
-    o = set(request);
-  } else {
+  const bool get_single = service == cip::Service::kGetAttributeSingle;
+  const bool set_single = service == cip::Service::kSetAttributeSingle;
+  if (!exists(request.class_id, request.instance_id)) {
+    o = {GeneralStatus::kObjectDoesNotExist};
+  } else if (!get_single && !set_single) {
     o = {GeneralStatus::kServiceNotSupported};
+  } else if (set_single && request.instance_id == 0) {
+    o = {GeneralStatus::kServiceNotSupported};  // no Set at class level
+  } else if (!request.attribute) {
+    o = {GeneralStatus::kNotEnoughData};
+  } else if (get_single && !request.data.empty()) {
+    o = {GeneralStatus::kTooMuchData};
+  } else {
+    o = get_single ? get(request, w) : set(request);
   }
   if (o.status == GeneralStatus::kSuccess && !w.ok()) o = {GeneralStatus::kReplyDataTooLarge};
   if (o.status == GeneralStatus::kSuccess) {

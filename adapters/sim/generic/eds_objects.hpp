@@ -5,29 +5,37 @@
 //   Identity (class 0x01, instance 1): 1 vendor, 2 product type, 3 product
 //     code, 4 revision (major, minor), 5 status (0), 6 serial number (UDINT),
 //     7 product name (SHORT_STRING), from [Device] and the serial given.
-//   Assembly (class 0x04): class attributes 1 revision (2), 2 max instance;
-//     per AssemN of the EDS, instance N: 1 number of members, 2 member list
+//   Assembly (class 0x04): class attributes 1 revision (1), 2 max instance;
+//     per AssemN of the EDS, the instance its path names: 1 number of
+//     members, 2 member list
 //     (each member's size in bits and path: its own path, a ParamN's link
 //     path, an AssemN's path; empty for padding), 3 data (the members packed,
 //     parameters' values at their bits, the rest zero; Get only). The
 //     1203-CN1 manual's Assembly object (shared/seeds/003).
 //   Parameter (class 0x0F): class attribute 2 max instance; per ParamN,
 //     instance N attribute 1 the value, Set within the EDS's limits (0x09
-//     outside them), refused when read only (0x0E); starts at the default.
+//     outside them, or not a finite number), refused when read only
+//     (0x0E); starts at the default. String parameters are kept empty and
+//     are not settable here.
 //   Acknowledge Handler (class 0x2B, instance 1): class attributes 1
 //     revision (1), 2 max instance (1); 1 acknowledge timer (UINT ms,
 //     1..65535, default 20), 2 retry limit (USINT, default 1), 3 COS
 //     producing connection instance (UINT, default 4), 4 ack list size
 //     (BYTE, 1; Get only), 5 ack list (BYTE count, USINT instances; the
 //     COS connection's once it is acknowledged; Get only). The LUFP9
-//     manual, appendix D (shared/seeds/000).
+//     manual, appendix D (shared/seeds/000). Attribute 3 is kept to
+//     1..255, which the ack list can hold.
+//   Identity's class attributes 1 revision and 2 max instance are 1.
 //
-// Anything else is answered with the CIP error for it: 0x08 service not
-// supported, 0x16 object does not exist, 0x14 attribute not supported, 0x0E
-// attribute not settable, 0x13 / 0x15 not enough / too much data.
+// Anything else is answered with the CIP error for it, checked in the order
+// the CDN127 simulator checks: 0x16 object does not exist, 0x08 service not
+// supported (any other service; Set at class level), 0x13 no attribute,
+// 0x15 data with a Get, 0x14 attribute not supported, 0x0E attribute not
+// settable, 0x13 / 0x15 for the size of a Set, 0x09 a value refused.
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "bridge/cip/assembly.hpp"
@@ -57,12 +65,16 @@ class EdsObjects {
   // A parameter's value, little-endian in its data size; empty if no such
   // parameter.
   std::vector<std::uint8_t> param_value(unsigned number) const;
+  // A numeric parameter's value as a number; nothing for a string or none.
+  std::optional<double> param_number(unsigned number) const;
   // Sets it as the device itself would (an input changing), limits unchecked;
   // false if no such parameter or the size differs.
   bool set_param_value(unsigned number, Bytes value);
-  // Assembly `number`'s data: its members packed, least significant bit
-  // first; empty if no such assembly.
-  std::vector<std::uint8_t> assembly_data(unsigned number) const;
+  // The data of the assembly at `instance`: its members packed, least
+  // significant bit first; empty if no such assembly.
+  std::vector<std::uint8_t> assembly_data(unsigned instance) const;
+  // How deep nested assemblies are packed.
+  static constexpr unsigned kMaxNesting = 8;
 
   const AckHandler& ack_handler() const noexcept { return ack_; }
   AckHandler& ack_handler() noexcept { return ack_; }
@@ -79,7 +91,11 @@ class EdsObjects {
   Outcome get_assembly(std::uint16_t instance, std::uint8_t attribute, ByteWriter& out) const;
   Outcome get_parameter(std::uint16_t instance, std::uint8_t attribute, ByteWriter& out) const;
   Outcome get_ack_handler(std::uint16_t instance, std::uint8_t attribute, ByteWriter& out) const;
-  const eds::Assembly* assembly(unsigned number) const noexcept;
+  bool exists(std::uint16_t class_id, std::uint16_t instance) const noexcept;
+  // The assembly at an instance (its path's), and AssemN.
+  const eds::Assembly* assembly(unsigned instance) const noexcept;
+  const eds::Assembly* assembly_numbered(unsigned number) const noexcept;
+  std::vector<std::uint8_t> packed(const eds::Assembly& assembly, unsigned depth) const;
   std::vector<cip::AssemblyMember> member_list(const eds::Assembly& a) const;
 
   eds::EdsFile file_;

@@ -15,12 +15,13 @@
 // - Nothing for 4 × EPR is the connection's loss (its inactivity watchdog),
 //   handled as a poll timeout is.
 //
-// What the master sees of the device's retries: the same data again within
-// the acknowledge timer (plus `ack_slack`) of the message before, and sooner
-// than an EPR after it, which a change of state cannot be (it needs a
-// change) and a heartbeat or cycle is not (it comes an EPR apart). With an
-// EPR no longer than the acknowledge timer, a heartbeat supersedes a retry
-// before it is due, and nothing counts. Counted as repeats, acknowledged as
+// What the master sees of the device's retries: the same data again, k
+// acknowledge timers (plus `ack_slack`) at most after the message it
+// repeats for its k-th retry, and more than `ack_slack` sooner than an EPR
+// after it: a change of state cannot be that (it needs a change), nor a
+// heartbeat or cycle (it comes an EPR after). With an EPR no longer than
+// the acknowledge timer, a heartbeat supersedes a retry before it is due,
+// and nothing counts. Counted as repeats, acknowledged as
 // any message; none with acknowledgment suppressed (nothing is retried).
 // An EPR of 0 means no watchdog (as the Connection object's 0 is read;
 // UNVERIFIED).
@@ -86,6 +87,7 @@ class CosConsumer {
   MacId slave_;
   CosSettings settings_;
   TimePoint last_;
+  TimePoint original_;  // of the last message that was not a repeat
   bool have_data_ = false;
   bool lost_ = false;
   std::vector<std::uint8_t> data_;

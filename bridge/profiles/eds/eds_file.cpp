@@ -494,13 +494,20 @@ class Reader {
                                 p.maximum.value_or(INFINITY)));
       return std::nullopt;
     }
-    if (!type->is_float && type->size != 0) {
+    if (type->size != 0) {
+      // The type's range: [lo, end) for integers (end = 2^n or 2^(n-1), exact
+      // in a double, where 2^64 - 1 is not), |v| <= FLT_MAX for a REAL.
       const double lo = type->is_signed ? -std::ldexp(1.0, type->size * 8 - 1) : 0.0;
-      const double hi = type->is_signed ? std::ldexp(1.0, type->size * 8 - 1) - 1
-                                        : std::ldexp(1.0, type->size * 8) - 1;
+      const double end = std::ldexp(1.0, type->size * 8 - (type->is_signed ? 1 : 0));
+      const auto fits = [&](double v) {
+        if (type->is_float) {
+          return type->size == 8 || std::abs(v) <= std::numeric_limits<float>::max();
+        }
+        return v >= lo && v < end && std::floor(v) == v;
+      };
       for (auto [value, what] : {std::pair{p.minimum, "minimum"}, std::pair{p.maximum, "maximum"},
                                  std::pair{p.default_value, "default"}}) {
-        if (value && (*value < lo || *value > hi || std::floor(*value) != *value)) {
+        if (value && !fits(*value)) {
           error(e.line, fmt::format("{} ({}): {} {} is not a {} value", e.keyword, p.name, what,
                                     *value, type->name));
           return std::nullopt;
@@ -531,7 +538,7 @@ class Reader {
     a.number = number;
     a.line = e.line;
     a.name = string(e, 0);
-    if (given(e, 1) != nullptr) {
+    if (given(e, 1) != nullptr && !e.fields[1].text.empty()) {
       auto p = path(e, 1, "path");
       if (!p) return std::nullopt;
       a.path = *p;
@@ -561,6 +568,8 @@ class Reader {
       const Field* ref = given(e, i + 1);
       if (ref == nullptr) {
         m.kind = Member::Kind::kPadding;
+      } else if (ref->quoted && ref->text.empty()) {
+        m.kind = Member::Kind::kPadding;  // "" is an empty path
       } else if (ref->quoted) {
         auto p = path(e, i + 1, "member path");
         if (!p) return std::nullopt;
@@ -588,7 +597,45 @@ class Reader {
     return a;
   }
 
+  // AssemN members that lead back to an assembly they are in.
+  void assembly_cycles(const EdsFile& f) {
+    const auto find = [&](unsigned n) -> const Assembly* {
+      for (const Assembly& a : f.assemblies) {
+        if (a.number == n) return &a;
+      }
+      return nullptr;
+    };
+    for (const Assembly& start : f.assemblies) {
+      // Depth-first along AssemN members, as far as there are assemblies.
+      std::vector<std::pair<const Assembly*, std::size_t>> stack{{&start, 0}};
+      std::set<unsigned> on_path{start.number};
+      bool found = false;
+      while (!stack.empty() && !found) {
+        auto& [a, next] = stack.back();
+        if (next == a->members.size()) {
+          on_path.erase(a->number);
+          stack.pop_back();
+          continue;
+        }
+        const Member& m = a->members[next++];
+        if (m.kind != Member::Kind::kAssembly) continue;
+        if (m.number == start.number) {
+          error(start.line, fmt::format("Assem{} ({}) contains itself through its members",
+                                        start.number, start.name));
+          failed_.insert(entry_key(fmt::format("Assem{}", start.number)));
+          found = true;
+          continue;
+        }
+        const Assembly* nested = find(m.number);
+        if (nested != nullptr && on_path.insert(nested->number).second) {
+          stack.emplace_back(nested, 0);
+        }
+      }
+    }
+  }
+
   void cross_check(const EdsFile& f) {
+    assembly_cycles(f);
     for (const auto& c : f.io.connections) {
       if (c.input != 0 && f.io.input(c.input) == nullptr &&
           !has_failed(fmt::format("Input{}", c.input))) {

@@ -3,13 +3,15 @@
 // a device of a small EDS with parameters of several types, an assembly of
 // parameters, padding and a nested assembly. Properties: every request is
 // answered, with a success response to its service or an error response;
-// a parameter keeps its size whatever is set; the assembly data keeps its
-// size.
+// no Set leaves a parameter outside its limits or not a number (REALs by
+// their limits as REALs); the assembly data keeps its size.
+#include "adapters/sim/generic/eds_objects.hpp"
+
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
-#include "adapters/sim/generic/eds_objects.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;
@@ -43,8 +45,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::size_t n = device().execute(*request, MutableBytes(out));
   FUZZ_CHECK(n >= 1);
   FUZZ_CHECK(out[0] == (request->service | 0x80) || (out[0] == 0x94 && n == 3));
-  FUZZ_CHECK(device().param_value(1).size() == 2);
-  FUZZ_CHECK(device().param_value(3).size() == 4);
+  // No Set leaves a value outside its limits, nor one that is not a number.
+  for (unsigned number = 1; number <= 4; ++number) {
+    const eds::Param* p = device().file().param(number);
+    const auto v = device().param_number(number);
+    FUZZ_CHECK(p != nullptr && v.has_value() && std::isfinite(*v));
+    const auto limit = [&](double l) {
+      return p->type.is_float && p->size == 4 ? double{static_cast<float>(l)} : l;
+    };
+    FUZZ_CHECK(!p->minimum || *v >= limit(*p->minimum));
+    FUZZ_CHECK(!p->maximum || *v <= limit(*p->maximum));
+  }
   FUZZ_CHECK(device().assembly_data(1).size() == 5);
   return 0;
 }

@@ -268,6 +268,18 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"a member naming a parameter that is not there",
                   minimal("[Assembly]\nAssem1 = \"a\", , 8, 0, , , 8, Param9;\n"), 4,
                   "member Param9 is not in [Params]"},
+        Malformed{"an assembly that contains itself",
+                  minimal("[Assembly]\nAssem1 = \"a\", , 8, 0, , , 8, Assem2;\n"
+                          "Assem2 = \"b\", , 8, 0, , , 8, Assem1;\n"),
+                  4, "Assem1 (a) contains itself through its members"},
+        Malformed{"a REAL limit no REAL holds",
+                  minimal("[Params]\nParam1 = 0, 0, , 0, 0xCA, 4, \"x\", \"\", \"\", 0, 1e39, "
+                          "0;\n"),
+                  4, "maximum 1e+39 is not a REAL value"},
+        Malformed{"an 8-byte limit one past the type",
+                  minimal("[Params]\nParam1 = 0, 0, , 0, 0xC9, 8, \"x\", \"\", \"\", 0, "
+                          "18446744073709551615, 0;\n"),
+                  4, "is not a ULINT value"},
         Malformed{"a member that is not a reference",
                   minimal("[Assembly]\nAssem1 = \"a\", , 8, 0, , , 8, Widget;\n"), 4,
                   "member 1 \"Widget\" is neither a path, ParamN nor AssemN"}),
