@@ -127,7 +127,7 @@ std::vector<std::uint8_t> EdsObjects::packed(const eds::Assembly& assembly, unsi
   std::uint32_t at = 0;
   const auto put = [&](const std::vector<std::uint8_t>& from, std::uint32_t bits) {
     for (std::uint32_t i = 0; i < bits && i / 8 < from.size() && at + i < total; ++i) {
-      if ((from[i / 8] >> (i % 8)) & 1u) {
+      if ((static_cast<unsigned>(from[i / 8]) >> (i % 8)) & 1u) {
         out[(at + i) / 8] = static_cast<std::uint8_t>(out[(at + i) / 8] | (1u << ((at + i) % 8)));
       }
     }
