@@ -151,8 +151,11 @@ class Reader {
       device(*device_section, file.device);
     }
     if (const Section* s = text.find("IO_Info")) io_info(*s, file.io);
-    if (const Section* s = text.find("Params")) params(*s, file.params);
-    if (const Section* s = text.find("Assembly")) assemblies(*s, file.assemblies);
+    if (const Section* s = text.find("Params"))
+      numbered_entries(*s, "Param", file.params, &Reader::param);
+    if (const Section* s = text.find("Assembly")) {
+      numbered_entries(*s, "Assem", file.assemblies, &Reader::assembly);
+    }
     cross_check(file);
     if (out_.errors > 0) return std::nullopt;
     return file;
@@ -407,16 +410,22 @@ class Reader {
     list.push_back(std::move(d));
   }
 
-  void params(const Section& s, std::vector<Param>& out) {
+  // The numbered entries PREFIXn of a section, each read by `read_one` (which
+  // reports its own errors); one given twice is an error, whether or not the
+  // first was read.
+  template <typename T, typename Read>
+  void numbered_entries(const Section& s, std::string_view prefix, std::vector<T>& out,
+                        Read read_one) {
+    std::set<unsigned> seen;
     for (const Entry& e : s.entries) {
-      auto n = number_after(e.keyword, "Param");
-      if (!n) continue;  // Enum, Group and vendors' entries are not read
-      if (!seen_params_.insert(*n).second) {
+      auto n = number_after(e.keyword, prefix);
+      if (!n) continue;  // other entries (Enum, Group, vendors') are not read
+      if (!seen.insert(*n).second) {
         error(e.line, fmt::format("{} is given twice", e.keyword));
         continue;
       }
-      if (auto p = param(e, *n)) {
-        out.push_back(std::move(*p));
+      if (auto item = (this->*read_one)(e, *n)) {
+        out.push_back(std::move(*item));
       } else {
         failed(e);
       }
@@ -515,22 +524,6 @@ class Reader {
       }
     }
     return p;
-  }
-
-  void assemblies(const Section& s, std::vector<Assembly>& out) {
-    for (const Entry& e : s.entries) {
-      auto n = number_after(e.keyword, "Assem");
-      if (!n) continue;
-      if (std::any_of(out.begin(), out.end(), [&](const Assembly& a) { return a.number == *n; })) {
-        error(e.line, fmt::format("{} is given twice", e.keyword));
-        continue;
-      }
-      if (auto a = assembly(e, *n)) {
-        out.push_back(std::move(*a));
-      } else {
-        failed(e);
-      }
-    }
   }
 
   std::optional<Assembly> assembly(const Entry& e, unsigned number) {
@@ -696,7 +689,6 @@ class Reader {
 
   Parsed& out_;
   std::set<std::string> failed_;
-  std::set<unsigned> seen_params_;
   std::uint32_t defaults_line_ = 0;
 };
 

@@ -347,6 +347,15 @@ TEST(EdsFile, AParameterGivenTwiceIsAnErrorEvenWhenTheFirstWasLeftOut) {
   EXPECT_THAT(all(parsed), HasSubstr("t.eds:5: error: Param1 is given twice"));
 }
 
+TEST(EdsFile, AnAssemblyGivenTwiceIsAnErrorEvenWhenTheFirstWasLeftOut) {
+  const Parsed parsed =
+      parse(minimal("[Assembly]\nAssem1 = \"a\", , 99999999;\n"
+                    "Assem1 = \"b\", , 8, 0, , , 8, ;\n"));
+  EXPECT_THAT(all(parsed), HasSubstr("t.eds:4: error: Assem1: size in bits 99999999"));
+  EXPECT_THAT(all(parsed), HasSubstr("t.eds:5: error: Assem1 is given twice"));
+  EXPECT_FALSE(parsed.file.has_value());
+}
+
 TEST(EdsFile, AnErrorPastTheProblemsShownStillMakesTheFileUnusable) {
   std::string text = minimal("[IO_Info]\n");
   for (int i = 0; i < 60; ++i)
