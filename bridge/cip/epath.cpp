@@ -84,6 +84,13 @@ Result<std::size_t> encode(const EPath& path, MutableBytes out, LogicalFormat mi
   return w.size();
 }
 
+std::vector<std::uint8_t> encoded(const EPath& path) {
+  std::vector<std::uint8_t> out(encoded_size(path));
+  auto n = encode(path, MutableBytes(out));
+  out.resize(n ? *n : 0);
+  return out;
+}
+
 Result<EPath> decode_epath(Bytes data) noexcept {
   ByteReader r(data);
   EPath path;

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/result.hpp"
@@ -58,6 +59,8 @@ std::size_t encoded_size(const EPath& path,
 // Encodes into `out`; kBufferTooSmall if it does not fit. Returns the size written.
 Result<std::size_t> encode(const EPath& path, MutableBytes out,
                            LogicalFormat min_format = LogicalFormat::k8Bit) noexcept;
+// The path's bytes (each segment in its smallest format).
+std::vector<std::uint8_t> encoded(const EPath& path);
 // Decodes a whole path (its length is known from the attribute or field that
 // holds it). Fails with kTruncated when a segment's value is cut off, kMalformed
 // for a reserved format, a repeated segment or segments out of the order above,

@@ -67,7 +67,7 @@ TEST(DnbctlEds, JsonDescribesAUsableFile) {
   ASSERT_EQ(doc["connections"].size(), 3u);
   EXPECT_EQ(doc["connections"][0]["kind"], "poll");
   EXPECT_EQ(doc["connections"][0]["input_bytes"], 4);
-  EXPECT_EQ(doc["parameters"].size(), 5u);
+  EXPECT_EQ(doc["parameters"].size(), 9u);
   EXPECT_EQ(doc["assemblies"][1]["members"][1], "8 bits padding");
 }
 

@@ -1,7 +1,5 @@
 #include "bridge/profiles/cdn127/node_profile.hpp"
 
-#include <array>
-
 #include "bridge/cip/epath.hpp"
 
 namespace dnbridge::profiles::cdn127 {
@@ -24,9 +22,7 @@ std::vector<std::uint8_t> assembly_path(std::uint8_t instance) {
   path.class_id = class_id::kAssembly;
   path.instance_id = instance;
   path.attribute = 3;
-  std::array<std::uint8_t, 16> buf{};
-  auto size = cip::encode(path, MutableBytes(buf));
-  return {buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(size.value_or(0))};
+  return cip::encoded(path);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "bridge/common/text.hpp"
+#include "bridge/profiles/eds/io_layout.hpp"
 
 namespace dnbridge::eds {
 
@@ -504,19 +505,10 @@ class Reader {
       return std::nullopt;
     }
     if (type->size != 0) {
-      // The type's range: [lo, end) for integers (end = 2^n or 2^(n-1), exact
-      // in a double, where 2^64 - 1 is not), |v| <= FLT_MAX for a REAL.
-      const double lo = type->is_signed ? -std::ldexp(1.0, type->size * 8 - 1) : 0.0;
-      const double end = std::ldexp(1.0, type->size * 8 - (type->is_signed ? 1 : 0));
-      const auto fits = [&](double v) {
-        if (type->is_float) {
-          return type->size == 8 || std::abs(v) <= std::numeric_limits<float>::max();
-        }
-        return v >= lo && v < end && std::floor(v) == v;
-      };
+      const auto bits = static_cast<std::uint16_t>(type->size * 8);
       for (auto [value, what] : {std::pair{p.minimum, "minimum"}, std::pair{p.maximum, "maximum"},
                                  std::pair{p.default_value, "default"}}) {
-        if (value && !fits(*value)) {
+        if (value && !to_raw(*type, bits, *value)) {
           error(e.line, fmt::format("{} ({}): {} {} is not a {} value", e.keyword, p.name, what,
                                     *value, type->name));
           return std::nullopt;

@@ -8,22 +8,17 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
 #include <ostream>
-#include <sstream>
 #include <string>
+
+#include "tests/support/example_eds.hpp"
 
 namespace dnbridge::eds {
 namespace {
 
 using ::testing::HasSubstr;
 
-std::string example(const std::string& name) {
-  std::ifstream in(std::string(DNBRIDGE_EDS_DIR) + "/" + name);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using test::example_eds_text;
 
 std::string all(const Parsed& parsed) {
   std::string out;
@@ -43,7 +38,7 @@ std::string minimal(const std::string& extra = {}) {
 }
 
 TEST(EdsFile, TheIoBlockExampleReadsAsItShips) {
-  const Parsed parsed = parse(example("dnbridge-example-io-block.eds"));
+  const Parsed parsed = parse(example_eds_text("dnbridge-example-io-block.eds"));
   ASSERT_TRUE(parsed.file.has_value()) << all(parsed);
   EXPECT_TRUE(parsed.problems.empty()) << all(parsed);
   const EdsFile& f = *parsed.file;
@@ -73,7 +68,12 @@ TEST(EdsFile, TheIoBlockExampleReadsAsItShips) {
   ASSERT_NE(f.io.output(1), nullptr);
   EXPECT_EQ(f.io.output(1)->size, 2);
 
-  ASSERT_EQ(f.params.size(), 5u);
+  ASSERT_EQ(f.params.size(), 9u);
+  const Param* idle = f.param("Output idle value");
+  ASSERT_NE(idle, nullptr);
+  EXPECT_EQ(idle->number, 9u);
+  EXPECT_EQ(idle->type.name, "BYTE");
+  EXPECT_FALSE(idle->read_only());
   const Param* ai = f.param("analog input 1");
   ASSERT_NE(ai, nullptr);
   EXPECT_EQ(ai->number, 2u);
@@ -104,7 +104,7 @@ TEST(EdsFile, TheIoBlockExampleReadsAsItShips) {
 }
 
 TEST(EdsFile, TheValveManifoldExampleReadsAsItShips) {
-  const Parsed parsed = parse(example("dnbridge-example-valve-manifold.eds"));
+  const Parsed parsed = parse(example_eds_text("dnbridge-example-valve-manifold.eds"));
   ASSERT_TRUE(parsed.file.has_value()) << all(parsed);
   EXPECT_TRUE(parsed.problems.empty()) << all(parsed);
   const EdsFile& f = *parsed.file;

@@ -3,10 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "bridge/profiles/eds/member_check.hpp"
+#include "tests/support/example_eds.hpp"
 
 namespace dnbridge::eds {
 namespace {
@@ -14,14 +12,7 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::IsEmpty;
 
-EdsFile io_block() {
-  std::ifstream in(std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-io-block.eds");
-  std::stringstream text;
-  text << in.rdbuf();
-  auto parsed = parse(text.str());
-  EXPECT_TRUE(parsed.file.has_value());
-  return parsed.file.value_or(EdsFile{});
-}
+EdsFile io_block() { return test::example_eds(test::kIoBlockEds); }
 
 cip::AssemblyMember member(std::uint16_t bits, std::vector<std::uint8_t> path) {
   cip::AssemblyMember m;

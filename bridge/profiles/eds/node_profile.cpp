@@ -1,0 +1,149 @@
+#include "bridge/profiles/eds/node_profile.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <set>
+#include <string_view>
+
+#include "bridge/cip/epath.hpp"
+#include "bridge/common/closest.hpp"
+#include "bridge/common/text.hpp"
+
+namespace dnbridge::eds {
+namespace {
+
+// Says why in `why` and returns `code`.
+Errc explain(std::string* why, Errc code, std::string text) {
+  if (why != nullptr) *why = std::move(text);
+  return code;
+}
+
+std::string describe_data(const IoLayout& io, std::string_view what) {
+  if (io.size == 0) return fmt::format("no {}", what);
+  std::string text = fmt::format("{} {} B \"{}\"", what, io.size, io.name);
+  if (!io.assembly.empty()) text += fmt::format(" = {}", io.assembly);
+  return text;
+}
+
+// The setting that makes `param` hold `value` on the device.
+Result<devicenet::AttributeSetting> setting_of(const EdsFile& file, const ParameterValue& given,
+                                               std::string_view list, std::string* why) {
+  const Param* p = file.param(given.name);
+  if (p == nullptr) {
+    std::vector<std::string_view> names;
+    for (const auto& q : file.params) names.push_back(q.name);
+    const auto near = closest(given.name, names, std::max<std::size_t>(2, given.name.size() / 4));
+    return explain(why, Errc::kMalformed,
+                   fmt::format("{}: the EDS has no parameter \"{}\"{}", list, given.name,
+                               near ? fmt::format(" (did you mean \"{}\"?)", *near) : ""));
+  }
+  const std::string label = fmt::format("{}: Param{} \"{}\"", list, p->number, p->name);
+  if (p->read_only()) {
+    return explain(why, Errc::kMalformed, fmt::format("{} is read only", label));
+  }
+  const cip::EPath& link = p->link;
+  if (!link.class_id || !link.instance_id || !link.attribute || link.connection_point ||
+      *link.class_id > 0xFFFF || *link.instance_id > 0xFFFF || *link.attribute > 0xFF) {
+    return explain(why, Errc::kUnsupported,
+                   fmt::format("{} has no link path to an attribute (its link path: {})", label,
+                               link.empty() ? "none" : "not class/instance/attribute"));
+  }
+  if (p->type.size == 0) {
+    return explain(
+        why, Errc::kUnsupported,
+        fmt::format("{} is a {}: only numbers are set at start-up", label, p->type.name));
+  }
+  if ((p->minimum && given.value < *p->minimum) || (p->maximum && given.value > *p->maximum)) {
+    return explain(why, Errc::kOutOfRange,
+                   fmt::format("{}: {} is outside the EDS's limits {}..{}", label, given.value,
+                               p->minimum.value_or(-INFINITY), p->maximum.value_or(INFINITY)));
+  }
+  const auto bits = static_cast<std::uint16_t>(p->size * 8);
+  const auto raw = to_raw(p->type, bits, given.value);
+  if (!raw) {
+    return explain(why, Errc::kOutOfRange,
+                   fmt::format("{}: {} is not a {} value", label, given.value, p->type.name));
+  }
+  devicenet::AttributeSetting s;
+  s.class_id = static_cast<std::uint16_t>(*link.class_id);
+  s.instance_id = static_cast<std::uint16_t>(*link.instance_id);
+  s.attribute = static_cast<std::uint8_t>(*link.attribute);
+  for (unsigned i = 0; i < p->size; ++i) {
+    s.value.push_back(static_cast<std::uint8_t>(*raw >> (8 * i)));
+  }
+  s.name = fmt::format("Param{} {}", p->number, p->name);
+  return s;
+}
+
+}  // namespace
+
+Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::string* why) {
+  const ConnectionInfo* c = file.io.connection(connection);
+  if (c == nullptr) {
+    std::string offered;
+    for (const auto& o : file.io.connections) {
+      offered += fmt::format("{}{}", offered.empty() ? "" : ", ", to_string(o.kind));
+    }
+    return explain(why, Errc::kUnsupported,
+                   fmt::format("the EDS offers no {} connection (it offers: {})",
+                               to_string(connection), offered.empty() ? "none" : offered));
+  }
+  NodeIo io;
+  if (c->input != 0) {
+    if (const IoData* d = file.io.input(c->input)) io.produced = layout_of(file, *d);
+  }
+  if (c->output != 0) {
+    if (const IoData* d = file.io.output(c->output)) io.consumed = layout_of(file, *d);
+  }
+  return io;
+}
+
+Result<devicenet::NodeProfile> make_node_profile(const EdsFile& file, const EdsNode& node,
+                                                 std::string* why) {
+  auto io = node_io(file, node.connection, why);
+  if (!io) return io.error();
+  if (node.connection != ConnectionKind::kPoll) {
+    return explain(why, Errc::kUnsupported,
+                   fmt::format("connection \"{}\": dnbridge's master opens poll connections only",
+                               to_string(node.connection)));
+  }
+  if (io->consumed.size > 0 && node.safe_state.empty()) {
+    return explain(
+        why, Errc::kMalformed,
+        fmt::format("the node has outputs ({}) and no safe state: give the parameters that set "
+                    "their fault and idle actions (safe_state)",
+                    describe_data(io->consumed, "output")));
+  }
+
+  devicenet::NodeProfile p;
+  p.identity = {file.device.vendor_code, file.device.product_type, file.device.product_code};
+  std::set<unsigned> seen;
+  const auto add = [&](const std::vector<ParameterValue>& list, std::string_view label) -> Status {
+    for (const ParameterValue& v : list) {
+      auto s = setting_of(file, v, label, why);
+      if (!s) return s.error();
+      const Param* param = file.param(v.name);
+      if (!seen.insert(param->number).second) {
+        return explain(
+            why, Errc::kMalformed,
+            fmt::format("{}: Param{} \"{}\" is given twice", label, param->number, param->name));
+      }
+      p.settings.push_back(std::move(*s));
+    }
+    return {};
+  };
+  if (auto s = add(node.parameters, "parameters"); !s) return s.error();
+  if (auto s = add(node.safe_state, "safe_state"); !s) return s.error();
+
+  const ConnectionInfo* c = file.io.connection(node.connection);
+  if (const IoData* d = file.io.input(c->input)) p.produced_path = cip::encoded(d->path);
+  if (const IoData* d = file.io.output(c->output)) p.consumed_path = cip::encoded(d->path);
+  p.produced_size = io->produced.size;
+  p.consumed_size = io->consumed.size;
+  p.format_description = fmt::format("{}, {}", describe_data(io->produced, "input"),
+                                     describe_data(io->consumed, "output"));
+  return p;
+}
+
+}  // namespace dnbridge::eds

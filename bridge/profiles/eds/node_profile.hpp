@@ -1,0 +1,61 @@
+#pragma once
+// What the master must know to bring up a node described by its EDS file
+// (profile "eds"): the identity it must show ([Device] vendor, product type,
+// product code), the I/O connection's data (the chosen [IO_Info] connection's
+// InputN and OutputN: paths and sizes), and the parameters set before the
+// connection starts, by their EDS names, each at its link path: read first,
+// written only when it differs, read back (devicenet::AttributeSetting).
+//
+// Safe means configured: a node whose connection has outputs needs its safe
+// state given, as the parameters that set its outputs' fault and idle
+// actions and values (which ones they are, the EDS's help texts say; no
+// standard names them). They are downloaded after the other parameters and
+// verified like them. Without them the node is refused, not run on the
+// device's factory actions.
+#include <string>
+#include <vector>
+
+#include "bridge/common/result.hpp"
+#include "bridge/devicenet/master/scan_list.hpp"
+#include "bridge/profiles/eds/eds_file.hpp"
+#include "bridge/profiles/eds/io_layout.hpp"
+
+namespace dnbridge::eds {
+
+// A parameter's value as the device holds it (the EDS's minimum, maximum
+// and default are in these units; no scaling).
+struct ParameterValue {
+  std::string name;  // the EDS's ParamN name, any case
+  double value = 0;
+
+  friend bool operator==(const ParameterValue&, const ParameterValue&) = default;
+};
+
+struct EdsNode {
+  ConnectionKind connection = ConnectionKind::kPoll;
+  std::vector<ParameterValue> parameters;  // set in this order
+  std::vector<ParameterValue> safe_state;  // then these
+
+  friend bool operator==(const EdsNode&, const EdsNode&) = default;
+};
+
+// The connection's data as the EDS lays it out.
+struct NodeIo {
+  IoLayout produced;  // the node's inputs (InputN); size 0: none
+  IoLayout consumed;  // its outputs (OutputN); size 0: none
+};
+
+// The chosen connection's InputN and OutputN. kUnsupported when the EDS
+// does not offer the connection, `why` saying so.
+Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::string* why = nullptr);
+
+// The scan-list profile of `node`. Fails (kUnsupported, kMalformed,
+// kOutOfRange), `why` naming the parameter and what is wrong, for: a
+// connection the EDS does not offer or the master does not open (only poll
+// today), an unknown parameter (with the nearest name), one given twice, one
+// read only, one without a link path or of a string type, a value outside
+// its type or the EDS's limits, and outputs without a safe state.
+Result<devicenet::NodeProfile> make_node_profile(const EdsFile& file, const EdsNode& node,
+                                                 std::string* why = nullptr);
+
+}  // namespace dnbridge::eds

@@ -1,0 +1,154 @@
+// A node described by its EDS as the master takes it: identity, the poll
+// connection's paths and sizes, the parameters and then the safe state as
+// settings at their link paths, and each refusal said with the parameter.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "bridge/profiles/eds/node_profile.hpp"
+#include "tests/support/example_eds.hpp"
+
+namespace dnbridge::eds {
+namespace {
+
+using ::testing::HasSubstr;
+using ByteVec = std::vector<std::uint8_t>;
+
+const std::vector<ParameterValue> kSafeState{{"Output fault action", 0},
+                                             {"Output fault value", 0},
+                                             {"Output idle action", 0},
+                                             {"output idle value", 0x80}};
+
+EdsNode polled(std::vector<ParameterValue> parameters = {}) {
+  EdsNode n;
+  n.parameters = std::move(parameters);
+  n.safe_state = kSafeState;
+  return n;
+}
+
+TEST(EdsNodeProfile, TheIoBlockPolledWithItsParametersThenItsSafeState) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  std::string why;
+  auto p = make_node_profile(f, polled({{"Input filter", 5}}), &why);
+  ASSERT_TRUE(p.ok()) << why;
+  EXPECT_EQ(p->identity, (devicenet::ExpectedIdentity{65001, 7, 1}));
+  EXPECT_EQ(p->produced_path, (ByteVec{0x20, 0x04, 0x24, 0x64, 0x30, 0x03}));
+  EXPECT_EQ(p->consumed_path, (ByteVec{0x20, 0x04, 0x24, 0x96, 0x30, 0x03}));
+  EXPECT_EQ(p->produced_size, 4u);
+  EXPECT_EQ(p->consumed_size, 2u);
+  EXPECT_EQ(p->format_description,
+            "input 4 B \"Inputs and status\" = Assem100 (Inputs and status), output 2 B "
+            "\"Outputs\" = Assem150 (Outputs)");
+  EXPECT_FALSE(p->has_size_fallback);
+  ASSERT_EQ(p->settings.size(), 5u);
+  const auto& filter = p->settings[0];
+  EXPECT_EQ(filter.class_id, 0x0F);
+  EXPECT_EQ(filter.instance_id, 1);
+  EXPECT_EQ(filter.attribute, 1);
+  EXPECT_EQ(filter.value, (ByteVec{5, 0}));  // UINT
+  EXPECT_EQ(filter.name, "Param1 Input filter");
+  EXPECT_FALSE(filter.keep_device_value);
+  EXPECT_EQ(p->settings[1].name, "Param6 Output fault action");
+  EXPECT_EQ(p->settings[1].instance_id, 6);
+  EXPECT_EQ(p->settings[4].name, "Param9 Output idle value");
+  EXPECT_EQ(p->settings[4].value, (ByteVec{0x80}));
+}
+
+TEST(EdsNodeProfile, OutputsWithoutASafeStateAreRefused) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  EdsNode n;
+  std::string why;
+  EXPECT_EQ(make_node_profile(f, n, &why).error(), make_error_code(Errc::kMalformed));
+  EXPECT_EQ(why,
+            "the node has outputs (output 2 B \"Outputs\" = Assem150 (Outputs)) and no safe "
+            "state: give the parameters that set their fault and idle actions (safe_state)");
+}
+
+struct Refusal {
+  const char* what;
+  std::vector<ParameterValue> parameters;
+  Errc code;
+  const char* why;
+};
+
+class EdsNodeProfileRefusal : public ::testing::TestWithParam<Refusal> {};
+
+TEST_P(EdsNodeProfileRefusal, NamesTheParameterAndWhatIsWrong) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  std::string why;
+  auto p = make_node_profile(f, polled(GetParam().parameters), &why);
+  ASSERT_FALSE(p.ok()) << GetParam().what;
+  EXPECT_EQ(p.error(), make_error_code(GetParam().code)) << GetParam().what;
+  EXPECT_EQ(why, GetParam().why) << GetParam().what;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Each, EdsNodeProfileRefusal,
+    ::testing::Values(
+        Refusal{"unknown",
+                {{"Input filtr", 1}},
+                Errc::kMalformed,
+                "parameters: the EDS has no parameter \"Input filtr\" (did you mean \"Input "
+                "filter\"?)"},
+        Refusal{"read only",
+                {{"Analog input 1", 1}},
+                Errc::kMalformed,
+                "parameters: Param2 \"Analog input 1\" is read only"},
+        Refusal{"beyond the limits",
+                {{"Input filter", 101}},
+                Errc::kOutOfRange,
+                "parameters: Param1 \"Input filter\": 101 is outside the EDS's limits 0..100"},
+        Refusal{"not an integer",
+                {{"Input filter", 2.5}},
+                Errc::kOutOfRange,
+                "parameters: Param1 \"Input filter\": 2.5 is not a UINT value"},
+        Refusal{"also in the safe state",
+                {{"Output idle action", 1}},
+                Errc::kMalformed,
+                "safe_state: Param8 \"Output idle action\" is given twice"}));
+
+TEST(EdsNodeProfile, AConnectionTheEdsDoesNotOfferOrTheMasterDoesNotOpenIsRefused) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  EdsNode n = polled();
+  std::string why;
+  n.connection = ConnectionKind::kStrobe;
+  EXPECT_EQ(make_node_profile(f, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why,
+            "the EDS offers no bit-strobe connection (it offers: poll, change of state, cyclic)");
+  n.connection = ConnectionKind::kChangeOfState;
+  EXPECT_EQ(make_node_profile(f, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why, "connection \"change of state\": dnbridge's master opens poll connections only");
+}
+
+TEST(EdsNodeProfile, AParameterWithoutALinkPathOrOfAStringTypeIsNotSet) {
+  auto parsed = parse(
+      "[Device]\nVendCode = 1; ProdType = 0; ProdCode = 2; MajRev = 1; MinRev = 1;\n"
+      "[IO_Info]\nPollInfo = 1, 1, 0;\n"
+      "Input1 = 1, 0, 1, \"in\", 0, \"\", \"\";\n"
+      "[Params]\n"
+      "Param1 = 0, 0, , 0, 0xC6, 1, \"unlinked\", \"\", \"\", 0, 9, 0;\n"
+      "Param2 = 0, 6, \"20 0F 24 02 30 01\", 0, 0xDA, 0, \"label\", \"\", \"\";\n");
+  ASSERT_TRUE(parsed.file.has_value());
+  EdsNode n;
+  n.parameters = {{"unlinked", 1}};
+  std::string why;
+  EXPECT_EQ(make_node_profile(*parsed.file, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why,
+            "parameters: Param1 \"unlinked\" has no link path to an attribute (its link path: "
+            "none)");
+  n.parameters = {{"label", 1}};
+  EXPECT_EQ(make_node_profile(*parsed.file, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why,
+            "parameters: Param2 \"label\" is a SHORT_STRING: only numbers are set at start-up");
+  // Inputs only: no safe state is needed.
+  n.parameters.clear();
+  auto p = make_node_profile(*parsed.file, n, &why);
+  ASSERT_TRUE(p.ok()) << why;
+  EXPECT_EQ(p->consumed_size, 0u);
+  EXPECT_TRUE(p->consumed_path.empty());
+  EXPECT_EQ(p->format_description, "input 1 B \"in\", no output");
+}
+
+}  // namespace
+}  // namespace dnbridge::eds
