@@ -121,7 +121,7 @@ TEST_F(EdsObjectsTest, ParametersAreSetWithinTheirLimits) {
   EXPECT_EQ(status(call(kSet, 0x0F, 1, 1, {50})), 0x13);
   EXPECT_EQ(status(call(kSet, 0x0F, 1, 1, {50, 0, 0})), 0x15);
   EXPECT_EQ(status(call(kSet, 0x0F, 2, 1, {0, 0})), 0x0E);  // read only
-  EXPECT_EQ(status(call(kSet, 0x0F, 9, 1, {0})), 0x16);
+  EXPECT_EQ(status(call(kSet, 0x0F, 10, 1, {0})), 0x16);    // no Param10
   EXPECT_EQ(get(0x0F, 0, 2), (std::vector<std::uint8_t>{9, 0}));
 }
 

@@ -16,11 +16,15 @@ namespace alloc = devicenet::allocation;
 
 namespace {
 
-// Allocate/Release additional codes (bridge/PROTOCOL.md §3).
-constexpr std::uint8_t kAllocationConflict = 0x01;
-constexpr std::uint8_t kInvalidChoice = 0x02;
-
-constexpr std::uint8_t kSupportedChoices = alloc::kExplicit | alloc::kPoll;
+ConnectionSetOptions connection_options(const SlaveOptions& o) noexcept {
+  ConnectionSetOptions c;
+  c.supported_choices = alloc::kExplicit | alloc::kPoll;
+  c.timer_resolution = o.timer_resolution;
+  c.explicit_timeout_action_settable = o.explicit_timeout_action_settable;
+  c.poll_produced_assembly = profiles::cdn127::kDefaultProducedAssembly;
+  c.poll_consumed_assembly = profiles::cdn127::kDefaultConsumedAssembly;
+  return c;
+}
 
 E2Memory initial_e2(const SlaveOptions& o) noexcept {
   E2Memory e2;
@@ -75,7 +79,8 @@ Cdn127Device::Cdn127Device(const SlaveOptions& options) noexcept
       mac_switch_(options.mac_switch),
       baud_switch_(options.baud_switch),
       mac_switch_at_power_up_(options.mac_switch),
-      baud_switch_at_power_up_(options.baud_switch) {}
+      baud_switch_at_power_up_(options.baud_switch),
+      connections_(connection_options(options), *this) {}
 
 void Cdn127Device::power_up(TimePoint now, PowerUpCause cause) noexcept {
   now_ = now;
@@ -92,7 +97,8 @@ void Cdn127Device::power_up(TimePoint now, PowerUpCause cause) noexcept {
   mac_ = MacId::from_bits(e2_.mac);
   baud_ = e2_.baud;
   bus_off_counter_ = 0;
-  drop_connection_set();
+  connections_.drop();
+  poll_running_ = false;
   pending_ = PendingAction::kNone;
   pump_.set_outputs(PumpOutputs{}, OutputCause::kPowerUp, now);
 }
@@ -124,196 +130,39 @@ Reply Cdn127Device::set_baud(std::uint8_t baud) noexcept {
   return kReplyOk;
 }
 
-std::uint8_t Cdn127Device::allocation_choice() const noexcept {
-  std::uint8_t c = 0;
-  if (explicit_.state != ConnectionState::kNonExistent) c |= alloc::kExplicit;
-  if (poll_.state != ConnectionState::kNonExistent) c |= alloc::kPoll;
-  return c;
-}
-
-Reply Cdn127Device::allocate(std::uint8_t choice, std::uint8_t allocator, TimePoint now) noexcept {
-  now_ = now;
-  if (allocator > MacId::kMax) return reply_error(GeneralStatus::kInvalidParameter);
-  if (owned() && owner_ != allocator) {
-    return reply_error(GeneralStatus::kObjectStateConflict, kAllocationConflict);
+std::uint16_t Cdn127Device::connection_size(std::uint16_t instance, bool produced) const noexcept {
+  if (instance == connection_instance::kExplicit) return kExplicitMessageSize;
+  const Connection& poll = connections_.poll_connection();
+  if (produced) {
+    auto layout = profiles::cdn127::produced_assembly_layout(
+        static_cast<std::uint8_t>(poll.produced_assembly), e2_.configuration);
+    return layout.ok() ? static_cast<std::uint16_t>(layout->size) : 0;
   }
-  if (choice == 0) return reply_error(GeneralStatus::kInvalidAttributeValue, kInvalidChoice);
-  if ((choice & ~kSupportedChoices) != 0) {
-    return reply_error(GeneralStatus::kResourceUnavailable, kInvalidChoice);
-  }
-  const std::uint8_t allocated = allocation_choice();
-  if ((choice & allocated) != 0) {
-    return reply_error(GeneralStatus::kAlreadyInRequestedMode, kInvalidChoice);
-  }
-  // I/O connections are configured through the explicit connection: one of
-  // them must be requested or already there.
-  if (((choice | allocated) & alloc::kExplicit) == 0) {
-    return reply_error(GeneralStatus::kInvalidAttributeValue, kInvalidChoice);
-  }
-  owner_ = allocator;
-  if ((choice & alloc::kExplicit) != 0) open_explicit(now);
-  if ((choice & alloc::kPoll) != 0) open_poll();
-  return kReplyOk;
-}
-
-Reply Cdn127Device::release(std::uint8_t choice, std::uint8_t requester, TimePoint now) noexcept {
-  now_ = now;
-  if (owned() && owner_ != requester) {
-    return reply_error(GeneralStatus::kObjectStateConflict, kAllocationConflict);
-  }
-  if (choice == 0) return reply_error(GeneralStatus::kInvalidAttributeValue, kInvalidChoice);
-  if ((choice & ~kSupportedChoices) != 0) {
-    return reply_error(GeneralStatus::kResourceUnavailable, kInvalidChoice);
-  }
-  if ((choice & ~allocation_choice()) != 0) {
-    return reply_error(GeneralStatus::kAlreadyInRequestedMode, kInvalidChoice);
-  }
-  if ((choice & alloc::kPoll) != 0) delete_poll(now);
-  if ((choice & alloc::kExplicit) != 0) explicit_ = Connection{};
-  if (allocation_choice() == 0) owner_ = MacId::kNone;
-  return kReplyOk;
-}
-
-void Cdn127Device::open_explicit(TimePoint now) noexcept {
-  explicit_ = Connection{};
-  explicit_.state = ConnectionState::kEstablished;
-  explicit_.expected_packet_rate_ms = kExplicitDefaultEprMs;
-  explicit_.watchdog_action = WatchdogAction::kAutoDelete;
-  restart_watchdog(explicit_, now);
-}
-
-void Cdn127Device::open_poll() noexcept {
-  poll_ = Connection{};
-  poll_.state = ConnectionState::kConfiguring;
-  poll_.watchdog_action = WatchdogAction::kTimedOut;  // "I/O Messaging default"
-  poll_.produced_assembly = profiles::cdn127::kDefaultProducedAssembly;
-  poll_.consumed_assembly = profiles::cdn127::kDefaultConsumedAssembly;
-  poll_running_ = false;
-}
-
-void Cdn127Device::delete_poll(TimePoint now) noexcept {
-  // A master that releases the poll connection has stopped the exchange on
-  // purpose: the outputs take their idle values (the manual names no action
-  // for this case; idle rather than fault is this simulator's reading).
-  if (poll_.state == ConnectionState::kEstablished) apply_idle_actions(now);
-  poll_ = Connection{};
-  poll_running_ = false;
-}
-
-const Connection* Cdn127Device::connection(std::uint16_t instance) const noexcept {
-  if (instance == profiles::cdn127::connection_instance::kExplicit) return &explicit_;
-  if (instance == profiles::cdn127::connection_instance::kPoll) return &poll_;
-  return nullptr;
-}
-
-Connection* Cdn127Device::mutable_connection(std::uint16_t instance) noexcept {
-  return const_cast<Connection*>(std::as_const(*this).connection(instance));
-}
-
-bool Cdn127Device::connection_exists(std::uint16_t instance) const noexcept {
-  const Connection* c = connection(instance);
-  return c != nullptr && c->state != ConnectionState::kNonExistent;
-}
-
-std::uint16_t Cdn127Device::round_rate(std::uint16_t requested_ms) const noexcept {
-  const auto res = std::max<std::int64_t>(
-      1, std::chrono::duration_cast<milliseconds>(options_.timer_resolution).count());
-  const std::int64_t rounded = (requested_ms + res - 1) / res * res;
-  if (rounded > 0xFFFF) return static_cast<std::uint16_t>(0xFFFF / res * res);
-  return static_cast<std::uint16_t>(rounded);
-}
-
-void Cdn127Device::restart_watchdog(Connection& c, TimePoint now) noexcept {
-  c.watchdog_deadline = c.expected_packet_rate_ms == 0
-                            ? kNever
-                            : now + milliseconds(kWatchdogMultiplier * c.expected_packet_rate_ms);
-}
-
-Reply Cdn127Device::set_expected_packet_rate(std::uint16_t instance, std::uint16_t requested_ms,
-                                             TimePoint now, std::uint16_t& actual) noexcept {
-  now_ = now;
-  Connection* c = mutable_connection(instance);
-  if (c == nullptr || c->state == ConnectionState::kNonExistent) {
-    return reply_error(GeneralStatus::kObjectDoesNotExist);
-  }
-  if (c->state != ConnectionState::kConfiguring && c->state != ConnectionState::kEstablished) {
-    return reply_error(GeneralStatus::kObjectStateConflict);
-  }
-  actual = round_rate(requested_ms);
-  c->expected_packet_rate_ms = actual;
-  // Setting the rate is what moves a Configuring I/O connection to
-  // Established (bridge/PROTOCOL.md §7).
-  if (c->state == ConnectionState::kConfiguring) {
-    c->state = ConnectionState::kEstablished;
-    poll_running_ = false;
-  }
-  restart_watchdog(*c, now);
-  return kReplyOk;
-}
-
-Reply Cdn127Device::set_watchdog_action(std::uint16_t instance, std::uint8_t action) noexcept {
-  Connection* c = mutable_connection(instance);
-  if (c == nullptr || c->state == ConnectionState::kNonExistent) {
-    return reply_error(GeneralStatus::kObjectDoesNotExist);
-  }
-  if (instance == profiles::cdn127::connection_instance::kExplicit) {
-    if (!options_.explicit_timeout_action_settable) {
-      return reply_error(GeneralStatus::kAttributeNotSettable);
-    }
-    if (action != 1 && action != 3) return reply_error(GeneralStatus::kInvalidAttributeValue);
-  } else if (action > 3) {
-    return reply_error(GeneralStatus::kInvalidAttributeValue);
-  }
-  c->watchdog_action = static_cast<WatchdogAction>(action);
-  return kReplyOk;
-}
-
-Reply Cdn127Device::set_poll_assembly(bool produced, std::uint8_t assembly) noexcept {
-  if (poll_.state == ConnectionState::kNonExistent) {
-    return reply_error(GeneralStatus::kObjectDoesNotExist);
-  }
-  if (poll_.state != ConnectionState::kConfiguring) {
-    return reply_error(GeneralStatus::kObjectStateConflict);
-  }
-  if (produced ? !is_produced_assembly(assembly) : !is_consumed_assembly(assembly)) {
-    return reply_error(GeneralStatus::kInvalidAttributeValue);
-  }
-  (produced ? poll_.produced_assembly : poll_.consumed_assembly) = assembly;
-  return kReplyOk;
-}
-
-Reply Cdn127Device::reset_connection(std::uint16_t instance, TimePoint now) noexcept {
-  now_ = now;
-  Connection* c = mutable_connection(instance);
-  if (c == nullptr || c->state == ConnectionState::kNonExistent) {
-    return reply_error(GeneralStatus::kObjectDoesNotExist);
-  }
-  if (c->state == ConnectionState::kConfiguring) return kReplyOk;  // nothing to restart
-  if (c->state == ConnectionState::kDeferredDelete) {
-    return reply_error(GeneralStatus::kObjectStateConflict);
-  }
-  c->state = ConnectionState::kEstablished;
-  restart_watchdog(*c, now);
-  return kReplyOk;
-}
-
-std::uint16_t Cdn127Device::produced_size(std::uint16_t instance) const noexcept {
-  if (instance == profiles::cdn127::connection_instance::kExplicit) return kExplicitMessageSize;
-  auto layout =
-      profiles::cdn127::produced_assembly_layout(poll_.produced_assembly, e2_.configuration);
+  auto layout = profiles::cdn127::consumed_assembly_layout(
+      static_cast<std::uint8_t>(poll.consumed_assembly), e2_.configuration);
   return layout.ok() ? static_cast<std::uint16_t>(layout->size) : 0;
 }
 
-std::uint16_t Cdn127Device::consumed_size(std::uint16_t instance) const noexcept {
-  if (instance == profiles::cdn127::connection_instance::kExplicit) return kExplicitMessageSize;
-  auto layout =
-      profiles::cdn127::consumed_assembly_layout(poll_.consumed_assembly, e2_.configuration);
-  return layout.ok() ? static_cast<std::uint16_t>(layout->size) : 0;
+bool Cdn127Device::assembly_allowed(std::uint16_t instance, bool produced,
+                                    std::uint16_t assembly) const noexcept {
+  if (instance != connection_instance::kPoll || assembly > 0xFF) return false;
+  const auto a = static_cast<std::uint8_t>(assembly);
+  return produced ? is_produced_assembly(a) : is_consumed_assembly(a);
 }
 
-void Cdn127Device::explicit_consumed(TimePoint now) noexcept {
-  now_ = now;
-  if (explicit_.state == ConnectionState::kEstablished) restart_watchdog(explicit_, now);
+void Cdn127Device::on_io_established(std::uint16_t, TimePoint) noexcept { poll_running_ = false; }
+
+// A master that releases the poll connection has stopped the exchange on
+// purpose: the outputs take their idle values (the manual names no action for
+// this case; idle rather than fault is this simulator's reading).
+void Cdn127Device::on_io_released(std::uint16_t, bool was_established, TimePoint now) noexcept {
+  if (was_established) apply_idle_actions(now);
+  poll_running_ = false;
+}
+
+void Cdn127Device::on_io_timed_out(std::uint16_t, TimePoint now) noexcept {
+  apply_fault_actions(now);
+  poll_running_ = false;
 }
 
 std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout,
@@ -335,17 +184,18 @@ std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout,
 PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {
   now_ = now;
   PollResult result;
-  if (poll_.state != ConnectionState::kEstablished) return result;
-  auto request_layout =
-      profiles::cdn127::consumed_assembly_layout(poll_.consumed_assembly, e2_.configuration);
-  auto response_layout =
-      profiles::cdn127::produced_assembly_layout(poll_.produced_assembly, e2_.configuration);
+  const Connection& poll = connections_.poll_connection();
+  if (poll.state != ConnectionState::kEstablished) return result;
+  auto request_layout = profiles::cdn127::consumed_assembly_layout(
+      static_cast<std::uint8_t>(poll.consumed_assembly), e2_.configuration);
+  auto response_layout = profiles::cdn127::produced_assembly_layout(
+      static_cast<std::uint8_t>(poll.produced_assembly), e2_.configuration);
   if (!request_layout.ok() || !response_layout.ok()) return result;
   if (command.size() > request_layout->size) {
     result.outcome = PollOutcome::kOversize;
     return result;
   }
-  restart_watchdog(poll_, now);
+  connections_.consumed(connection_instance::kPoll, now);
 
   // A command shorter than the consumed size is the idle condition; with a
   // consumed size of 0 there is none (manual, "Poll Packet Sizes").
@@ -411,7 +261,8 @@ Reply Cdn127Device::set_consumed_assembly(std::uint8_t assembly, Bytes data,
   if (data.size() < layout->size) return reply_error(GeneralStatus::kNotEnoughData);
   if (data.size() > layout->size) return reply_error(GeneralStatus::kTooMuchData);
   // The poll connection owns the assembly it consumes while it runs.
-  if (poll_.state == ConnectionState::kEstablished && poll_.consumed_assembly == assembly) {
+  if (connections_.established(connection_instance::kPoll) &&
+      connections_.poll_connection().consumed_assembly == assembly) {
     return reply_error(GeneralStatus::kObjectStateConflict);
   }
   if (major_fault()) return reply_error(GeneralStatus::kDeviceStateConflict);
@@ -466,8 +317,8 @@ Reply Cdn127Device::set_configuration(const profiles::cdn127::IoConfiguration& c
   // "may only be set when the POLL connection is not in the RUNNING state":
   // Established, or, read strictly, allocated in any state.
   const bool locked = options_.configuration_locked_while_poll_allocated
-                          ? poll_.state != ConnectionState::kNonExistent
-                          : poll_.state == ConnectionState::kEstablished;
+                          ? connections_.exists(connection_instance::kPoll)
+                          : connections_.established(connection_instance::kPoll);
   if (locked) return reply_error(GeneralStatus::kObjectStateConflict);
   // Mode bits 3..5 "should be set to 0"; counts within the device's maxima.
   if ((config.mode & 0x38) != 0 || !profiles::cdn127::validate(config).ok()) {
@@ -507,10 +358,12 @@ void Cdn127Device::set_faults(const IdentityFaults& faults, TimePoint now) noexc
 // S-Device Supervisor stops in Abort on a recoverable fault and in Critical
 // Fault on an unrecoverable one.
 std::uint8_t Cdn127Device::supervisor_device_status() const noexcept {
-  if (faults_.major_unrecoverable) return 6;                                    // Critical Fault
-  if (faults_.major_recoverable) return 5;                                      // Abort
-  if (poll_.state == ConnectionState::kEstablished && poll_running_) return 4;  // Executing
-  return 2;                                                                     // Idle
+  if (faults_.major_unrecoverable) return 6;  // Critical Fault
+  if (faults_.major_recoverable) return 5;    // Abort
+  if (connections_.established(connection_instance::kPoll) && poll_running_) {
+    return 4;  // Executing
+  }
+  return 2;  // Idle
 }
 
 std::uint8_t Cdn127Device::exception_status_byte() noexcept {
@@ -539,89 +392,21 @@ PendingAction Cdn127Device::take_pending_action() noexcept {
   return std::exchange(pending_, PendingAction::kNone);
 }
 
-void Cdn127Device::explicit_timeout(TimePoint now) noexcept {
-  (void)now;
-  if (explicit_.watchdog_action == WatchdogAction::kDeferredDelete &&
-      poll_.state == ConnectionState::kEstablished) {
-    explicit_.state = ConnectionState::kDeferredDelete;
-    explicit_.watchdog_deadline = kNever;
-    return;
-  }
-  explicit_ = Connection{};  // auto delete
-}
-
-void Cdn127Device::poll_timeout(TimePoint now) noexcept {
-  apply_fault_actions(now);
-  poll_running_ = false;
-  switch (poll_.watchdog_action) {
-    case WatchdogAction::kTimedOut:
-      poll_.state = ConnectionState::kTimedOut;
-      poll_.watchdog_deadline = kNever;
-      break;
-    case WatchdogAction::kAutoDelete:
-      poll_ = Connection{};
-      break;
-    case WatchdogAction::kAutoReset:
-      restart_watchdog(poll_, now);
-      break;
-    case WatchdogAction::kDeferredDelete:
-      if (explicit_.state == ConnectionState::kEstablished) {
-        poll_.state = ConnectionState::kDeferredDelete;
-        poll_.watchdog_deadline = kNever;
-      } else {
-        poll_ = Connection{};
-      }
-      break;
-  }
-}
-
-void Cdn127Device::release_if_nothing_established() noexcept {
-  if (!owned()) return;
-  if (explicit_.state == ConnectionState::kEstablished ||
-      poll_.state == ConnectionState::kEstablished) {
-    return;
-  }
-  // With nothing left established the slave drops the whole set; the master
-  // must allocate again (bridge/PROTOCOL.md §7).
-  drop_connection_set();
-}
-
-void Cdn127Device::drop_connection_set() noexcept {
-  explicit_ = Connection{};
-  poll_ = Connection{};
-  poll_running_ = false;
-  owner_ = MacId::kNone;
-}
-
 void Cdn127Device::go_offline(TimePoint now) noexcept {
   now_ = now;
-  if (poll_.state == ConnectionState::kEstablished) apply_fault_actions(now);
-  drop_connection_set();
+  if (connections_.established(connection_instance::kPoll)) apply_fault_actions(now);
+  connections_.drop();
+  poll_running_ = false;
 }
 
 void Cdn127Device::on_timer(TimePoint now) noexcept {
   now_ = now;
   pump_.advance(now);
-  bool expired = false;
-  if (explicit_.state == ConnectionState::kEstablished && now >= explicit_.watchdog_deadline) {
-    explicit_timeout(now);
-    ++watchdog_timeouts_;
-    expired = true;
-  }
-  if (poll_.state == ConnectionState::kEstablished && now >= poll_.watchdog_deadline) {
-    poll_timeout(now);
-    ++watchdog_timeouts_;
-    expired = true;
-  }
-  if (expired) release_if_nothing_established();
+  connections_.on_timer(now);
 }
 
 TimePoint Cdn127Device::next_deadline() const noexcept {
-  TimePoint t = pump_.next_deadline();
-  if (explicit_.state == ConnectionState::kEstablished)
-    t = std::min(t, explicit_.watchdog_deadline);
-  if (poll_.state == ConnectionState::kEstablished) t = std::min(t, poll_.watchdog_deadline);
-  return t;
+  return std::min(pump_.next_deadline(), connections_.next_deadline());
 }
 
 }  // namespace dnbridge::sim

@@ -10,6 +10,9 @@
 #include <vector>
 
 #include "adapters/sim/cdn127/pump_model.hpp"
+#include "adapters/sim/generic/connection_object.hpp"
+#include "adapters/sim/generic/connection_set.hpp"
+#include "adapters/sim/generic/group2_device.hpp"
 #include "bridge/cip/general_status.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
@@ -20,57 +23,6 @@
 #include "bridge/profiles/cdn127/poll_format.hpp"
 
 namespace dnbridge::sim {
-
-// Connection object attribute 1 (bridge/PROTOCOL.md §7).
-enum class ConnectionState : std::uint8_t {
-  kNonExistent = 0,
-  kConfiguring = 1,
-  kWaitingForConnectionId = 2,
-  kEstablished = 3,
-  kTimedOut = 4,
-  kDeferredDelete = 5,
-};
-
-// Connection object attribute 12 (bridge/PROTOCOL.md §7).
-enum class WatchdogAction : std::uint8_t {
-  kTimedOut = 0,
-  kAutoDelete = 1,
-  kAutoReset = 2,
-  kDeferredDelete = 3,
-};
-
-// The outcome of a service: CIP general status and additional code.
-struct Reply {
-  cip::GeneralStatus status = cip::GeneralStatus::kSuccess;
-  std::uint8_t additional = cip::kNoAdditionalCode;
-
-  bool ok() const noexcept { return status == cip::GeneralStatus::kSuccess; }
-  friend bool operator==(const Reply&, const Reply&) = default;
-};
-inline constexpr Reply kReplyOk{};
-constexpr Reply reply_error(cip::GeneralStatus s,
-                            std::uint8_t additional = cip::kNoAdditionalCode) noexcept {
-  return Reply{s, additional};
-}
-
-// The Group 4 Offline Connection Set (bridge/PROTOCOL.md §9, UNVERIFIED; layouts
-// and sources in bridge/devicenet/wire/offline_connection.hpp). Where the sources
-// disagree or are silent, the choice is here.
-struct OfflineOptions {
-  // The manual ("DeviceNet Message Types") lists the set as supported.
-  bool supported = true;
-  // Layout of the answer to an identify request: Wireshark's 8-byte form
-  // [match/value][R/R | service][vendor][serial] (value = the node's MAC), or
-  // the ICP DAS manual's 7-byte [port][vendor][serial].
-  devicenet::CommFaultedLayout identify_response = devicenet::CommFaultedLayout::kLong;
-  devicenet::OwnershipIdentity ownership_identity = devicenet::OwnershipIdentity::kTarget;
-  // The identify service is the ICP DAS example's. No source gives the
-  // service that sets the MAC offline: Set_Attribute_Single (the DeviceNet
-  // object's MAC ID attribute, implied), the new MAC in the value field of a
-  // long-form request that names the node by vendor and serial.
-  std::uint8_t identify_service = devicenet::kCommFaultedIdentifyService;
-  std::uint8_t set_mac_service = 0x10;
-};
 
 // An instance attribute of a class, on every instance of it.
 struct ClassAttribute {
@@ -237,15 +189,6 @@ struct E2Memory {
   bool warning_enable = true;
 };
 
-struct Connection {
-  ConnectionState state = ConnectionState::kNonExistent;
-  std::uint16_t expected_packet_rate_ms = 0;
-  WatchdogAction watchdog_action = WatchdogAction::kTimedOut;
-  std::uint8_t produced_assembly = 0;  // poll connection only
-  std::uint8_t consumed_assembly = 0;
-  TimePoint watchdog_deadline = kNever;
-};
-
 // Identity attribute 5 bits 8..11 (ODVA numbering; the manual lists 8/9 twice).
 // A recoverable fault lasts as long as its cause, which is outside the device
 // (a short on a DOP, the +24 Vdc gone): it stays until cleared, power cycles
@@ -263,40 +206,13 @@ struct IdentityFaults {
   friend bool operator==(const IdentityFaults&, const IdentityFaults&) = default;
 };
 
-// What starts the device up: power applied, which ends unrecoverable faults,
-// or a restart with power on (Identity Reset, a new MAC), which does not.
-enum class PowerUpCause : std::uint8_t { kPowerOn, kRestart };
-
-// Work to do once the response to the current request has been sent.
-enum class PendingAction : std::uint8_t {
-  kNone,
-  kRestart,                 // Identity Reset type 0, or a new MAC: re-enter the network
-  kRestartFactoryDefaults,  // Identity Reset type 1
-};
-
-enum class PollOutcome : std::uint8_t {
-  kNotEstablished,  // ignored: no established poll connection
-  kOversize,        // ignored: longer than the consumed size
-  kApplied,         // outputs updated, response built
-  kIdle,            // shorter than the consumed size: idle actions, response built
-                    // (empty with SlaveOptions::idle_poll_answered_empty)
-  kInvalid,         // full size but an analog value over 4095: outputs kept, response built
-  kMajorFault,      // a major fault stands: outputs kept in their fault state, response
-                    // built (empty for an idle poll with idle_poll_answered_empty)
-};
-
-struct PollResult {
-  PollOutcome outcome = PollOutcome::kNotEstablished;
-  InlineBytes<8> response;  // the produced data, when outcome is not an ignore
-};
-
-inline constexpr unsigned kWatchdogMultiplier = 4;
-inline constexpr std::uint16_t kExplicitDefaultEprMs = 2500;
 inline constexpr std::uint16_t kExplicitMessageSize = 24;  // attributes 7/8 of instance 1
 
-class Cdn127Device {
+class Cdn127Device final : private ConnectionEvents, public IoAssemblies {
  public:
   explicit Cdn127Device(const SlaveOptions& options) noexcept;
+  Cdn127Device(const Cdn127Device&) = delete;
+  Cdn127Device& operator=(const Cdn127Device&) = delete;
 
   // Power-up: volatile state cleared, switches read, outputs off; with
   // power applied, the unrecoverable faults end too (IdentityFaults). E2
@@ -329,37 +245,29 @@ class Cdn127Device {
   Reply set_mac(std::uint8_t mac) noexcept;
   Reply set_baud(std::uint8_t baud) noexcept;
 
-  // --- allocation (bridge/PROTOCOL.md §3) ---
+  // --- allocation (bridge/PROTOCOL.md §3) and the Connection object ---
+  ConnectionSet& connections() noexcept { return connections_; }
+  const ConnectionSet& connections() const noexcept { return connections_; }
   // 255 when no master owns the connection set.
-  std::uint8_t owner() const noexcept { return owner_; }
-  bool owned() const noexcept { return owner_ != devicenet::MacId::kNone; }
-  std::uint8_t allocation_choice() const noexcept;
-  Reply allocate(std::uint8_t choice, std::uint8_t allocator, TimePoint now) noexcept;
-  Reply release(std::uint8_t choice, std::uint8_t requester, TimePoint now) noexcept;
-
-  // --- Connection object ---
-  const Connection& explicit_connection() const noexcept { return explicit_; }
-  const Connection& poll_connection() const noexcept { return poll_; }
-  // instance 1 or 2; nullptr for others
-  const Connection* connection(std::uint16_t instance) const noexcept;
-  bool connection_exists(std::uint16_t instance) const noexcept;
-  // Sets attribute 9, rounded up to the timer resolution; `actual` receives
-  // the value kept. Establishes a Configuring poll connection.
-  Reply set_expected_packet_rate(std::uint16_t instance, std::uint16_t requested_ms, TimePoint now,
-                                 std::uint16_t& actual) noexcept;
-  Reply set_watchdog_action(std::uint16_t instance, std::uint8_t action) noexcept;
-  // Attributes 14/16 of the poll connection, while Configuring.
-  Reply set_poll_assembly(bool produced, std::uint8_t assembly) noexcept;
-  // Connection Reset: restarts the watchdog; a timed-out poll connection is
-  // Established again.
-  Reply reset_connection(std::uint16_t instance, TimePoint now) noexcept;
-  std::uint16_t produced_size(std::uint16_t instance) const noexcept;
-  std::uint16_t consumed_size(std::uint16_t instance) const noexcept;
-  // Every message the explicit connection consumes restarts its watchdog.
-  void explicit_consumed(TimePoint now) noexcept;
-  bool explicit_established() const noexcept {
-    return explicit_.state == ConnectionState::kEstablished;
+  std::uint8_t owner() const noexcept { return connections_.owner(); }
+  bool owned() const noexcept { return connections_.owned(); }
+  std::uint8_t allocation_choice() const noexcept { return connections_.allocation_choice(); }
+  const Connection& explicit_connection() const noexcept {
+    return connections_.explicit_connection();
   }
+  const Connection& poll_connection() const noexcept { return connections_.poll_connection(); }
+  bool explicit_established() const noexcept { return connections_.explicit_established(); }
+  // Connection attributes 7/8: the explicit connection's message size, the
+  // poll connection's assemblies as the Configuration object lays them out.
+  std::uint16_t connection_size(std::uint16_t instance, bool produced) const noexcept override;
+  bool assembly_allowed(std::uint16_t instance, bool produced,
+                        std::uint16_t assembly) const noexcept override;
+  std::uint32_t max_assembly() const noexcept override { return 0xFF; }
+  // The Connection table lists 14/16 as Get, but the Assembly section selects
+  // the poll assemblies "by writing the corresponding DeviceNet Path
+  // information" to them: settable while Configuring, unless
+  // SlaveOptions::poll_paths_fixed.
+  bool paths_fixed() const noexcept override { return options_.poll_paths_fixed; }
 
   // --- poll I/O ---
   PollResult on_poll(Bytes command, TimePoint now) noexcept;
@@ -416,23 +324,18 @@ class Cdn127Device {
   // Communication Fault: connections and ownership dropped; a running poll
   // connection's outputs take their fault values.
   void go_offline(TimePoint now) noexcept;
-  std::uint32_t watchdog_timeouts() const noexcept { return watchdog_timeouts_; }
+  std::uint32_t watchdog_timeouts() const noexcept { return connections_.watchdog_timeouts(); }
 
   // --- time ---
   void on_timer(TimePoint now) noexcept;
   TimePoint next_deadline() const noexcept;
 
  private:
-  Connection* mutable_connection(std::uint16_t instance) noexcept;
-  void open_explicit(TimePoint now) noexcept;
-  void open_poll() noexcept;
-  void delete_poll(TimePoint now) noexcept;
-  void explicit_timeout(TimePoint now) noexcept;
-  void poll_timeout(TimePoint now) noexcept;
-  void release_if_nothing_established() noexcept;
-  void drop_connection_set() noexcept;
-  void restart_watchdog(Connection& c, TimePoint now) noexcept;
-  std::uint16_t round_rate(std::uint16_t requested_ms) const noexcept;
+  // The poll connection's changes (ConnectionEvents).
+  void on_io_established(std::uint16_t instance, TimePoint now) noexcept override;
+  void on_io_released(std::uint16_t instance, bool was_established,
+                      TimePoint now) noexcept override;
+  void on_io_timed_out(std::uint16_t instance, TimePoint now) noexcept override;
   void apply_decoded_outputs(const profiles::cdn127::PollRequestLayout& layout,
                              const profiles::cdn127::PumpOutputs& decoded, OutputCause cause,
                              TimePoint now) noexcept;
@@ -451,15 +354,12 @@ class Cdn127Device {
   std::uint8_t baud_switch_at_power_up_;
   std::uint8_t bus_off_counter_ = 0;
 
-  std::uint8_t owner_ = devicenet::MacId::kNone;
-  Connection explicit_;
-  Connection poll_;
+  ConnectionSet connections_;
   bool poll_running_ = false;  // a full poll since the poll connection was established
 
   IdentityFaults faults_;
   std::array<std::optional<std::uint16_t>, 2> failed_analog_{};
   PendingAction pending_ = PendingAction::kNone;
-  std::uint32_t watchdog_timeouts_ = 0;
   TimePoint now_{};
 };
 

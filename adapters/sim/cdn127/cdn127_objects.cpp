@@ -4,6 +4,8 @@
 #include <optional>
 #include <string_view>
 
+#include "adapters/sim/generic/attribute_codec.hpp"
+#include "adapters/sim/generic/connection_object.hpp"
 #include "bridge/cip/data_types.hpp"
 #include "bridge/cip/epath.hpp"
 #include "bridge/cip/service.hpp"
@@ -23,45 +25,11 @@ namespace cls = profiles::cdn127::class_id;
 // ---------------------------------------------------------------------------
 // Helpers for attribute handlers.
 
-Reply put_u8(ByteWriter& w, std::uint8_t v) noexcept {
-  w.u8(v);
-  return kReplyOk;
-}
-Reply put_u16(ByteWriter& w, std::uint16_t v) noexcept {
-  w.u16le(v);
-  return kReplyOk;
-}
 Reply put_short_string(ByteWriter& w, std::string_view text) noexcept {
   std::array<std::uint8_t, 1 + cip::kMaxShortStringLength> buf{};
   auto size = cip::encode_short_string(text, buf);
   if (!size.ok()) return reply_error(GeneralStatus::kReplyDataTooLarge);
   w.bytes(Bytes(buf.data(), *size));
-  return kReplyOk;
-}
-
-// Set data must be exactly the attribute's size.
-Reply expect_size(Bytes data, std::size_t n) noexcept {
-  if (data.size() < n) return reply_error(GeneralStatus::kNotEnoughData);
-  if (data.size() > n) return reply_error(GeneralStatus::kTooMuchData);
-  return kReplyOk;
-}
-Reply read_u8(Bytes data, std::uint8_t& v) noexcept {
-  Reply r = expect_size(data, 1);
-  if (r.ok()) v = data[0];
-  return r;
-}
-Reply read_u16(Bytes data, std::uint16_t& v) noexcept {
-  Reply r = expect_size(data, 2);
-  if (r.ok()) v = static_cast<std::uint16_t>(data[0] | (data[1] << 8));
-  return r;
-}
-// BOOL/BOOLEAN: 0 or 1.
-Reply read_bool(Bytes data, bool& v) noexcept {
-  std::uint8_t b = 0;
-  Reply r = read_u8(data, b);
-  if (!r.ok()) return r;
-  if (b > 1) return reply_error(GeneralStatus::kInvalidAttributeValue);
-  v = b != 0;
   return kReplyOk;
 }
 
@@ -212,9 +180,7 @@ const AttributeDef kDeviceNetAttributes[] = {
      }},
     {5, Access::kGet,  // "Get/Spc": changed only by Allocate and Release
      [](const RequestContext& c, ByteWriter& w) noexcept {
-       w.u8(c.device.allocation_choice());
-       w.u8(c.device.owner());
-       return kReplyOk;
+       return put_allocation_information(c.device.connections(), w);
      },
      nullptr},
     {6, Access::kGet,
@@ -231,20 +197,11 @@ const AttributeDef kDeviceNetAttributes[] = {
      nullptr},
 };
 
-// Allocate: [choice][allocator MAC] -> [reserved:4 | body format:4].
 Reply devicenet_allocate(const RequestContext& c, Bytes data, ByteWriter& w) noexcept {
-  Reply r = expect_size(data, 2);
-  if (!r.ok()) return r;
-  r = c.device.allocate(data[0], data[1], c.now);
-  if (r.ok()) w.u8(static_cast<std::uint8_t>(devicenet::BodyFormat::k8_8));
-  return r;
+  return allocate_service(c.device.connections(), data, c.now, w);
 }
-
-// Release: [choice] -> no data.
 Reply devicenet_release(const RequestContext& c, Bytes data, ByteWriter&) noexcept {
-  Reply r = expect_size(data, 1);
-  if (!r.ok()) return r;
-  return c.device.release(data[0], c.requester, c.now);
+  return release_service(c.device.connections(), data, c.requester, c.now);
 }
 
 // ---------------------------------------------------------------------------
@@ -276,167 +233,51 @@ const AttributeDef kAssemblyAttributes[] = {
 };
 
 // ---------------------------------------------------------------------------
-// Connection, class 0x05: instance 1 explicit, 2 poll.
+// Connection, class 0x05: instance 1 explicit, 2 poll (connection_object.hpp).
 
 constexpr ClassAttributeDef kConnectionClass[] = {{1, 1}};
 
 bool connection_exists(const Cdn127Device& d, std::uint16_t i) noexcept {
-  return d.connection_exists(i);
-}
-bool is_explicit(const RequestContext& c) noexcept {
-  return c.instance == profiles::cdn127::connection_instance::kExplicit;
+  return i <= connection_instance::kPoll && d.connections().exists(i);
 }
 
-cip::EPath assembly_path(std::uint8_t assembly) noexcept {
-  cip::EPath p;
-  p.class_id = cls::kAssembly;
-  p.instance_id = assembly;
-  p.attribute = 3;
-  return p;
+template <std::uint8_t Attribute>
+Reply get_connection(const RequestContext& c, ByteWriter& w) noexcept {
+  return get_connection_attribute(c.device.connections(), c.device.mac(), c.device, c.instance,
+                                  Attribute, w);
+}
+template <std::uint8_t Attribute>
+Reply set_connection(const RequestContext& c, Bytes data, ByteWriter& w) noexcept {
+  return set_connection_attribute(c.device.connections(), c.device, c.instance, Attribute, data,
+                                  c.now, w);
 }
 
-// Attributes 13..16: the explicit connection has null paths.
-Reply put_path_length(const RequestContext& c, ByteWriter& w, bool produced) noexcept {
-  if (is_explicit(c)) return put_u8(w, 0);
-  const Connection& p = c.device.poll_connection();
-  return put_u8(w, static_cast<std::uint8_t>(cip::encoded_size(
-                       assembly_path(produced ? p.produced_assembly : p.consumed_assembly))));
-}
-Reply put_path(const RequestContext& c, ByteWriter& w, bool produced) noexcept {
-  if (is_explicit(c)) return kReplyOk;
-  const Connection& p = c.device.poll_connection();
-  std::array<std::uint8_t, 16> buf{};
-  auto n = cip::encode(assembly_path(produced ? p.produced_assembly : p.consumed_assembly), buf);
-  if (!n.ok()) return reply_error(GeneralStatus::kReplyDataTooLarge);
-  w.bytes(Bytes(buf.data(), *n));
-  return kReplyOk;
-}
-// The Connection table lists 14/16 as Get, but the Assembly section selects the
-// poll assemblies "by writing the corresponding DeviceNet Path information" to
-// them: settable on the poll connection while it is Configuring. A device
-// that follows the table (SlaveOptions::poll_paths_fixed) refuses them always.
-Reply set_path(const RequestContext& c, Bytes data, bool produced) noexcept {
-  if (is_explicit(c) || c.device.options().poll_paths_fixed) {
-    return reply_error(GeneralStatus::kAttributeNotSettable);
-  }
-  auto path = cip::decode_epath(data);
-  if (!path.ok() || path->class_id != std::optional<std::uint32_t>(cls::kAssembly) ||
-      !path->instance_id || *path->instance_id > 0xFF || path->connection_point ||
-      path->attribute != std::optional<std::uint32_t>(3)) {
-    return reply_error(GeneralStatus::kInvalidAttributeValue);
-  }
-  return c.device.set_poll_assembly(produced, static_cast<std::uint8_t>(*path->instance_id));
-}
-
-std::uint16_t produced_connection_id(const RequestContext& c) noexcept {
-  const auto mac = c.device.mac();
-  return static_cast<std::uint16_t>(
-      is_explicit(c) ? devicenet::group2_id(mac, Group2Message::kSlaveExplicitResponse)
-                     : devicenet::group1_id(Group1Message::kSlavePollResponse, mac));
-}
-std::uint16_t consumed_connection_id(const RequestContext& c) noexcept {
-  const auto mac = c.device.mac();
-  return static_cast<std::uint16_t>(devicenet::group2_id(
-      mac, is_explicit(c) ? Group2Message::kMasterExplicitRequest : Group2Message::kMasterIoPoll));
-}
-
+// 12 is Get only on the explicit connection (manual: "fixed value"), unless
+// SlaveOptions::explicit_timeout_action_settable; 17 is Get only.
 const AttributeDef kConnectionAttributes[] = {
-    {1, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u8(w, static_cast<std::uint8_t>(c.device.connection(c.instance)->state));
-     },
-     nullptr},
-    {2, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u8(w, is_explicit(c) ? 0 : 1);
-     },
-     nullptr},
-    {3, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u8(w, is_explicit(c) ? 0x83 : 0x82);
-     },
-     nullptr},
-    {4, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u16(w, produced_connection_id(c));
-     },
-     nullptr},
-    {5, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u16(w, consumed_connection_id(c));
-     },
-     nullptr},
-    {6, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u8(w, is_explicit(c) ? 0x21 : 0x01);
-     },
-     nullptr},
-    {7, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u16(w, c.device.produced_size(c.instance));
-     },
-     nullptr},
-    {8, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u16(w, c.device.consumed_size(c.instance));
-     },
-     nullptr},
-    {9, Access::kGetSet,
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u16(w, c.device.connection(c.instance)->expected_packet_rate_ms);
-     },
-     // The response carries the rate kept, rounded up (bridge/PROTOCOL.md §7).
-     [](const RequestContext& c, Bytes data, ByteWriter& w) noexcept {
-       std::uint16_t requested = 0;
-       Reply r = read_u16(data, requested);
-       if (!r.ok()) return r;
-       std::uint16_t actual = 0;
-       r = c.device.set_expected_packet_rate(c.instance, requested, c.now, actual);
-       if (r.ok()) w.u16le(actual);
-       return r;
-     }},
-    {12, Access::kGetSet,  // Get only on the explicit connection (manual: "fixed value")
-     [](const RequestContext& c, ByteWriter& w) noexcept {
-       return put_u8(w,
-                     static_cast<std::uint8_t>(c.device.connection(c.instance)->watchdog_action));
-     },
-     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
-       std::uint8_t v = 0;
-       Reply r = read_u8(data, v);
-       return r.ok() ? c.device.set_watchdog_action(c.instance, v) : r;
-     }},
-    {13, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_path_length(c, w, true); },
-     nullptr},
-    {14, Access::kGetSet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_path(c, w, true); },
-     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
-       return set_path(c, data, true);
-     }},
-    {15, Access::kGet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_path_length(c, w, false); },
-     nullptr},
-    {16, Access::kGetSet,
-     [](const RequestContext& c, ByteWriter& w) noexcept { return put_path(c, w, false); },
-     [](const RequestContext& c, Bytes data, ByteWriter&) noexcept {
-       return set_path(c, data, false);
-     }},
-    {17, Access::kGet, [](const RequestContext&, ByteWriter& w) noexcept { return put_u16(w, 0); },
-     nullptr},
+    {1, Access::kGet, get_connection<1>, nullptr},
+    {2, Access::kGet, get_connection<2>, nullptr},
+    {3, Access::kGet, get_connection<3>, nullptr},
+    {4, Access::kGet, get_connection<4>, nullptr},
+    {5, Access::kGet, get_connection<5>, nullptr},
+    {6, Access::kGet, get_connection<6>, nullptr},
+    {7, Access::kGet, get_connection<7>, nullptr},
+    {8, Access::kGet, get_connection<8>, nullptr},
+    {9, Access::kGetSet, get_connection<9>, set_connection<9>},
+    {12, Access::kGetSet, get_connection<12>, set_connection<12>},
+    {13, Access::kGet, get_connection<13>, nullptr},
+    {14, Access::kGetSet, get_connection<14>, set_connection<14>},
+    {15, Access::kGet, get_connection<15>, nullptr},
+    {16, Access::kGetSet, get_connection<16>, set_connection<16>},
+    {17, Access::kGet, get_connection<17>, nullptr},
 };
 
 Reply connection_reset(const RequestContext& c, Bytes data, ByteWriter&) noexcept {
-  if (!data.empty()) return reply_error(GeneralStatus::kTooMuchData);
-  return c.device.reset_connection(c.instance, c.now);
+  return reset_connection(c.device.connections(), c.instance, data, c.now);
 }
 
-// Class-level Reset: every existing instance.
 Reply connection_class_reset(const RequestContext& c, Bytes data, ByteWriter&) noexcept {
-  if (!data.empty()) return reply_error(GeneralStatus::kTooMuchData);
-  for (std::uint16_t i = 1; i <= 2; ++i) {
-    if (c.device.connection_exists(i)) (void)c.device.reset_connection(i, c.now);
-  }
-  return kReplyOk;
+  return reset_connection_class(c.device.connections(), data, c.now);
 }
 
 // ---------------------------------------------------------------------------
@@ -859,15 +700,8 @@ std::size_t execute_request(Cdn127Device& device, const devicenet::RequestMessag
                             std::uint8_t requester, TimePoint now, MutableBytes out) noexcept {
   std::array<std::uint8_t, 64> data{};
   ByteWriter w(data);
-  Reply r = dispatch(device, request, requester, now, w);
-  if (r.ok() && !w.ok()) r = reply_error(GeneralStatus::kReplyDataTooLarge);
-  if (r.ok()) {
-    auto n = devicenet::encode_success_response(request.service, w.written(), out);
-    if (n.ok()) return *n;
-    r = reply_error(GeneralStatus::kReplyDataTooLarge);
-  }
-  auto n = devicenet::encode_error_response(r.status, r.additional, out);
-  return n.ok() ? *n : 0;
+  const Reply r = dispatch(device, request, requester, now, w);
+  return encode_reply(request.service, r, w, out);
 }
 
 }  // namespace dnbridge::sim

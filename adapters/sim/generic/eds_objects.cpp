@@ -145,6 +145,41 @@ std::vector<std::uint8_t> EdsObjects::packed(const eds::Assembly& assembly, unsi
   return out;
 }
 
+bool EdsObjects::set_assembly_data(unsigned instance, Bytes data) {
+  const eds::Assembly* a = assembly(instance);
+  if (a == nullptr || data.size() != (a->size_bits() + 7) / 8) return false;
+  unpack(*a, data, 0, 0);
+  return true;
+}
+
+// The inverse of packed(): each parameter member's bits from `data`, the
+// assembly starting at bit `at`; a parameter's bits past its member's stay.
+void EdsObjects::unpack(const eds::Assembly& assembly, Bytes data, std::uint32_t at,
+                        unsigned depth) {
+  const auto bit = [&](std::uint32_t i) {
+    return i / 8 < data.size() && ((static_cast<unsigned>(data[i / 8]) >> (i % 8)) & 1u) != 0;
+  };
+  for (const auto& m : assembly.members) {
+    if (m.kind == eds::Member::Kind::kParam) {
+      auto it = values_.find(m.number);
+      if (it != values_.end()) {
+        auto& value = it->second;
+        for (std::uint32_t i = 0; i < m.bits && i / 8 < value.size(); ++i) {
+          const auto mask = static_cast<std::uint8_t>(1u << (i % 8));
+          value[i / 8] =
+              static_cast<std::uint8_t>(bit(at + i) ? value[i / 8] | mask : value[i / 8] & ~mask);
+        }
+      }
+    }
+    if (m.kind == eds::Member::Kind::kAssembly && depth < kMaxNesting) {
+      if (const eds::Assembly* nested = assembly_numbered(m.number)) {
+        unpack(*nested, data, at, depth + 1);
+      }
+    }
+    at += m.bits;
+  }
+}
+
 std::vector<cip::AssemblyMember> EdsObjects::member_list(const eds::Assembly& a) const {
   std::vector<cip::AssemblyMember> list;
   for (const auto& m : a.members) {

@@ -73,6 +73,11 @@ class EdsObjects {
   // The data of the assembly at `instance`: its members packed, least
   // significant bit first; empty if no such assembly.
   std::vector<std::uint8_t> assembly_data(unsigned instance) const;
+  // Unpacks `data` into the parameters the assembly at `instance` names
+  // (nested assemblies too; padding and paths taken as they are), limits
+  // unchecked, as the device takes its outputs from a connection; false if
+  // no such assembly or `data` is not its size.
+  bool set_assembly_data(unsigned instance, Bytes data);
   // How deep nested assemblies are packed.
   static constexpr unsigned kMaxNesting = 8;
 
@@ -96,6 +101,7 @@ class EdsObjects {
   const eds::Assembly* assembly(unsigned instance) const noexcept;
   const eds::Assembly* assembly_numbered(unsigned number) const noexcept;
   std::vector<std::uint8_t> packed(const eds::Assembly& assembly, unsigned depth) const;
+  void unpack(const eds::Assembly& assembly, Bytes data, std::uint32_t at, unsigned depth);
   std::vector<cip::AssemblyMember> member_list(const eds::Assembly& a) const;
 
   eds::EdsFile file_;

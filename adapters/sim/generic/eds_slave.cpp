@@ -1,0 +1,342 @@
+#include "adapters/sim/generic/eds_slave.hpp"
+
+#include <algorithm>
+#include <array>
+#include <utility>
+#include <vector>
+
+#include "adapters/sim/generic/attribute_codec.hpp"
+#include "bridge/cip/objects.hpp"
+#include "bridge/cip/service.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
+
+namespace dnbridge::sim {
+namespace {
+
+using cip::GeneralStatus;
+using devicenet::Group1Message;
+using devicenet::Group2Message;
+using devicenet::MacId;
+namespace alloc = devicenet::allocation;
+
+constexpr std::uint16_t kConnectionClass = 0x05;
+// The explicit connection's produced and consumed size (attributes 7/8):
+// the longest message it reassembles.
+constexpr std::uint16_t kExplicitMessageSize = devicenet::kMaxExplicitMessage;
+
+// The assembly an [IO_Info] input or output names; 0 for none.
+std::uint16_t io_assembly(const eds::EdsFile& file, const eds::IoData* data) noexcept {
+  if (data == nullptr) return 0;
+  const eds::Assembly* a = file.assembly_at(data->path);
+  if (a == nullptr || !a->path.instance_id || *a->path.instance_id > 0xFFFF) return 0;
+  return static_cast<std::uint16_t>(*a->path.instance_id);
+}
+
+struct IoDefaults {
+  std::uint16_t poll_input = 0;
+  std::uint16_t poll_output = 0;
+  std::uint16_t cos_input = 0;
+  std::uint8_t choices = alloc::kExplicit | alloc::kPoll;
+};
+
+IoDefaults io_defaults(const eds::EdsFile& file) noexcept {
+  IoDefaults d;
+  const eds::IoInfo& io = file.io;
+  if (const auto* poll = io.connection(eds::ConnectionKind::kPoll)) {
+    d.poll_input = io_assembly(file, io.input(poll->input));
+    d.poll_output = io_assembly(file, io.output(poll->output));
+  }
+  const auto* cos = io.connection(eds::ConnectionKind::kChangeOfState);
+  const auto* cyclic = io.connection(eds::ConnectionKind::kCyclic);
+  if (cos != nullptr) d.choices |= alloc::kChangeOfState | alloc::kAckSuppression;
+  if (cyclic != nullptr) d.choices |= alloc::kCyclic | alloc::kAckSuppression;
+  if (const auto* produced = cos != nullptr ? cos : cyclic) {
+    d.cos_input = io_assembly(file, io.input(produced->input));
+  }
+  return d;
+}
+
+ConnectionSetOptions connection_options(const EdsSlaveOptions& o, const IoDefaults& d) noexcept {
+  ConnectionSetOptions c;
+  c.supported_choices = d.choices;
+  c.timer_resolution = o.timer_resolution;
+  c.poll_produced_assembly = d.poll_input;
+  c.poll_consumed_assembly = d.poll_output;
+  c.cos_produced_assembly = d.cos_input;
+  return c;
+}
+
+Group2Options wire_options(const eds::EdsFile& file, const EdsSlaveOptions& o) noexcept {
+  Group2Options w = o.wire;
+  w.vendor_id = file.device.vendor_code;
+  w.serial_number = o.serial_number;
+  return w;
+}
+
+}  // namespace
+
+EdsSlave::EdsSlave(can::FrameSink& sink, eds::EdsFile file, EdsSlaveOptions options, Logger log)
+    : Group2Slave(sink, wire_options(file, options), std::move(log)),
+      options_(options),
+      objects_(std::move(file), options.serial_number),
+      mac_(MacId::from_bits(options.mac)),
+      connections_(connection_options(options_, io_defaults(objects_.file())), *this) {
+  const IoDefaults d = io_defaults(objects_.file());
+  poll_input_ = d.poll_input;
+  poll_output_ = d.poll_output;
+  cos_input_ = d.cos_input;
+}
+
+void EdsSlave::power_up_device(TimePoint, PowerUpCause) noexcept {
+  connections_.drop();
+  end_cos();
+  objects_.ack_handler().cos_acknowledged = false;
+  if (poll_output_ != 0) {
+    const std::vector<std::uint8_t> zero(objects_.assembly_data(poll_output_).size(), 0);
+    (void)objects_.set_assembly_data(poll_output_, Bytes(zero.data(), zero.size()));
+  }
+}
+
+// --- time and production -----------------------------------------------------
+
+void EdsSlave::device_timer(TimePoint now) noexcept {
+  connections_.on_timer(now);
+  if (cos_ && now >= cos_->next_deadline()) produce(cos_->on_timer(now), now);
+}
+
+TimePoint EdsSlave::device_deadline() const noexcept {
+  return std::min(connections_.next_deadline(), cos_ ? cos_->next_deadline() : kNever);
+}
+
+void EdsSlave::inputs_changed(TimePoint now) noexcept {
+  if (!cos_ || network_state() != NetworkState::kOnline) return;
+  const auto data = objects_.assembly_data(connections_.cos_connection().produced_assembly);
+  produce(cos_->set_data(Bytes(data.data(), data.size()), now), now);
+}
+
+void EdsSlave::produce(const std::optional<std::vector<std::uint8_t>>& message,
+                       TimePoint now) noexcept {
+  if (!message) return;
+  send(devicenet::group1_id(Group1Message::kSlaveCosCyclic, mac_),
+       Bytes(message->data(), std::min(message->size(), kMaxPollData)), now);
+}
+
+bool EdsSlave::on_io_message(Group2Message message, const can::CanFrame&, TimePoint now) noexcept {
+  if (message != Group2Message::kMasterCosCyclicAck || !cos_ ||
+      objects_.ack_handler().cos_producing_instance != connection_instance::kChangeOfState) {
+    return false;
+  }
+  cos_->on_ack();
+  connections_.consumed(connection_instance::kChangeOfState, now);
+  return true;
+}
+
+CosProducerCounters EdsSlave::cos_counters() const noexcept {
+  CosProducerCounters c = cos_ended_;
+  if (cos_) {
+    c.produced += cos_->counters().produced;
+    c.retries += cos_->counters().retries;
+    c.acks_received += cos_->counters().acks_received;
+    c.given_up += cos_->counters().given_up;
+  }
+  return c;
+}
+
+void EdsSlave::end_cos() noexcept {
+  if (!cos_) return;
+  cos_ended_.produced += cos_->counters().produced;
+  cos_ended_.retries += cos_->counters().retries;
+  cos_ended_.acks_received += cos_->counters().acks_received;
+  cos_ended_.given_up += cos_->counters().given_up;
+  cos_.reset();
+}
+
+// --- the I/O connections' changes ------------------------------------------------
+
+void EdsSlave::on_io_established(std::uint16_t instance, TimePoint now) noexcept {
+  if (instance != connection_instance::kChangeOfState) return;
+  const Connection& c = connections_.cos_connection();
+  const AckHandler& ack = objects_.ack_handler();
+  CosProduction p;
+  p.expected_packet_rate = milliseconds(c.expected_packet_rate_ms);
+  p.inhibit = milliseconds(c.inhibit_ms);
+  p.cyclic = (c.allocated_as & alloc::kCyclic) != 0;
+  p.ack_suppressed = (c.allocated_as & alloc::kAckSuppression) != 0;
+  p.ack_timer = milliseconds(ack.ack_timer_ms);
+  p.retry_limit = ack.retry_limit;
+  const auto data = objects_.assembly_data(c.produced_assembly);
+  end_cos();
+  cos_.emplace(p, Bytes(data.data(), data.size()), now);
+  objects_.ack_handler().cos_acknowledged = !p.ack_suppressed;
+}
+
+void EdsSlave::on_io_released(std::uint16_t instance, bool was_established, TimePoint) noexcept {
+  if (instance == connection_instance::kChangeOfState) {
+    end_cos();
+    objects_.ack_handler().cos_acknowledged = false;
+    return;
+  }
+  if (was_established) apply_output_action(options_.idle_action);
+}
+
+void EdsSlave::on_io_timed_out(std::uint16_t instance, TimePoint) noexcept {
+  if (instance == connection_instance::kChangeOfState) {
+    end_cos();
+    objects_.ack_handler().cos_acknowledged = false;
+    return;
+  }
+  apply_output_action(options_.fault_action);
+}
+
+void EdsSlave::go_offline(TimePoint) noexcept {
+  if (connections_.established(connection_instance::kPoll)) {
+    apply_output_action(options_.fault_action);
+  }
+  connections_.drop();
+  end_cos();
+}
+
+void EdsSlave::apply_output_action(OutputAction action) noexcept {
+  const std::uint16_t assembly = connections_.poll_connection().consumed_assembly;
+  const std::uint16_t outputs = assembly != 0 ? assembly : poll_output_;
+  if (action != OutputAction::kZero || outputs == 0) return;
+  const std::vector<std::uint8_t> zero(objects_.assembly_data(outputs).size(), 0);
+  (void)objects_.set_assembly_data(outputs, Bytes(zero.data(), zero.size()));
+}
+
+// --- poll --------------------------------------------------------------------------
+
+PollResult EdsSlave::poll(Bytes command, TimePoint now) noexcept {
+  PollResult result;
+  const Connection& c = connections_.poll_connection();
+  if (c.state != ConnectionState::kEstablished) return result;
+  const std::uint16_t consumed = connection_size(connection_instance::kPoll, false);
+  if (command.size() > consumed) {
+    result.outcome = PollOutcome::kOversize;
+    return result;
+  }
+  connections_.consumed(connection_instance::kPoll, now);
+  // Shorter than the consumed size: the idle condition; a connection that
+  // consumes nothing has none (bridge/PROTOCOL.md §7).
+  const bool idle = command.size() < consumed;
+  if (idle) {
+    result.outcome = PollOutcome::kIdle;
+    apply_output_action(options_.idle_action);
+  } else {
+    result.outcome = PollOutcome::kApplied;
+    if (consumed > 0 && !objects_.set_assembly_data(c.consumed_assembly, command)) {
+      result.outcome = PollOutcome::kInvalid;
+    }
+  }
+  if (!(idle && options_.idle_poll_answered_empty)) {
+    const auto data = objects_.assembly_data(c.produced_assembly);
+    (void)result.response.assign(Bytes(data.data(), std::min(data.size(), kMaxPollData)));
+  }
+  return result;
+}
+
+std::uint16_t EdsSlave::connection_size(std::uint16_t instance, bool produced) const noexcept {
+  if (instance == connection_instance::kExplicit) return kExplicitMessageSize;
+  const Connection* c = connections_.connection(instance);
+  if (c == nullptr) return 0;
+  const std::uint16_t assembly = produced ? c->produced_assembly : c->consumed_assembly;
+  if (assembly == 0) return 0;
+  return static_cast<std::uint16_t>(objects_.assembly_data(assembly).size());
+}
+
+bool EdsSlave::assembly_allowed(std::uint16_t instance, bool,
+                                std::uint16_t assembly) const noexcept {
+  // The data must fit one frame (no I/O fragmentation here).
+  const std::size_t size = objects_.assembly_data(assembly).size();
+  return instance != connection_instance::kExplicit && size > 0 && size <= kMaxPollData;
+}
+
+// --- explicit requests -------------------------------------------------------------
+
+std::size_t EdsSlave::execute(const devicenet::RequestMessage& request, std::uint8_t requester,
+                              TimePoint now, MutableBytes out) noexcept {
+  std::array<std::uint8_t, devicenet::kMaxExplicitMessage> data{};
+  ByteWriter w{MutableBytes(data)};
+  switch (request.class_id) {
+    case devicenet::kDeviceNetClass:
+      return encode_reply(request.service, devicenet_object(request, requester, now, w), w, out);
+    case kConnectionClass:
+      return encode_reply(request.service, connection_object(request, now, w), w, out);
+    default: {
+      const std::size_t n = objects_.execute(request, out);
+      // A Set may have changed what the change-of-state connection produces.
+      inputs_changed(now);
+      return n;
+    }
+  }
+}
+
+// The checks in the order the other objects make them (eds_objects.hpp):
+// instance, service, attribute, data with a Get, attribute supported,
+// settable.
+Reply EdsSlave::devicenet_object(const devicenet::RequestMessage& r, std::uint8_t requester,
+                                 TimePoint now, ByteWriter& w) noexcept {
+  if (r.instance_id > 1) return reply_error(GeneralStatus::kObjectDoesNotExist);
+  const auto service = static_cast<cip::Service>(r.service);
+  if (r.instance_id == 1 && service == cip::Service::kAllocateMasterSlave) {
+    return allocate_service(connections_, r.data, now, w);
+  }
+  if (r.instance_id == 1 && service == cip::Service::kReleaseMasterSlave) {
+    return release_service(connections_, r.data, requester, now);
+  }
+  const bool get = service == cip::Service::kGetAttributeSingle;
+  if (!get && !(service == cip::Service::kSetAttributeSingle && r.instance_id == 1)) {
+    return reply_error(GeneralStatus::kServiceNotSupported);
+  }
+  if (!r.attribute) return reply_error(GeneralStatus::kNotEnoughData);
+  if (get && !r.data.empty()) return reply_error(GeneralStatus::kTooMuchData);
+  const std::uint8_t a = *r.attribute;
+  if (r.instance_id == 0) {
+    if (a != cip::class_attr::kRevision) return reply_error(GeneralStatus::kAttributeNotSupported);
+    return put_u16(w, 2);
+  }
+  if (a != 1 && a != 2 && a != 5) return reply_error(GeneralStatus::kAttributeNotSupported);
+  // The MAC and baud rate are the switches' here.
+  if (!get) return reply_error(GeneralStatus::kAttributeNotSettable);
+  if (a == 1) return put_u8(w, mac_.value());
+  if (a == 2) return put_u8(w, options_.baud);
+  return put_allocation_information(connections_, w);
+}
+
+Reply EdsSlave::connection_object(const devicenet::RequestMessage& r, TimePoint now,
+                                  ByteWriter& w) noexcept {
+  const bool class_level = r.instance_id == 0;
+  if (!class_level && !connections_.exists(r.instance_id)) {
+    return reply_error(GeneralStatus::kObjectDoesNotExist);
+  }
+  const auto service = static_cast<cip::Service>(r.service);
+  if (service == cip::Service::kReset) {
+    return class_level ? reset_connection_class(connections_, r.data, now)
+                       : reset_connection(connections_, r.instance_id, r.data, now);
+  }
+  const bool get = service == cip::Service::kGetAttributeSingle;
+  if (!get && !(service == cip::Service::kSetAttributeSingle && !class_level)) {
+    return reply_error(GeneralStatus::kServiceNotSupported);
+  }
+  if (!r.attribute) return reply_error(GeneralStatus::kNotEnoughData);
+  if (get && !r.data.empty()) return reply_error(GeneralStatus::kTooMuchData);
+  const std::uint8_t a = *r.attribute;
+  if (class_level) {
+    if (a != cip::class_attr::kRevision) return reply_error(GeneralStatus::kAttributeNotSupported);
+    return put_u16(w, 1);
+  }
+  if (!connection_attribute_exists(a)) return reply_error(GeneralStatus::kAttributeNotSupported);
+  if (get) return get_connection_attribute(connections_, mac_, *this, r.instance_id, a, w);
+  if (!connection_attribute_settable(r.instance_id, a)) {
+    return reply_error(GeneralStatus::kAttributeNotSettable);
+  }
+  return set_connection_attribute(connections_, *this, r.instance_id, a, r.data, now, w);
+}
+
+// The MAC is the switches' (DeviceNet object attribute 1 is Get here): the
+// offline set cannot change it.
+Reply EdsSlave::set_mac(std::uint8_t) noexcept {
+  return reply_error(GeneralStatus::kAttributeNotSettable);
+}
+
+}  // namespace dnbridge::sim

@@ -1,0 +1,157 @@
+#pragma once
+// A simulated Group 2 only slave of the predefined master/slave connection
+// set whose objects are those an EDS file describes (EdsObjects: Identity,
+// Assembly, Parameter, Acknowledge Handler), on the wire every such slave
+// shares (Group2Slave: duplicate MAC check, explicit messaging and its
+// fragments, Allocate/Release, poll, the Offline Connection Set, delays).
+//
+// Besides the EDS's objects it has the DeviceNet object (class 0x03,
+// instance 1: 1 MAC, 2 baud rate, 5 allocation information, Get only;
+// Allocate and Release) and the Connection object (class 0x05,
+// connection_object.hpp) of instances 1 (explicit), 2 (poll) and 4 (change
+// of state or cyclic, when the EDS's [IO_Info] offers either).
+//
+// Poll (instance 2): its produced path names the assembly whose packed data
+// answers each poll (EdsObjects::assembly_data), its consumed path the one
+// the poll command is unpacked into (EdsObjects::set_assembly_data: the
+// member parameters take the outputs). By default the EDS's PollInfo input
+// and output; attributes 7/8 are the sizes they pack to. A poll command
+// shorter than the consumed size is the idle condition (bridge/PROTOCOL.md
+// §7): the idle action; Release of an established poll connection is idle
+// too; its watchdog expiring, or a duplicate MAC, the fault action
+// (EdsSlaveOptions). At power-up the outputs are zero. I/O data longer than
+// one frame (8 bytes) is not fragmented here: such an assembly cannot be
+// chosen.
+//
+// Change of state / cyclic (instance 4), allocated with choice 0x10 or 0x20
+// (0x40 suppresses acknowledgment): produced path the COSInfo's (or
+// CyclicInfo's) input, consumed nothing. Once its EPR is set it produces on
+// Group 1 message 13 through a CosProducer: on a change of its data
+// (inputs_changed(), explicit Sets), no sooner than its inhibit time
+// (attribute 17, settable while Configuring), and once per EPR (the
+// heartbeat, or the cycle), each message acknowledged by the master on
+// Group 2 message 2 unless suppressed, retried at the Acknowledge Handler's
+// timer up to its retry limit (attributes 1 and 2, read when the connection
+// is established). An acknowledgment counts when the Acknowledge Handler's
+// COS producing connection instance (attribute 3) is 4; it may carry data,
+// which is ignored. The connection's watchdog (4 x EPR) is restarted by each
+// acknowledgment and does not run with acknowledgment suppressed (nothing
+// consumed): this simulator's reading.
+#include <cstdint>
+#include <optional>
+
+#include "adapters/sim/generic/connection_object.hpp"
+#include "adapters/sim/generic/connection_set.hpp"
+#include "adapters/sim/generic/cos_producer.hpp"
+#include "adapters/sim/generic/eds_objects.hpp"
+#include "adapters/sim/generic/group2_slave.hpp"
+#include "bridge/profiles/eds/eds_file.hpp"
+
+namespace dnbridge::sim {
+
+// What the outputs (the consumed assembly's parameters) do when the master
+// goes idle or away.
+enum class OutputAction : std::uint8_t {
+  kZero,  // every bit of the assembly 0
+  kHold,  // the last values kept
+};
+
+struct EdsSlaveOptions {
+  std::uint8_t mac = 63;
+  std::uint8_t baud = 0;  // DeviceNet object attribute 2: 0 125k, 1 250k, 2 500k
+  std::uint32_t serial_number = 1;
+  OutputAction idle_action = OutputAction::kZero;
+  OutputAction fault_action = OutputAction::kZero;
+  // An idle poll answered with no data rather than the produced data
+  // (bridge/PROTOCOL.md §7 leaves it open).
+  bool idle_poll_answered_empty = false;
+  // Expected packet rates are rounded up to this (bridge/PROTOCOL.md §7).
+  Duration timer_resolution = milliseconds(10);
+  // The wire's readings and delays; its vendor ID and serial number are the
+  // EDS's VendCode and serial_number above.
+  Group2Options wire{};
+};
+
+class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoAssemblies {
+ public:
+  EdsSlave(can::FrameSink& sink, eds::EdsFile file, EdsSlaveOptions options = {}, Logger log = {});
+
+  devicenet::MacId mac() const noexcept { return mac_; }
+  // 255 when no master owns the connection set.
+  std::uint8_t owner() const noexcept { return connections_.owner(); }
+  const ConnectionSet& connections() const noexcept { return connections_; }
+  ConnectionState explicit_state() const noexcept {
+    return connections_.explicit_connection().state;
+  }
+  ConnectionState poll_state() const noexcept { return connections_.poll_connection().state; }
+  ConnectionState cos_state() const noexcept { return connections_.cos_connection().state; }
+  const EdsSlaveOptions& options() const noexcept { return options_; }
+
+  // The device's objects; a test sets inputs with objects().set_param_value()
+  // and then calls inputs_changed().
+  EdsObjects& objects() noexcept { return objects_; }
+  const EdsObjects& objects() const noexcept { return objects_; }
+  // The change-of-state connection's data may have changed: a message now,
+  // if it is due.
+  void inputs_changed(TimePoint now) noexcept;
+
+  // The change-of-state connection's messages, every connection since
+  // power-on added up (produced counts retries too).
+  CosProducerCounters cos_counters() const noexcept;
+  // The default assemblies of the poll and change-of-state connections, from
+  // [IO_Info]; 0 for none.
+  std::uint16_t poll_input_assembly() const noexcept { return poll_input_; }
+  std::uint16_t poll_output_assembly() const noexcept { return poll_output_; }
+  std::uint16_t cos_input_assembly() const noexcept { return cos_input_; }
+
+ private:
+  // Group2Slave
+  devicenet::MacId device_mac() const noexcept override { return mac_; }
+  const ConnectionSet& connection_set() const noexcept override { return connections_; }
+  ConnectionSet& connection_set() noexcept override { return connections_; }
+  void power_up_device(TimePoint now, PowerUpCause cause) noexcept override;
+  void advance_device(TimePoint) noexcept override {}
+  TimePoint process_deadline() const noexcept override { return kNever; }
+  void device_timer(TimePoint now) noexcept override;
+  TimePoint device_deadline() const noexcept override;
+  std::size_t execute(const devicenet::RequestMessage& request, std::uint8_t requester,
+                      TimePoint now, MutableBytes out) noexcept override;
+  PendingAction take_pending_action() noexcept override { return PendingAction::kNone; }
+  void restore_factory_defaults() noexcept override {}
+  PollResult poll(Bytes command, TimePoint now) noexcept override;
+  void go_offline(TimePoint now) noexcept override;
+  Reply set_mac(std::uint8_t mac) noexcept override;
+  bool on_io_message(devicenet::Group2Message message, const can::CanFrame& frame,
+                     TimePoint now) noexcept override;
+
+  // ConnectionEvents
+  void on_io_established(std::uint16_t instance, TimePoint now) noexcept override;
+  void on_io_released(std::uint16_t instance, bool was_established,
+                      TimePoint now) noexcept override;
+  void on_io_timed_out(std::uint16_t instance, TimePoint now) noexcept override;
+
+  // IoAssemblies
+  std::uint16_t connection_size(std::uint16_t instance, bool produced) const noexcept override;
+  bool assembly_allowed(std::uint16_t instance, bool produced,
+                        std::uint16_t assembly) const noexcept override;
+
+  Reply devicenet_object(const devicenet::RequestMessage& r, std::uint8_t requester, TimePoint now,
+                         ByteWriter& w) noexcept;
+  Reply connection_object(const devicenet::RequestMessage& r, TimePoint now,
+                          ByteWriter& w) noexcept;
+  void apply_output_action(OutputAction action) noexcept;
+  void end_cos() noexcept;
+  void produce(const std::optional<std::vector<std::uint8_t>>& message, TimePoint now) noexcept;
+
+  EdsSlaveOptions options_;
+  EdsObjects objects_;
+  devicenet::MacId mac_;
+  std::uint16_t poll_input_ = 0;
+  std::uint16_t poll_output_ = 0;
+  std::uint16_t cos_input_ = 0;
+  ConnectionSet connections_;
+  std::optional<CosProducer> cos_;
+  CosProducerCounters cos_ended_;  // of the connections before the current one
+};
+
+}  // namespace dnbridge::sim

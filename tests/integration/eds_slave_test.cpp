@@ -1,0 +1,429 @@
+// A simulated slave described by the example I/O block EDS on the in-process
+// bus, fake clock: the product's master brings it online exactly as it does a
+// CDN127 (allocation, identity, paths, sizes, expected packet rates) and polls
+// it; the poll response is the input assembly, the poll command lands in the
+// output assembly's parameters, an idle poll and a lost connection take the
+// outputs to zero; Release and the watchdog behave as the CDN127's. Its
+// change-of-state connection produces on Group 1 message 13, is acknowledged
+// by a test node on Group 2 message 2, and retries when it is not.
+#include "adapters/sim/generic/eds_slave.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "adapters/sim/world/sim_master.hpp"
+#include "adapters/sim/world/sim_world.hpp"
+#include "bridge/devicenet/wire/identifier.hpp"
+#include "support/example_eds.hpp"
+
+namespace dnbridge::test {
+namespace {
+
+using devicenet::MacId;
+using devicenet::NodeState;
+
+constexpr unsigned kSlaveMac = 5;
+constexpr unsigned kMasterMac = 0;
+// Example I/O block: Assembly 100 (inputs: Param3 DI, Param5 status, Param2
+// AI) and 150 (outputs: Param4 DO, a pad byte).
+constexpr std::uint16_t kInputs = 100;
+constexpr std::uint16_t kOutputs = 150;
+
+MacId mac(unsigned v) { return MacId::from(v).value(); }
+
+// The slave on the world's bus.
+class EdsNode final : public sim::SimEndpoint {
+ public:
+  EdsNode(sim::SimWorld& world, sim::EdsSlaveOptions options)
+      : world_(world),
+        handle_(world.bus().attach(*this)),
+        slave_(world.bus().sink(handle_), example_eds(kIoBlockEds), options) {
+    world_.add(*this);
+    slave_.power_on(world.now());
+  }
+  ~EdsNode() override {
+    world_.remove(*this);
+    (void)world_.bus().detach(handle_);
+  }
+  EdsNode(const EdsNode&) = delete;
+  EdsNode& operator=(const EdsNode&) = delete;
+
+  void on_frame(const can::CanFrame& frame, TimePoint rx_time) override {
+    slave_.on_frame(frame, rx_time);
+  }
+  TimePoint next_deadline() const override { return slave_.next_deadline(); }
+  void on_timer(TimePoint now) override { slave_.on_timer(now); }
+  sim::EdsSlave& slave() { return slave_; }
+
+ private:
+  sim::SimWorld& world_;
+  sim::NodeHandle handle_;
+  sim::EdsSlave slave_;
+};
+
+// A node the test speaks through: records what it hears, sends what it is told.
+class TestNode final : public sim::SimEndpoint {
+ public:
+  explicit TestNode(sim::SimWorld& world) : world_(world), handle_(world.bus().attach(*this)) {
+    world_.add(*this);
+  }
+  ~TestNode() override {
+    world_.remove(*this);
+    (void)world_.bus().detach(handle_);
+  }
+  TestNode(const TestNode&) = delete;
+  TestNode& operator=(const TestNode&) = delete;
+
+  void on_frame(const can::CanFrame& frame, TimePoint rx_time) override {
+    heard.push_back({frame, rx_time});
+    if (auto_ack && frame.id == cos_id()) send(ack_frame());
+  }
+  TimePoint next_deadline() const override { return kNever; }
+  void on_timer(TimePoint) override {}
+
+  void send(const can::CanFrame& frame) { world_.bus().sink(handle_).send(frame, world_.now()); }
+  static can::CanFrame frame(std::uint32_t id, std::vector<std::uint8_t> data) {
+    return can::CanFrame::make(id, Bytes(data.data(), data.size())).value();
+  }
+  static std::uint32_t cos_id() {
+    return devicenet::group1_id(devicenet::Group1Message::kSlaveCosCyclic, mac(kSlaveMac));
+  }
+  static can::CanFrame ack_frame() {
+    return frame(
+        devicenet::group2_id(mac(kSlaveMac), devicenet::Group2Message::kMasterCosCyclicAck), {});
+  }
+  // The frames heard with `id`, and their times.
+  std::vector<std::pair<can::CanFrame, TimePoint>> with_id(std::uint32_t id) const {
+    std::vector<std::pair<can::CanFrame, TimePoint>> out;
+    for (const auto& h : heard) {
+      if (h.first.id == id) out.push_back(h);
+    }
+    return out;
+  }
+
+  bool auto_ack = false;
+  std::vector<std::pair<can::CanFrame, TimePoint>> heard;
+
+ private:
+  sim::SimWorld& world_;
+  sim::NodeHandle handle_;
+};
+
+class Recorder final : public devicenet::ScannerObserver {
+ public:
+  void on_node_state(MacId, NodeState, NodeState to, const std::string& reason,
+                     TimePoint) override {
+    state = to;
+    last_reason = reason;
+  }
+  void on_poll_response(MacId, Bytes data, TimePoint) override {
+    last_response.assign(data.begin(), data.end());
+    ++responses;
+  }
+  NodeState state = NodeState::kAbsent;
+  std::string last_reason;
+  std::vector<std::uint8_t> last_response;
+  unsigned responses = 0;
+};
+
+// The master's profile of the node, filled by hand from the EDS: [Device],
+// PollInfo's Input1 (Assembly 100, 4 bytes) and Output1 (Assembly 150, 2).
+devicenet::NodeConfig eds_node() {
+  devicenet::NodeConfig n;
+  n.mac = mac(kSlaveMac);
+  n.name = "io-block";
+  n.profile.identity = {65001, 7, 1};
+  n.profile.produced_path = {0x20, 0x04, 0x24, 0x64, 0x30, 0x03};
+  n.profile.consumed_path = {0x20, 0x04, 0x24, 0x96, 0x30, 0x03};
+  n.profile.produced_size = 4;
+  n.profile.consumed_size = 2;
+  n.profile.format_description = "Input1 4 B, Output1 2 B";
+  n.poll_period = milliseconds(100);
+  n.expected_packet_rate = milliseconds(400);
+  return n;
+}
+
+class EdsSlaveOnTheBus : public ::testing::Test {
+ protected:
+  void start(sim::EdsSlaveOptions options = {}) {
+    options.mac = kSlaveMac;
+    options.serial_number = 0x0A0B0C0D;
+    slave_.emplace(world_, options);
+    devicenet::ScannerConfig port;
+    port.master_mac = mac(kMasterMac);
+    port.nodes.push_back(eds_node());
+    master_.emplace(world_, port, events_);
+    master_->scanner().start(world_.now());
+  }
+  bool run_until_online() {
+    return world_.run_until([&] { return events_.state == NodeState::kOnline; }, seconds(10));
+  }
+  sim::EdsSlave& slave() { return slave_->slave(); }
+  devicenet::Scanner& scanner() { return master_->scanner(); }
+  const devicenet::Node& node() { return *scanner().node(mac(kSlaveMac)); }
+  std::optional<double> param(unsigned n) { return slave().objects().param_number(n); }
+  void set_param(unsigned n, std::vector<std::uint8_t> value) {
+    ASSERT_TRUE(slave().objects().set_param_value(n, Bytes(value.data(), value.size())));
+  }
+
+  sim::SimWorld world_;
+  Recorder events_;
+  std::optional<EdsNode> slave_;
+  std::optional<sim::SimMaster> master_;
+};
+
+TEST_F(EdsSlaveOnTheBus, TheMasterBringsItOnlineAndPollsTheInputAssembly) {
+  start();
+  ASSERT_TRUE(run_until_online()) << events_.last_reason;
+  EXPECT_EQ(node().identity().product_name, "Example IO block 8DI/8DO/1AI");  // fragmented
+  EXPECT_EQ(node().identity().serial_number, 0x0A0B0C0Du);
+  EXPECT_EQ(slave().owner(), kMasterMac);
+  EXPECT_EQ(slave().explicit_state(), sim::ConnectionState::kEstablished);
+  EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kEstablished);
+  // The paths the master asked for, the sizes they pack to, the EPR it set.
+  const sim::Connection& poll = slave().connections().poll_connection();
+  EXPECT_EQ(poll.produced_assembly, kInputs);
+  EXPECT_EQ(poll.consumed_assembly, kOutputs);
+  EXPECT_EQ(poll.expected_packet_rate_ms, 400);
+  EXPECT_EQ(slave().counters().requests_refused, 1u);  // Identity.State: not in the EDS
+
+  // DI 0xA5, status 1, AI -2 mV (0xFFFE): [A5][01][FE FF].
+  set_param(3, {0xA5});
+  set_param(5, {0x01});
+  set_param(2, {0xFE, 0xFF});
+  world_.run_for(milliseconds(250));
+  EXPECT_EQ(events_.last_response, (std::vector<std::uint8_t>{0xA5, 0x01, 0xFE, 0xFF}));
+  EXPECT_EQ(events_.last_response, slave().objects().assembly_data(kInputs));
+  set_param(3, {0x0F});
+  world_.run_for(milliseconds(150));
+  EXPECT_EQ(events_.last_response, (std::vector<std::uint8_t>{0x0F, 0x01, 0xFE, 0xFF}));
+
+  // Outputs: DO 0x3C and the pad byte reach Param4 through Assembly 150.
+  const std::array<std::uint8_t, 2> outputs{0x3C, 0x00};
+  ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  EXPECT_EQ(param(4), 0x3C);
+  EXPECT_EQ(slave().objects().assembly_data(kOutputs), (std::vector<std::uint8_t>{0x3C, 0x00}));
+  EXPECT_GT(slave().counters().polls_applied, 0u);  // idle polls until the first outputs
+
+  // Stays online: the keep-alives and polls keep both watchdogs fed.
+  world_.run_for(seconds(5));
+  EXPECT_EQ(events_.state, NodeState::kOnline);
+  EXPECT_EQ(node().counters().timeouts, 0u);
+  EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kEstablished);
+}
+
+TEST_F(EdsSlaveOnTheBus, AnIdlePollTakesTheOutputsToZeroUnlessConfiguredToHold) {
+  start();
+  ASSERT_TRUE(run_until_online()) << events_.last_reason;
+  const std::array<std::uint8_t, 2> outputs{0x81, 0x00};
+  ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  ASSERT_EQ(param(4), 0x81);
+  ASSERT_TRUE(scanner().set_idle(mac(kSlaveMac), true, world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  EXPECT_EQ(param(4), 0);
+  EXPECT_GT(slave().counters().polls_idle, 0u);
+  // The idle poll is answered with the inputs all the same.
+  EXPECT_EQ(events_.last_response.size(), 4u);
+  EXPECT_EQ(events_.state, NodeState::kOnline);
+}
+
+TEST_F(EdsSlaveOnTheBus, AHoldingDeviceKeepsItsOutputsOnIdle) {
+  sim::EdsSlaveOptions options;
+  options.idle_action = sim::OutputAction::kHold;
+  start(options);
+  ASSERT_TRUE(run_until_online()) << events_.last_reason;
+  const std::array<std::uint8_t, 2> outputs{0x81, 0x00};
+  ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  ASSERT_TRUE(scanner().set_idle(mac(kSlaveMac), true, world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  EXPECT_GT(slave().counters().polls_idle, 0u);
+  EXPECT_EQ(param(4), 0x81);
+}
+
+TEST_F(EdsSlaveOnTheBus, ReleaseAtShutdownLeavesTheSetUnownedAndTheOutputsIdle) {
+  start();
+  ASSERT_TRUE(run_until_online()) << events_.last_reason;
+  const std::array<std::uint8_t, 2> outputs{0xFF, 0x00};
+  ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  ASSERT_EQ(param(4), 0xFF);
+  scanner().stop(world_.now());
+  ASSERT_TRUE(world_.run_until([&] { return events_.state == NodeState::kStopped; }, seconds(5)));
+  EXPECT_EQ(slave().owner(), devicenet::MacId::kNone);
+  EXPECT_EQ(slave().explicit_state(), sim::ConnectionState::kNonExistent);
+  EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kNonExistent);
+  EXPECT_EQ(param(4), 0);
+}
+
+TEST_F(EdsSlaveOnTheBus, ASilentMasterTimesThePollConnectionOutAndTheOutputsFault) {
+  start();
+  ASSERT_TRUE(run_until_online()) << events_.last_reason;
+  const std::array<std::uint8_t, 2> outputs{0x42, 0x00};
+  ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  ASSERT_EQ(param(4), 0x42);
+  // The master leaves the bus: after 4 x EPR (1600 ms) the poll connection
+  // times out (action 0: timed out, the outputs to their fault value); after
+  // 4 x the explicit EPR the explicit connection goes too, and with nothing
+  // established the set is released (bridge/PROTOCOL.md §7).
+  const TimePoint gone = world_.now();
+  master_.reset();
+  world_.run_until(gone + milliseconds(1450));
+  EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kEstablished);
+  EXPECT_EQ(param(4), 0x42);
+  world_.run_until(gone + milliseconds(1700));
+  EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kTimedOut);
+  EXPECT_EQ(param(4), 0);
+  world_.run_until(gone + seconds(11));
+  EXPECT_EQ(slave().explicit_state(), sim::ConnectionState::kNonExistent);
+  EXPECT_EQ(slave().owner(), devicenet::MacId::kNone);
+  EXPECT_EQ(slave().connections().watchdog_timeouts(), 2u);
+}
+
+// --- change of state ------------------------------------------------------------
+
+class EdsSlaveChangeOfState : public ::testing::Test {
+ protected:
+  EdsSlaveChangeOfState() : slave_(world_, options()), tester_(world_) {}
+  static sim::EdsSlaveOptions options() {
+    sim::EdsSlaveOptions o;
+    o.mac = kSlaveMac;
+    return o;
+  }
+  sim::EdsSlave& slave() { return slave_.slave(); }
+  std::uint32_t request_id() {
+    return devicenet::group2_id(mac(kSlaveMac), devicenet::Group2Message::kMasterExplicitRequest);
+  }
+  // Allocates explicit + `cos_choice` from the test node (MAC 0), and sets
+  // instance 4's EPR: the connection is established.
+  void establish(std::uint8_t cos_choice, std::uint16_t epr_ms) {
+    ASSERT_TRUE(world_.run_until(
+        [&] { return slave().network_state() == sim::Group2Slave::NetworkState::kOnline; },
+        seconds(5)));
+    tester_.send(TestNode::frame(
+        devicenet::group2_id(mac(kSlaveMac), devicenet::Group2Message::kUnconnectedExplicitRequest),
+        {0x00, 0x4B, 0x03, 0x01, static_cast<std::uint8_t>(0x01 | cos_choice), 0x00}));
+    world_.run_for(milliseconds(10));
+    ASSERT_EQ(slave().cos_state(), sim::ConnectionState::kConfiguring);
+    // Set_Attribute_Single Connection 4 attribute 9.
+    tester_.send(TestNode::frame(request_id(),
+                                 {0x00, 0x10, 0x05, 0x04, 0x09, static_cast<std::uint8_t>(epr_ms),
+                                  static_cast<std::uint8_t>(epr_ms >> 8)}));
+    world_.run_for(milliseconds(10));
+    ASSERT_EQ(slave().cos_state(), sim::ConnectionState::kEstablished);
+    established_ = world_.now();
+  }
+  void change_inputs(std::uint8_t di) {
+    const std::array<std::uint8_t, 1> v{di};
+    ASSERT_TRUE(slave().objects().set_param_value(3, Bytes(v)));
+    slave().inputs_changed(world_.now());
+  }
+
+  sim::SimWorld world_;
+  EdsNode slave_;
+  TestNode tester_;
+  TimePoint established_{};
+};
+
+TEST_F(EdsSlaveChangeOfState, AChangeIsProducedOnMessage13AndTheAckStopsRetries) {
+  establish(0x10, 1000);
+  tester_.auto_ack = true;
+  tester_.heard.clear();
+  change_inputs(0x5A);
+  world_.run_for(milliseconds(200));
+  const auto cos = tester_.with_id(TestNode::cos_id());
+  ASSERT_EQ(cos.size(), 1u);
+  EXPECT_EQ(cos[0].first.id, 0x340u + kSlaveMac);
+  EXPECT_EQ(std::vector<std::uint8_t>(cos[0].first.payload().begin(), cos[0].first.payload().end()),
+            slave().objects().assembly_data(kInputs));
+  EXPECT_EQ(cos[0].first.payload()[0], 0x5A);
+  EXPECT_EQ(slave().cos_counters().produced, 1u);
+  EXPECT_EQ(slave().cos_counters().acks_received, 1u);
+  EXPECT_EQ(slave().cos_counters().retries, 0u);
+  // The heartbeat: the data again an EPR after, acknowledged too.
+  world_.run_for(milliseconds(1000));
+  EXPECT_EQ(tester_.with_id(TestNode::cos_id()).size(), 2u);
+  EXPECT_EQ(slave().cos_counters().retries, 0u);
+  EXPECT_EQ(slave().cos_state(), sim::ConnectionState::kEstablished);
+  // Connection 4 as the master reads it: produced on 0x340 + MAC, consumed on
+  // Group 2 message 2, 4 bytes produced.
+  tester_.send(TestNode::frame(request_id(), {0x00, 0x0E, 0x05, 0x04, 0x04}));
+  tester_.send(TestNode::frame(request_id(), {0x00, 0x0E, 0x05, 0x04, 0x07}));
+  world_.run_for(milliseconds(20));
+  const auto answers = tester_.with_id(
+      devicenet::group2_id(mac(kSlaveMac), devicenet::Group2Message::kSlaveExplicitResponse));
+  ASSERT_GE(answers.size(), 2u);
+  const auto& produced_id = answers[answers.size() - 2].first;
+  const auto& size = answers.back().first;
+  EXPECT_EQ(std::vector<std::uint8_t>(produced_id.payload().begin(), produced_id.payload().end()),
+            (std::vector<std::uint8_t>{0x00, 0x8E, 0x45, 0x03}));
+  EXPECT_EQ(std::vector<std::uint8_t>(size.payload().begin(), size.payload().end()),
+            (std::vector<std::uint8_t>{0x00, 0x8E, 0x04, 0x00}));
+}
+
+TEST_F(EdsSlaveChangeOfState, WithoutAckTheMessageIsRetriedUpToTheRetryLimit) {
+  // Acknowledge Handler: timer 20 ms, retry limit 3 (attribute 2, set before
+  // the connection is established).
+  slave().objects().ack_handler().retry_limit = 3;
+  establish(0x10, 1000);
+  tester_.heard.clear();
+  change_inputs(0x11);
+  world_.run_for(milliseconds(200));
+  const auto cos = tester_.with_id(TestNode::cos_id());
+  // The message, then 3 retries 20 ms apart; then given up.
+  ASSERT_EQ(cos.size(), 4u);
+  EXPECT_EQ(cos[1].second - cos[0].second, milliseconds(20));
+  EXPECT_EQ(cos[3].second - cos[2].second, milliseconds(20));
+  EXPECT_EQ(slave().cos_counters().produced, 4u);
+  EXPECT_EQ(slave().cos_counters().retries, 3u);
+  EXPECT_EQ(slave().cos_counters().given_up, 1u);
+  EXPECT_EQ(slave().cos_counters().acks_received, 0u);
+  // A late acknowledgment of the next change stops its retries at once.
+  change_inputs(0x12);
+  world_.run_for(milliseconds(5));
+  tester_.send(TestNode::ack_frame());
+  world_.run_for(milliseconds(200));
+  EXPECT_EQ(tester_.with_id(TestNode::cos_id()).size(), 5u);
+  EXPECT_EQ(slave().cos_counters().retries, 3u);
+  EXPECT_EQ(slave().cos_counters().acks_received, 1u);
+}
+
+TEST_F(EdsSlaveChangeOfState, AckSuppressionAndAllocationRefusals) {
+  ASSERT_TRUE(world_.run_until(
+      [&] { return slave().network_state() == sim::Group2Slave::NetworkState::kOnline; },
+      seconds(5)));
+  const auto allocate = [&](std::uint8_t choice) {
+    tester_.heard.clear();
+    tester_.send(TestNode::frame(
+        devicenet::group2_id(mac(kSlaveMac), devicenet::Group2Message::kUnconnectedExplicitRequest),
+        {0x00, 0x4B, 0x03, 0x01, choice, 0x00}));
+    world_.run_for(milliseconds(10));
+    const auto r = tester_.with_id(
+        devicenet::group2_id(mac(kSlaveMac), devicenet::Group2Message::kSlaveExplicitResponse));
+    return r.empty() ? std::vector<std::uint8_t>{}
+                     : std::vector<std::uint8_t>(r[0].first.payload().begin(),
+                                                 r[0].first.payload().end());
+  };
+  // Acknowledge suppression alone, COS and cyclic together, bit-strobe: refused.
+  EXPECT_EQ(allocate(0x41), (std::vector<std::uint8_t>{0x00, 0x94, 0x09, 0x02}));
+  EXPECT_EQ(allocate(0x31), (std::vector<std::uint8_t>{0x00, 0x94, 0x09, 0x02}));
+  EXPECT_EQ(allocate(0x05), (std::vector<std::uint8_t>{0x00, 0x94, 0x02, 0x02}));
+  // Cyclic with acknowledgment suppressed: taken; no acks, no retries.
+  EXPECT_EQ(allocate(0x61), (std::vector<std::uint8_t>{0x00, 0xCB, 0x00}));
+  EXPECT_EQ(slave().connections().allocation_choice(), 0x61);
+  tester_.send(TestNode::frame(request_id(), {0x00, 0x10, 0x05, 0x04, 0x09, 100, 0}));
+  world_.run_for(milliseconds(350));
+  // Cyclic: every EPR, whatever the data.
+  EXPECT_EQ(tester_.with_id(TestNode::cos_id()).size(), 3u);
+  EXPECT_EQ(slave().cos_counters().retries, 0u);
+  EXPECT_FALSE(slave().objects().ack_handler().cos_acknowledged);
+}
+
+}  // namespace
+}  // namespace dnbridge::test
