@@ -54,6 +54,19 @@ std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Problem
 // Node settings: a node's own keys, else [defaults], else the built-in values.
 
 constexpr std::string_view kProfileCdn127 = "cdn127";
+constexpr std::string_view kProfileEds = "eds";
+
+// The keys only a CDN127 node has, and only a profile = "eds" node has.
+constexpr std::array<std::string_view, 9> kCdn127OnlyKeys{"io",
+                                                          "identity",
+                                                          "pump_on_fault",
+                                                          "pump_on_idle",
+                                                          "n2_ballast_on_fault",
+                                                          "n2_ballast_on_idle",
+                                                          "analog_output_on_fault",
+                                                          "analog_output_on_idle",
+                                                          "analog_deadband_volts"};
+constexpr std::array<std::string_view, 3> kEdsOnlyKeys{"eds", "connection", "parameters"};
 
 enum class Level { kBuiltIn, kDefaults, kNode };
 
@@ -330,6 +343,18 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
       s.pump.safe_state.values.*k.analog = *v;
     }
   }
+  // Opt-ins that give up a guarantee: said in the log at every start.
+  if (layers.per_node() && keep_device) {
+    const Found f = layers.find("safe_state");
+    r.warning(f.value->source(),
+              fmt::format("node {} keeps the device's own fault and idle actions "
+                          "(safe_state = \"device\"): read and shown, never written",
+                          s.pump.node.mac.value()));
+  }
+}
+
+// resume: what a node's outputs do when it is back after a loss.
+void read_resume(const Layers& layers, NodeSettings& s, Problems& r) {
   if (Found f = layers.find("resume"); f.value) {
     if (auto v = read_string(*f.value, "resume", r)) {
       if (*v == "new-command") {
@@ -343,14 +368,6 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
                             *v));
       }
     }
-  }
-  // Opt-ins that give up a guarantee: said in the log at every start.
-  if (layers.per_node() && keep_device) {
-    const Found f = layers.find("safe_state");
-    r.warning(f.value->source(),
-              fmt::format("node {} keeps the device's own fault and idle actions "
-                          "(safe_state = \"device\"): read and shown, never written",
-                          s.pump.node.mac.value()));
   }
   if (layers.per_node() && s.pump.resume == rack::ResumePolicy::kLastCommand) {
     const Found f = layers.find("resume");
@@ -367,18 +384,23 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
 void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
   if (Found f = layers.find("profile"); f.value) {
     if (auto v = read_string(*f.value, "profile", r)) {
-      if (*v == kProfileCdn127) {
+      if (*v == kProfileCdn127 || *v == kProfileEds) {
         s.profile = *v;
       } else {
         r.error(f.value->source(),
-                fmt::format("profile \"{}\" is not supported: the only profile is \"cdn127\"", *v));
+                fmt::format("profile \"{}\" is not a profile: use \"cdn127\" (the default) or "
+                            "\"eds\" (a device described by its EDS file)",
+                            *v));
       }
     }
   }
-  if (Found f = layers.find("io"); f.value) {
+  // A CDN127's own settings; a node of another profile refuses them
+  // (read_eds_node), [defaults] may hold them for the CDN127s.
+  const bool cdn127 = s.profile == kProfileCdn127;
+  if (Found f = layers.find("io"); f.value && cdn127) {
     if (auto v = read_io(*f.value, r)) s.pump.io = *v;
   }
-  if (Found f = layers.find("identity"); f.value) {
+  if (Found f = layers.find("identity"); f.value && cdn127) {
     if (auto v = read_identity(*f.value, r)) s.pump.identity = *v;
   }
 
@@ -457,7 +479,7 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
       }
     }
   }
-  if (Found f = layers.find("analog_deadband_volts"); f.value) {
+  if (Found f = layers.find("analog_deadband_volts"); f.value && cdn127) {
     if (auto v = read_number(*f.value, "analog_deadband_volts", r)) {
       if (*v < 0 || *v > kAnalogFullScaleVolts) {
         r.error(f.value->source(),
@@ -489,7 +511,167 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
       }
     }
   }
-  read_safe_state(layers, s, r);
+  if (cdn127) read_safe_state(layers, s, r);
+  read_resume(layers, s, r);
+}
+
+// ---------------------------------------------------------------------------
+// Nodes described by their EDS files (profile = "eds").
+
+// What reading one configuration keeps besides its problems: where relative
+// EDS paths start, and each EDS file read, once.
+struct EdsRead {
+  std::shared_ptr<const eds::EdsFile> file;  // null: not usable
+  std::uint64_t digest = 0;
+  std::uint32_t first_line = 0;  // of the `eds` key that read it
+};
+struct ReadContext {
+  std::filesystem::path base_dir;
+  std::map<std::string, EdsRead> eds_files;  // by resolved path
+};
+
+// 64-bit FNV-1a: a changed file is told from the one in force.
+std::uint64_t digest_of(std::string_view text) {
+  std::uint64_t h = 14695981039346656037ULL;
+  for (char c : text) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+// The EDS file at `path`, read and checked at its first use, its problems
+// reported there (each "FILE:LINE: ..." of the EDS, at the `eds` key).
+const EdsRead& read_eds_file(const std::string& path, const toml::node& key, ReadContext& ctx,
+                             Problems& r) {
+  auto [it, first] = ctx.eds_files.try_emplace(path);
+  EdsRead& e = it->second;
+  if (!first) {
+    if (!e.file) {
+      r.error(key.source(), fmt::format("eds = \"{}\" is not usable (its problems are listed at "
+                                        "line {})",
+                                        path, e.first_line));
+    }
+    return e;
+  }
+  e.first_line = line_of(key.source());
+  auto text = toml_config::read_file(path, "an EDS file");
+  if (!text.text) {
+    r.error(key.source(), fmt::format("eds: {}", text.error));
+    return e;
+  }
+  const eds::Parsed parsed = eds::parse(*text.text);
+  for (const auto& problem : parsed.problems) {
+    const std::string line = fmt::format("eds: {}", eds::format_problem(path, problem));
+    if (problem.severity == eds::Problem::Severity::kError) {
+      r.error(key.source(), line);
+    } else {
+      r.warning(key.source(), line);
+    }
+  }
+  if (parsed.not_shown > 0) {
+    r.error(key.source(), fmt::format("eds: {}: {} more problems not shown ({} errors in all)",
+                                      path, parsed.not_shown, parsed.errors));
+  }
+  if (parsed.file) {
+    e.file = std::make_shared<const eds::EdsFile>(*parsed.file);
+    e.digest = digest_of(*text.text);
+  }
+  return e;
+}
+
+// connection = "poll" | "bit-strobe" | "change-of-state" | "cyclic".
+std::optional<eds::ConnectionKind> read_connection(const toml::node& n, Problems& r) {
+  auto v = read_string(n, "connection", r);
+  if (!v) return std::nullopt;
+  static constexpr std::pair<std::string_view, eds::ConnectionKind> kKinds[] = {
+      {"poll", eds::ConnectionKind::kPoll},
+      {"bit-strobe", eds::ConnectionKind::kStrobe},
+      {"change-of-state", eds::ConnectionKind::kChangeOfState},
+      {"cyclic", eds::ConnectionKind::kCyclic}};
+  for (const auto& [name, kind] : kKinds) {
+    if (*v == name) return kind;
+  }
+  r.error(n.source(), fmt::format("connection = \"{}\" is not a connection: use \"poll\", "
+                                  "\"bit-strobe\", \"change-of-state\" or \"cyclic\"",
+                                  *v));
+  return std::nullopt;
+}
+
+// KEY = [{ name = "...", value = N }, ...]: EDS parameters by name, in order.
+std::optional<std::vector<eds::ParameterValue>> read_parameter_values(const toml::node& n,
+                                                                      std::string_view key,
+                                                                      Problems& r) {
+  const toml::array* list = n.as_array();
+  if (!list || (!list->empty() && !list->is_array_of_tables())) {
+    r.error(n.source(), fmt::format("{} must be an array of {{ name = \"...\", value = ... }}, "
+                                    "not {}",
+                                    key, type_name(n.type())));
+    return std::nullopt;
+  }
+  std::vector<eds::ParameterValue> out;
+  bool ok = true;
+  for (const toml::node& element : *list) {
+    TableReader t(*element.as_table(), std::string(key), r);
+    const toml::node* name = t.require("name");
+    const toml::node* value = t.require("value");
+    auto name_v = name ? read_string(*name, fmt::format("{}.name", key), r) : std::nullopt;
+    auto value_v = value ? read_number(*value, fmt::format("{}.value", key), r) : std::nullopt;
+    if (name_v && value_v) {
+      out.push_back({*name_v, *value_v});
+    } else {
+      ok = false;
+    }
+  }
+  if (!ok) return std::nullopt;
+  return out;
+}
+
+// A profile = "eds" node's own keys: eds (the file, relative to the
+// configuration's directory), connection, parameters, safe_state; checked
+// against the EDS as the master will take them.
+void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems& r) {
+  for (std::string_view key : kCdn127OnlyKeys) {
+    if (const toml::node* n = nt.get(key)) {
+      r.error(n->source(),
+              fmt::format("{} is a CDN127 setting: this node has profile = \"eds\"", key));
+    }
+  }
+  const toml::node* connection = nt.get("connection");
+  if (connection) {
+    if (auto v = read_connection(*connection, r)) s.eds_node.connection = *v;
+  }
+  const toml::node* parameters = nt.get("parameters");
+  if (parameters) {
+    if (auto v = read_parameter_values(*parameters, "parameters", r)) s.eds_node.parameters = *v;
+  }
+  const toml::node* safe = nt.get("safe_state");
+  if (safe) {
+    if (auto v = read_parameter_values(*safe, "safe_state", r)) s.eds_node.safe_state = *v;
+  }
+  const toml::node* key = nt.require("eds");
+  if (!key) return;
+  auto given = read_string(*key, "eds", r);
+  if (!given) return;
+  std::filesystem::path path(*given);
+  if (path.is_relative() && !ctx.base_dir.empty()) path = ctx.base_dir / path;
+  s.eds_path = path.lexically_normal().string();
+  const EdsRead& e = read_eds_file(s.eds_path, *key, ctx, r);
+  if (!e.file) return;
+  s.eds = e.file;
+  s.eds_digest = e.digest;
+  std::string why;
+  if (!eds::make_node_profile(*e.file, s.eds_node, &why)) {
+    // At the key the problem is about.
+    const toml::node* at = key;
+    if (why.starts_with("parameters") && parameters) at = parameters;
+    if (why.starts_with("safe_state") && safe) at = safe;
+    if ((why.starts_with("connection") || why.starts_with("the EDS offers")) && connection) {
+      at = connection;
+    }
+    r.error(at->source(),
+            fmt::format("node {} ({}): {}", s.pump.node.mac.value(), s.eds_path, why));
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -541,10 +723,10 @@ void read_simulated_unconfigured(const toml::node& n, PortConfig& port, Problems
 }
 
 void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
-                     TableReader* defaults, Problems& r);
+                     TableReader* defaults, ReadContext& ctx, Problems& r);
 
 PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableReader* defaults,
-                     Problems& r) {
+                     ReadContext& ctx, Problems& r) {
   TableReader t(table, "[[port]]", r);
   PortConfig port;
   port.master.master_mac = rack.master_mac;
@@ -635,7 +817,7 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
             "allocate_retry_max_ms is shorter than allocate_retry_min_ms");
   }
 
-  read_port_nodes(t, table, port, defaults, r);
+  read_port_nodes(t, table, port, defaults, ctx, r);
   if (const toml::node* n = t.get("simulated_unconfigured")) {
     read_simulated_unconfigured(*n, port, r);
   }
@@ -644,7 +826,7 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
 
 // The port's [[port.node]] tables.
 void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
-                     TableReader* defaults, Problems& r) {
+                     TableReader* defaults, ReadContext& ctx, Problems& r) {
   const toml::node* master_mac_node = t.get("master_mac");
   const toml::node* nodes = t.get("node");
   const toml::array* list = nodes ? nodes->as_array() : nullptr;
@@ -713,6 +895,15 @@ void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
       ok = false;
     }
     read_node_settings(Layers{&nt, defaults}, s, r);
+    if (s.is_eds()) {
+      read_eds_node(nt, ctx, s, r);
+    } else {
+      for (std::string_view key : kEdsOnlyKeys) {
+        if (const toml::node* n = nt.get(key)) {
+          r.error(n->source(), fmt::format("{} is for profile = \"eds\" nodes", key));
+        }
+      }
+    }
     if (ok) port.nodes.push_back(std::move(s));
   }
 }
@@ -790,7 +981,8 @@ std::optional<LogLevel> log_level_named(std::string_view name) {
 // highest that fits is 232.
 constexpr std::int64_t kMaxDomainId = 232;
 
-DaemonConfig read_rack(const toml::table& table, std::string_view source, Problems& r) {
+DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadContext& ctx,
+                       Problems& r) {
   TableReader root(table, "the top level", r);
   DaemonConfig config;
   config.source = std::string(source);
@@ -880,7 +1072,7 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, Proble
   std::map<std::string, std::string> interfaces;
   for (const toml::node& element : *list) {
     const toml::table& pt = *element.as_table();
-    PortConfig port = read_port(pt, config, defaults ? &*defaults : nullptr, r);
+    PortConfig port = read_port(pt, config, defaults ? &*defaults : nullptr, ctx, r);
     if (!port.name.empty()) {
       const toml::node* name_node = pt.get("name");
       auto [it, added] = names.try_emplace(port.name, line_of(name_node->source()));
@@ -918,11 +1110,13 @@ std::string_view to_string(NoCommanderPolicy policy) noexcept {
   return "?";
 }
 
-DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
+DaemonConfig parse_config(std::string_view text, std::string_view source_name,
+                          const std::filesystem::path& base_dir) {
   Problems r{std::string(source_name)};
   const auto root = toml_config::parse(text, r);
   if (!root) throw ConfigError(r.errors());
-  DaemonConfig config = read_rack(*root, source_name, r);
+  ReadContext ctx{base_dir, {}};
+  DaemonConfig config = read_rack(*root, source_name, ctx, r);
   if (r.has_errors()) throw ConfigError(r.errors());
   config.warnings = r.warnings();
   return config;
@@ -931,7 +1125,8 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
 DaemonConfig load_config_file(const std::filesystem::path& path) {
   auto file = toml_config::read_file(path, "a configuration file");
   if (!file.text) throw ConfigError({std::move(file.error)});
-  DaemonConfig config = parse_config(*file.text, path.string());
+  DaemonConfig config =
+      parse_config(*file.text, path.string(), std::filesystem::absolute(path).parent_path());
   // [security]'s relative paths are the configuration file's neighbours.
   if (config.security) {
     config.security->resolve_relative_to(std::filesystem::absolute(path).parent_path());
@@ -949,11 +1144,32 @@ rack::PumpConfig NodeSettings::cdn127_pump() {
   return p;
 }
 
-std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port) {
-  std::vector<rack::PumpConfig> out;
-  out.reserve(port.nodes.size());
-  for (const auto& n : port.nodes) out.push_back(n.pump);
+rack::DeviceConfig NodeSettings::device() const {
+  rack::DeviceConfig d;
+  d.node = pump.node;
+  d.no_commander = pump.no_commander;
+  d.resume = pump.resume;
+  d.eds = eds;
+  d.eds_path = eds_path;
+  d.eds_digest = eds_digest;
+  d.settings = eds_node;
+  return d;
+}
+
+rack::PortNodes to_port_nodes(const PortConfig& port) {
+  rack::PortNodes out;
+  for (const auto& n : port.nodes) {
+    if (n.is_eds()) {
+      out.devices.push_back(n.device());
+    } else {
+      out.pumps.push_back(n.pump);
+    }
+  }
   return out;
+}
+
+std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port) {
+  return to_port_nodes(port).pumps;
 }
 
 devicenet::ScannerConfig to_scanner_config(const PortConfig& port, std::string_view host_id) {

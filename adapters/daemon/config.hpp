@@ -7,6 +7,7 @@
 // values, complete once loaded (every default resolved).
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -20,9 +21,12 @@
 #include "bridge/devicenet/master/scan_list.hpp"
 #include "bridge/devicenet/wire/mac_id.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
+#include "bridge/profiles/eds/node_profile.hpp"
+#include "bridge/rack/device_rack.hpp"
 #include "bridge/rack/explicit_policy.hpp"
 #include "bridge/rack/publish_gate.hpp"
 #include "bridge/rack/pump_rack.hpp"
+#include "bridge/rack/rack_port.hpp"
 
 namespace dnbridge::daemon {
 
@@ -32,14 +36,26 @@ using NoCommanderPolicy = rack::NoCommanderPolicy;
 
 std::string_view to_string(NoCommanderPolicy policy) noexcept;  // "idle", "hold"
 
-// A node of the scan list as the configuration gives it: the rack model's
-// own PumpConfig (its node's MAC, name and timings, its I/O configuration,
-// identity, no-commander and resume policies, safe state), filled by the
+// A node of the scan list as the configuration gives it, filled by the
 // loader with every default resolved, and how its samples are published.
+// Profile "cdn127": the rack model's own PumpConfig (its node's MAC, name
+// and timings, its I/O configuration, identity, no-commander and resume
+// policies, safe state). Profile "eds": the same PumpConfig's node and
+// policies, and the EDS file read with the node's settings from it.
 struct NodeSettings {
   rack::PumpConfig pump = cdn127_pump();
   PublishPolicy publish;
-  std::string profile = "cdn127";  // the only device profile there is
+  std::string profile = "cdn127";  // or "eds"
+
+  // Profile "eds".
+  std::shared_ptr<const eds::EdsFile> eds;
+  std::string eds_path;          // as resolved (absolute, or relative to the working directory)
+  std::uint64_t eds_digest = 0;  // of its text
+  eds::EdsNode eds_node;         // connection, parameters, safe state
+
+  bool is_eds() const noexcept { return profile == "eds"; }
+  // Profile "eds" as the rack model takes it.
+  rack::DeviceConfig device() const;
 
   // A CDN127 with the rack model's defaults.
   static rack::PumpConfig cdn127_pump();
@@ -109,22 +125,26 @@ class ConfigError : public std::runtime_error {
 DaemonConfig load_config_file(const std::filesystem::path& path);
 
 // Parses and checks configuration text; `source_name` names it in messages
-// and in DaemonConfig::source. Throws ConfigError.
-DaemonConfig parse_config(std::string_view text, std::string_view source_name);
+// and in DaemonConfig::source. Relative EDS paths are taken from `base_dir`
+// (the working directory when empty). Throws ConfigError.
+DaemonConfig parse_config(std::string_view text, std::string_view source_name,
+                          const std::filesystem::path& base_dir = {});
 
 // What `dnbridge-sim --simulate` runs: rack "sim-rack", eight CDN127 pumps on a
 // simulated 500 kbit/s port. The text is what --print-default-config prints.
 std::string_view embedded_default_config_text() noexcept;
 DaemonConfig embedded_default_config();
 
-// The scan-list entries of the port's nodes and the I/O configurations their
-// data is decoded with; each node's profile is filled by
-// rack::PumpRack::scanner_config.
+// The scan-list entries of the port's nodes, by profile, as the rack models
+// take them; each node's scan-list profile is filled by
+// rack::RackPort::scan_list.
+rack::PortNodes to_port_nodes(const PortConfig& port);
+// Its CDN127 nodes only.
 std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port);
 
 // The port's master: MAC, duplicate MAC identity and timings. The nodes are
-// left empty: rack::PumpRack::scanner_config(to_scanner_config(...),
-// to_pump_configs(port)) fills them. The loader has already resolved what
+// left empty: rack::RackPort::scan_list(to_scanner_config(...),
+// to_port_nodes(port)) fills them. The loader has already resolved what
 // the port takes from the rack (the master MAC). `host_id` (read_host_id())
 // gives the master's serial number where the port sets none.
 devicenet::ScannerConfig to_scanner_config(const PortConfig& port, std::string_view host_id);

@@ -30,8 +30,10 @@ port::PortLoopConfig loop_config(const DaemonConfig& rack, const PortConfig& p,
   c.port = p.name;
   c.explicit_policy = rack.explicit_policy;
   c.scanner = to_scanner_config(p, host_id);
-  c.pumps = to_pump_configs(p);
-  for (const auto& n : p.nodes) c.publish.push_back(n.publish);
+  rack::PortNodes nodes = to_port_nodes(p);
+  c.pumps = std::move(nodes.pumps);
+  c.devices = std::move(nodes.devices);
+  for (const auto& n : p.nodes) (n.is_eds() ? c.device_publish : c.publish).push_back(n.publish);
   return c;
 }
 
@@ -286,8 +288,9 @@ ReloadReport Daemon::reload() {
     for (const auto& p : plan.in_force.ports) {
       try {
         loops.push_back(loop_config(plan.in_force, p, host_id_));
-        devicenet::Scanner::check(
-            rack::PumpRack::scanner_config(loops.back().scanner, loops.back().pumps));
+        const auto& loop = loops.back();
+        devicenet::Scanner::check(rack::RackPort::scan_list(
+            loop.scanner, rack::PortNodes{loop.pumps, loop.devices}));
       } catch (const std::exception& e) {
         r.status = ReloadStatus::kRefused;
         r.problems.push_back(fmt::format("port {}: {}", p.name, e.what()));

@@ -24,13 +24,18 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
       publisher_(publisher),
       log_(Logger(log, fmt::format("port {}", config_.port)).with("PORT", config_.port)) {
   // The master's events reach the rack model first, then this loop.
-  port_.emplace(config_.scanner, config_.pumps, backend_->sink(), log_);
+  port_.emplace(config_.scanner, rack::PortNodes{config_.pumps, config_.devices}, backend_->sink(),
+                log_);
   port_->observe(static_cast<devicenet::ScannerObserver&>(*this));
   gateway_.emplace(scanner(), rack::ExplicitGateway::Limits{}, config_.explicit_policy, log_);
+  const auto policy = [](const std::vector<rack::PublishPolicy>& list, std::size_t i) {
+    return i < list.size() ? list[i] : rack::PublishPolicy{};
+  };
   for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
-    const rack::PublishPolicy policy =
-        i < config_.publish.size() ? config_.publish[i] : rack::PublishPolicy{};
-    published_.push_back(Published{rack::PumpStateGate(policy)});
+    published_.push_back({rack::PumpStateGate(policy(config_.publish, i))});
+  }
+  for (std::size_t i = 0; i < config_.devices.size(); ++i) {
+    published_devices_.push_back({rack::DeviceStateGate(policy(config_.device_publish, i))});
   }
   note_scan_list();
 }
@@ -38,6 +43,7 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
 void PortLoop::note_scan_list() {
   std::uint64_t bits = 0;
   for (const auto& p : config_.pumps) bits |= std::uint64_t{1} << p.node.mac.value();
+  for (const auto& d : config_.devices) bits |= std::uint64_t{1} << d.node.mac.value();
   scan_list_.store(bits, std::memory_order_relaxed);
 }
 
@@ -68,6 +74,9 @@ std::string PortLoop::problem() const {
 void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs,
                        std::string issuer) {
   push(Command{mac, outputs, std::move(issuer)});
+}
+void PortLoop::command(MacId mac, DeviceOutputs outputs, std::string issuer) {
+  push(DeviceCommand{mac, std::move(outputs), std::move(issuer)});
 }
 void PortLoop::release_command(MacId mac) { push(Release{mac}); }
 void PortLoop::explicit_request(rack::ExplicitCall call) {
@@ -103,11 +112,17 @@ std::future<PortChange> PortLoop::reconfigure(PortLoopConfig next) {
 void PortLoop::apply(const Reconfigure& r, TimePoint now) {
   PortLoopConfig& next = *r.config;
   PortChange change;
-  // published_ follows the rack's views, in their order: which MAC each is.
-  std::vector<MacId> published_macs;
-  for (const auto& v : rack().pumps()) published_macs.push_back(v.mac);
+  // The published entries follow the racks' views, in their order: which MAC each is.
+  const auto macs_of = [](const auto& views) {
+    std::vector<MacId> out;
+    for (const auto& v : views) out.push_back(v.mac);
+    return out;
+  };
+  const std::vector<MacId> pumps_before = macs_of(rack().pumps());
+  const std::vector<MacId> devices_before = macs_of(devices().devices());
   try {
-    change.scan_list = port_->reconfigure(next.scanner, next.pumps, now);
+    change.scan_list =
+        port_->reconfigure(next.scanner, rack::PortNodes{next.pumps, next.devices}, now);
   } catch (const std::exception& e) {
     change.refused = e.what();
     log_.error("configuration not applied: {}", change.refused);
@@ -115,36 +130,18 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
     return;
   }
   const auto& sc = change.scan_list;
-  const auto listed = [](const std::vector<MacId>& macs, MacId mac) {
-    return std::find(macs.begin(), macs.end(), mac) != macs.end();
+  const auto policy_in = [](const auto& configs, const std::vector<rack::PublishPolicy>& policies) {
+    return [&configs, &policies](MacId mac) {
+      for (std::size_t i = 0; i < configs.size() && i < policies.size(); ++i) {
+        if (configs[i].node.mac == mac) return policies[i];
+      }
+      return rack::PublishPolicy{};
+    };
   };
-  const auto policy_of = [&](MacId mac) {
-    for (std::size_t i = 0; i < next.pumps.size() && i < next.publish.size(); ++i) {
-      if (next.pumps[i].node.mac == mac) return next.publish[i];
-    }
-    return rack::PublishPolicy{};
-  };
-  // What is published of each pump follows the rack's views, in their
-  // order: a node kept keeps its gate (a new one if its policy changed), a
-  // new or re-configured one starts afresh.
-  std::array<std::optional<Published>, MacId::kMax + 1> kept;
-  for (std::size_t i = 0; i < published_macs.size(); ++i) {
-    kept[published_macs[i].value()] = std::move(published_[i]);
-  }
-  published_.clear();
-  for (const auto& v : rack().pumps()) {
-    const rack::PublishPolicy policy = policy_of(v.mac);
-    auto& old = kept[v.mac.value()];
-    if (!old || listed(sc.added, v.mac) || listed(sc.reconfigured, v.mac)) {
-      published_.push_back(Published{rack::PumpStateGate(policy)});
-      continue;
-    }
-    if (!(old->gate.policy() == policy)) {
-      old->gate = rack::PumpStateGate(policy);
-      change.publish_changed.push_back(v.mac);
-    }
-    published_.push_back(std::move(*old));
-  }
+  carry_published(pumps_before, rack().pumps(), published_, sc, policy_in(next.pumps, next.publish),
+                  change.publish_changed);
+  carry_published(devices_before, devices().devices(), published_devices_, sc,
+                  policy_in(next.devices, next.device_publish), change.publish_changed);
   for (MacId mac : sc.removed) publisher_.node_removed(config_.port, mac);
   if (!(gateway_->policy() == next.explicit_policy)) {
     gateway_->set_policy(next.explicit_policy);
@@ -152,6 +149,8 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
   }
   config_.pumps = std::move(next.pumps);
   config_.publish = std::move(next.publish);
+  config_.devices = std::move(next.devices);
+  config_.device_publish = std::move(next.device_publish);
   config_.explicit_policy = next.explicit_policy;
   note_scan_list();
   port_dirty_ = true;
@@ -173,6 +172,35 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
       sc.timings_changed ? "; the port's timings changed" : "",
       change.explicit_policy_changed ? "; the explicit policy changed" : "");
   r.done->set_value(std::move(change));
+}
+
+template <class View, class Gate>
+void PortLoop::carry_published(const std::vector<MacId>& before, const std::vector<View>& views,
+                               std::vector<Published<Gate>>& published,
+                               const rack::ScanListChange& sc,
+                               const std::function<rack::PublishPolicy(MacId)>& policy_of,
+                               std::vector<MacId>& policy_changed) {
+  const auto listed = [](const std::vector<MacId>& macs, MacId mac) {
+    return std::find(macs.begin(), macs.end(), mac) != macs.end();
+  };
+  // A node kept keeps its gate (a new one if its policy changed), a new or
+  // re-configured one starts afresh.
+  std::array<std::optional<Published<Gate>>, MacId::kMax + 1> kept;
+  for (std::size_t i = 0; i < before.size(); ++i) kept[before[i].value()] = std::move(published[i]);
+  published.clear();
+  for (const auto& v : views) {
+    const rack::PublishPolicy policy = policy_of(v.mac);
+    auto& old = kept[v.mac.value()];
+    if (!old || listed(sc.added, v.mac) || listed(sc.reconfigured, v.mac)) {
+      published.push_back({Gate(policy)});
+      continue;
+    }
+    if (!(old->gate.policy() == policy)) {
+      old->gate = Gate(policy);
+      policy_changed.push_back(v.mac);
+    }
+    published.push_back(std::move(*old));
+  }
 }
 
 void PortLoop::handle_scan_call(ScanCall call, TimePoint now) {
@@ -273,11 +301,22 @@ bool PortLoop::drain_inbox(TimePoint now) {
         const rack::PumpView* pump = rack().pump(c->mac);
         log_.warn("command refused: {}",
                   pump ? pump->last_command_refused
-                       : fmt::format("from {}: MAC {} is not in this port's scan list", c->issuer,
-                                     c->mac.value()));
+                       : fmt::format("from {}: MAC {} is not a pump of this port's scan list",
+                                     c->issuer, c->mac.value()));
+      }
+    } else if (auto* d = std::get_if<DeviceCommand>(&item)) {
+      const auto s = std::visit(
+          [&](const auto& outputs) { return devices().command(d->mac, outputs, d->issuer, now); },
+          d->outputs);
+      if (!s) {
+        const rack::DeviceView* device = devices().device(d->mac);
+        log_.warn("command refused: {}",
+                  device ? device->last_command_refused
+                         : fmt::format("from {}: MAC {} is not a device of this port's scan list",
+                                       d->issuer, d->mac.value()));
       }
     } else if (auto* r = std::get_if<Release>(&item)) {
-      if (rack().release_command(r->mac, now)) {
+      if (port_->release_command(r->mac, now)) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
     } else if (auto* scan = std::get_if<ScanCall>(&item)) {
@@ -349,6 +388,9 @@ void PortLoop::run() {
     for (const auto& p : published_) {
       wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
     }
+    for (const auto& p : published_devices_) {
+      wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
+    }
     if (calls_waiting_) wake = now;
     note_busy(pass_start);
     FrameReceiver& receiver = *this;
@@ -377,32 +419,48 @@ void PortLoop::start_master_when_up(TimePoint now) {
   }
 }
 
-void PortLoop::publish(TimePoint now, bool force) {
-  const auto& views = rack().pumps();
+template <class View, class Gate, class State, class Status>
+void PortLoop::publish_views(const std::vector<View>& views,
+                             std::vector<Published<Gate>>& published, TimePoint now, bool force,
+                             State state, Status status) {
   for (std::size_t i = 0; i < views.size(); ++i) {
-    const rack::PumpView& v = views[i];
-    Published& p = published_[i];
+    const View& v = views[i];
+    Published<Gate>& p = published[i];
     // The source time is that of the latest event the sample reflects; a
     // node nothing has happened to yet has been absent since the loop started.
     TimePoint source = std::max(v.state_since, started_);
     if (v.has_inputs) source = std::max(source, v.inputs_time);
-    // Unchanged since the gate was last asked, a pump is due only by time.
+    // Unchanged since the gate was last asked, a node is due only by time.
     if (force || v.changes != p.checked || now >= p.gate.deadline()) {
       p.checked = v.changes;
       if (force || p.gate.due(v, now)) {
-        publisher_.pump_state(config_.port, v, source);
+        state(v, source);
         p.gate.published(v, now);
       }
     }
     if (force || !p.status_once || v.status_changes != p.changes ||
         now >= p.status_time + config_.status_period) {
-      publisher_.node_status(config_.port, v, NodeStatusView::of(*scanner().node(v.mac)),
-                             std::max(source, p.status_time));
+      status(v, NodeStatusView::of(*scanner().node(v.mac)), std::max(source, p.status_time));
       p.changes = v.status_changes;
       p.status_time = now;
       p.status_once = true;
     }
   }
+}
+
+void PortLoop::publish(TimePoint now, bool force) {
+  publish_views(
+      rack().pumps(), published_, now, force,
+      [&](const rack::PumpView& v, TimePoint t) { publisher_.pump_state(config_.port, v, t); },
+      [&](const rack::PumpView& v, const NodeStatusView& n, TimePoint t) {
+        publisher_.node_status(config_.port, v, n, t);
+      });
+  publish_views(
+      devices().devices(), published_devices_, now, force,
+      [&](const rack::DeviceView& v, TimePoint t) { publisher_.device_state(config_.port, v, t); },
+      [&](const rack::DeviceView& v, const NodeStatusView& n, TimePoint t) {
+        publisher_.device_status(config_.port, v, n, t);
+      });
   if (force || port_dirty_ || now >= port_status_time_ + config_.status_period) publish_port(now);
 }
 
@@ -427,10 +485,12 @@ void PortLoop::publish_port(TimePoint now) {
     std::lock_guard lock(problem_mutex_);
     if (problem != problem_) problem_ = problem;
   }
-  const auto& views = rack().pumps();
-  s.nodes_configured = static_cast<std::uint16_t>(views.size());
-  s.nodes_online = static_cast<std::uint16_t>(
-      std::count_if(views.begin(), views.end(), [](const auto& v) { return v.online; }));
+  const auto online = [](const auto& views) {
+    return std::count_if(views.begin(), views.end(), [](const auto& v) { return v.online; });
+  };
+  s.nodes_configured =
+      static_cast<std::uint16_t>(rack().pumps().size() + devices().devices().size());
+  s.nodes_online = static_cast<std::uint16_t>(online(rack().pumps()) + online(devices().devices()));
   // Rates are measured over whole status periods; a state change in between
   // publishes the last measured ones.
   if (now - metrics_time_ >= config_.status_period) update_metrics(s.bus, now);
@@ -461,17 +521,20 @@ void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
   const double elapsed = std::chrono::duration<double>(now - metrics_time_).count();
   double cycle_sum = 0;
   unsigned cycles = 0;
-  const auto& views = rack().pumps();
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    const auto* node = scanner().node(views[i].mac);
-    std::uint64_t& last = published_[i].polls;
-    const std::uint64_t polls = node->counters().polls;
-    if (node->state() == devicenet::NodeState::kOnline && polls > last) {
-      cycle_sum += 1000.0 * elapsed / static_cast<double>(polls - last);
-      ++cycles;
+  const auto add_cycles = [&](const auto& views, auto& published) {
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const auto* node = scanner().node(views[i].mac);
+      std::uint64_t& last = published[i].polls;
+      const std::uint64_t polls = node->counters().polls;
+      if (node->state() == devicenet::NodeState::kOnline && polls > last) {
+        cycle_sum += 1000.0 * elapsed / static_cast<double>(polls - last);
+        ++cycles;
+      }
+      last = polls;
     }
-    last = polls;
-  }
+  };
+  add_cycles(rack().pumps(), published_);
+  add_cycles(devices().devices(), published_devices_);
   metrics_.frames_per_second = static_cast<double>(bus.frames - last_counters_.frames) / elapsed;
   const auto bitrate = backend_->bitrate();
   metrics_.bus_load_percent = bitrate

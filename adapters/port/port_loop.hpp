@@ -23,6 +23,7 @@
 #include "adapters/port/port_publisher.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/master/scanner.hpp"
+#include "bridge/rack/device_rack.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
 #include "bridge/rack/publish_gate.hpp"
 #include "bridge/rack/pump_rack.hpp"
@@ -32,9 +33,11 @@ namespace dnbridge::port {
 
 struct PortLoopConfig {
   std::string port;                          // the port's name
-  devicenet::ScannerConfig scanner;          // master MAC and timings; nodes from `pumps`
-  std::vector<rack::PumpConfig> pumps;       // the scan list
+  devicenet::ScannerConfig scanner;          // master MAC and timings; nodes from the lists below
+  std::vector<rack::PumpConfig> pumps;       // the scan list: CDN127s
   std::vector<rack::PublishPolicy> publish;  // per pump, same order
+  std::vector<rack::DeviceConfig> devices;   // the scan list: devices described by their EDS
+  std::vector<rack::PublishPolicy> device_publish;  // per device, same order
   rack::ExplicitPolicy explicit_policy;      // the rack's [explicit_policy]
   Duration status_period = seconds(1);       // NodeStatus/PortStatus at least this often
   Duration shutdown_timeout = seconds(3);    // for idling and releasing every node
@@ -71,6 +74,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // From any thread: queued for the port's thread, which is woken.
   void command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
                std::string issuer);
+  // A device's (profile "eds") outputs, as bytes or as its fields.
+  using DeviceOutputs = std::variant<std::vector<std::uint8_t>, std::vector<eds::FieldSetting>>;
+  void command(devicenet::MacId mac, DeviceOutputs outputs, std::string issuer);
   void release_command(devicenet::MacId mac);
   // Past kMaxQueuedCalls requests waiting for the loop, answered at once
   // with "out of buffers" (on the caller's thread, through the publisher).
@@ -129,6 +135,11 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     profiles::cdn127::PumpOutputs outputs;
     std::string issuer;
   };
+  struct DeviceCommand {
+    devicenet::MacId mac;
+    DeviceOutputs outputs;
+    std::string issuer;
+  };
   struct Release {
     devicenet::MacId mac;
   };
@@ -137,8 +148,8 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     std::shared_ptr<PortLoopConfig> config;
     std::shared_ptr<std::promise<PortChange>> done;
   };
-  using Item =
-      std::variant<Command, Release, Stop, ScanCall, Reconfigure, std::function<void(CanBackend&)>>;
+  using Item = std::variant<Command, DeviceCommand, Release, Stop, ScanCall, Reconfigure,
+                            std::function<void(CanBackend&)>>;
   void apply(const Reconfigure& r, TimePoint now);
   void note_scan_list();
 
@@ -179,19 +190,32 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   Logger log_;
   std::optional<rack::RackPort> port_;  // the master and the rack model
   rack::PumpRack& rack() { return port_->pumps(); }
+  rack::DeviceRack& devices() { return port_->devices(); }
   devicenet::Scanner& scanner() { return port_->scanner(); }
   std::optional<rack::ExplicitGateway> gateway_;
 
+  // What was published of a node, and when its state is next due.
+  template <class Gate>
   struct Published {
-    rack::PumpStateGate gate;
-    std::uint64_t checked = ~0ull;  // PumpView::changes when the gate was last asked
-    std::uint64_t changes = ~0ull;  // PumpView::status_changes at the last NodeStatus
+    Gate gate;
+    std::uint64_t checked = ~0ull;  // the view's changes when the gate was last asked
+    std::uint64_t changes = ~0ull;  // the view's status_changes at the last NodeStatus
     TimePoint status_time{};
     bool status_once = false;
-    TimePoint event_time{};  // latest event of this node: the source time
     std::uint64_t polls = 0;  // the node's polls at the last metrics update
   };
-  std::vector<Published> published_;  // in the rack's order of pumps
+  std::vector<Published<rack::PumpStateGate>> published_;            // in the rack's order of pumps
+  std::vector<Published<rack::DeviceStateGate>> published_devices_;  // and of devices
+  // Publishes each view of `views` whose state or status is due.
+  template <class View, class Gate, class State, class Status>
+  void publish_views(const std::vector<View>& views, std::vector<Published<Gate>>& published,
+                     TimePoint now, bool force, State state, Status status);
+  // After a reload: `published` follows the rack's new views, in their order.
+  template <class View, class Gate>
+  void carry_published(const std::vector<devicenet::MacId>& before, const std::vector<View>& views,
+                       std::vector<Published<Gate>>& published, const rack::ScanListChange& sc,
+                       const std::function<rack::PublishPolicy(devicenet::MacId)>& policy_of,
+                       std::vector<devicenet::MacId>& policy_changed);
   TimePoint started_{};              // when run() began
   bool master_started_ = false;
   bool port_dirty_ = true;

@@ -10,6 +10,7 @@
 #include "adapters/port/can_backend.hpp"
 #include "bridge/devicenet/master/node.hpp"
 #include "bridge/devicenet/master/scanner_events.hpp"
+#include "bridge/rack/device_rack.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
 #include "bridge/rack/pump_rack.hpp"
 
@@ -94,6 +95,12 @@ class PortPublisher {
                           TimePoint source_time) = 0;
   virtual void node_status(const std::string& port, const rack::PumpView& pump,
                            const NodeStatusView& node, TimePoint source_time) = 0;
+  // A device described by its EDS file (profile "eds"): its DeviceState and
+  // its NodeStatus. Publishers without a use for them leave them out.
+  virtual void device_state(const std::string& /*port*/, const rack::DeviceView& /*device*/,
+                            TimePoint /*source_time*/) {}
+  virtual void device_status(const std::string& /*port*/, const rack::DeviceView& /*device*/,
+                             const NodeStatusView& /*node*/, TimePoint /*source_time*/) {}
   virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;
   // `port`: the port whose gateway answers; empty for a request no port took.
   virtual void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) = 0;

@@ -19,6 +19,16 @@ class PublisherTee final : public PortPublisher {
     first_.node_status(port, pump, node, source_time);
     second_.node_status(port, pump, node, source_time);
   }
+  void device_state(const std::string& port, const rack::DeviceView& device,
+                    TimePoint source_time) override {
+    first_.device_state(port, device, source_time);
+    second_.device_state(port, device, source_time);
+  }
+  void device_status(const std::string& port, const rack::DeviceView& device,
+                     const NodeStatusView& node, TimePoint source_time) override {
+    first_.device_status(port, device, node, source_time);
+    second_.device_status(port, device, node, source_time);
+  }
   void port_status(const PortStatusView& status, TimePoint source_time) override {
     first_.port_status(status, source_time);
     second_.port_status(status, source_time);

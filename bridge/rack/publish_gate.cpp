@@ -54,4 +54,26 @@ void PumpStateGate::published(const PumpView& view, TimePoint now) {
   last_commander_ = view.commanded_by;
 }
 
+DeviceStateGate::Seen DeviceStateGate::seen(const DeviceView& v) {
+  Seen s;
+  s.online = v.online;
+  s.inputs_valid = v.has_inputs;
+  if (v.has_inputs) s.inputs = v.inputs;
+  s.outputs_idle = v.outputs_idle;
+  if (!v.outputs_idle) s.outputs = v.outputs_applied;
+  s.commanded_by = v.commanded_by;
+  return s;
+}
+
+bool DeviceStateGate::due(const DeviceView& view, TimePoint now) const {
+  if (!published_once_ || now >= last_time_ + policy_.max_period) return true;
+  return !(seen(view) == last_);
+}
+
+void DeviceStateGate::published(const DeviceView& view, TimePoint now) {
+  published_once_ = true;
+  last_time_ = now;
+  last_ = seen(view);
+}
+
 }  // namespace dnbridge::rack

@@ -1,20 +1,23 @@
 #pragma once
-// When a pump's state is worth a new sample: at once on any change of a
-// discrete value (online, inputs, alarms, outputs, idle, who commands), on an
-// analog change larger than the deadband, and in any case once per maximum
-// period, so that readers can hold the bridge to a deadline.
+// When a node's state is worth a new sample. A pump's: at once on any
+// change of a discrete value (online, inputs, alarms, outputs, idle, who
+// commands), on an analog change larger than the deadband. A device's
+// (profile "eds"): at once on any change of its data or of those states (its
+// EDS says nothing of which bits are analog). Either in any case once per
+// maximum period, so that readers can hold the bridge to a deadline.
 #include <array>
 #include <cstdint>
 #include <string>
 
 #include "bridge/common/time.hpp"
+#include "bridge/rack/device_rack.hpp"
 #include "bridge/rack/pump_rack.hpp"
 
 namespace dnbridge::rack {
 
 struct PublishPolicy {
   Duration max_period = seconds(1);
-  double analog_deadband_volts = 0.05;
+  double analog_deadband_volts = 0.05;  // pumps only
 
   friend bool operator==(const PublishPolicy&, const PublishPolicy&) = default;
 };
@@ -53,6 +56,33 @@ class PumpStateGate {
   Discrete last_;
   std::array<int, 2> last_analog_{-1, -1};
   std::string last_commander_;
+};
+
+class DeviceStateGate {
+ public:
+  explicit DeviceStateGate(PublishPolicy policy) : policy_(policy) {}
+
+  bool due(const DeviceView& view, TimePoint now) const;
+  void published(const DeviceView& view, TimePoint now);
+  TimePoint deadline() const { return published_once_ ? last_time_ + policy_.max_period : kNever; }
+  const PublishPolicy& policy() const { return policy_; }
+
+ private:
+  struct Seen {
+    bool online = false;
+    bool inputs_valid = false;
+    std::vector<std::uint8_t> inputs;
+    bool outputs_idle = true;
+    std::vector<std::uint8_t> outputs;
+    std::string commanded_by;
+    friend bool operator==(const Seen&, const Seen&) = default;
+  };
+  static Seen seen(const DeviceView& view);
+
+  PublishPolicy policy_;
+  bool published_once_ = false;
+  TimePoint last_time_{};
+  Seen last_;
 };
 
 }  // namespace dnbridge::rack

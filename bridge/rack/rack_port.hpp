@@ -1,9 +1,10 @@
 #pragma once
 // One port of a rack, composed the one way it is everywhere (the daemon's
 // port loop, dnbridge-sim, the benchmark, the simulated rack of the tests):
-// the master (devicenet::Scanner) built from the pumps' scan list, the rack
-// model (PumpRack) hearing the master's events first, then the observers
-// added, in the order added.
+// the master (devicenet::Scanner) built from the scan list of the pumps
+// (CDN127s) and the devices described by their EDS files, the rack models
+// (PumpRack, then DeviceRack) hearing the master's events first, then the
+// observers added, in the order added.
 #include <functional>
 #include <optional>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "bridge/can/frame_sink.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/master/scanner.hpp"
+#include "bridge/rack/device_rack.hpp"
 #include "bridge/rack/pump_rack.hpp"
 
 namespace dnbridge::rack {
@@ -21,7 +23,8 @@ struct ScanListChange {
   std::vector<devicenet::MacId> added;
   std::vector<devicenet::MacId> removed;
   // Its device settings differ (I/O configuration, safe state, identity,
-  // timings, serial): released, then configured again.
+  // timings, serial; its EDS, parameters or connection; its profile):
+  // released, then configured again.
   std::vector<devicenet::MacId> reconfigured;
   // Only what the bridge does with it differs (name, no-commander and
   // resume policies): applied in place, the node untouched.
@@ -36,20 +39,28 @@ struct ScanListChange {
   }
 };
 
-ScanListChange compare(const devicenet::ScannerConfig& port_before,
-                       const std::vector<PumpConfig>& before,
-                       const devicenet::ScannerConfig& port_after,
-                       const std::vector<PumpConfig>& after);
+// The nodes of a port's scan list, by profile.
+struct PortNodes {
+  std::vector<PumpConfig> pumps;
+  std::vector<DeviceConfig> devices;
+};
+
+ScanListChange compare(const devicenet::ScannerConfig& port_before, const PortNodes& before,
+                       const devicenet::ScannerConfig& port_after, const PortNodes& after);
 
 class RackPort {
  public:
-  // `port`: the master's MAC and timings (its nodes come from `pumps`).
+  // `port`: the master's MAC and timings (its nodes come from `nodes`).
   // `adjust`: a change to the scan list after it is built (tests: a profile
   // that disagrees with the device). Throws std::invalid_argument for a scan
   // list the master refuses.
+  RackPort(devicenet::ScannerConfig port, const PortNodes& nodes, can::FrameSink& sink, Logger log,
+           const std::function<void(devicenet::ScannerConfig&)>& adjust = {});
+  // Pumps only.
   RackPort(devicenet::ScannerConfig port, const std::vector<PumpConfig>& pumps,
            can::FrameSink& sink, Logger log,
-           const std::function<void(devicenet::ScannerConfig&)>& adjust = {});
+           const std::function<void(devicenet::ScannerConfig&)>& adjust = {})
+      : RackPort(std::move(port), PortNodes{pumps, {}}, sink, std::move(log), adjust) {}
   RackPort(const RackPort&) = delete;
   RackPort& operator=(const RackPort&) = delete;
 
@@ -62,17 +73,37 @@ class RackPort {
   // The master's MAC and duplicate MAC ID identity are not changed here.
   // Checks the whole first: throws std::invalid_argument, changing nothing,
   // for a scan list the master refuses.
+  ScanListChange reconfigure(const devicenet::ScannerConfig& port, const PortNodes& nodes,
+                             TimePoint now);
+  // Pumps only.
   ScanListChange reconfigure(const devicenet::ScannerConfig& port,
-                             const std::vector<PumpConfig>& pumps, TimePoint now);
+                             const std::vector<PumpConfig>& pumps, TimePoint now) {
+    return reconfigure(port, PortNodes{pumps, {}}, now);
+  }
+
+  // The master's scan list for `nodes` (the port's MAC and timings from
+  // `port`). Throws std::invalid_argument for a node its profile refuses.
+  static devicenet::ScannerConfig scan_list(devicenet::ScannerConfig port, const PortNodes& nodes);
+
+  // No live commander left for the node, whichever its profile
+  // (NodeRack::release_command); kOutOfRange for a MAC of no rack model.
+  Status release_command(devicenet::MacId mac, TimePoint now);
+  // Whether `mac` is a node of the scan list.
+  bool has_node(devicenet::MacId mac) const {
+    return pumps_.node(mac) != nullptr || devices_.node(mac) != nullptr;
+  }
 
   devicenet::Scanner& scanner() { return *scanner_; }
   const devicenet::Scanner& scanner() const { return *scanner_; }
   PumpRack& pumps() { return pumps_; }
   const PumpRack& pumps() const { return pumps_; }
+  DeviceRack& devices() { return devices_; }
+  const DeviceRack& devices() const { return devices_; }
 
  private:
-  std::vector<PumpConfig> in_force_;
+  PortNodes in_force_;
   PumpRack pumps_;
+  DeviceRack devices_;
   devicenet::ObserverFanout observers_;
   std::optional<devicenet::Scanner> scanner_;
 };

@@ -803,7 +803,8 @@ TEST(ConfigErrors, UnsupportedChoices) {
             "\"info\", \"warn\" or \"error\"\n"
             "t.toml:5:13: interface = \"can0/x\" is not a CAN interface name: use \"simulated\" "
             "or a SocketCAN interface such as \"can0\" (at most 15 characters)\n"
-            "t.toml:10:11: profile \"cdn999\" is not supported: the only profile is \"cdn127\"");
+            "t.toml:10:11: profile \"cdn999\" is not a profile: use \"cdn127\" (the default) or "
+            "\"eds\" (a device described by its EDS file)");
 }
 
 TEST(ConfigErrors, RetryBoundsInOrder) {

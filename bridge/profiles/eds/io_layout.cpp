@@ -126,6 +126,15 @@ void write_bits(std::vector<std::uint8_t>& data, std::uint32_t offset, std::uint
   }
 }
 
+// "NAME: VALUE is outside MIN..MAX" when `value` is beyond the field's EDS limits.
+std::optional<std::string> beyond_limits(const IoField& f, double value) {
+  if ((f.minimum && value < *f.minimum) || (f.maximum && value > *f.maximum)) {
+    return fmt::format("{}: {} is outside {}..{}", f.name, value, f.minimum.value_or(-INFINITY),
+                       f.maximum.value_or(INFINITY));
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 const IoField* IoLayout::field(std::string_view wanted) const noexcept {
@@ -220,11 +229,7 @@ Result<std::vector<std::uint8_t>> encode(const IoLayout& layout,
       return fail(Errc::kMalformed,
                   fmt::format("{} ({}, {} bits) is not a number", f->name, f->type.name, f->bits));
     }
-    if ((f->minimum && s.value < *f->minimum) || (f->maximum && s.value > *f->maximum)) {
-      return fail(Errc::kOutOfRange,
-                  fmt::format("{}: {} is outside {}..{}", f->name, s.value,
-                              f->minimum.value_or(-INFINITY), f->maximum.value_or(INFINITY)));
-    }
+    if (auto outside = beyond_limits(*f, s.value)) return fail(Errc::kOutOfRange, *outside);
     auto raw = to_raw(f->type, f->bits, s.value);
     if (!raw) {
       return fail(Errc::kOutOfRange, fmt::format("{}: {} is not a {} of {} bits", f->name, s.value,
@@ -243,6 +248,25 @@ Result<std::vector<std::uint8_t>> encode(const IoLayout& layout,
     }
   }
   return data;
+}
+
+Status check(const IoLayout& layout, Bytes data, std::string* why) {
+  const auto fail = [&](Errc code, std::string text) -> Status {
+    if (why != nullptr) *why = std::move(text);
+    return code;
+  };
+  if (data.size() != layout.size) {
+    return fail(Errc::kMalformed, fmt::format("{} bytes given, \"{}\" is {} bytes", data.size(),
+                                              layout.name, layout.size));
+  }
+  for (const FieldValue& v : decode(layout, data)) {
+    const IoField& f = layout.fields[v.field];
+    if (!std::isfinite(v.value)) {
+      return fail(Errc::kOutOfRange, fmt::format("{}: not a finite number", f.name));
+    }
+    if (auto outside = beyond_limits(f, v.value)) return fail(Errc::kOutOfRange, *outside);
+  }
+  return {};
 }
 
 }  // namespace dnbridge::eds

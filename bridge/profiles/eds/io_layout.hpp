@@ -84,4 +84,9 @@ Result<std::vector<std::uint8_t>> encode(const IoLayout& layout,
                                          const std::vector<FieldSetting>& settings,
                                          std::string* why = nullptr);
 
+// Whether `data` may be sent as the layout's data: its size, and every
+// numeric field a finite number within the EDS's limits. kMalformed for
+// another size, kOutOfRange for a field, `why` saying which and what.
+Status check(const IoLayout& layout, Bytes data, std::string* why = nullptr);
+
 }  // namespace dnbridge::eds

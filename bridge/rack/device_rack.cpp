@@ -1,0 +1,106 @@
+#include "bridge/rack/device_rack.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace dnbridge::rack {
+
+using devicenet::MacId;
+
+namespace {
+
+const eds::EdsFile& eds_of(const DeviceConfig& d) {
+  if (!d.eds) {
+    throw std::invalid_argument(
+        fmt::format("node {} ({}): no EDS file read", d.node.mac.value(), d.node.name));
+  }
+  return *d.eds;
+}
+
+}  // namespace
+
+devicenet::ScannerConfig DeviceRack::scanner_config(devicenet::ScannerConfig port,
+                                                    const std::vector<DeviceConfig>& devices) {
+  for (const auto& d : devices) {
+    std::string why;
+    auto profile = eds::make_node_profile(eds_of(d), d.settings, &why);
+    if (!profile) {
+      throw std::invalid_argument(
+          fmt::format("node {} ({}): {}: {}", d.node.mac.value(), d.node.name, d.eds_path, why));
+    }
+    devicenet::NodeConfig node = d.node;
+    node.profile = std::move(*profile);
+    port.nodes.push_back(std::move(node));
+  }
+  return port;
+}
+
+DeviceProfile::Slot DeviceProfile::slot_of(const DeviceConfig& d) {
+  std::string why;
+  auto io = eds::node_io(eds_of(d), d.settings.connection, &why);
+  if (!io) {
+    throw std::invalid_argument(
+        fmt::format("node {} ({}): {}", d.node.mac.value(), d.node.name, why));
+  }
+  return {std::make_shared<const eds::NodeIo>(std::move(*io))};
+}
+
+DeviceView DeviceProfile::view_of(const DeviceConfig& d) {
+  DeviceView v;
+  v.mac = d.node.mac;
+  v.name = d.node.name;
+  v.reason = "not started";
+  v.product = eds_of(d).device.product_name;
+  v.io = slot_of(d).io;
+  return v;
+}
+
+void DeviceProfile::carry_over(const DeviceView&, DeviceView&) {}
+
+bool DeviceProfile::take_inputs(DeviceView& v, const Slot& slot, Bytes data) {
+  v.inputs.assign(data.begin(), data.end());
+  v.input_values = eds::decode(slot.io->produced, data);
+  return true;
+}
+
+void DeviceProfile::take_applied(DeviceView& v, const Slot& slot, Bytes outputs) {
+  v.outputs_applied.assign(outputs.begin(), outputs.end());
+  v.output_values = eds::decode(slot.io->consumed, outputs);
+}
+
+Status DeviceRack::command(MacId mac, const std::vector<std::uint8_t>& data,
+                           std::string_view issuer, TimePoint now) {
+  DeviceView* v = find(mac);
+  if (!v || !scanner()) return Errc::kOutOfRange;
+  const eds::IoLayout& out = slot(mac).io->consumed;
+  if (out.size == 0) {
+    return refuse(*v, Errc::kUnsupported,
+                  fmt::format("from {}: the node's connection has no outputs", issuer));
+  }
+  std::string why;
+  if (auto s = eds::check(out, Bytes(data.data(), data.size()), &why); !s) {
+    return refuse(*v, s, fmt::format("from {}: {}", issuer, why));
+  }
+  if (auto s = refuse_unless_online(*v, issuer); !s) return s;
+  return apply_command(*v, Bytes(data.data(), data.size()), data, issuer, now);
+}
+
+Status DeviceRack::command(MacId mac, const std::vector<eds::FieldSetting>& fields,
+                           std::string_view issuer, TimePoint now) {
+  DeviceView* v = find(mac);
+  if (!v || !scanner()) return Errc::kOutOfRange;
+  const eds::IoLayout& out = slot(mac).io->consumed;
+  if (out.size != 0 && out.fields.empty()) {
+    return refuse(*v, Errc::kUnsupported,
+                  fmt::format("from {}: the EDS names no fields of the node's outputs (\"{}\"); "
+                              "command them as bytes",
+                              issuer, out.name));
+  }
+  std::string why;
+  auto data = eds::encode(out, fields, &why);
+  if (!data) return refuse(*v, data.error(), fmt::format("from {}: {}", issuer, why));
+  return command(mac, *data, issuer, now);
+}
+
+}  // namespace dnbridge::rack

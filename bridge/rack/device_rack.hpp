@@ -1,0 +1,90 @@
+#pragma once
+// The state of a rack's devices described by their EDS files (profile
+// "eds") as the layer above sees it: NodeRack with the connection's data as
+// bytes and as the EDS's named, typed fields (profiles/eds/io_layout.hpp).
+// Commands come as the output data's bytes or as its fields; either way
+// every field is checked against its type and the EDS's limits before the
+// master gets the bytes.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bridge/profiles/eds/eds_file.hpp"
+#include "bridge/profiles/eds/io_layout.hpp"
+#include "bridge/profiles/eds/node_profile.hpp"
+#include "bridge/rack/node_rack.hpp"
+
+namespace dnbridge::rack {
+
+struct DeviceConfig {
+  devicenet::NodeConfig node;  // its profile is made from the EDS (scanner_config)
+  NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
+  ResumePolicy resume = ResumePolicy::kFreshCommand;
+  std::shared_ptr<const eds::EdsFile> eds;
+  std::string eds_path;          // as configured, for people
+  std::uint64_t eds_digest = 0;  // of the file's text: a changed file is a changed device
+  eds::EdsNode settings;         // connection, parameters, safe state
+};
+
+struct DeviceView : NodeView {
+  std::string product;  // the EDS's product name
+  // The connection's data as the EDS lays it out (field names, types, units).
+  std::shared_ptr<const eds::NodeIo> io;
+  // Inputs from the last poll response (valid once `has_inputs`): the bytes
+  // and their numeric fields.
+  std::vector<std::uint8_t> inputs;
+  std::vector<eds::FieldValue> input_values;
+  // Outputs the device applied with its last answered poll (when not
+  // `outputs_idle`).
+  std::vector<std::uint8_t> outputs_applied;
+  std::vector<eds::FieldValue> output_values;
+  // Outputs requested by the layer above (not yet necessarily applied), by
+  // `commanded_by`.
+  std::optional<std::vector<std::uint8_t>> outputs_requested;
+  std::string_view idle_reason() const {
+    return outputs_requested ? std::string_view{} : to_string(idle_cause);
+  }
+};
+
+struct DeviceProfile {
+  using Config = DeviceConfig;
+  using View = DeviceView;
+  using Outputs = std::vector<std::uint8_t>;
+  struct Slot {
+    std::shared_ptr<const eds::NodeIo> io;
+  };
+  static Slot slot_of(const DeviceConfig& device);
+  static DeviceView view_of(const DeviceConfig& device);
+  static void carry_over(const DeviceView& old, DeviceView& fresh);
+  static void on_online(DeviceView&, const Slot&, const devicenet::Node&) {}
+  static bool take_inputs(DeviceView& view, const Slot& slot, Bytes data);
+  static void take_applied(DeviceView& view, const Slot& slot, Bytes outputs);
+};
+
+class DeviceRack final : public NodeRack<DeviceProfile> {
+ public:
+  // Adds the devices' nodes to the scan list, each profile made from its
+  // EDS. Throws std::invalid_argument, naming the node and what is wrong,
+  // for one the EDS does not allow.
+  static devicenet::ScannerConfig scanner_config(devicenet::ScannerConfig port,
+                                                 const std::vector<DeviceConfig>& devices);
+
+  using NodeRack::NodeRack;
+
+  // New outputs as the output data's bytes: refused unless the node is
+  // online, has outputs, the size is theirs and every field of them is
+  // within its type and the EDS's limits. kOutOfRange for a MAC not in the
+  // rack. A refusal is counted and its reason kept in the view.
+  Status command(devicenet::MacId mac, const std::vector<std::uint8_t>& data,
+                 std::string_view issuer, TimePoint now);
+  // The same, the outputs given field by field (every numeric field once).
+  Status command(devicenet::MacId mac, const std::vector<eds::FieldSetting>& fields,
+                 std::string_view issuer, TimePoint now);
+
+  const std::vector<DeviceView>& devices() const { return nodes(); }
+  const DeviceView* device(devicenet::MacId mac) const { return node(mac); }
+};
+
+}  // namespace dnbridge::rack

@@ -1,0 +1,369 @@
+#pragma once
+// What every kind of node in a rack shares, whatever its profile: the
+// master's events turned into a view (life cycle, identity, device state,
+// inputs and applied outputs), and the rules for its outputs: commanded
+// only while online, idle when the last commander goes (or held, if so
+// configured), void after a loss (unless configured otherwise) and after a
+// device fault always, refused with the reason kept.
+//
+// NodeRack<Profile> is that logic once; a profile says what its data is:
+//
+//   struct Profile {
+//     using Config = ...;   // .node (devicenet::NodeConfig), .no_commander, .resume
+//     using View = ...;     // derives from NodeView; .outputs_requested (std::optional<Outputs>)
+//     using Outputs = ...;  // a command's outputs, as the layer above gives them
+//     struct Slot;          // what the profile keeps per node (its data layout)
+//     static Slot slot_of(const Config&);               // throws std::invalid_argument
+//     static View view_of(const Config&);
+//     static void carry_over(const View& old, View& fresh);  // counters kept on a reconfiguration
+//     static void on_online(View&, const Slot&, const devicenet::Node&);
+//     static bool take_inputs(View&, const Slot&, Bytes data);  // false: not decodable
+//     static void take_applied(View&, const Slot&, Bytes outputs);
+//   };
+//
+// PumpRack (the CDN127) and DeviceRack (nodes described by their EDS) are
+// its two profiles.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bridge/devicenet/master/scanner.hpp"
+
+namespace dnbridge::rack {
+
+// What the bridge does with a node's outputs when no live commander is left.
+enum class NoCommanderPolicy : std::uint8_t {
+  kIdle,             // idle polls: the device applies its own configured idle actions
+  kHoldLastOutputs,  // keep polling the last commanded outputs
+};
+
+// What a node's outputs do when it is back after a loss (poll timeout,
+// power cycle, bus-off, interface down, device fault).
+enum class ResumePolicy : std::uint8_t {
+  kFreshCommand,  // idle until a command taken after its return
+  kLastCommand,   // the last command again, at once (unsafe: a pump may start
+                  // on its own after a power cycle)
+};
+
+// Why a node's outputs are idle (the bridge polls idle: the device holds
+// its configured idle state).
+enum class IdleCause : std::uint8_t {
+  kNoCommandYet,  // nothing commanded since the bridge started
+  kNoCommander,   // the last commander went away
+  kAfterLoss,     // back after a loss: a new command is needed (ResumePolicy::kFreshCommand)
+  kReconfigured,  // configured again after a reload: a new command is needed
+};
+std::string_view to_string(IdleCause cause) noexcept;
+
+// The part of a node's view every profile has.
+struct NodeView {
+  devicenet::MacId mac;
+  std::string name;
+  bool online = false;
+  devicenet::NodeState state = devicenet::NodeState::kAbsent;
+  std::string reason;
+  TimePoint state_since{};
+
+  // Inputs from the last poll response are in the profile's view (valid
+  // once `has_inputs`).
+  bool has_inputs = false;
+  // The device answers idle polls without data: while idle its inputs are
+  // not known (has_inputs is false), rather than shown as they last were.
+  bool inputs_withheld_when_idle = false;
+  TimePoint inputs_time{};  // CAN receive time of that response
+
+  // The device applied idle outputs with its last answered poll.
+  bool outputs_idle = true;
+  // Who asked for the outputs requested (the profile's view has them).
+  std::string commanded_by;
+  // Why the outputs are idle, when no command is in force.
+  IdleCause idle_cause = IdleCause::kNoCommandYet;
+  // The device's minor faults (Identity.Status), in words; empty when none.
+  std::string minor_faults;
+
+  std::uint64_t commands_accepted = 0;
+  std::uint64_t commands_refused = 0;
+  std::string last_command_refused;  // why the last refused command was refused
+
+  devicenet::NodeIdentity identity;
+  std::optional<std::uint8_t> device_state;
+  std::uint64_t changes = 0;         // bumped on every change, for publishers
+  std::uint64_t status_changes = 0;  // bumped on changes of state, identity,
+                                     // device state and command refusals only
+};
+
+template <class Profile>
+class NodeRack : public devicenet::ScannerObserver {
+ public:
+  using Config = typename Profile::Config;
+  using View = typename Profile::View;
+  using Outputs = typename Profile::Outputs;
+  using Slot = typename Profile::Slot;
+
+  explicit NodeRack(const std::vector<Config>& nodes) {
+    index_.fill(-1);
+    for (const auto& n : nodes) add(n);
+  }
+
+  // Attach after the scanner is built (the scanner reports to this rack).
+  void attach(devicenet::Scanner& scanner) { scanner_ = &scanner; }
+
+  // No live commander left: the node goes idle (zero-length polls, so the
+  // device applies its own configured idle actions) or, if configured so,
+  // keeps its last outputs.
+  Status release_command(devicenet::MacId mac, TimePoint now) {
+    View* v = find(mac);
+    if (!v || !scanner_) return Errc::kOutOfRange;
+    Entry& e = entry(mac);
+    if (e.no_commander == NoCommanderPolicy::kHoldLastOutputs) {
+      e.held_without_commander = v->outputs_requested.has_value();
+      return {};
+    }
+    e.held_without_commander = false;
+    if (v->outputs_requested) v->idle_cause = IdleCause::kNoCommander;
+    v->outputs_requested.reset();
+    v->commanded_by.clear();
+    ++v->changes;
+    return scanner_->set_idle(mac, true, now);
+  }
+
+  // Live changes, made together with the master's scan list
+  // (RackPort::reconfigure). A new node's view is absent, with no command.
+  void add(const Config& c) {
+    if (index_[c.node.mac.value()] >= 0) {
+      throw std::invalid_argument("node " + std::to_string(c.node.mac.value()) +
+                                  " is in the rack twice");
+    }
+    entries_.push_back(entry_of(c));
+    index_[c.node.mac.value()] = static_cast<int>(views_.size());
+    views_.push_back(Profile::view_of(c));
+  }
+  void remove(devicenet::MacId mac) {
+    const int i = index_[mac.value()];
+    if (i < 0) return;
+    views_.erase(views_.begin() + i);
+    entries_.erase(entries_.begin() + i);
+    index_.fill(-1);
+    for (std::size_t k = 0; k < views_.size(); ++k) {
+      index_[views_[k].mac.value()] = static_cast<int>(k);
+    }
+  }
+  // The node's device settings changed: the master releases it and
+  // configures it again, so its view starts afresh, in its place, and no
+  // command survives.
+  void replace(const Config& c) {
+    const int i = index_[c.node.mac.value()];
+    if (i < 0) return add(c);
+    const auto index = static_cast<std::size_t>(i);
+    entries_[index] = entry_of(c);
+    View& v = views_[index];
+    // Its counters go on (they are the node's, whatever its settings); the
+    // rest starts again.
+    View fresh = Profile::view_of(c);
+    fresh.commands_accepted = v.commands_accepted;
+    fresh.commands_refused = v.commands_refused;
+    Profile::carry_over(v, fresh);
+    fresh.reason = "configuration changed: released, to be configured again";
+    fresh.state_since = v.state_since;
+    fresh.idle_cause = IdleCause::kReconfigured;
+    fresh.changes = v.changes + 1;
+    fresh.status_changes = v.status_changes + 1;
+    v = std::move(fresh);
+  }
+  // Only what the bridge itself does with the node changed (its name, its
+  // no-commander and resume policies): view and command are kept, but for
+  // outputs held for a commander that has gone when the new policy is idle.
+  void update(const Config& c, TimePoint now) {
+    View* v = find(c.node.mac);
+    if (!v) return;
+    Entry& e = entry(c.node.mac);
+    e.no_commander = c.no_commander;
+    e.resume = c.resume;
+    v->name = c.node.name;
+    ++v->changes;
+    ++v->status_changes;
+    if (e.held_without_commander && c.no_commander == NoCommanderPolicy::kIdle) {
+      (void)release_command(c.node.mac, now);
+    }
+  }
+
+  const std::vector<View>& nodes() const { return views_; }
+  const View* node(devicenet::MacId mac) const {
+    const int i = index_[mac.value()];
+    return i < 0 ? nullptr : &views_[static_cast<std::size_t>(i)];
+  }
+  devicenet::PortState port_state() const { return port_state_; }
+  const std::string& port_reason() const { return port_reason_; }
+
+  // ScannerObserver
+  void on_port_state(devicenet::PortState state, const std::string& reason, TimePoint) override {
+    port_state_ = state;
+    port_reason_ = reason;
+  }
+  void on_node_state(devicenet::MacId mac, devicenet::NodeState from, devicenet::NodeState to,
+                     const std::string& reason, TimePoint at) override {
+    using devicenet::NodeState;
+    View* v = find(mac);
+    if (!v) return;
+    // A device fault voids a command even before the node was first online:
+    // the fault may clear long after the command was given.
+    if ((from == NodeState::kOnline && to != NodeState::kOnline && to != NodeState::kStopped) ||
+        to == NodeState::kDeviceFault) {
+      on_loss(*v, entry(mac), to, at);
+    }
+    if (to == NodeState::kOnline && scanner_ != nullptr) {
+      if (const devicenet::Node* node = scanner_->node(mac)) {
+        Profile::on_online(*v, entry(mac).slot, *node);
+      }
+    }
+    v->state = to;
+    v->reason = reason;
+    v->state_since = at;
+    v->online = to == NodeState::kOnline;
+    v->has_inputs = false;  // until a poll response since this transition
+    v->inputs_withheld_when_idle = false;
+    ++v->changes;
+    ++v->status_changes;
+  }
+  void on_node_identity(devicenet::MacId mac, const devicenet::NodeIdentity& identity,
+                        TimePoint) override {
+    if (View* v = find(mac)) {
+      v->identity = identity;
+      const devicenet::Node* node = scanner_ ? scanner_->node(mac) : nullptr;
+      v->minor_faults = node ? node->minor_faults() : "";
+      ++v->changes;
+      ++v->status_changes;
+    }
+  }
+  void on_poll_response(devicenet::MacId mac, Bytes data, TimePoint rx_time) override {
+    View* v = find(mac);
+    if (!v) return;
+    const Slot& slot = entry(mac).slot;
+    if (data.empty()) {
+      // An idle poll answered with no data: the device applied its idle
+      // outputs, and said nothing of its inputs. What they last were is not
+      // what they are: no inputs are published until a response carries them.
+      if (v->has_inputs || !v->inputs_withheld_when_idle) ++v->status_changes;
+      v->has_inputs = false;
+      v->inputs_withheld_when_idle = true;
+      refresh_applied(*v, slot);
+      ++v->changes;
+      return;
+    }
+    if (v->inputs_withheld_when_idle) ++v->status_changes;
+    v->inputs_withheld_when_idle = false;
+    if (!Profile::take_inputs(*v, slot, data)) return;  // the master checked the size
+    v->has_inputs = true;
+    v->inputs_time = rx_time;
+    refresh_applied(*v, slot);
+    ++v->changes;
+  }
+  void on_device_state(devicenet::MacId mac, std::uint8_t state, TimePoint) override {
+    if (View* v = find(mac)) {
+      v->device_state = state;
+      ++v->changes;
+      ++v->status_changes;
+    }
+  }
+
+ protected:
+  View* find(devicenet::MacId mac) {
+    const int i = index_[mac.value()];
+    return i < 0 ? nullptr : &views_[static_cast<std::size_t>(i)];
+  }
+  const Slot& slot(devicenet::MacId mac) const {
+    return entries_[static_cast<std::size_t>(index_[mac.value()])].slot;
+  }
+  devicenet::Scanner* scanner() { return scanner_; }
+
+  // A refusal: counted, its reason kept in the view.
+  Status refuse(View& view, Status why, std::string text) {
+    ++view.commands_refused;
+    view.last_command_refused = std::move(text);
+    ++view.changes;
+    ++view.status_changes;
+    return why;
+  }
+
+  // Only an online node is commanded: a command kept for a node that is
+  // away would act whenever it comes (back), perhaps hours later. A refusal
+  // (counted) when it is not; nothing otherwise.
+  Status refuse_unless_online(View& v, std::string_view issuer) {
+    if (v.online) return {};
+    return refuse(v, Errc::kNotConnected,
+                  v.idle_cause == IdleCause::kAfterLoss
+                      ? "from " + std::string(issuer) +
+                            ": the node was lost and is not back online; only a command "
+                            "written after its return is applied"
+                      : "from " + std::string(issuer) + ": the node is not online (" +
+                            std::string(devicenet::to_string(v.state)) +
+                            "); a command applies only to an online node");
+  }
+
+  // Hands `data` (the poll request's bytes for `outputs`) to the master and
+  // records the command; a refusal if the master does not take it.
+  Status apply_command(View& v, Bytes data, const Outputs& outputs, std::string_view issuer,
+                       TimePoint now) {
+    if (auto s = scanner_->set_outputs(v.mac, data, now); !s) {
+      return refuse(v, s, "from " + std::string(issuer) + ": " + s.error().message());
+    }
+    v.outputs_requested = outputs;
+    v.commanded_by = std::string(issuer);
+    entry(v.mac).held_without_commander = false;
+    ++v.commands_accepted;
+    ++v.changes;
+    return {};
+  }
+
+ private:
+  struct Entry {
+    Slot slot;
+    NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
+    ResumePolicy resume = ResumePolicy::kFreshCommand;
+    // The last commander went away while the policy held its outputs.
+    bool held_without_commander = false;
+  };
+  static Entry entry_of(const Config& c) {
+    return Entry{Profile::slot_of(c), c.no_commander, c.resume, false};
+  }
+  Entry& entry(devicenet::MacId mac) {
+    return entries_[static_cast<std::size_t>(index_[mac.value()])];
+  }
+
+  // The node left online, or has a device fault: with kFreshCommand (and
+  // for a device fault always) its command is void, and it comes back idle.
+  void on_loss(View& v, const Entry& e, devicenet::NodeState to, TimePoint at) {
+    // A device fault voids the command whatever the policy: the fault (a loss
+    // of the outputs' supply) may clear long after.
+    if (e.resume == ResumePolicy::kLastCommand && to != devicenet::NodeState::kDeviceFault) {
+      return;
+    }
+    // The last command was for the device as it was before: after a power
+    // cycle, a cable or a bus-off nobody has seen its state since. Idle polls
+    // until a commander, having seen it back, commands it again.
+    v.idle_cause = IdleCause::kAfterLoss;
+    v.outputs_requested.reset();
+    v.commanded_by.clear();
+    if (scanner_) (void)scanner_->set_idle(v.mac, true, at);
+  }
+
+  void refresh_applied(View& v, const Slot& slot) {
+    const devicenet::Node* node = scanner_ ? scanner_->node(v.mac) : nullptr;
+    if (!node) return;
+    v.outputs_idle = node->applied_idle();
+    if (!v.outputs_idle) Profile::take_applied(v, slot, node->applied_outputs());
+  }
+
+  devicenet::Scanner* scanner_ = nullptr;
+  std::vector<View> views_;
+  std::vector<Entry> entries_;
+  std::array<int, devicenet::MacId::kMax + 1> index_{};
+  devicenet::PortState port_state_ = devicenet::PortState::kStopped;
+  std::string port_reason_;
+};
+
+}  // namespace dnbridge::rack

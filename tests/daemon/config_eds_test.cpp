@@ -1,0 +1,173 @@
+// Nodes described by their EDS files in the configuration (profile = "eds"):
+// the file read relative to the configuration, its problems reported at the
+// eds key with their own FILE:LINE, the connection, parameters and safe
+// state checked against it, and the keys of one profile refused on the other.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "adapters/daemon/config.hpp"
+
+namespace dnbridge::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Lines 1..5: a rack with one simulated port.
+#define ONE_PORT                \
+  "rack = \"r\"\n"              \
+  "[[port]]\n"                  \
+  "name = \"A\"\n"              \
+  "interface = \"simulated\"\n" \
+  "bitrate = 500000\n"
+
+// Lines 6..: the example I/O block at MAC 20, with its safe state.
+#define IO_BLOCK                                                    \
+  "[[port.node]]\n"                                                 \
+  "mac = 20\n"                                                      \
+  "name = \"io-1\"\n"                                               \
+  "profile = \"eds\"\n"                                             \
+  "eds = \"dnbridge-example-io-block.eds\"\n"                       \
+  "safe_state = [ { name = \"Output fault action\", value = 0 },\n" \
+  "               { name = \"Output fault value\", value = 0 },\n"  \
+  "               { name = \"Output idle action\", value = 0 },\n"  \
+  "               { name = \"Output idle value\", value = 0 } ]\n"
+
+DaemonConfig parse(std::string_view text, const std::filesystem::path& base = DNBRIDGE_EDS_DIR) {
+  return parse_config(text, "t.toml", base);
+}
+
+std::string problems(std::string_view text, const std::filesystem::path& base = DNBRIDGE_EDS_DIR) {
+  try {
+    parse(text, base);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(none)";
+}
+
+TEST(ConfigEds, ANodeDescribedByItsEdsLoadsWithItsParametersAndSafeState) {
+  const DaemonConfig c = parse(ONE_PORT IO_BLOCK
+                               "parameters = [ { name = \"Input filter\", value = 5 } ]\n"
+                               "connection = \"poll\"\n"
+                               "poll_period_ms = 20\n"
+                               "no_commander = \"hold\"\n");
+  ASSERT_EQ(c.ports.at(0).nodes.size(), 1u);
+  const NodeSettings& n = c.ports[0].nodes[0];
+  EXPECT_TRUE(n.is_eds());
+  ASSERT_NE(n.eds, nullptr);
+  EXPECT_EQ(n.eds->device.product_name, "Example IO block 8DI/8DO/1AI");
+  EXPECT_EQ(n.eds_path, std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-io-block.eds");
+  EXPECT_NE(n.eds_digest, 0u);
+  ASSERT_EQ(n.eds_node.parameters.size(), 1u);
+  EXPECT_EQ(n.eds_node.parameters[0], (eds::ParameterValue{"Input filter", 5}));
+  EXPECT_EQ(n.eds_node.safe_state.size(), 4u);
+
+  const rack::PortNodes nodes = to_port_nodes(c.ports[0]);
+  EXPECT_TRUE(nodes.pumps.empty());
+  ASSERT_EQ(nodes.devices.size(), 1u);
+  const rack::DeviceConfig& d = nodes.devices[0];
+  EXPECT_EQ(d.node.mac.value(), 20);
+  EXPECT_EQ(d.node.name, "io-1");
+  EXPECT_EQ(d.node.poll_period, milliseconds(20));
+  EXPECT_EQ(d.no_commander, rack::NoCommanderPolicy::kHoldLastOutputs);
+  EXPECT_EQ(d.eds, n.eds);
+  // The master's scan list takes it as the EDS says.
+  const auto list = rack::RackPort::scan_list(to_scanner_config(c.ports[0], "host"), nodes);
+  ASSERT_EQ(list.nodes.size(), 1u);
+  EXPECT_EQ(list.nodes[0].profile.identity, (devicenet::ExpectedIdentity{65001, 7, 1}));
+  EXPECT_EQ(list.nodes[0].profile.settings.size(), 5u);
+}
+
+TEST(ConfigEds, APumpAndADeviceShareAPort) {
+  const DaemonConfig c = parse(ONE_PORT "[[port.node]]\nmac = 1\nname = \"pump-1\"\n" IO_BLOCK);
+  const rack::PortNodes nodes = to_port_nodes(c.ports.at(0));
+  ASSERT_EQ(nodes.pumps.size(), 1u);
+  ASSERT_EQ(nodes.devices.size(), 1u);
+  EXPECT_EQ(to_pump_configs(c.ports[0]).size(), 1u);
+}
+
+TEST(ConfigEds, ARelativePathIsTheConfigurationFilesNeighbour) {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / "config_eds_relative";
+  std::filesystem::create_directories(dir / "eds");
+  std::filesystem::copy_file(std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-io-block.eds",
+                             dir / "eds" / "block.eds",
+                             std::filesystem::copy_options::overwrite_existing);
+  {
+    std::ofstream f(dir / "rack.toml");
+    f << ONE_PORT
+        "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\neds = \"eds/block.eds\"\n"
+        "safe_state = [ { name = \"Output idle action\", value = 0 } ]\n";
+  }
+  const DaemonConfig c = load_config_file(dir / "rack.toml");
+  ASSERT_NE(c.ports.at(0).nodes.at(0).eds, nullptr);
+  EXPECT_EQ(c.ports[0].nodes[0].eds_path, (dir / "eds" / "block.eds").string());
+}
+
+TEST(ConfigEds, AnEdsFilesProblemsAreReportedAtTheKeyWithTheirOwnLines) {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / "config_eds_bad";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir / "bad.eds");
+    f << "[Device]\nVendCode = 1; ProdType = 0; ProdCode = 2; MajRev = 1; MinRev = 1;\n"
+         "[IO_Info]\nPollInfo = 1, 3, 0;\n";
+  }
+  const std::string text = ONE_PORT
+      "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\neds = \"bad.eds\"\n"
+      "[[port.node]]\nmac = 21\nname = \"io-2\"\nprofile = \"eds\"\neds = \"bad.eds\"\n";
+  const std::string p = problems(text, dir);
+  const std::string bad = (dir / "bad.eds").string();
+  EXPECT_THAT(p, HasSubstr("t.toml:10:7: eds: " + bad +
+                           ":4: error: poll connection: Input3 is not in [IO_Info]"));
+  // Read once: the second node says where its problems are.
+  EXPECT_THAT(p, HasSubstr("t.toml:15:7: eds = \"" + bad +
+                           "\" is not usable (its problems are listed at line 10)"));
+  EXPECT_THAT(problems(ONE_PORT "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                                "eds = \"no-such.eds\"\n"),
+              HasSubstr("t.toml:10:7: eds: " + std::string(DNBRIDGE_EDS_DIR) +
+                        "/no-such.eds: cannot open: No such file or directory"));
+}
+
+TEST(ConfigEds, WhatTheMasterWouldRefuseIsAnErrorAtItsKey) {
+  // Outputs without a safe state.
+  EXPECT_THAT(problems(ONE_PORT "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                                "eds = \"dnbridge-example-io-block.eds\"\n"),
+              HasSubstr("t.toml:10:7: node 20 (" + std::string(DNBRIDGE_EDS_DIR) +
+                        "/dnbridge-example-io-block.eds): the node has outputs"));
+  // A parameter that is not in the EDS, at the parameters key.
+  EXPECT_THAT(
+      problems(ONE_PORT IO_BLOCK "parameters = [ { name = \"Input filtr\", value = 5 } ]\n"),
+      HasSubstr("t.toml:15:14: node 20 (" + std::string(DNBRIDGE_EDS_DIR) +
+                "/dnbridge-example-io-block.eds): parameters: the EDS has no parameter "
+                "\"Input filtr\" (did you mean \"Input filter\"?)"));
+  // A connection the EDS does not offer, at the connection key.
+  EXPECT_THAT(
+      problems(ONE_PORT IO_BLOCK "connection = \"bit-strobe\"\n"),
+      HasSubstr("t.toml:15:14: node 20 (" + std::string(DNBRIDGE_EDS_DIR) +
+                "/dnbridge-example-io-block.eds): the EDS offers no bit-strobe connection"));
+  EXPECT_THAT(problems(ONE_PORT IO_BLOCK "connection = \"strobe\"\n"),
+              HasSubstr("t.toml:15:14: connection = \"strobe\" is not a connection"));
+  EXPECT_THAT(problems(ONE_PORT IO_BLOCK "parameters = [ { name = \"Input filter\" } ]\n"),
+              HasSubstr("t.toml:15:16: missing required key 'value' in parameters"));
+}
+
+TEST(ConfigEds, TheKeysOfOneProfileAreRefusedOnTheOther) {
+  EXPECT_THAT(problems(ONE_PORT IO_BLOCK "io = \"cdn127\"\npump_on_fault = \"off\"\n"),
+              HasSubstr("t.toml:15:6: io is a CDN127 setting: this node has profile = \"eds\""));
+  EXPECT_THAT(problems(ONE_PORT IO_BLOCK "io = \"cdn127\"\npump_on_fault = \"off\"\n"),
+              HasSubstr("t.toml:16:17: pump_on_fault is a CDN127 setting"));
+  EXPECT_THAT(problems(ONE_PORT "[[port.node]]\nmac = 1\nname = \"p\"\neds = \"x.eds\"\n"),
+              HasSubstr("t.toml:9:7: eds is for profile = \"eds\" nodes"));
+  EXPECT_THAT(
+      problems(ONE_PORT "[[port.node]]\nmac = 1\nname = \"p\"\nprofile = \"edz\"\n"),
+      HasSubstr("profile \"edz\" is not a profile: use \"cdn127\" (the default) or \"eds\""));
+  // [defaults] may hold CDN127 settings: they are for the CDN127s.
+  EXPECT_EQ(problems(ONE_PORT "[defaults]\npump_on_fault = \"off\"\nio = \"cdn118\"\n" IO_BLOCK),
+            "(none)");
+}
+
+}  // namespace
+}  // namespace dnbridge::daemon
