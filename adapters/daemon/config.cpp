@@ -660,6 +660,16 @@ void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems&
   if (!e.file) return;
   s.eds = e.file;
   s.eds_digest = e.digest;
+  // Outputs whose safe state the node leaves as the device has it.
+  const auto& io = eds::node_io(*e.file, s.eds_node.connection);
+  if (io && io->consumed.size > 0) {
+    for (const eds::Param* p : eds::safe_state_left_to_device(*e.file, s.eds_node)) {
+      r.warning(key->source(),
+                fmt::format("node {}: Param{} \"{}\" is set neither in safe_state nor in "
+                            "parameters: the device keeps its own value",
+                            s.pump.node.mac.value(), p->number, p->name));
+    }
+  }
   std::string why;
   if (!eds::make_node_profile(*e.file, s.eds_node, &why)) {
     // At the key the problem is about.

@@ -301,12 +301,13 @@ void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& 
   if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
   port::PortLoop* loop = port_of(dds::view(c.port));
   const auto mac = devicenet::MacId::from(c.mac);
-  if (!loop || !mac || !loop->has_node(*mac)) {
+  if (!loop || !mac || !loop->has_pump(*mac)) {
     command_warn_limit_.warn(
-        command_log_, port::steady_now(),
-        "command{} for port \"{}\" MAC {} refused: not in this rack's configuration",
+        command_log_, port::steady_now(), "pump command{} for port \"{}\" MAC {} refused: {}",
         info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "", dds::view(c.port),
-        c.mac);
+        c.mac,
+        loop && mac && loop->has_node(*mac) ? "the node is not a pump (its profile is \"eds\")"
+                                            : "not in this rack's configuration");
     return;
   }
   // No live commander left for this pump (all writers gone, or disposed):

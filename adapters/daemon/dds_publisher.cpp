@@ -36,6 +36,9 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
       node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
       port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
       reply_writer_(participant, reply_topic_, dds::reply_writer_qos(partition_)),
+      devices_(unless_denied(
+          log_, "the devices' state (dnbridge/DeviceState)",
+          [&] { return DeviceOut(participant, dds::state_writer_qos(state_deadline)); })),
       scan_(unless_denied(log_, "the bus scan (dnbridge/BusScanRequest, BusScanReply)",
                           [&] {
                             return Service<dnbridge_BusScanRequest, dnbridge_BusScanReply>(
@@ -73,12 +76,14 @@ dds::Owned<T> key_of(const std::string& rack, const std::string& port, std::uint
 
 }  // namespace
 
+void DdsPublisher::note_written(const std::string& port, std::uint8_t mac, Written kind) {
+  std::lock_guard lock(mutex_);
+  written_[port][mac] = kind;
+}
+
 void DdsPublisher::pump_state(const std::string& port, const rack::PumpView& pump,
                               TimePoint source_time) {
-  {
-    std::lock_guard lock(mutex_);
-    written_[port].insert(pump.mac.value());
-  }
+  note_written(port, pump.mac.value(), Written::kPump);
   dds::Owned<dnbridge_PumpState> sample;
   fill_pump_state(*sample, rack_, port, pump);
   check_state(pump_writer_.write(*sample, clock_.to_wall(source_time)), "PumpState");
@@ -88,6 +93,23 @@ void DdsPublisher::node_status(const std::string& port, const rack::PumpView& pu
                                const port::NodeStatusView& node, TimePoint source_time) {
   dds::Owned<dnbridge_NodeStatus> sample;
   fill_node_status(*sample, rack_, port, pump, node);
+  check_state(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
+}
+
+void DdsPublisher::device_state(const std::string& port, const rack::DeviceView& device,
+                                TimePoint source_time) {
+  if (!devices_) return;
+  note_written(port, device.mac.value(), Written::kDevice);
+  dds::Owned<dnbridge_DeviceState> sample;
+  fill_device_state(*sample, rack_, port, device);
+  check_state(devices_->writer.write(*sample, clock_.to_wall(source_time)), "DeviceState");
+}
+
+void DdsPublisher::device_status(const std::string& port, const rack::DeviceView& device,
+                                 const port::NodeStatusView& node, TimePoint source_time) {
+  note_written(port, device.mac.value(), Written::kDevice);
+  dds::Owned<dnbridge_NodeStatus> sample;
+  fill_node_status(*sample, rack_, port, device, node);
   check_state(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
 }
 
@@ -137,38 +159,49 @@ std::uint64_t DdsPublisher::replies_undelivered(const std::string& port) const {
   return it == undelivered_.end() ? 0 : it->second;
 }
 
-void DdsPublisher::release_node(const std::string& port, std::uint8_t mac, bool dispose) {
+void DdsPublisher::release_node(const std::string& port, std::uint8_t mac, Written kind,
+                                bool dispose) {
   const auto now = dds::dds_now();
-  const auto pump_key = key_of<dnbridge_PumpState>(rack_, port, mac);
   const auto node_key = key_of<dnbridge_NodeStatus>(rack_, port, mac);
-  if (dispose) {
-    check_state(pump_writer_.dispose(*pump_key, now), "PumpState disposal");
-    check_state(node_writer_.dispose(*node_key, now), "NodeStatus disposal");
+  if (kind == Written::kPump) {
+    const auto key = key_of<dnbridge_PumpState>(rack_, port, mac);
+    if (dispose) check_state(pump_writer_.dispose(*key, now), "PumpState disposal");
+    check_state(pump_writer_.unregister_instance(*key, now), "PumpState unregistration");
+  } else if (devices_) {
+    const auto key = key_of<dnbridge_DeviceState>(rack_, port, mac);
+    if (dispose) check_state(devices_->writer.dispose(*key, now), "DeviceState disposal");
+    check_state(devices_->writer.unregister_instance(*key, now), "DeviceState unregistration");
   }
-  check_state(pump_writer_.unregister_instance(*pump_key, now), "PumpState unregistration");
+  if (dispose) check_state(node_writer_.dispose(*node_key, now), "NodeStatus disposal");
   check_state(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
 }
 
 void DdsPublisher::node_removed(const std::string& port, devicenet::MacId mac) {
+  std::optional<Written> kind;
   {
     std::lock_guard lock(mutex_);
-    written_[port].erase(mac.value());
+    auto& macs = written_[port];
+    if (auto it = macs.find(mac.value()); it != macs.end()) {
+      kind = it->second;
+      macs.erase(it);
+    }
   }
-  // Disposed: the pump is no longer the rack's, which unregistering (the
-  // bridge gone) would not say.
-  release_node(port, mac.value(), true);
+  // Disposed: the node is no longer the rack's (or no longer of that
+  // profile), which unregistering (the bridge gone) would not say. Only
+  // what was written.
+  if (kind) release_node(port, mac.value(), *kind, true);
 }
 
 void DdsPublisher::port_stopped(const std::string& port) {
   // Unregister, never dispose: the last samples (online false, stopped) stay
   // what late readers see until the bridge is back.
-  std::set<std::uint8_t> macs;
+  std::map<std::uint8_t, Written> macs;
   {
     std::lock_guard lock(mutex_);
     macs = std::move(written_[port]);
     written_.erase(port);
   }
-  for (std::uint8_t mac : macs) release_node(port, mac, false);
+  for (const auto& [mac, kind] : macs) release_node(port, mac, kind, false);
   dds::Owned<dnbridge_PortStatus> port_key;
   dds::set_string(port_key->rack, rack_);
   dds::set_string(port_key->port, port);

@@ -86,6 +86,10 @@ class DdsPublisher final : public port::PortPublisher {
                   TimePoint source_time) override;
   void node_status(const std::string& port, const rack::PumpView& pump,
                    const port::NodeStatusView& node, TimePoint source_time) override;
+  void device_state(const std::string& port, const rack::DeviceView& device,
+                    TimePoint source_time) override;
+  void device_status(const std::string& port, const rack::DeviceView& device,
+                     const port::NodeStatusView& node, TimePoint source_time) override;
   void port_status(const port::PortStatusView& status, TimePoint source_time) override;
   void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) override;
   void bus_scan_reply(const std::string& port, const port::BusScanAnswer& answer) override;
@@ -125,9 +129,12 @@ class DdsPublisher final : public port::PortPublisher {
   bool check(Status s, const char* what);
   // The same for a state topic's write, disposal or unregistration, counted.
   void check_state(Status s, const char* what);
-  // A node's PumpState and NodeStatus instances unregistered, after being
-  // disposed when `dispose`.
-  void release_node(const std::string& port, std::uint8_t mac, bool dispose);
+  // Which state topic a node's samples are on, besides NodeStatus.
+  enum class Written : std::uint8_t { kPump, kDevice };
+  void note_written(const std::string& port, std::uint8_t mac, Written kind);
+  // A node's state instance (PumpState or DeviceState) and NodeStatus
+  // unregistered, after being disposed when `dispose`.
+  void release_node(const std::string& port, std::uint8_t mac, Written kind, bool dispose);
 
   std::string rack_;
   Logger log_;
@@ -144,13 +151,22 @@ class DdsPublisher final : public port::PortPublisher {
   dds::Writer<dnbridge_NodeStatus> node_writer_;
   dds::Writer<dnbridge_PortStatus> port_writer_;
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;
+  // The devices described by their EDS: DeviceState's topic and writer;
+  // none when DDS Security does not grant the topic (unless_denied).
+  struct DeviceOut {
+    DeviceOut(const dds::Participant& participant, const dds::Qos& qos)
+        : topic(participant), writer(participant, topic, qos) {}
+    dds::Topic<dnbridge_DeviceState> topic;
+    dds::Writer<dnbridge_DeviceState> writer;
+  };
+  std::optional<DeviceOut> devices_;
   std::optional<Service<dnbridge_BusScanRequest, dnbridge_BusScanReply>> scan_;
   std::optional<Service<dnbridge_ReloadRequest, dnbridge_ReloadReply>> reload_;
 
   void undelivered(const std::string& port);
 
   mutable std::mutex mutex_;
-  std::map<std::string, std::set<std::uint8_t>> written_;  // per port, the MACs written
+  std::map<std::string, std::map<std::uint8_t, Written>> written_;  // per port, by MAC
   std::map<std::string, std::uint64_t> undelivered_;  // per port
   std::mutex log_mutex_;
   RateLimitedLog error_limit_;

@@ -111,8 +111,11 @@ void fill_safe_state(dnbridge_SafeState& out, const rack::PumpView& v) {
 
 }  // namespace
 
-void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
-                      const rack::PumpView& v, const port::NodeStatusView& node) {
+namespace {
+
+// What NodeStatus says of any node, whatever its profile.
+void fill_node_common(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
+                      const rack::NodeView& v, const port::NodeStatusView& node) {
   set_string(out.rack, rack);
   set_string(out.port, port);
   out.mac = v.mac.value();
@@ -151,21 +154,12 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.last_error_general_status = static_cast<std::uint8_t>(error.general_status);
   out.last_error_additional_status = error.additional_status;
   set_string(out.last_command_refused, v.last_command_refused);
-  std::string invalid;
-  if (v.online && v.inputs_withheld_when_idle) {
-    invalid = "no inputs while idle: the device answers idle polls without data";
-  }
-  for (std::size_t i = 0; i < v.inputs.analog_inputs_raw.size(); ++i) {
-    const auto& raw = v.inputs.analog_inputs_raw[i];
-    if (!v.has_inputs || !raw || v.inputs.analog_input_in_range[i]) continue;
-    if (!invalid.empty()) invalid += "; ";
-    invalid +=
-        fmt::format("analog input {}: {} counts, above {}", i + 1, *raw, cdn127::kAnalogMaxRaw);
-  }
-  set_string(out.invalid_inputs, invalid);
+  set_string(out.invalid_inputs,
+             v.online && v.inputs_withheld_when_idle
+                 ? std::string_view{"no inputs while idle: the device answers idle polls without "
+                                    "data"}
+                 : std::string_view{});
   set_string(out.device_faults, v.minor_faults);
-  fill_safe_state(out.safe_state, v);
-  set_string(out.idle_reason, v.idle_reason());
 
   const auto& c = node.counters;
   const auto& e = node.explicit_counters;
@@ -184,9 +178,91 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.counters.explicit_requests = e.requests;
   out.counters.explicit_timeouts = e.timeouts;
   out.counters.explicit_device_errors = e.device_errors;
-  out.counters.responses_with_invalid_inputs = v.responses_with_invalid_inputs;
   out.counters.commands_accepted = v.commands_accepted;
   out.counters.commands_refused = v.commands_refused;
+}
+
+}  // namespace
+
+void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
+                      const rack::PumpView& v, const port::NodeStatusView& node) {
+  fill_node_common(out, rack, port, v, node);
+  std::string invalid(dds::view(out.invalid_inputs));
+  for (std::size_t i = 0; i < v.inputs.analog_inputs_raw.size(); ++i) {
+    const auto& raw = v.inputs.analog_inputs_raw[i];
+    if (!v.has_inputs || !raw || v.inputs.analog_input_in_range[i]) continue;
+    if (!invalid.empty()) invalid += "; ";
+    invalid +=
+        fmt::format("analog input {}: {} counts, above {}", i + 1, *raw, cdn127::kAnalogMaxRaw);
+  }
+  set_string(out.invalid_inputs, invalid);
+  fill_safe_state(out.safe_state, v);
+  set_string(out.idle_reason, v.idle_reason());
+  out.counters.responses_with_invalid_inputs = v.responses_with_invalid_inputs;
+}
+
+void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
+                      const rack::DeviceView& v, const port::NodeStatusView& node) {
+  fill_node_common(out, rack, port, v, node);
+  // Its safe state is the EDS parameters the configuration gives: no
+  // CDN127 action to name, the values read back in words.
+  const auto unknown = dnbridge_SAFE_ACTION_UNKNOWN;
+  auto& safe = out.safe_state;
+  safe.known = !v.safe_state_text.empty();
+  safe.source = dnbridge_SAFE_STATE_CONFIGURED;
+  safe.pump_on_fault = safe.pump_on_idle = safe.n2_ballast_on_fault = safe.n2_ballast_on_idle =
+      safe.analog_output_on_fault = safe.analog_output_on_idle = unknown;
+  safe.analog_output_fault_raw = safe.analog_output_idle_raw = 0;
+  set_string(safe.text,
+             safe.known ? std::string_view(v.safe_state_text) : std::string_view{"not read yet"});
+  set_string(out.idle_reason, v.idle_reason());
+}
+
+namespace {
+
+// A sequence of fields the sample owns (freed with it).
+void set_fields(dds_sequence_dnbridge_DeviceField& seq, const eds::IoLayout& layout,
+                const std::vector<eds::FieldValue>& values) {
+  seq._length = seq._maximum = static_cast<std::uint32_t>(values.size());
+  seq._release = true;
+  seq._buffer =
+      values.empty() ? nullptr : dds_sequence_dnbridge_DeviceField_allocbuf(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const eds::FieldValue& v = values[i];
+    const eds::IoField& f = layout.fields[v.field];
+    auto& o = seq._buffer[i];
+    set_string(o.name, f.name);
+    set_string(o.type, f.type.name);
+    set_string(o.units, f.units);
+    o.bit_offset = f.offset;
+    o.bits = f.bits;
+    o.value = v.value;
+    o.shown = v.shown;
+  }
+}
+
+}  // namespace
+
+void fill_device_state(dnbridge_DeviceState& out, std::string_view rack, std::string_view port,
+                       const rack::DeviceView& v) {
+  set_string(out.rack, rack);
+  set_string(out.port, port);
+  out.mac = v.mac.value();
+  set_string(out.name, v.name);
+  set_string(out.product, cip::utf8_from_iso8859_1(v.product));
+  out.online = v.online;
+  out.inputs_valid = v.online && v.has_inputs;
+  const std::vector<eds::FieldValue> none;
+  set_octets(out.inputs, out.inputs_valid ? std::span<const std::uint8_t>(v.inputs)
+                                          : std::span<const std::uint8_t>{});
+  set_fields(out.input_fields, v.io->produced, out.inputs_valid ? v.input_values : none);
+  out.outputs_idle = v.outputs_idle;
+  set_string(out.idle_reason, v.idle_reason());
+  set_octets(out.outputs, v.outputs_idle ? std::span<const std::uint8_t>{}
+                                         : std::span<const std::uint8_t>(v.outputs_applied));
+  set_fields(out.output_fields, v.io->consumed, v.outputs_idle ? none : v.output_values);
+  set_string(out.commanded_by,
+             v.outputs_idle ? std::string_view{} : std::string_view(v.commanded_by));
 }
 
 void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,

@@ -7,6 +7,7 @@
 #include "adapters/daemon/reload.hpp"
 #include "adapters/dds/sample.hpp"
 #include "adapters/port/port_publisher.hpp"
+#include "bridge/rack/device_rack.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
 #include "bridge/rack/pump_rack.hpp"
 #include "dnbridge.h"
@@ -17,6 +18,10 @@ void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string
                      const rack::PumpView& pump);
 void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
                       const rack::PumpView& pump, const port::NodeStatusView& node);
+void fill_device_state(dnbridge_DeviceState& out, std::string_view rack, std::string_view port,
+                       const rack::DeviceView& device);
+void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
+                      const rack::DeviceView& device, const port::NodeStatusView& node);
 void fill_port_status(dnbridge_PortStatus& out, std::string_view rack,
                       const port::PortStatusView& status);
 void fill_explicit_reply(dnbridge_ExplicitReply& out, const rack::ExplicitAnswer& answer);

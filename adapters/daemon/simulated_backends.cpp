@@ -11,11 +11,18 @@ BackendFactory simulated_backend_factory(LogSink& log) {
              const PortConfig& p) -> std::unique_ptr<port::CanBackend> {
     if (p.interface != kSimulatedInterface) return others(p);
     std::vector<devicenet::MacId> macs;
-    for (const auto& n : p.nodes) macs.push_back(n.pump.node.mac);
+    std::vector<sim::EdsDeviceSpec> eds_devices;
+    for (const auto& n : p.nodes) {
+      if (n.is_eds()) {
+        eds_devices.push_back({n.pump.node.mac, n.eds});
+      } else {
+        macs.push_back(n.pump.node.mac);
+      }
+    }
     // Devices the configuration does not have: powered up with the others,
     // they are heard checking their MAC ID, and never polled.
     for (const auto mac : p.simulated_unconfigured) macs.push_back(mac);
-    return std::make_unique<sim::SimBackend>(p.bitrate, macs, &log);
+    return std::make_unique<sim::SimBackend>(p.bitrate, macs, &log, eds_devices);
   };
 }
 

@@ -28,6 +28,12 @@ struct TopicTraits<dnbridge_PumpCommand> {
   static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_PumpCommand_desc;
 };
 template <>
+struct TopicTraits<dnbridge_DeviceState> {
+  static constexpr const char* kName = "dnbridge/DeviceState";
+  static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_DeviceState_desc;
+};
+
+template <>
 struct TopicTraits<dnbridge_NodeStatus> {
   static constexpr const char* kName = "dnbridge/NodeStatus";
   static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_NodeStatus_desc;
@@ -73,7 +79,7 @@ struct TopicTraits<dnbridge_ReloadReply> {
 // BusScanRequest, ReloadRequest) with their replies, is published and read
 // in that rack's partition, "dnbridge/RACK": DDS delivers a bridge only its
 // own rack's commands and requests, and a command goes to the one bridge
-// that serves its pump. The state topics (PumpState, NodeStatus, PortStatus)
+// that serves its pump. The state topics (PumpState, DeviceState, NodeStatus, PortStatus)
 // are in the default partition, so that one reader sees every rack; so are
 // readers that set no partition (a generic tool). A client of several racks
 // reads their replies with each rack's partition, or with
@@ -86,7 +92,7 @@ inline constexpr std::string_view kEveryRackPartition = "dnbridge/*";
 std::vector<std::string> rack_partitions(std::span<const std::string> racks);
 std::vector<std::string> rack_partitions(std::string_view rack);
 
-// --- State topics: PumpState, NodeStatus, PortStatus -------------------------
+// --- State topics: PumpState, DeviceState, NodeStatus, PortStatus -------------
 // Reliable, transient-local, keep-last 1: a late joiner gets each instance's
 // current state at once. Automatic liveliness (a bridge that dies is noticed
 // through its participant's lease). Ordered by source timestamp (the CAN

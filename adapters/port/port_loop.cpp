@@ -41,10 +41,12 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
 }
 
 void PortLoop::note_scan_list() {
-  std::uint64_t bits = 0;
-  for (const auto& p : config_.pumps) bits |= std::uint64_t{1} << p.node.mac.value();
-  for (const auto& d : config_.devices) bits |= std::uint64_t{1} << d.node.mac.value();
-  scan_list_.store(bits, std::memory_order_relaxed);
+  std::uint64_t pumps = 0;
+  std::uint64_t devices = 0;
+  for (const auto& p : config_.pumps) pumps |= std::uint64_t{1} << p.node.mac.value();
+  for (const auto& d : config_.devices) devices |= std::uint64_t{1} << d.node.mac.value();
+  pump_list_.store(pumps, std::memory_order_relaxed);
+  scan_list_.store(pumps | devices, std::memory_order_relaxed);
 }
 
 PortLoop::~PortLoop() {
@@ -143,6 +145,12 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
   carry_published(devices_before, devices().devices(), published_devices_, sc,
                   policy_in(next.devices, next.device_publish), change.publish_changed);
   for (MacId mac : sc.removed) publisher_.node_removed(config_.port, mac);
+  // A node of another profile now: its instances of the old one go (disposed).
+  for (MacId mac : sc.reconfigured) {
+    const bool was_pump =
+        std::find(pumps_before.begin(), pumps_before.end(), mac) != pumps_before.end();
+    if (was_pump != (rack().pump(mac) != nullptr)) publisher_.node_removed(config_.port, mac);
+  }
   if (!(gateway_->policy() == next.explicit_policy)) {
     gateway_->set_policy(next.explicit_policy);
     change.explicit_policy_changed = true;
@@ -296,7 +304,7 @@ bool PortLoop::drain_inbox(TimePoint now) {
   for (auto& item : items) {
     if (auto* c = std::get_if<Command>(&item)) {
       // The MAC was checked against the scan list where the command came
-      // in (has_node); here the rack finds its pump by it at once.
+      // in (has_pump); here the rack finds its pump by it at once.
       if (auto s = rack().command(c->mac, c->outputs, c->issuer, now); !s) {
         const rack::PumpView* pump = rack().pump(c->mac);
         log_.warn("command refused: {}",
@@ -316,7 +324,7 @@ bool PortLoop::drain_inbox(TimePoint now) {
                                        d->issuer, d->mac.value()));
       }
     } else if (auto* r = std::get_if<Release>(&item)) {
-      if (port_->release_command(r->mac, now)) {
+      if (rack().release_command(r->mac, now)) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
     } else if (auto* scan = std::get_if<ScanCall>(&item)) {

@@ -77,6 +77,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // A device's (profile "eds") outputs, as bytes or as its fields.
   using DeviceOutputs = std::variant<std::vector<std::uint8_t>, std::vector<eds::FieldSetting>>;
   void command(devicenet::MacId mac, DeviceOutputs outputs, std::string issuer);
+  // No live commander left for the pump at `mac`.
   void release_command(devicenet::MacId mac);
   // Past kMaxQueuedCalls requests waiting for the loop, answered at once
   // with "out of buffers" (on the caller's thread, through the publisher).
@@ -106,9 +107,12 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void post(std::function<void(CanBackend&)> fn);
 
   const std::string& name() const { return config_.port; }
-  // Whether `mac` is in the port's scan list (any thread).
+  // Whether `mac` is in the port's scan list; whether it is a pump (a CDN127) (any thread).
   bool has_node(devicenet::MacId mac) const {
     return (scan_list_.load(std::memory_order_relaxed) >> mac.value()) & 1u;
+  }
+  bool has_pump(devicenet::MacId mac) const {
+    return (pump_list_.load(std::memory_order_relaxed) >> mac.value()) & 1u;
   }
 
   // For a service manager, from any thread. The port has finished its
@@ -238,6 +242,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   Duration longest_pass_{};
 
   std::atomic<std::uint64_t> scan_list_{0};  // bit per MAC; set on the port's thread
+  std::atomic<std::uint64_t> pump_list_{0};  // the same, of the pumps
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
   std::deque<rack::ExplicitCall> calls_;

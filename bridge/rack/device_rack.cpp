@@ -43,20 +43,40 @@ DeviceProfile::Slot DeviceProfile::slot_of(const DeviceConfig& d) {
     throw std::invalid_argument(
         fmt::format("node {} ({}): {}", d.node.mac.value(), d.node.name, why));
   }
-  return {std::make_shared<const eds::NodeIo>(std::move(*io))};
+  return {std::make_shared<const eds::NodeIo>(std::move(*io)), d.eds, d.settings};
 }
 
-DeviceView DeviceProfile::view_of(const DeviceConfig& d) {
+DeviceView DeviceProfile::view_of(const DeviceConfig& d, const Slot& slot) {
   DeviceView v;
   v.mac = d.node.mac;
   v.name = d.node.name;
   v.reason = "not started";
   v.product = eds_of(d).device.product_name;
-  v.io = slot_of(d).io;
+  v.io = slot.io;
   return v;
 }
 
 void DeviceProfile::carry_over(const DeviceView&, DeviceView&) {}
+
+void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::Node& node) {
+  // The safe state's settings follow the parameters' (eds::make_node_profile).
+  const auto& in_force = node.settings_in_force();
+  const std::size_t first = slot.settings.parameters.size();
+  std::string text;
+  for (std::size_t i = 0; i < slot.settings.safe_state.size(); ++i) {
+    const eds::Param* p = slot.eds->param(slot.settings.safe_state[i].name);
+    if (p == nullptr || first + i >= in_force.size()) continue;
+    const auto& bytes = in_force[first + i];
+    std::uint64_t raw = 0;
+    for (std::size_t b = 0; b < bytes.size() && b < 8; ++b) {
+      raw |= std::uint64_t{bytes[b]} << (8 * b);
+    }
+    const auto bits = static_cast<std::uint16_t>(std::min<std::size_t>(bytes.size() * 8, 64));
+    text += fmt::format("{}Param{} {} = {}{}", text.empty() ? "" : "; ", p->number, p->name,
+                        eds::from_raw(p->type, bits, raw), p->units.empty() ? "" : " " + p->units);
+  }
+  v.safe_state_text = std::move(text);
+}
 
 bool DeviceProfile::take_inputs(DeviceView& v, const Slot& slot, Bytes data) {
   v.inputs.assign(data.begin(), data.end());

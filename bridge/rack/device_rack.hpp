@@ -46,6 +46,11 @@ struct DeviceView : NodeView {
   std::string_view idle_reason() const {
     return outputs_requested ? std::string_view{} : to_string(idle_cause);
   }
+
+  // The safe state the device had when the node last came online: each
+  // safe_state parameter as read back after the download, in words
+  // ("Param6 Output fault action = 0; ..."); empty until then.
+  std::string safe_state_text;
 };
 
 struct DeviceProfile {
@@ -54,11 +59,14 @@ struct DeviceProfile {
   using Outputs = std::vector<std::uint8_t>;
   struct Slot {
     std::shared_ptr<const eds::NodeIo> io;
+    std::shared_ptr<const eds::EdsFile> eds;
+    eds::EdsNode settings;
   };
   static Slot slot_of(const DeviceConfig& device);
-  static DeviceView view_of(const DeviceConfig& device);
+  static DeviceView view_of(const DeviceConfig& device, const Slot& slot);
   static void carry_over(const DeviceView& old, DeviceView& fresh);
-  static void on_online(DeviceView&, const Slot&, const devicenet::Node&) {}
+  // What the device's safe state is.
+  static void on_online(DeviceView& view, const Slot& slot, const devicenet::Node& node);
   static bool take_inputs(DeviceView& view, const Slot& slot, Bytes data);
   static void take_applied(DeviceView& view, const Slot& slot, Bytes outputs);
 };

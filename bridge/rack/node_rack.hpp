@@ -14,7 +14,7 @@
 //     using Outputs = ...;  // a command's outputs, as the layer above gives them
 //     struct Slot;          // what the profile keeps per node (its data layout)
 //     static Slot slot_of(const Config&);               // throws std::invalid_argument
-//     static View view_of(const Config&);
+//     static View view_of(const Config&, const Slot&);
 //     static void carry_over(const View& old, View& fresh);  // counters kept on a reconfiguration
 //     static void on_online(View&, const Slot&, const devicenet::Node&);
 //     static bool take_inputs(View&, const Slot&, Bytes data);  // false: not decodable
@@ -140,7 +140,7 @@ class NodeRack : public devicenet::ScannerObserver {
     }
     entries_.push_back(entry_of(c));
     index_[c.node.mac.value()] = static_cast<int>(views_.size());
-    views_.push_back(Profile::view_of(c));
+    views_.push_back(Profile::view_of(c, entries_.back().slot));
   }
   void remove(devicenet::MacId mac) {
     const int i = index_[mac.value()];
@@ -163,7 +163,7 @@ class NodeRack : public devicenet::ScannerObserver {
     View& v = views_[index];
     // Its counters go on (they are the node's, whatever its settings); the
     // rest starts again.
-    View fresh = Profile::view_of(c);
+    View fresh = Profile::view_of(c, entries_[index].slot);
     fresh.commands_accepted = v.commands_accepted;
     fresh.commands_refused = v.commands_refused;
     Profile::carry_over(v, fresh);

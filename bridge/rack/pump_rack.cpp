@@ -38,7 +38,7 @@ PumpProfile::Slot PumpProfile::slot_of(const PumpConfig& p) {
   return {p.io, *format};
 }
 
-PumpView PumpProfile::view_of(const PumpConfig& p) {
+PumpView PumpProfile::view_of(const PumpConfig& p, const Slot&) {
   PumpView v;
   v.mac = p.node.mac;
   v.name = p.node.name;

@@ -69,7 +69,7 @@ struct PumpProfile {
     profiles::cdn127::PollFormat format;
   };
   static Slot slot_of(const PumpConfig& pump);
-  static PumpView view_of(const PumpConfig& pump);
+  static PumpView view_of(const PumpConfig& pump, const Slot& slot);
   static void carry_over(const PumpView& old, PumpView& fresh);
   // What the device's safe state is.
   static void on_online(PumpView& view, const Slot& slot, const devicenet::Node& node);

@@ -105,11 +105,6 @@ RackPort::RackPort(devicenet::ScannerConfig port, const PortNodes& nodes, can::F
   devices_.attach(*scanner_);
 }
 
-Status RackPort::release_command(MacId mac, TimePoint now) {
-  if (pumps_.node(mac)) return pumps_.release_command(mac, now);
-  return devices_.release_command(mac, now);
-}
-
 ScanListChange RackPort::reconfigure(const devicenet::ScannerConfig& port, const PortNodes& nodes,
                                      TimePoint now) {
   if (scanner_->state() == devicenet::PortState::kStopping) {

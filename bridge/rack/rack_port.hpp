@@ -85,14 +85,6 @@ class RackPort {
   // `port`). Throws std::invalid_argument for a node its profile refuses.
   static devicenet::ScannerConfig scan_list(devicenet::ScannerConfig port, const PortNodes& nodes);
 
-  // No live commander left for the node, whichever its profile
-  // (NodeRack::release_command); kOutOfRange for a MAC of no rack model.
-  Status release_command(devicenet::MacId mac, TimePoint now);
-  // Whether `mac` is a node of the scan list.
-  bool has_node(devicenet::MacId mac) const {
-    return pumps_.node(mac) != nullptr || devices_.node(mac) != nullptr;
-  }
-
   devicenet::Scanner& scanner() { return *scanner_; }
   const devicenet::Scanner& scanner() const { return *scanner_; }
   PumpRack& pumps() { return pumps_; }

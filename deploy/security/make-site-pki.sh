@@ -25,8 +25,8 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
                       later runs keep the site's, which changes only with
                       --new-ca)
   --bridge NAME[=RACK]
-                      a rack's bridge: publishes PumpState, NodeStatus,
-                      PortStatus, ExplicitReply, BusScanReply and
+                      a rack's bridge: publishes PumpState, DeviceState,
+                      NodeStatus, PortStatus, ExplicitReply, BusScanReply and
                       ReloadReply, reads PumpCommand, ExplicitRequest,
                       BusScanRequest and ReloadRequest; with =RACK, the
                       commands and requests of that rack only
@@ -35,8 +35,8 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
                       PumpCommand, ExplicitRequest, BusScanRequest and
                       ReloadRequest; with =RACK,..., commands and requests
                       to those racks only (=* : every rack again)
-  --monitor NAME      a monitoring host: reads PumpState, NodeStatus and
-                      PortStatus only
+  --monitor NAME      a monitoring host: reads PumpState, DeviceState,
+                      NodeStatus and PortStatus only
   --days N            validity of new identities and of the permissions
                       grants, days (default 365)
   --ca-days N         validity of new CAs, days (default 3650)
@@ -321,7 +321,7 @@ topics() { for t in "$@"; do echo "            <topic>dnbridge/$t</topic>"; done
 # replies in their rack's, "dnbridge/RACK" (every rack's: "dnbridge/*"),
 # and in the default partition too, where bridges and supervisors of
 # versions before partitions have them (an upgrade goes rack by rack).
-state_topics() { topics PumpState NodeStatus PortStatus; }
+state_topics() { topics PumpState DeviceState NodeStatus PortStatus; }
 publish_of() {
   case $1 in
     bridge) state_topics ;;

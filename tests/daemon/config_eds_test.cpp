@@ -82,6 +82,20 @@ TEST(ConfigEds, ANodeDescribedByItsEdsLoadsWithItsParametersAndSafeState) {
   EXPECT_EQ(list.nodes[0].profile.settings.size(), 5u);
 }
 
+TEST(ConfigEds, SafeStateParametersLeftToTheDeviceAreWarnedOf) {
+  const DaemonConfig c = parse(ONE_PORT
+                               "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                               "eds = \"dnbridge-example-io-block.eds\"\n"
+                               "safe_state = [ { name = \"Output idle action\", value = 0 },\n"
+                               "               { name = \"Output idle value\", value = 0 } ]\n");
+  ASSERT_EQ(c.warnings.size(), 2u);
+  EXPECT_THAT(c.warnings[0], HasSubstr("t.toml:10:7: node 20: Param6 \"Output fault action\" is "
+                                       "set neither in safe_state nor in parameters: the device "
+                                       "keeps its own value"));
+  EXPECT_THAT(c.warnings[1], HasSubstr("Param7 \"Output fault value\""));
+  EXPECT_TRUE(parse(ONE_PORT IO_BLOCK).warnings.empty());
+}
+
 TEST(ConfigEds, APumpAndADeviceShareAPort) {
   const DaemonConfig c = parse(ONE_PORT "[[port.node]]\nmac = 1\nname = \"pump-1\"\n" IO_BLOCK);
   const rack::PortNodes nodes = to_port_nodes(c.ports.at(0));

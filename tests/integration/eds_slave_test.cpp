@@ -14,6 +14,7 @@
 #include <optional>
 #include <vector>
 
+#include "adapters/sim/world/sim_eds_slave.hpp"
 #include "adapters/sim/world/sim_master.hpp"
 #include "adapters/sim/world/sim_world.hpp"
 #include "bridge/devicenet/wire/identifier.hpp"
@@ -33,36 +34,6 @@ constexpr std::uint16_t kInputs = 100;
 constexpr std::uint16_t kOutputs = 150;
 
 MacId mac(unsigned v) { return MacId::from(v).value(); }
-
-// The slave on the world's bus.
-class EdsNode final : public sim::SimEndpoint {
- public:
-  EdsNode(sim::SimWorld& world, sim::EdsSlaveOptions options)
-      : world_(world),
-        handle_(world.bus().attach(*this)),
-        slave_(world.bus().sink(handle_), example_eds(kIoBlockEds), options) {
-    world_.add(*this);
-    slave_.power_on(world.now());
-  }
-  ~EdsNode() override {
-    world_.remove(*this);
-    (void)world_.bus().detach(handle_);
-  }
-  EdsNode(const EdsNode&) = delete;
-  EdsNode& operator=(const EdsNode&) = delete;
-
-  void on_frame(const can::CanFrame& frame, TimePoint rx_time) override {
-    slave_.on_frame(frame, rx_time);
-  }
-  TimePoint next_deadline() const override { return slave_.next_deadline(); }
-  void on_timer(TimePoint now) override { slave_.on_timer(now); }
-  sim::EdsSlave& slave() { return slave_; }
-
- private:
-  sim::SimWorld& world_;
-  sim::NodeHandle handle_;
-  sim::EdsSlave slave_;
-};
 
 // A node the test speaks through: records what it hears, sends what it is told.
 class TestNode final : public sim::SimEndpoint {
@@ -148,10 +119,11 @@ devicenet::NodeConfig eds_node() {
 
 class EdsSlaveOnTheBus : public ::testing::Test {
  protected:
-  void start(sim::EdsSlaveOptions options = {}) {
+  void start(sim::EdsSlaveOptions options = {},
+             eds::EdsFile file = test::example_eds(test::kIoBlockEds)) {
     options.mac = kSlaveMac;
     options.serial_number = 0x0A0B0C0D;
-    slave_.emplace(world_, options);
+    slave_.emplace(world_, std::move(file), options, world_.now());
     devicenet::ScannerConfig port;
     port.master_mac = mac(kMasterMac);
     port.nodes.push_back(eds_node());
@@ -161,7 +133,7 @@ class EdsSlaveOnTheBus : public ::testing::Test {
   bool run_until_online() {
     return world_.run_until([&] { return events_.state == NodeState::kOnline; }, seconds(10));
   }
-  sim::EdsSlave& slave() { return slave_->slave(); }
+  sim::EdsSlave& slave() { return slave_->device(); }
   devicenet::Scanner& scanner() { return master_->scanner(); }
   const devicenet::Node& node() { return *scanner().node(mac(kSlaveMac)); }
   std::optional<double> param(unsigned n) { return slave().objects().param_number(n); }
@@ -171,7 +143,7 @@ class EdsSlaveOnTheBus : public ::testing::Test {
 
   sim::SimWorld world_;
   Recorder events_;
-  std::optional<EdsNode> slave_;
+  std::optional<sim::SimEdsSlave> slave_;
   std::optional<sim::SimMaster> master_;
 };
 
@@ -232,10 +204,46 @@ TEST_F(EdsSlaveOnTheBus, AnIdlePollTakesTheOutputsToZeroUnlessConfiguredToHold) 
   EXPECT_EQ(events_.state, NodeState::kOnline);
 }
 
-TEST_F(EdsSlaveOnTheBus, AHoldingDeviceKeepsItsOutputsOnIdle) {
+TEST_F(EdsSlaveOnTheBus, ADeviceSetToHoldKeepsItsOutputsOnIdle) {
+  start();
+  set_param(8, {1});  // Output idle action: hold
+  ASSERT_TRUE(run_until_online()) << events_.last_reason;
+  const std::array<std::uint8_t, 2> outputs{0x81, 0x00};
+  ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  ASSERT_TRUE(scanner().set_idle(mac(kSlaveMac), true, world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  EXPECT_GT(slave().counters().polls_idle, 0u);
+  EXPECT_EQ(param(4), 0x81);
+}
+
+TEST_F(EdsSlaveOnTheBus, TheOutputsTakeTheIdleAndFaultValuesTheirParametersHold) {
+  start();
+  set_param(9, {0x42});  // Output idle value
+  set_param(7, {0x24});  // Output fault value
+  ASSERT_TRUE(run_until_online()) << events_.last_reason;
+  const std::array<std::uint8_t, 2> outputs{0x81, 0x00};
+  ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  ASSERT_TRUE(scanner().set_idle(mac(kSlaveMac), true, world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  EXPECT_EQ(param(4), 0x42);
+  ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
+  world_.run_for(milliseconds(150));
+  ASSERT_EQ(param(4), 0x81);
+  // The master gone: the poll connection's watchdog is the fault.
+  master_.reset();
+  world_.run_for(seconds(3));
+  EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kTimedOut);
+  EXPECT_EQ(param(4), 0x24);
+}
+
+TEST_F(EdsSlaveOnTheBus, WithoutTheSafeStateParametersTheOptionsDecide) {
+  eds::EdsFile file = test::example_eds(test::kIoBlockEds);
+  std::erase_if(file.params, [](const eds::Param& p) { return p.number >= 6; });
   sim::EdsSlaveOptions options;
   options.idle_action = sim::OutputAction::kHold;
-  start(options);
+  start(options, std::move(file));
   ASSERT_TRUE(run_until_online()) << events_.last_reason;
   const std::array<std::uint8_t, 2> outputs{0x81, 0x00};
   ASSERT_TRUE(scanner().set_outputs(mac(kSlaveMac), Bytes(outputs), world_.now()).ok());
@@ -290,13 +298,15 @@ TEST_F(EdsSlaveOnTheBus, ASilentMasterTimesThePollConnectionOutAndTheOutputsFaul
 
 class EdsSlaveChangeOfState : public ::testing::Test {
  protected:
-  EdsSlaveChangeOfState() : slave_(world_, options()), tester_(world_) {}
+  EdsSlaveChangeOfState()
+      : slave_(world_, test::example_eds(test::kIoBlockEds), options(), world_.now()),
+        tester_(world_) {}
   static sim::EdsSlaveOptions options() {
     sim::EdsSlaveOptions o;
     o.mac = kSlaveMac;
     return o;
   }
-  sim::EdsSlave& slave() { return slave_.slave(); }
+  sim::EdsSlave& slave() { return slave_.device(); }
   std::uint32_t request_id() {
     return devicenet::group2_id(mac(kSlaveMac), devicenet::Group2Message::kMasterExplicitRequest);
   }
@@ -326,7 +336,7 @@ class EdsSlaveChangeOfState : public ::testing::Test {
   }
 
   sim::SimWorld world_;
-  EdsNode slave_;
+  sim::SimEdsSlave slave_;
   TestNode tester_;
   TimePoint established_{};
 };

@@ -55,10 +55,10 @@ grep -q "<enable_join_access_control>true<" "$pki/governance.xml" || fail "join 
 [ "$(grep -c "<default>DENY</default>" "$pki/permissions.xml")" = 3 ] || fail "not every grant defaults to DENY"
 subject=$(openssl x509 -in "$pki/hosts/ops-1/cert.pem" -noout -subject -nameopt RFC2253 | sed 's/^subject=//')
 grep -q "<subject_name>$subject</subject_name>" "$pki/permissions.xml" || fail "no grant names $subject"
-# The monitor's grant: PumpState, NodeStatus, PortStatus read; nothing written.
+# The monitor's grant: PumpState, DeviceState, NodeStatus, PortStatus read; nothing written.
 grant=$(sed -n '/<grant name="monitor-ops-1">/,/<\/grant>/p' "$pki/permissions.xml")
 grep -q "<publish>" <<<"$grant" && fail "the monitor may publish"
-[ "$(grep -c "<topic>" <<<"$grant")" = 3 ] || fail "the monitor reads other than the three state topics"
+[ "$(grep -c "<topic>" <<<"$grant")" = 4 ] || fail "the monitor reads other than the four state topics"
 days=$(( ( $(date -d "$(openssl x509 -in "$pki/hosts/rack-A/cert.pem" -noout -enddate | cut -d= -f2)" +%s) - $(date +%s) ) / 86400 ))
 [ "$days" -ge 29 ] && [ "$days" -le 30 ] || fail "--days 30 gave a certificate valid $days days"
 

@@ -66,6 +66,20 @@ ConnectionSetOptions connection_options(const EdsSlaveOptions& o, const IoDefaul
   return c;
 }
 
+// The parameters of the outputs' safe state, by this simulator's convention
+// (eds_slave.hpp), when the EDS has all four.
+std::optional<std::array<unsigned, 4>> safe_state_params(const eds::EdsFile& file) noexcept {
+  std::array<unsigned, 4> numbers{};
+  const std::array<std::string_view, 4> names{"Output fault action", "Output fault value",
+                                              "Output idle action", "Output idle value"};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const eds::Param* p = file.param(names[i]);
+    if (p == nullptr) return std::nullopt;
+    numbers[i] = p->number;
+  }
+  return numbers;
+}
+
 Group2Options wire_options(const eds::EdsFile& file, const EdsSlaveOptions& o) noexcept {
   Group2Options w = o.wire;
   w.vendor_id = file.device.vendor_code;
@@ -85,6 +99,9 @@ EdsSlave::EdsSlave(can::FrameSink& sink, eds::EdsFile file, EdsSlaveOptions opti
   poll_input_ = d.poll_input;
   poll_output_ = d.poll_output;
   cos_input_ = d.cos_input;
+  if (auto n = safe_state_params(objects_.file())) {
+    safe_state_params_ = SafeStateParams{(*n)[0], (*n)[1], (*n)[2], (*n)[3]};
+  }
 }
 
 void EdsSlave::power_up_device(TimePoint, PowerUpCause) noexcept {
@@ -176,7 +193,7 @@ void EdsSlave::on_io_released(std::uint16_t instance, bool was_established, Time
     objects_.ack_handler().cos_acknowledged = false;
     return;
   }
-  if (was_established) apply_output_action(options_.idle_action);
+  if (was_established) apply_output_action(false);
 }
 
 void EdsSlave::on_io_timed_out(std::uint16_t instance, TimePoint) noexcept {
@@ -185,23 +202,32 @@ void EdsSlave::on_io_timed_out(std::uint16_t instance, TimePoint) noexcept {
     objects_.ack_handler().cos_acknowledged = false;
     return;
   }
-  apply_output_action(options_.fault_action);
+  apply_output_action(true);
 }
 
 void EdsSlave::go_offline(TimePoint) noexcept {
   if (connections_.established(connection_instance::kPoll)) {
-    apply_output_action(options_.fault_action);
+    apply_output_action(true);
   }
   connections_.drop();
   end_cos();
 }
 
-void EdsSlave::apply_output_action(OutputAction action) noexcept {
+void EdsSlave::apply_output_action(bool fault) noexcept {
   const std::uint16_t assembly = connections_.poll_connection().consumed_assembly;
   const std::uint16_t outputs = assembly != 0 ? assembly : poll_output_;
-  if (action != OutputAction::kZero || outputs == 0) return;
-  const std::vector<std::uint8_t> zero(objects_.assembly_data(outputs).size(), 0);
-  (void)objects_.set_assembly_data(outputs, Bytes(zero.data(), zero.size()));
+  if (outputs == 0) return;
+  std::vector<std::uint8_t> data(objects_.assembly_data(outputs).size(), 0);
+  if (safe_state_params_) {
+    const SafeStateParams& p = *safe_state_params_;
+    const auto action = objects_.param_number(fault ? p.fault_action : p.idle_action);
+    if (action && *action != 0) return;  // hold
+    const auto value = objects_.param_value(fault ? p.fault_value : p.idle_value);
+    std::copy_n(value.begin(), std::min(value.size(), data.size()), data.begin());
+  } else if ((fault ? options_.fault_action : options_.idle_action) == OutputAction::kHold) {
+    return;
+  }
+  (void)objects_.set_assembly_data(outputs, Bytes(data.data(), data.size()));
 }
 
 // --- poll --------------------------------------------------------------------------
@@ -221,7 +247,7 @@ PollResult EdsSlave::poll(Bytes command, TimePoint now) noexcept {
   const bool idle = command.size() < consumed;
   if (idle) {
     result.outcome = PollOutcome::kIdle;
-    apply_output_action(options_.idle_action);
+    apply_output_action(false);
   } else {
     result.outcome = PollOutcome::kApplied;
     if (consumed > 0 && !objects_.set_assembly_data(c.consumed_assembly, command)) {

@@ -18,8 +18,14 @@
 // and output; attributes 7/8 are the sizes they pack to. A poll command
 // shorter than the consumed size is the idle condition (bridge/PROTOCOL.md
 // §7): the idle action; Release of an established poll connection is idle
-// too; its watchdog expiring, or a duplicate MAC, the fault action
-// (EdsSlaveOptions). At power-up the outputs are zero. I/O data longer than
+// too; its watchdog expiring, or a duplicate MAC, the fault action. At
+// power-up the outputs are zero. The actions are EdsSlaveOptions', unless
+// the EDS has the four parameters of this simulator's convention (as the
+// example I/O block's EDS does): "Output fault action" and "Output idle
+// action" (0: the outputs take the value, 1: they hold) with "Output fault
+// value" and "Output idle value" (the output data, from its first byte, the
+// rest zero). Then what the master downloads to them is what the outputs do,
+// as on a device whose safe state is configured. I/O data longer than
 // one frame (8 bytes) is not fragmented here: such an assembly cannot be
 // chosen.
 //
@@ -60,6 +66,7 @@ struct EdsSlaveOptions {
   std::uint8_t mac = 63;
   std::uint8_t baud = 0;  // DeviceNet object attribute 2: 0 125k, 1 250k, 2 500k
   std::uint32_t serial_number = 1;
+  // Unless the EDS has the safe-state parameters of the convention above.
   OutputAction idle_action = OutputAction::kZero;
   OutputAction fault_action = OutputAction::kZero;
   // An idle poll answered with no data rather than the produced data
@@ -139,7 +146,13 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
                          ByteWriter& w) noexcept;
   Reply connection_object(const devicenet::RequestMessage& r, TimePoint now,
                           ByteWriter& w) noexcept;
-  void apply_output_action(OutputAction action) noexcept;
+  // The outputs on idle (`fault` false) or on a fault.
+  void apply_output_action(bool fault) noexcept;
+  // The convention's parameters, when the EDS has all four (ParamN's N).
+  struct SafeStateParams {
+    unsigned fault_action = 0, fault_value = 0, idle_action = 0, idle_value = 0;
+  };
+  std::optional<SafeStateParams> safe_state_params_;
   void end_cos() noexcept;
   void produce(const std::optional<std::vector<std::uint8_t>>& message, TimePoint now) noexcept;
 

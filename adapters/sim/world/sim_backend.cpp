@@ -11,12 +11,18 @@
 namespace dnbridge::sim {
 
 SimBackend::SimBackend(std::uint32_t bitrate, const std::vector<devicenet::MacId>& device_macs,
-                       LogSink* log)
+                       LogSink* log, const std::vector<EdsDeviceSpec>& eds_devices)
     : world_(BusConfig{bitrate}, port::steady_now()), handle_(world_.bus().attach(*this)) {
+  const auto device_log = [log](devicenet::MacId mac) {
+    return log ? Logger(*log, fmt::format("sim {}", mac.value())) : Logger();
+  };
   for (auto mac : device_macs) {
-    Logger device_log = log ? Logger(*log, fmt::format("sim {}", mac.value())) : Logger();
     devices_[mac.value()] = std::make_unique<SimSlave>(world_, sim::default_slave_options(mac),
-                                                       world_.now(), std::move(device_log));
+                                                       world_.now(), device_log(mac));
+  }
+  for (const auto& d : eds_devices) {
+    eds_devices_[d.mac.value()] = std::make_unique<SimEdsSlave>(
+        world_, *d.eds, default_eds_slave_options(d.mac), world_.now(), device_log(d.mac));
   }
 }
 
@@ -28,6 +34,13 @@ SimSlave& SimBackend::device(devicenet::MacId mac) {
   auto it = devices_.find(mac.value());
   if (it == devices_.end())
     throw std::out_of_range(fmt::format("no simulated device {}", mac.value()));
+  return *it->second;
+}
+
+SimEdsSlave& SimBackend::eds_device(devicenet::MacId mac) {
+  auto it = eds_devices_.find(mac.value());
+  if (it == eds_devices_.end())
+    throw std::out_of_range(fmt::format("no simulated EDS device {}", mac.value()));
   return *it->second;
 }
 

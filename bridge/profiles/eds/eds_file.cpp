@@ -83,11 +83,44 @@ const Param* EdsFile::param(unsigned number) const noexcept {
   return nullptr;
 }
 
-const Param* EdsFile::param(std::string_view name) const noexcept {
-  for (const auto& p : params) {
-    if (iequals(p.name, name)) return &p;
+namespace {
+
+// "Input12" with prefix "Input": 12. Nothing when the keyword is not the
+// prefix followed by a number from 1.
+std::optional<unsigned> number_after(std::string_view keyword, std::string_view prefix) {
+  if (keyword.size() <= prefix.size() || !iequals(keyword.substr(0, prefix.size()), prefix)) {
+    return std::nullopt;
   }
-  return nullptr;
+  const std::string_view digits = keyword.substr(prefix.size());
+  unsigned n = 0;
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), n);
+  if (ec != std::errc{} || end != digits.data() + digits.size() || n == 0) return std::nullopt;
+  return n;
+}
+
+}  // namespace
+
+std::optional<unsigned> param_number(std::string_view name) noexcept {
+  return number_after(name, "Param");
+}
+
+const Param* EdsFile::param(std::string_view name) const noexcept {
+  if (auto n = param_number(name)) return param(*n);
+  const Param* found = nullptr;
+  for (const auto& p : params) {
+    if (!iequals(p.name, name)) continue;
+    if (found != nullptr) return nullptr;  // several
+    found = &p;
+  }
+  return found;
+}
+
+std::vector<unsigned> EdsFile::params_named(std::string_view name) const {
+  std::vector<unsigned> numbers;
+  for (const auto& p : params) {
+    if (iequals(p.name, name)) numbers.push_back(p.number);
+  }
+  return numbers;
 }
 
 const Assembly* EdsFile::assembly_at(const cip::EPath& path) const noexcept {
@@ -105,19 +138,6 @@ std::string format_problem(std::string_view file, const Problem& problem) {
 }
 
 namespace {
-
-// "Input12" with prefix "Input": 12. Nothing when the keyword is not the
-// prefix followed by a number from 1.
-std::optional<unsigned> number_after(std::string_view keyword, std::string_view prefix) {
-  if (keyword.size() <= prefix.size() || !iequals(keyword.substr(0, prefix.size()), prefix)) {
-    return std::nullopt;
-  }
-  const std::string_view digits = keyword.substr(prefix.size());
-  unsigned n = 0;
-  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), n);
-  if (ec != std::errc{} || end != digits.data() + digits.size() || n == 0) return std::nullopt;
-  return n;
-}
 
 // An entry's identity: "param5" for Param5 or PARAM05 (the numbered
 // keywords by their number), the keyword in lower case for the others.

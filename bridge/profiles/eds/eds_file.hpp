@@ -165,10 +165,17 @@ struct EdsFile {
   std::vector<Assembly> assemblies;
 
   const Param* param(unsigned number) const noexcept;
-  const Param* param(std::string_view name) const noexcept;  // by name, case-insensitive
+  // The parameter `name` names: "ParamN", or a name (any case) no other
+  // parameter has. nullptr when none does, or several (params_named()).
+  const Param* param(std::string_view name) const noexcept;
+  // The numbers of the parameters with this name (any case).
+  std::vector<unsigned> params_named(std::string_view name) const;
   // The assembly an IoData's path leads to (its class 4 instance), if described.
   const Assembly* assembly_at(const cip::EPath& path) const noexcept;
 };
+
+// N of "ParamN" (any case); nothing for another name.
+std::optional<unsigned> param_number(std::string_view name) noexcept;
 
 struct Parsed {
   std::optional<EdsFile> file;  // absent when there is an error

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -128,20 +129,41 @@ void write_bits(std::vector<std::uint8_t>& data, std::uint32_t offset, std::uint
 
 // "NAME: VALUE is outside MIN..MAX" when `value` is beyond the field's EDS limits.
 std::optional<std::string> beyond_limits(const IoField& f, double value) {
-  if ((f.minimum && value < *f.minimum) || (f.maximum && value > *f.maximum)) {
-    return fmt::format("{}: {} is outside {}..{}", f.name, value, f.minimum.value_or(-INFINITY),
-                       f.maximum.value_or(INFINITY));
-  }
-  return std::nullopt;
+  if (within_limits(f.minimum, f.maximum, value)) return std::nullopt;
+  return fmt::format("{}: {} is outside {}", f.name, value, limits_text(f.minimum, f.maximum));
 }
 
 }  // namespace
 
+bool within_limits(const std::optional<double>& minimum, const std::optional<double>& maximum,
+                   double value) noexcept {
+  return !((minimum && value < *minimum) || (maximum && value > *maximum));
+}
+
+std::string limits_text(const std::optional<double>& minimum,
+                        const std::optional<double>& maximum) {
+  return fmt::format("{}..{}", minimum.value_or(-INFINITY), maximum.value_or(INFINITY));
+}
+
 const IoField* IoLayout::field(std::string_view wanted) const noexcept {
-  for (const auto& f : fields) {
-    if (iequals(f.name, wanted)) return &f;
+  if (auto n = param_number(wanted)) {
+    for (const auto& f : fields) {
+      if (f.param == *n) return &f;
+    }
+    return nullptr;
   }
-  return nullptr;
+  const IoField* found = nullptr;
+  for (const auto& f : fields) {
+    if (!iequals(f.name, wanted)) continue;
+    if (found != nullptr) return nullptr;  // several
+    found = &f;
+  }
+  return found;
+}
+
+std::size_t IoLayout::fields_named(std::string_view wanted) const noexcept {
+  return static_cast<std::size_t>(std::count_if(
+      fields.begin(), fields.end(), [&](const IoField& f) { return iequals(f.name, wanted); }));
 }
 
 IoLayout layout_of(const EdsFile& file, const IoData& data) {
@@ -221,7 +243,13 @@ Result<std::vector<std::uint8_t>> encode(const IoLayout& layout,
   std::vector<bool> given(layout.fields.size(), false);
   for (const FieldSetting& s : settings) {
     const IoField* f = layout.field(s.name);
-    if (f == nullptr) return fail(Errc::kMalformed, fmt::format("no field \"{}\"", s.name));
+    if (f == nullptr) {
+      if (const std::size_t n = layout.fields_named(s.name); n > 1) {
+        return fail(Errc::kMalformed,
+                    fmt::format("\"{}\" names {} fields: name one as ParamN", s.name, n));
+      }
+      return fail(Errc::kMalformed, fmt::format("no field \"{}\"", s.name));
+    }
     const auto index = static_cast<std::size_t>(f - layout.fields.data());
     if (given[index]) return fail(Errc::kMalformed, fmt::format("{} is given twice", f->name));
     given[index] = true;
@@ -234,6 +262,10 @@ Result<std::vector<std::uint8_t>> encode(const IoLayout& layout,
     if (!raw) {
       return fail(Errc::kOutOfRange, fmt::format("{}: {} is not a {} of {} bits", f->name, s.value,
                                                  f->type.name, f->bits));
+    }
+    // The limits hold for the value as sent, too (a REAL in single precision).
+    if (auto outside = beyond_limits(*f, from_raw(f->type, f->bits, *raw))) {
+      return fail(Errc::kOutOfRange, *outside);
     }
     if (std::uint64_t{f->offset} + f->bits > std::uint64_t{layout.size} * 8) {
       return fail(Errc::kOutOfRange,
@@ -258,6 +290,25 @@ Status check(const IoLayout& layout, Bytes data, std::string* why) {
   if (data.size() != layout.size) {
     return fail(Errc::kMalformed, fmt::format("{} bytes given, \"{}\" is {} bytes", data.size(),
                                               layout.name, layout.size));
+  }
+  // Where the EDS describes the data, what it leaves undescribed (padding,
+  // fields that are not numbers) must be zero, as encode() leaves it.
+  if (!layout.fields.empty()) {
+    std::vector<bool> covered(data.size() * 8, false);
+    for (const IoField& f : layout.fields) {
+      if (!f.numeric) continue;
+      for (std::uint32_t b = f.offset; b < f.offset + f.bits && b < covered.size(); ++b) {
+        covered[b] = true;
+      }
+    }
+    for (std::size_t b = 0; b < covered.size(); ++b) {
+      if (!covered[b] && ((data[b / 8] >> (b % 8)) & 1U) != 0) {
+        return fail(Errc::kOutOfRange,
+                    fmt::format("bit {} of byte {} is set, and the EDS gives it no field (padding, "
+                                "or a field that is not a number): it must be 0",
+                                b % 8, b / 8));
+      }
+    }
   }
   for (const FieldValue& v : decode(layout, data)) {
     const IoField& f = layout.fields[v.field];

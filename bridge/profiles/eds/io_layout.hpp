@@ -45,7 +45,10 @@ struct IoLayout {
   std::string assembly;    // "Assem100 (Inputs and status)"; empty: no fields known
   std::vector<IoField> fields;
 
-  const IoField* field(std::string_view name) const noexcept;  // case-insensitive
+  // The field `name` names: "ParamN" (its parameter's), or a name (any case)
+  // no other field has; nullptr when none does, or several.
+  const IoField* field(std::string_view name) const noexcept;
+  std::size_t fields_named(std::string_view name) const noexcept;
 };
 
 // The layout of `data` (an InputN or OutputN of `file`).
@@ -57,6 +60,12 @@ IoLayout layout_of(const EdsFile& file, const IoData& data);
 std::optional<std::uint64_t> to_raw(const DataType& type, std::uint16_t bits, double value);
 // The number `raw` (the low `bits` bits) is, read as `type`.
 double from_raw(const DataType& type, std::uint16_t bits, std::uint64_t raw);
+
+// Whether `value` is within the EDS's limits (either may be absent), and
+// the limits as "MIN..MAX" ("-inf" or "inf" for an absent one).
+bool within_limits(const std::optional<double>& minimum, const std::optional<double>& maximum,
+                   double value) noexcept;
+std::string limits_text(const std::optional<double>& minimum, const std::optional<double>& maximum);
 
 struct FieldValue {
   std::size_t field = 0;  // index in IoLayout::fields

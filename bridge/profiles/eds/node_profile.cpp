@@ -30,6 +30,13 @@ std::string describe_data(const IoLayout& io, std::string_view what) {
 Result<devicenet::AttributeSetting> setting_of(const EdsFile& file, const ParameterValue& given,
                                                std::string_view list, std::string* why) {
   const Param* p = file.param(given.name);
+  if (const auto named = file.params_named(given.name); p == nullptr && named.size() > 1) {
+    std::string numbers;
+    for (unsigned n : named) numbers += fmt::format("{}Param{}", numbers.empty() ? "" : ", ", n);
+    return explain(why, Errc::kMalformed,
+                   fmt::format("{}: \"{}\" names {} parameters ({}): name one as ParamN", list,
+                               given.name, named.size(), numbers));
+  }
   if (p == nullptr) {
     std::vector<std::string_view> names;
     for (const auto& q : file.params) names.push_back(q.name);
@@ -54,16 +61,23 @@ Result<devicenet::AttributeSetting> setting_of(const EdsFile& file, const Parame
         why, Errc::kUnsupported,
         fmt::format("{} is a {}: only numbers are set at start-up", label, p->type.name));
   }
-  if ((p->minimum && given.value < *p->minimum) || (p->maximum && given.value > *p->maximum)) {
+  if (!within_limits(p->minimum, p->maximum, given.value)) {
     return explain(why, Errc::kOutOfRange,
-                   fmt::format("{}: {} is outside the EDS's limits {}..{}", label, given.value,
-                               p->minimum.value_or(-INFINITY), p->maximum.value_or(INFINITY)));
+                   fmt::format("{}: {} is outside the EDS's limits {}", label, given.value,
+                               limits_text(p->minimum, p->maximum)));
   }
   const auto bits = static_cast<std::uint16_t>(p->size * 8);
   const auto raw = to_raw(p->type, bits, given.value);
   if (!raw) {
     return explain(why, Errc::kOutOfRange,
                    fmt::format("{}: {} is not a {} value", label, given.value, p->type.name));
+  }
+  // The limits hold for the value as the device gets it, too (a REAL in
+  // single precision).
+  if (!within_limits(p->minimum, p->maximum, from_raw(p->type, bits, *raw))) {
+    return explain(why, Errc::kOutOfRange,
+                   fmt::format("{}: {} is outside the EDS's limits {}", label, given.value,
+                               limits_text(p->minimum, p->maximum)));
   }
   devicenet::AttributeSetting s;
   s.class_id = static_cast<std::uint16_t>(*link.class_id);
@@ -144,6 +158,27 @@ Result<devicenet::NodeProfile> make_node_profile(const EdsFile& file, const EdsN
   p.format_description = fmt::format("{}, {}", describe_data(io->produced, "input"),
                                      describe_data(io->consumed, "output"));
   return p;
+}
+
+std::vector<const Param*> safe_state_left_to_device(const EdsFile& file, const EdsNode& node) {
+  const auto speaks_of = [](std::string_view name, std::string_view word) {
+    return to_lower(name).find(word) != std::string::npos;
+  };
+  const auto set = [&](const Param& p) {
+    for (const auto* list : {&node.parameters, &node.safe_state}) {
+      for (const ParameterValue& v : *list) {
+        if (file.param(v.name) == &p) return true;
+      }
+    }
+    return false;
+  };
+  std::vector<const Param*> left;
+  for (const Param& p : file.params) {
+    if (p.read_only() || p.link.empty() || p.type.size == 0) continue;
+    if (!speaks_of(p.name, "fault") && !speaks_of(p.name, "idle")) continue;
+    if (!set(p)) left.push_back(&p);
+  }
+  return left;
 }
 
 }  // namespace dnbridge::eds

@@ -58,4 +58,11 @@ Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::stri
 Result<devicenet::NodeProfile> make_node_profile(const EdsFile& file, const EdsNode& node,
                                                  std::string* why = nullptr);
 
+// The writable, linked parameters whose names speak of a fault or an idle
+// state ("fault", "idle", any case) that the node sets in neither list:
+// values the device keeps as they are, which may be its factory's. No
+// standard names a device's safe-state parameters: for a warning, not a
+// refusal.
+std::vector<const Param*> safe_state_left_to_device(const EdsFile& file, const EdsNode& node);
+
 }  // namespace dnbridge::eds

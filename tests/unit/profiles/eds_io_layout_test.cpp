@@ -161,5 +161,75 @@ TEST(EdsIoLayout, ValuesTakeTheirTypesRangeWithinTheirBits) {
   EXPECT_FALSE(to_raw(type(0xC6), 8, INFINITY));
 }
 
+// Two outputs of one name, as channel parameters often are; a REAL limited
+// to 0.1.
+constexpr const char* kTwins =
+    "[Device]\nVendCode = 1; ProdType = 0; ProdCode = 2; MajRev = 1; MinRev = 1;\n"
+    "[IO_Info]\nPollInfo = 1, 0, 1;\n"
+    "Output1 = 6, 0, 1, \"out\", 6, \"20 04 24 02 30 03\", \"\";\n"
+    "[Params]\n"
+    "Param1 = 0, 0, , 0, 0xC6, 1, \"Channel\", \"\", \"\", 0, 10, 0;\n"
+    "Param2 = 0, 0, , 0, 0xC6, 1, \"channel\", \"\", \"\", 0, 10, 0;\n"
+    "Param3 = 0, 0, , 0, 0xCA, 4, \"gain\", \"\", \"\", 0, 0.1, 0;\n"
+    "[Assembly]\n"
+    "Assem2 = \"out\", \"20 04 24 02 30 03\", 48, 0, , , 8, Param1, 8, Param2, 32, Param3;\n";
+
+TEST(EdsIoLayout, FieldsOfOneNameAreNamedByTheirParameter) {
+  auto parsed = parse(kTwins);
+  ASSERT_TRUE(parsed.file.has_value());
+  const IoLayout out = layout_of(*parsed.file, *parsed.file->io.output(1));
+  EXPECT_EQ(out.field("channel"), nullptr);
+  EXPECT_EQ(out.fields_named("channel"), 2u);
+  EXPECT_EQ(out.field("Param2"), &out.fields[1]);
+  std::string why;
+  EXPECT_FALSE(encode(out, {{"Channel", 1}, {"gain", 0}}, &why).ok());
+  EXPECT_EQ(why, "\"Channel\" names 2 fields: name one as ParamN");
+  auto data = encode(out, {{"Param1", 1}, {"param2", 2}, {"gain", 0}}, &why);
+  ASSERT_TRUE(data.ok()) << why;
+  EXPECT_EQ((*data)[0], 1);
+  EXPECT_EQ((*data)[1], 2);
+}
+
+TEST(EdsIoLayout, AREALsLimitHoldsForTheValueAsSent) {
+  auto parsed = parse(kTwins);
+  ASSERT_TRUE(parsed.file.has_value());
+  const IoLayout out = layout_of(*parsed.file, *parsed.file->io.output(1));
+  std::string why;
+  // 0.1 as a float is 0.100000001...: above the limit 0.1 as the device
+  // would take it.
+  EXPECT_EQ(encode(out, {{"Param1", 0}, {"Param2", 0}, {"gain", 0.1}}, &why).error(),
+            make_error_code(Errc::kOutOfRange));
+  EXPECT_THAT(why, HasSubstr("gain: 0.10000000149011612 is outside 0..0.1"));
+  EXPECT_TRUE(encode(out, {{"Param1", 0}, {"Param2", 0}, {"gain", 0.0999999}}).ok());
+}
+
+TEST(EdsIoLayout, DataToSendHasItsSizeEveryFieldWithinItsLimitsAndPaddingZero) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  const IoLayout out = output1(f);
+  std::string why;
+  const ByteVec ok{0x81, 0x00};
+  EXPECT_TRUE(check(out, Bytes(ok.data(), ok.size()), &why).ok()) << why;
+  const ByteVec pad{0x81, 0x10};
+  EXPECT_EQ(check(out, Bytes(pad.data(), pad.size()), &why).error(),
+            make_error_code(Errc::kOutOfRange));
+  EXPECT_EQ(why,
+            "bit 4 of byte 1 is set, and the EDS gives it no field (padding, or a field that is "
+            "not a number): it must be 0");
+  const ByteVec shorter{0x81};
+  EXPECT_EQ(check(out, Bytes(shorter.data(), shorter.size()), &why).error(),
+            make_error_code(Errc::kMalformed));
+  EXPECT_EQ(why, "1 bytes given, \"Outputs\" is 2 bytes");
+  // A field beyond its EDS limits (the analog input: -10000..10000 mV).
+  const IoLayout in = input1(f);
+  const ByteVec beyond{0x00, 0x00, 0x11, 0x27};  // 10001
+  EXPECT_EQ(check(in, Bytes(beyond.data(), beyond.size()), &why).error(),
+            make_error_code(Errc::kOutOfRange));
+  EXPECT_EQ(why, "Analog input 1: 10001 is outside -10000..10000");
+  // Data the EDS describes no field of is sent as given.
+  IoLayout bare = out;
+  bare.fields.clear();
+  EXPECT_TRUE(check(bare, Bytes(pad.data(), pad.size())).ok());
+}
+
 }  // namespace
 }  // namespace dnbridge::eds

@@ -150,5 +150,44 @@ TEST(EdsNodeProfile, AParameterWithoutALinkPathOrOfAStringTypeIsNotSet) {
   EXPECT_EQ(p->format_description, "input 1 B \"in\", no output");
 }
 
+TEST(EdsNodeProfile, AParameterNameSeveralParametersHaveMustBeGivenAsParamN) {
+  auto parsed = parse(
+      "[Device]\nVendCode = 1; ProdType = 0; ProdCode = 2; MajRev = 1; MinRev = 1;\n"
+      "[IO_Info]\nPollInfo = 1, 1, 0;\n"
+      "Input1 = 1, 0, 1, \"in\", 0, \"\", \"\";\n"
+      "[Params]\n"
+      "Param1 = 0, 6, \"20 09 24 01 30 05\", 0, 0xC6, 1, \"Fault action\", \"\", \"\", 0, 1, 0;\n"
+      "Param2 = 0, 6, \"20 09 24 02 30 05\", 0, 0xC6, 1, \"Fault action\", \"\", \"\", 0, 1, 0;\n");
+  ASSERT_TRUE(parsed.file.has_value());
+  EdsNode n;
+  n.parameters = {{"fault action", 1}};
+  std::string why;
+  EXPECT_EQ(make_node_profile(*parsed.file, n, &why).error(), make_error_code(Errc::kMalformed));
+  EXPECT_EQ(why,
+            "parameters: \"fault action\" names 2 parameters (Param1, Param2): name one as "
+            "ParamN");
+  n.parameters = {{"Param1", 1}, {"param2", 1}};
+  auto p = make_node_profile(*parsed.file, n, &why);
+  ASSERT_TRUE(p.ok()) << why;
+  ASSERT_EQ(p->settings.size(), 2u);
+  EXPECT_EQ(p->settings[1].instance_id, 2);
+  // Both given: nothing of the safe state is left to the device.
+  EXPECT_TRUE(safe_state_left_to_device(*parsed.file, n).empty());
+  n.parameters = {{"Param1", 1}};
+  const auto left = safe_state_left_to_device(*parsed.file, n);
+  ASSERT_EQ(left.size(), 1u);
+  EXPECT_EQ(left[0]->number, 2u);
+}
+
+TEST(EdsNodeProfile, TheSafeStateParametersNotGivenAreTheDevicesOwn) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  EdsNode n = polled();
+  EXPECT_TRUE(safe_state_left_to_device(f, n).empty());
+  n.safe_state = {{"Output idle action", 0}};
+  std::vector<unsigned> left;
+  for (const Param* p : safe_state_left_to_device(f, n)) left.push_back(p->number);
+  EXPECT_EQ(left, (std::vector<unsigned>{6, 7, 9}));
+}
+
 }  // namespace
 }  // namespace dnbridge::eds
