@@ -142,6 +142,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       requests_(participant, publisher.request_topic(), dds::request_reader_qos(partition_)),
       reload_(std::move(reload)),
       command_buffer_(kBatch),
+      device_command_buffer_(kBatch),
       request_buffer_(kBatch),
       stop_(participant),
       waitset_(participant),
@@ -150,6 +151,10 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       command_log_(log_.to(command_sink_)),
       own_sink_(log_.sink(), [this] { drain_command_log(); }) {
   log_ = log_.to(own_sink_);
+  device_commands_ = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)", [&] {
+    return DeviceCommandsIn(participant, dds::command_reader_qos(partition_),
+                            command_listener_.get());
+  });
   // Readers of the services that DDS Security grants (the publisher has
   // their topics), each as far as it grants it.
   if (const auto* topic = publisher.scan_request_topic()) {
@@ -169,6 +174,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   // (every status) a matched writer's SUBSCRIPTION_MATCHED, never read here,
   // would keep the waitset triggered and this thread spinning.
   std::vector<const dds::Entity*> readers{&commands_, &requests_};
+  if (device_commands_) readers.push_back(&device_commands_->reader);
   if (scan_requests_) readers.push_back(&*scan_requests_);
   if (reload_requests_) readers.push_back(&*reload_requests_);
   for (const dds::Entity* reader : readers) {
@@ -198,6 +204,7 @@ void DdsInput::stop() {
   accepting_ = false;
   // No listener call after this: none is handing a command to a port.
   (void)dds::DataListener::detach(commands_);
+  if (device_commands_) (void)dds::DataListener::detach(device_commands_->reader);
   if (!thread_.joinable()) return;
   (void)stop_.trigger();
   thread_.join();
@@ -294,6 +301,30 @@ void DdsInput::take_commands() {
       [this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0,
       command_log_, "pump commands",
       [this](std::size_t i) { on_command(command_buffer_.data(i), command_buffer_.info(i)); });
+  if (!device_commands_) return;
+  take_batches([this] { return device_commands_->reader.take(device_command_buffer_); },
+               device_command_buffer_.capacity(), 0, command_log_, "device commands",
+               [this](std::size_t i) {
+                 on_device_command(device_command_buffer_.data(i), device_command_buffer_.info(i));
+               });
+}
+
+template <class Command>
+port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info, bool device) {
+  port::PortLoop* loop = port_of(dds::view(c.port));
+  const auto mac = devicenet::MacId::from(c.mac);
+  const bool node = loop && mac && loop->has_node(*mac);
+  const bool pump = node && loop->has_pump(*mac);
+  if (node && pump != device) return loop;
+  command_warn_limit_.warn(
+      command_log_, port::steady_now(), "{} command{} for port \"{}\" MAC {} refused: {}",
+      device ? "device" : "pump",
+      info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "", dds::view(c.port),
+      c.mac,
+      !node  ? "not in this rack's configuration"
+      : pump ? "the node is a pump (a CDN127): PumpCommand commands it"
+             : "the node is not a pump (its profile is \"eds\"): DeviceCommand commands it");
+  return nullptr;
 }
 
 void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
@@ -323,7 +354,24 @@ void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& 
   loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
 }
 
-void DdsInput::note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
+void DdsInput::on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info) {
+  if (dds::view(c.rack) != rack_) return;  // another bridge's device
+  if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
+  port::PortLoop* loop = loop_for(c, info, true);
+  if (!loop) return;
+  const auto mac = devicenet::MacId::from(c.mac);
+  // As for a pump (on_command): no live commander left, idle.
+  if (info.instance_state() != dds::InstanceState::kAlive) {
+    loop->release_device_command(*mac);
+    return;
+  }
+  if (!info.valid_data()) return;
+  note_clock_skew(c, info);
+  loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
+}
+
+template <class Command>
+void DdsInput::note_clock_skew(const Command& c, const dds::SampleInfo& info) {
   // Commands are applied in the order they arrive, whatever their stamps
   // (dds::command_reader_qos): a commander's clock cannot hold a pump. A
   // stamp far ahead still says that a commander's clock is wrong, and other

@@ -122,8 +122,15 @@ class DdsInput {
   void on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample);
   void take_reload_requests();
   void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
+  void on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info);
+  // The port loop a command sample is for, when the MAC is a node of that
+  // loop of the kind the topic commands (`device`: DeviceCommand); else the
+  // refusal is logged (rate-limited) and null.
+  template <class Command>
+  port::PortLoop* loop_for(const Command& c, const dds::SampleInfo& info, bool device);
   void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
-  void note_clock_skew(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
+  template <class Command>
+  void note_clock_skew(const Command& c, const dds::SampleInfo& info);
   port::PortLoop* port_of(std::string_view name);
 
   std::string rack_;
@@ -143,12 +150,23 @@ class DdsInput {
   dds::GuardCondition commands_held_;
   dds::DataListener command_listener_;  // before the reader: it outlives it
   dds::Reader<dnbridge_PumpCommand> commands_;
+  // DeviceCommand: its topic and reader (with the same listener); none when
+  // DDS Security does not grant the topic (unless_denied).
+  struct DeviceCommandsIn {
+    DeviceCommandsIn(const dds::Participant& participant, const dds::Qos& qos,
+                     const dds_listener_t* listener)
+        : topic(participant), reader(participant, topic, qos, listener) {}
+    dds::Topic<dnbridge_DeviceCommand> topic;
+    dds::Reader<dnbridge_DeviceCommand> reader;
+  };
+  std::optional<DeviceCommandsIn> device_commands_;
   dds::Reader<dnbridge_ExplicitRequest> requests_;
   // Absent when DDS Security does not grant the service (unless_denied).
   std::optional<dds::Reader<dnbridge_BusScanRequest>> scan_requests_;
   std::optional<dds::Reader<dnbridge_ReloadRequest>> reload_requests_;
   std::function<void(ReloadCall)> reload_;
   dds::TakeBuffer<dnbridge_PumpCommand> command_buffer_;
+  dds::TakeBuffer<dnbridge_DeviceCommand> device_command_buffer_;
   dds::TakeBuffer<dnbridge_ExplicitRequest> request_buffer_;
   std::vector<std::vector<unsigned char>> request_cdr_;
   dds::GuardCondition stop_;

@@ -364,6 +364,15 @@ void fill_reload_reply(dnbridge_ReloadReply& out, std::string_view rack, const R
   set_strings(out.problems, r.problems);
 }
 
+port::PortLoop::DeviceOutputs outputs_of(const dnbridge_DeviceCommand& c) {
+  const auto bytes = dds::view(c.outputs);
+  if (!bytes.empty()) return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
+  std::vector<eds::FieldSetting> fields;
+  const std::span<const dnbridge_DeviceFieldValue> given(c.fields._buffer, c.fields._length);
+  for (const auto& f : given) fields.push_back({std::string(dds::view(f.name)), f.value});
+  return fields;
+}
+
 cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& c) {
   cdn127::PumpOutputs o;
   o.pump_on = c.pump_on;

@@ -34,6 +34,12 @@ struct TopicTraits<dnbridge_DeviceState> {
 };
 
 template <>
+struct TopicTraits<dnbridge_DeviceCommand> {
+  static constexpr const char* kName = "dnbridge/DeviceCommand";
+  static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_DeviceCommand_desc;
+};
+
+template <>
 struct TopicTraits<dnbridge_NodeStatus> {
   static constexpr const char* kName = "dnbridge/NodeStatus";
   static constexpr const dds_topic_descriptor_t* kDescriptor = &dnbridge_NodeStatus_desc;
@@ -75,7 +81,7 @@ struct TopicTraits<dnbridge_ReloadReply> {
 };
 
 // --- Partitions ----------------------------------------------------------------
-// What is for one rack, PumpCommand and the requests (ExplicitRequest,
+// What is for one rack, PumpCommand, DeviceCommand and the requests (ExplicitRequest,
 // BusScanRequest, ReloadRequest) with their replies, is published and read
 // in that rack's partition, "dnbridge/RACK": DDS delivers a bridge only its
 // own rack's commands and requests, and a command goes to the one bridge
@@ -109,7 +115,7 @@ Qos state_writer_qos(Duration deadline);
 // (DDS matches only offered <= requested); none to match any writer.
 Qos state_reader_qos(std::optional<Duration> deadline = std::nullopt);
 
-// --- PumpCommand ---------------------------------------------------------------
+// --- PumpCommand, DeviceCommand ------------------------------------------------
 // Reliable, volatile, keep-last 1; exclusive ownership: of the live writers
 // of an instance the strongest commands. Automatic liveliness with `lease`:
 // a supervisor that stops renewing its lease loses its instances, which then

@@ -80,7 +80,8 @@ void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs,
 void PortLoop::command(MacId mac, DeviceOutputs outputs, std::string issuer) {
   push(DeviceCommand{mac, std::move(outputs), std::move(issuer)});
 }
-void PortLoop::release_command(MacId mac) { push(Release{mac}); }
+void PortLoop::release_command(MacId mac) { push(Release{mac, false}); }
+void PortLoop::release_device_command(MacId mac) { push(Release{mac, true}); }
 void PortLoop::explicit_request(rack::ExplicitCall call) {
   bool queued = false;
   {
@@ -324,7 +325,8 @@ bool PortLoop::drain_inbox(TimePoint now) {
                                        d->issuer, d->mac.value()));
       }
     } else if (auto* r = std::get_if<Release>(&item)) {
-      if (rack().release_command(r->mac, now)) {
+      if (r->device ? devices().release_command(r->mac, now)
+                    : rack().release_command(r->mac, now)) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
     } else if (auto* scan = std::get_if<ScanCall>(&item)) {

@@ -77,8 +77,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // A device's (profile "eds") outputs, as bytes or as its fields.
   using DeviceOutputs = std::variant<std::vector<std::uint8_t>, std::vector<eds::FieldSetting>>;
   void command(devicenet::MacId mac, DeviceOutputs outputs, std::string issuer);
-  // No live commander left for the pump at `mac`.
+  // No live commander left for the pump at `mac`; for the device at `mac`.
   void release_command(devicenet::MacId mac);
+  void release_device_command(devicenet::MacId mac);
   // Past kMaxQueuedCalls requests waiting for the loop, answered at once
   // with "out of buffers" (on the caller's thread, through the publisher).
   void explicit_request(rack::ExplicitCall call);
@@ -146,6 +147,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   };
   struct Release {
     devicenet::MacId mac;
+    bool device = false;  // a device's (profile "eds"), not a pump's
   };
   struct Stop {};
   struct Reconfigure {

@@ -27,14 +27,16 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
   --bridge NAME[=RACK]
                       a rack's bridge: publishes PumpState, DeviceState,
                       NodeStatus, PortStatus, ExplicitReply, BusScanReply and
-                      ReloadReply, reads PumpCommand, ExplicitRequest,
-                      BusScanRequest and ReloadRequest; with =RACK, the
-                      commands and requests of that rack only
+                      ReloadReply, reads PumpCommand, DeviceCommand,
+                      ExplicitRequest, BusScanRequest and ReloadRequest;
+                      with =RACK, the commands and requests of that rack
+                      only
   --supervisor NAME[=RACK,...]
                       a supervisory host: reads every dnbridge topic, writes
-                      PumpCommand, ExplicitRequest, BusScanRequest and
-                      ReloadRequest; with =RACK,..., commands and requests
-                      to those racks only (=* : every rack again)
+                      PumpCommand, DeviceCommand, ExplicitRequest,
+                      BusScanRequest and ReloadRequest; with =RACK,...,
+                      commands and requests to those racks only (=* :
+                      every rack again)
   --monitor NAME      a monitoring host: reads PumpState, DeviceState,
                       NodeStatus and PortStatus only
   --days N            validity of new identities and of the permissions
@@ -330,7 +332,7 @@ publish_of() {
 publish_in_racks_of() {
   case $1 in
     bridge) topics ExplicitReply BusScanReply ReloadReply ;;
-    supervisor) topics PumpCommand ExplicitRequest BusScanRequest ReloadRequest ;;
+    supervisor) topics PumpCommand DeviceCommand ExplicitRequest BusScanRequest ReloadRequest ;;
   esac
 }
 subscribe_of() {
@@ -340,10 +342,10 @@ subscribe_of() {
 }
 subscribe_in_racks_of() {
   case $1 in
-    bridge) topics PumpCommand ExplicitRequest BusScanRequest ReloadRequest ;;
+    bridge) topics PumpCommand DeviceCommand ExplicitRequest BusScanRequest ReloadRequest ;;
     supervisor)
-      topics ExplicitReply PumpCommand ExplicitRequest BusScanRequest BusScanReply ReloadRequest \
-        ReloadReply
+      topics ExplicitReply PumpCommand DeviceCommand ExplicitRequest BusScanRequest BusScanReply \
+        ReloadRequest ReloadReply
       ;;
   esac
 }
