@@ -6,18 +6,27 @@
 // outputs to zero; Release and the watchdog behave as the CDN127's. Its
 // change-of-state connection produces on Group 1 message 13, is acknowledged
 // by a test node on Group 2 message 2, and retries when it is not.
+// What the product's master never does (paths refused, the change-of-state
+// connection reset, timed out or given a new rate, a Release of odd choices)
+// a test node does frame by frame. Last, the CDN127's clock: the simulated
+// devices share the connection set.
 #include "adapters/sim/generic/eds_slave.hpp"
 
 #include <gtest/gtest.h>
 
 #include <array>
 #include <optional>
+#include <string>
 #include <vector>
 
+#include "adapters/sim/cdn127/cdn127_device.hpp"
+#include "adapters/sim/cdn127/cdn127_objects.hpp"
 #include "adapters/sim/world/sim_eds_slave.hpp"
 #include "adapters/sim/world/sim_master.hpp"
 #include "adapters/sim/world/sim_world.hpp"
 #include "bridge/devicenet/wire/identifier.hpp"
+#include "bridge/profiles/cdn127/io_data.hpp"
+#include "bridge/profiles/cdn127/poll_format.hpp"
 #include "support/example_eds.hpp"
 
 namespace dnbridge::test {
@@ -433,6 +442,373 @@ TEST_F(EdsSlaveChangeOfState, AckSuppressionAndAllocationRefusals) {
   EXPECT_EQ(tester_.with_id(TestNode::cos_id()).size(), 3u);
   EXPECT_EQ(slave().cos_counters().retries, 0u);
   EXPECT_FALSE(slave().objects().ack_handler().cos_acknowledged);
+}
+
+// --- frame by frame ------------------------------------------------------------
+
+// `text` with `from` replaced by `to` once; a test failure if it is not there.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+eds::EdsFile parsed(const std::string& text) {
+  auto r = eds::parse(text);
+  EXPECT_TRUE(r.file.has_value());
+  return r.file.value_or(eds::EdsFile{});
+}
+
+// The example I/O block with its input (Input1, Assembly 100) 10 bytes long:
+// 48 bits of padding after the analog input.
+eds::EdsFile io_block_with_long_input() {
+  std::string t = test::example_eds_text(test::kIoBlockEds);
+  t = replaced(t, "4,                      $ size in bytes", "10,");
+  t = replaced(t, "32,                     $ size in bits", "80,");
+  t = replaced(t, "16, Param2;", "16, Param2, 48, ;");
+  return parsed(t);
+}
+
+// The same with its output (Output1, Assembly 150) 10 bytes long.
+eds::EdsFile io_block_with_long_output() {
+  std::string t = test::example_eds_text(test::kIoBlockEds);
+  t = replaced(t, "Output1 =\n                2,", "Output1 =\n                10,");
+  t = replaced(t, "\n                16,\n", "\n                80,\n");
+  t = replaced(t, "8, ;", "8, , 64, ;");
+  return parsed(t);
+}
+
+// The example I/O block with a second output, Output2: Assembly 151, the
+// input filter (Param1, 2 bytes) as a master may set it on every poll.
+constexpr std::uint16_t kOutputs2 = 151;
+eds::EdsFile io_block_with_two_outputs() {
+  std::string t = test::example_eds_text(test::kIoBlockEds);
+  t = replaced(t, R"("Digital outputs 0..7, then a pad byte";)",
+               R"("Digital outputs 0..7, then a pad byte";
+        Output2 = 2, 0, 0x0001, "Filter", 6, "20 04 24 97 30 03", "Param1";)");
+  t += R"(
+        Assem151 = "Filter", "20 04 24 97 30 03", 16, 0x0000, ,, 16, Param1;
+)";
+  return parsed(t);
+}
+
+// The slave and a test node at MAC 0 that speaks to it frame by frame.
+class EdsSlaveByFrames : public ::testing::Test {
+ protected:
+  EdsSlaveByFrames() : tester_(world_) {}
+
+  void start(eds::EdsFile file = test::example_eds(test::kIoBlockEds)) {
+    sim::EdsSlaveOptions o;
+    o.mac = kSlaveMac;
+    slave_.emplace(world_, std::move(file), o, world_.now());
+    ASSERT_TRUE(world_.run_until(
+        [&] { return slave().network_state() == sim::Group2Slave::NetworkState::kOnline; },
+        seconds(5)));
+  }
+  sim::EdsSlave& slave() { return slave_->device(); }
+  std::optional<double> param(unsigned n) { return slave().objects().param_number(n); }
+  void set_param(unsigned n, std::vector<std::uint8_t> value) {
+    ASSERT_TRUE(slave().objects().set_param_value(n, Bytes(value.data(), value.size())));
+  }
+
+  static std::uint32_t id(devicenet::Group2Message m) {
+    return devicenet::group2_id(mac(kSlaveMac), m);
+  }
+  // The last explicit response heard since `from` (service byte first;
+  // fragment acks skipped); empty if none.
+  std::vector<std::uint8_t> response_since(std::size_t from) const {
+    std::vector<std::uint8_t> out;
+    for (std::size_t i = from; i < tester_.heard.size(); ++i) {
+      const can::CanFrame& f = tester_.heard[i].first;
+      if (f.id != id(devicenet::Group2Message::kSlaveExplicitResponse) || f.len == 0 ||
+          (f.data[0] & 0x80) != 0) {
+        continue;
+      }
+      out.assign(f.payload().begin() + 1, f.payload().end());
+    }
+    return out;
+  }
+  // An explicit request (service byte first) on the explicit connection, in
+  // fragments over 7 bytes; its response.
+  std::vector<std::uint8_t> request(const std::vector<std::uint8_t>& message) {
+    const std::size_t from = tester_.heard.size();
+    const auto to = id(devicenet::Group2Message::kMasterExplicitRequest);
+    if (message.size() <= 7) {
+      std::vector<std::uint8_t> p{0x00};
+      p.insert(p.end(), message.begin(), message.end());
+      tester_.send(TestNode::frame(to, p));
+    } else {
+      // [0x80: fragmented, MAC 0][type first 0x00 / middle 0x40 / last 0x80 | count][6 bytes]
+      for (std::size_t at = 0, count = 0; at < message.size(); at += 6, ++count) {
+        const std::size_t n = std::min<std::size_t>(6, message.size() - at);
+        const std::uint8_t type = at == 0 ? 0x00 : at + n == message.size() ? 0x80 : 0x40;
+        std::vector<std::uint8_t> p{0x80, static_cast<std::uint8_t>(type | count)};
+        p.insert(p.end(), message.begin() + static_cast<std::ptrdiff_t>(at),
+                 message.begin() + static_cast<std::ptrdiff_t>(at + n));
+        tester_.send(TestNode::frame(to, p));
+        world_.run_for(milliseconds(2));
+      }
+    }
+    world_.run_for(milliseconds(10));
+    return response_since(from);
+  }
+  // Allocate and Release on the unconnected port (DeviceNet object, instance 1).
+  std::vector<std::uint8_t> allocate(std::uint8_t choice) {
+    const std::size_t from = tester_.heard.size();
+    tester_.send(TestNode::frame(id(devicenet::Group2Message::kUnconnectedExplicitRequest),
+                                 {0x00, 0x4B, 0x03, 0x01, choice, kMasterMac}));
+    world_.run_for(milliseconds(10));
+    return response_since(from);
+  }
+  std::vector<std::uint8_t> release(std::uint8_t choice) {
+    const std::size_t from = tester_.heard.size();
+    tester_.send(TestNode::frame(id(devicenet::Group2Message::kUnconnectedExplicitRequest),
+                                 {0x00, 0x4C, 0x03, 0x01, choice}));
+    world_.run_for(milliseconds(10));
+    return response_since(from);
+  }
+  // Connection object (class 5): Get and Set of an attribute, Reset.
+  std::vector<std::uint8_t> get(std::uint8_t instance, std::uint8_t attribute) {
+    return request({0x0E, 0x05, instance, attribute});
+  }
+  std::vector<std::uint8_t> set(std::uint8_t instance, std::uint8_t attribute,
+                                std::vector<std::uint8_t> data) {
+    std::vector<std::uint8_t> m{0x10, 0x05, instance, attribute};
+    m.insert(m.end(), data.begin(), data.end());
+    return request(m);
+  }
+  std::vector<std::uint8_t> set_epr(std::uint8_t instance, std::uint16_t ms) {
+    return set(instance, 9, {static_cast<std::uint8_t>(ms), static_cast<std::uint8_t>(ms >> 8)});
+  }
+  std::vector<std::uint8_t> reset(std::uint8_t instance) { return request({0x05, 0x05, instance}); }
+  // The path of Assembly `instance`'s data: 20 04 24 <instance> 30 03.
+  static std::vector<std::uint8_t> assembly_path(std::uint16_t instance) {
+    return {0x20, 0x04, 0x24, static_cast<std::uint8_t>(instance), 0x30, 0x03};
+  }
+  // A poll command; the poll response heard, if any.
+  std::optional<std::vector<std::uint8_t>> poll(const std::vector<std::uint8_t>& command) {
+    const std::size_t from = tester_.heard.size();
+    tester_.send(TestNode::frame(id(devicenet::Group2Message::kMasterIoPoll), command));
+    world_.run_for(milliseconds(5));
+    std::optional<std::vector<std::uint8_t>> out;
+    const auto response_id =
+        devicenet::group1_id(devicenet::Group1Message::kSlavePollResponse, mac(kSlaveMac));
+    for (std::size_t i = from; i < tester_.heard.size(); ++i) {
+      const can::CanFrame& f = tester_.heard[i].first;
+      if (f.id == response_id) out.emplace(f.payload().begin(), f.payload().end());
+    }
+    return out;
+  }
+  // Change-of-state messages heard in [from, to).
+  std::size_t cos_messages(TimePoint from, TimePoint to) const {
+    std::size_t n = 0;
+    for (const auto& [frame, at] : tester_.with_id(TestNode::cos_id())) {
+      if (at >= from && at < to) ++n;
+    }
+    return n;
+  }
+  // The invariant: instance 4 produces exactly while it is Established.
+  void expect_cos_follows_connection() {
+    EXPECT_EQ(slave().cos_producing(), slave().cos_state() == sim::ConnectionState::kEstablished)
+        << "instance 4 state " << static_cast<int>(slave().cos_state());
+  }
+
+  using Reply = std::vector<std::uint8_t>;
+  static constexpr std::uint8_t kInstance2 = 2, kInstance4 = 4;
+
+  sim::SimWorld world_;
+  TestNode tester_;
+  std::optional<sim::SimEdsSlave> slave_;
+};
+
+// An input or output assembly larger than one frame is no default: the
+// connection carries nothing on that side, as attributes 7/8 say, rather than
+// data cut to 8 bytes (inputs) or every poll taken as idle (outputs).
+TEST_F(EdsSlaveByFrames, AnInputOverOneFrameIsNoDefaultAssembly) {
+  start(io_block_with_long_input());
+  EXPECT_EQ(slave().poll_input_assembly(), 0u);
+  EXPECT_EQ(slave().cos_input_assembly(), 0u);
+  EXPECT_EQ(slave().poll_output_assembly(), kOutputs);
+  ASSERT_EQ(allocate(0x03), (Reply{0xCB, 0x00}));
+  EXPECT_EQ(slave().connections().poll_connection().produced_assembly, 0u);
+  EXPECT_EQ(get(kInstance2, 7), (Reply{0x8E, 0x00, 0x00}));  // produced size 0
+  EXPECT_EQ(get(kInstance2, 13), (Reply{0x8E, 0x00}));       // no produced path
+  EXPECT_EQ(get(kInstance2, 8), (Reply{0x8E, 0x02, 0x00}));  // the output's 2 bytes
+  ASSERT_EQ(set_epr(kInstance2, 100), (Reply{0x90, 100, 0}));
+  // The poll is applied and answered with what attribute 7 says: nothing.
+  EXPECT_EQ(poll({0x3C, 0x00}), Reply{});
+  EXPECT_EQ(param(4), 0x3C);
+  // A path to the long input is refused as the default was.
+  EXPECT_EQ(allocate(0x10), (Reply{0xCB, 0x00}));
+  EXPECT_EQ(set(kInstance4, 14, assembly_path(kInputs)), (Reply{0x94, 0x09, 0xFF}));
+}
+
+TEST_F(EdsSlaveByFrames, AnOutputOverOneFrameIsNoDefaultAssembly) {
+  start(io_block_with_long_output());
+  EXPECT_EQ(slave().poll_input_assembly(), kInputs);
+  EXPECT_EQ(slave().poll_output_assembly(), 0u);
+  ASSERT_EQ(allocate(0x03), (Reply{0xCB, 0x00}));
+  EXPECT_EQ(get(kInstance2, 8), (Reply{0x8E, 0x00, 0x00}));  // consumed size 0
+  ASSERT_EQ(set_epr(kInstance2, 100), (Reply{0x90, 100, 0}));
+  // A connection that consumes nothing has no idle condition: an empty poll
+  // command is applied, a longer one ignored (oversize).
+  EXPECT_EQ(poll({}), (Reply{0x00, 0x00, 0x00, 0x00}));
+  EXPECT_EQ(slave().counters().polls_applied, 1u);
+  EXPECT_EQ(slave().counters().polls_idle, 0u);
+  EXPECT_EQ(poll({0x01, 0x02}), std::nullopt);
+  EXPECT_EQ(slave().counters().polls_oversize, 1u);
+}
+
+// A consumed path names an output assembly: the inputs' parameters (read
+// only, the device's own) are no poll command's to overwrite.
+TEST_F(EdsSlaveByFrames, AConsumedPathNamesAnOutputAssemblyOnly) {
+  start();
+  ASSERT_EQ(allocate(0x13), (Reply{0xCB, 0x00}));
+  EXPECT_EQ(set(kInstance2, 16, assembly_path(kInputs)), (Reply{0x94, 0x09, 0xFF}));
+  EXPECT_EQ(slave().connections().poll_connection().consumed_assembly, kOutputs);
+  EXPECT_EQ(set(kInstance2, 16, assembly_path(kOutputs)), (Reply{0x90}));
+  // Either assembly may be produced (an echo of the outputs).
+  EXPECT_EQ(set(kInstance2, 14, assembly_path(kOutputs)), (Reply{0x90}));
+  EXPECT_EQ(set(kInstance2, 14, assembly_path(kInputs)), (Reply{0x90}));
+  // The change-of-state connection consumes acknowledgments, no data: its
+  // consumed path is not settable, whatever it names.
+  EXPECT_EQ(set(kInstance4, 16, assembly_path(kOutputs)), (Reply{0x94, 0x0E, 0xFF}));
+  EXPECT_EQ(set(kInstance4, 16, assembly_path(kInputs)), (Reply{0x94, 0x0E, 0xFF}));
+  EXPECT_EQ(get(kInstance4, 15), (Reply{0x8E, 0x00}));
+}
+
+// Acknowledge suppression alone names no connection: refused in Release as in
+// Allocate, and the connection it qualifies stays.
+TEST_F(EdsSlaveByFrames, ReleaseOfAcknowledgeSuppressionAloneIsRefused) {
+  start();
+  ASSERT_EQ(allocate(0x51), (Reply{0xCB, 0x00}));
+  EXPECT_EQ(release(0x40), (Reply{0x94, 0x09, 0x02}));
+  EXPECT_EQ(slave().connections().allocation_choice(), 0x51);
+  EXPECT_EQ(slave().cos_state(), sim::ConnectionState::kConfiguring);
+  EXPECT_EQ(release(0x50), (Reply{0xCC}));
+  EXPECT_EQ(slave().connections().allocation_choice(), 0x01);
+  EXPECT_EQ(slave().cos_state(), sim::ConnectionState::kNonExistent);
+}
+
+// Release is idle for the assembly the connection consumed: the one its
+// consumed path named, not the EDS's default output.
+TEST_F(EdsSlaveByFrames, ReleaseAppliesTheIdleActionToTheAssemblyThePathNamed) {
+  start(io_block_with_two_outputs());
+  set_param(9, {0x42});  // Output idle value
+  set_param(4, {0x55});  // the default output's parameter, not consumed here
+  ASSERT_EQ(allocate(0x03), (Reply{0xCB, 0x00}));
+  ASSERT_EQ(set(kInstance2, 16, assembly_path(kOutputs2)), (Reply{0x90}));
+  ASSERT_EQ(set_epr(kInstance2, 100), (Reply{0x90, 100, 0}));
+  ASSERT_TRUE(poll({0x20, 0x00}).has_value());
+  ASSERT_EQ(param(1), 0x20);
+  EXPECT_EQ(release(0x02), (Reply{0xCC}));
+  EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kNonExistent);
+  EXPECT_EQ(param(1), 0x42);  // Output idle value, from the first byte
+  EXPECT_EQ(param(4), 0x55);
+}
+
+// The fault action too, after the watchdog's Auto Delete has deleted it.
+TEST_F(EdsSlaveByFrames, AutoDeleteAppliesTheFaultActionToTheAssemblyThePathNamed) {
+  start(io_block_with_two_outputs());
+  set_param(7, {0x24});  // Output fault value
+  set_param(4, {0x55});
+  ASSERT_EQ(allocate(0x03), (Reply{0xCB, 0x00}));
+  ASSERT_EQ(set(kInstance2, 16, assembly_path(kOutputs2)), (Reply{0x90}));
+  ASSERT_EQ(set(kInstance2, 12, {0x01}), (Reply{0x90}));  // Auto Delete
+  ASSERT_EQ(set_epr(kInstance2, 100), (Reply{0x90, 100, 0}));
+  ASSERT_TRUE(poll({0x20, 0x00}).has_value());
+  world_.run_for(milliseconds(450));
+  EXPECT_EQ(slave().poll_state(), sim::ConnectionState::kNonExistent);
+  EXPECT_EQ(param(1), 0x24);
+  EXPECT_EQ(param(4), 0x55);
+}
+
+// Instance 4 produces exactly while it is Established: on through a watchdog
+// with Auto Reset, again after a Connection Reset out of Timed Out, at the
+// rate last set.
+TEST_F(EdsSlaveByFrames, TheChangeOfStateConnectionGoesOnProducingThroughAutoReset) {
+  start();
+  ASSERT_EQ(allocate(0x11), (Reply{0xCB, 0x00}));
+  ASSERT_EQ(set(kInstance4, 12, {0x02}), (Reply{0x90}));  // Auto Reset
+  ASSERT_EQ(set_epr(kInstance4, 100), (Reply{0x90, 100, 0}));
+  expect_cos_follows_connection();
+  // No acknowledgment: the watchdog (4 x 100 ms) expires again and again.
+  const TimePoint t = world_.now();
+  world_.run_for(milliseconds(1000));
+  EXPECT_GE(slave().connections().watchdog_timeouts(), 2u);
+  EXPECT_EQ(slave().cos_state(), sim::ConnectionState::kEstablished);
+  expect_cos_follows_connection();
+  EXPECT_GE(cos_messages(t + milliseconds(500), t + milliseconds(1000)), 4u);
+}
+
+TEST_F(EdsSlaveByFrames, AResetOutOfTimedOutProducesAgain) {
+  start();
+  ASSERT_EQ(allocate(0x11), (Reply{0xCB, 0x00}));
+  ASSERT_EQ(set_epr(kInstance4, 100), (Reply{0x90, 100, 0}));
+  world_.run_for(milliseconds(450));  // no acknowledgment: timed out (action 0)
+  ASSERT_EQ(slave().cos_state(), sim::ConnectionState::kTimedOut);
+  expect_cos_follows_connection();
+  const TimePoint quiet = world_.now();
+  world_.run_for(milliseconds(300));
+  EXPECT_EQ(cos_messages(quiet, world_.now()), 0u);
+  EXPECT_EQ(reset(kInstance4), (Reply{0x85}));
+  EXPECT_EQ(slave().cos_state(), sim::ConnectionState::kEstablished);
+  expect_cos_follows_connection();
+  tester_.auto_ack = true;
+  const TimePoint t = world_.now();
+  world_.run_for(milliseconds(1000));
+  EXPECT_GE(cos_messages(t, world_.now()), 9u);  // the heartbeat, every 100 ms
+  EXPECT_EQ(slave().cos_state(), sim::ConnectionState::kEstablished);
+  EXPECT_TRUE(slave().objects().ack_handler().cos_acknowledged);
+}
+
+TEST_F(EdsSlaveByFrames, ANewRateOfAnEstablishedConnectionIsItsNewHeartbeat) {
+  start();
+  ASSERT_EQ(allocate(0x61), (Reply{0xCB, 0x00}));  // cyclic, no acknowledgment
+  ASSERT_EQ(set_epr(kInstance4, 1000), (Reply{0x90, 0xE8, 0x03}));
+  world_.run_for(milliseconds(1500));
+  EXPECT_EQ(cos_messages(world_.now() - milliseconds(1500), world_.now()), 1u);
+  ASSERT_EQ(set_epr(kInstance4, 100), (Reply{0x90, 100, 0}));
+  expect_cos_follows_connection();
+  const TimePoint t = world_.now();
+  world_.run_for(milliseconds(1000));
+  EXPECT_GE(cos_messages(t, world_.now()), 9u);
+  const auto& c = slave().connections().cos_connection();
+  EXPECT_EQ(c.expected_packet_rate_ms, 100);
+}
+
+// --- the CDN127's clock ---------------------------------------------------------
+
+// An explicit Get of a produced assembly samples the pump at the request's
+// time, not at the last poll's or timer's: the device is driven by the
+// request alone here (the message router, no wire, no timer).
+TEST(Cdn127DeviceClock, AProducedAssemblyIsSampledWhenItIsRead) {
+  sim::Cdn127Device device(sim::SlaveOptions{});
+  const TimePoint t0 = TimePoint{} + seconds(100);
+  device.power_up(t0, sim::PowerUpCause::kPowerOn);
+  profiles::cdn127::PumpOutputs on;
+  on.pump_on = true;
+  ASSERT_TRUE(device.set_outputs(on, sim::OutputCause::kExplicit, t0).ok());  // spin-up 3 s
+  const auto running_at = [&](TimePoint now) -> std::optional<bool> {
+    devicenet::RequestMessage get;
+    get.service = 0x0E;
+    get.class_id = 0x04;
+    get.instance_id = profiles::cdn127::kDefaultProducedAssembly;
+    get.attribute = 3;
+    std::array<std::uint8_t, devicenet::kMaxExplicitMessage> out{};
+    const std::size_t n = sim::execute_request(device, get, kMasterMac, now, MutableBytes(out));
+    if (n < 1 || out[0] != 0x8E) return std::nullopt;
+    auto layout = profiles::cdn127::produced_assembly_layout(
+        profiles::cdn127::kDefaultProducedAssembly, device.configuration());
+    if (!layout.ok()) return std::nullopt;
+    auto in = profiles::cdn127::decode_poll_response(*layout, device.configuration().no_nc_mask,
+                                                     Bytes(out.data() + 1, n - 1));
+    if (!in.ok() || !in->pump) return std::nullopt;
+    return in->pump->pump_running;
+  };
+  EXPECT_EQ(running_at(t0 + seconds(1)), false);
+  EXPECT_EQ(running_at(t0 + seconds(4)), true);
 }
 
 }  // namespace

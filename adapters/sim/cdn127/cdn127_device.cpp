@@ -36,11 +36,6 @@ E2Memory initial_e2(const SlaveOptions& o) noexcept {
   return e2;
 }
 
-bool is_produced_assembly(std::uint8_t a) noexcept {
-  return a == 1 || a == 2 || a == 3 || a == 101 || a == 102 || a == 103;
-}
-bool is_consumed_assembly(std::uint8_t a) noexcept { return a == 5 || a == 100 || a == 104; }
-
 std::uint16_t aop_action(std::uint8_t state, std::uint16_t value, std::uint16_t current) noexcept {
   switch (state) {
     case 1:
@@ -83,7 +78,6 @@ Cdn127Device::Cdn127Device(const SlaveOptions& options) noexcept
       connections_(connection_options(options), *this) {}
 
 void Cdn127Device::power_up(TimePoint now, PowerUpCause cause) noexcept {
-  now_ = now;
   if (cause == PowerUpCause::kPowerOn) {
     faults_.major_unrecoverable = false;
     faults_.minor_unrecoverable = false;
@@ -145,9 +139,8 @@ std::uint16_t Cdn127Device::connection_size(std::uint16_t instance, bool produce
 
 bool Cdn127Device::assembly_allowed(std::uint16_t instance, bool produced,
                                     std::uint16_t assembly) const noexcept {
-  if (instance != connection_instance::kPoll || assembly > 0xFF) return false;
-  const auto a = static_cast<std::uint8_t>(assembly);
-  return produced ? is_produced_assembly(a) : is_consumed_assembly(a);
+  if (instance != connection_instance::kPoll) return false;
+  return produced ? is_produced_assembly(assembly) : is_consumed_assembly(assembly);
 }
 
 void Cdn127Device::on_io_established(std::uint16_t, TimePoint) noexcept { poll_running_ = false; }
@@ -155,19 +148,19 @@ void Cdn127Device::on_io_established(std::uint16_t, TimePoint) noexcept { poll_r
 // A master that releases the poll connection has stopped the exchange on
 // purpose: the outputs take their idle values (the manual names no action for
 // this case; idle rather than fault is this simulator's reading).
-void Cdn127Device::on_io_released(std::uint16_t, bool was_established, TimePoint now) noexcept {
-  if (was_established) apply_idle_actions(now);
+void Cdn127Device::on_io_released(std::uint16_t, const Connection& before, TimePoint now) noexcept {
+  if (before.state == ConnectionState::kEstablished) apply_idle_actions(now);
   poll_running_ = false;
 }
 
-void Cdn127Device::on_io_timed_out(std::uint16_t, TimePoint now) noexcept {
+void Cdn127Device::on_io_timed_out(std::uint16_t, const Connection&, TimePoint now) noexcept {
   apply_fault_actions(now);
   poll_running_ = false;
 }
 
-std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout,
+std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout, TimePoint now,
                                          MutableBytes out) noexcept {
-  pump_.advance(now_);
+  pump_.advance(now);
   const std::uint8_t bits = pump_.inputs().encode(e2_.configuration.no_nc_mask);
   auto size = profiles::cdn127::encode_poll_response(layout, exception_status_byte(), bits,
                                                      pump_.analog_inputs_raw(), out);
@@ -182,7 +175,6 @@ std::size_t Cdn127Device::build_produced(const PollResponseLayout& layout,
 }
 
 PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {
-  now_ = now;
   PollResult result;
   const Connection& poll = connections_.poll_connection();
   if (poll.state != ConnectionState::kEstablished) return result;
@@ -234,16 +226,17 @@ PollResult Cdn127Device::on_poll(Bytes command, TimePoint now) noexcept {
   const bool answer_empty = idle && options_.idle_poll_answered_empty;
   if (!no_poll_update) apply();
   if (!answer_empty) {
-    result.response.resize(build_produced(*response_layout, result.response.storage()));
+    result.response.resize(build_produced(*response_layout, now, result.response.storage()));
   }
   if (no_poll_update) apply();
   return result;
 }
 
-std::size_t Cdn127Device::produced_data(std::uint8_t assembly, MutableBytes out) noexcept {
+std::size_t Cdn127Device::produced_data(std::uint8_t assembly, TimePoint now,
+                                        MutableBytes out) noexcept {
   auto layout = profiles::cdn127::produced_assembly_layout(assembly, e2_.configuration);
   if (!layout.ok()) return 0;
-  return build_produced(*layout, out);
+  return build_produced(*layout, now, out);
 }
 
 std::size_t Cdn127Device::consumed_data(std::uint8_t assembly, MutableBytes out) const noexcept {
@@ -255,7 +248,6 @@ std::size_t Cdn127Device::consumed_data(std::uint8_t assembly, MutableBytes out)
 
 Reply Cdn127Device::set_consumed_assembly(std::uint8_t assembly, Bytes data,
                                           TimePoint now) noexcept {
-  now_ = now;
   auto layout = profiles::cdn127::consumed_assembly_layout(assembly, e2_.configuration);
   if (!layout.ok()) return reply_error(GeneralStatus::kAttributeNotSettable);
   if (data.size() < layout->size) return reply_error(GeneralStatus::kNotEnoughData);
@@ -288,7 +280,6 @@ void Cdn127Device::apply_decoded_outputs(const PollRequestLayout& layout,
 
 Reply Cdn127Device::set_outputs(const PumpOutputs& outputs, OutputCause cause,
                                 TimePoint now) noexcept {
-  now_ = now;
   if (major_fault()) return reply_error(GeneralStatus::kDeviceStateConflict);
   pump_.set_outputs(outputs, cause, now);
   return kReplyOk;
@@ -345,7 +336,6 @@ std::uint8_t Cdn127Device::identity_state() const noexcept {
 }
 
 void Cdn127Device::set_faults(const IdentityFaults& faults, TimePoint now) noexcept {
-  now_ = now;
   const bool was_major = major_fault();
   faults_ = faults;
   if (!was_major && major_fault()) {
@@ -393,14 +383,12 @@ PendingAction Cdn127Device::take_pending_action() noexcept {
 }
 
 void Cdn127Device::go_offline(TimePoint now) noexcept {
-  now_ = now;
   if (connections_.established(connection_instance::kPoll)) apply_fault_actions(now);
   connections_.drop();
   poll_running_ = false;
 }
 
 void Cdn127Device::on_timer(TimePoint now) noexcept {
-  now_ = now;
   pump_.advance(now);
   connections_.on_timer(now);
 }

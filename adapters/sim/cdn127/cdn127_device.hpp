@@ -208,6 +208,15 @@ struct IdentityFaults {
 
 inline constexpr std::uint16_t kExplicitMessageSize = 24;  // attributes 7/8 of instance 1
 
+// The CDN127's assemblies (manual, "Assembly Object"): produced 1, 2, 3,
+// 101, 102, 103; consumed 5, 100, 104.
+constexpr bool is_produced_assembly(std::uint16_t a) noexcept {
+  return a == 1 || a == 2 || a == 3 || a == 101 || a == 102 || a == 103;
+}
+constexpr bool is_consumed_assembly(std::uint16_t a) noexcept {
+  return a == 5 || a == 100 || a == 104;
+}
+
 class Cdn127Device final : private ConnectionEvents, public IoAssemblies {
  public:
   explicit Cdn127Device(const SlaveOptions& options) noexcept;
@@ -271,8 +280,9 @@ class Cdn127Device final : private ConnectionEvents, public IoAssemblies {
 
   // --- poll I/O ---
   PollResult on_poll(Bytes command, TimePoint now) noexcept;
-  // Produced assembly data (1, 2, 3, 101, 102, 103); 0 if not produced.
-  std::size_t produced_data(std::uint8_t assembly, MutableBytes out) noexcept;
+  // Produced assembly data (1, 2, 3, 101, 102, 103) as sampled at `now`;
+  // 0 if not produced.
+  std::size_t produced_data(std::uint8_t assembly, TimePoint now, MutableBytes out) noexcept;
   std::size_t consumed_data(std::uint8_t assembly, MutableBytes out) const noexcept;
   Reply set_consumed_assembly(std::uint8_t assembly, Bytes data, TimePoint now) noexcept;
 
@@ -333,13 +343,16 @@ class Cdn127Device final : private ConnectionEvents, public IoAssemblies {
  private:
   // The poll connection's changes (ConnectionEvents).
   void on_io_established(std::uint16_t instance, TimePoint now) noexcept override;
-  void on_io_released(std::uint16_t instance, bool was_established,
+  void on_io_rate_changed(std::uint16_t, TimePoint) noexcept override {}
+  void on_io_released(std::uint16_t instance, const Connection& before,
                       TimePoint now) noexcept override;
-  void on_io_timed_out(std::uint16_t instance, TimePoint now) noexcept override;
+  void on_io_timed_out(std::uint16_t instance, const Connection& before,
+                       TimePoint now) noexcept override;
   void apply_decoded_outputs(const profiles::cdn127::PollRequestLayout& layout,
                              const profiles::cdn127::PumpOutputs& decoded, OutputCause cause,
                              TimePoint now) noexcept;
-  std::size_t build_produced(const profiles::cdn127::PollResponseLayout& layout,
+  // The inputs sampled at `now` (the pump advanced to it first).
+  std::size_t build_produced(const profiles::cdn127::PollResponseLayout& layout, TimePoint now,
                              MutableBytes out) noexcept;
 
   SlaveOptions options_;
@@ -360,7 +373,6 @@ class Cdn127Device final : private ConnectionEvents, public IoAssemblies {
   IdentityFaults faults_;
   std::array<std::optional<std::uint16_t>, 2> failed_analog_{};
   PendingAction pending_ = PendingAction::kNone;
-  TimePoint now_{};
 };
 
 }  // namespace dnbridge::sim

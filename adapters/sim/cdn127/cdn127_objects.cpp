@@ -7,17 +7,13 @@
 #include "adapters/sim/generic/attribute_codec.hpp"
 #include "adapters/sim/generic/connection_object.hpp"
 #include "bridge/cip/data_types.hpp"
-#include "bridge/cip/epath.hpp"
 #include "bridge/cip/service.hpp"
-#include "bridge/devicenet/wire/identifier.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
 namespace dnbridge::sim {
 namespace {
 
 using cip::GeneralStatus;
-using devicenet::Group1Message;
-using devicenet::Group2Message;
 using profiles::cdn127::IoConfiguration;
 using profiles::cdn127::PumpOutputs;
 namespace cls = profiles::cdn127::class_id;
@@ -210,9 +206,8 @@ Reply devicenet_release(const RequestContext& c, Bytes data, ByteWriter&) noexce
 
 constexpr ClassAttributeDef kAssemblyClass[] = {{1, 1}, {2, 100}};
 
-bool is_consumed_assembly(std::uint16_t i) noexcept { return i == 5 || i == 100 || i == 104; }
 bool assembly_exists(const Cdn127Device&, std::uint16_t i) noexcept {
-  return i == 1 || i == 2 || i == 3 || i == 101 || i == 102 || i == 103 || is_consumed_assembly(i);
+  return is_produced_assembly(i) || is_consumed_assembly(i);
 }
 
 const AttributeDef kAssemblyAttributes[] = {
@@ -221,7 +216,7 @@ const AttributeDef kAssemblyAttributes[] = {
        std::array<std::uint8_t, 8> buf{};
        const auto inst = static_cast<std::uint8_t>(c.instance);
        const std::size_t n = is_consumed_assembly(inst) ? c.device.consumed_data(inst, buf)
-                                                        : c.device.produced_data(inst, buf);
+                                                        : c.device.produced_data(inst, c.now, buf);
        w.bytes(Bytes(buf.data(), n));
        return kReplyOk;
      },

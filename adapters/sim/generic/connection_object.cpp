@@ -111,8 +111,11 @@ bool connection_attribute_settable(std::uint16_t instance, std::uint8_t attribut
     case attr::kExpectedPacketRate:
     case attr::kWatchdogTimeoutAction:
     case attr::kProducedPath:
-    case attr::kConsumedPath:
       return true;
+    case attr::kConsumedPath:
+      // The change-of-state connection consumes the master's
+      // acknowledgments, no data: there is no consumed path to choose.
+      return instance != connection_instance::kChangeOfState;
     case attr::kInhibitTime:
       return instance == connection_instance::kChangeOfState;
     default:

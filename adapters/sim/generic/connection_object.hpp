@@ -42,7 +42,8 @@ class IoAssemblies {
 };
 
 // Whether the object has the attribute, and whether it is settable (9, 12,
-// 14, 16; 17 on the change-of-state connection).
+// 14; 16 but on the change-of-state connection, which consumes no data; 17
+// on the change-of-state connection).
 bool connection_attribute_exists(std::uint8_t attribute) noexcept;
 bool connection_attribute_settable(std::uint16_t instance, std::uint8_t attribute) noexcept;
 

@@ -89,6 +89,11 @@ Reply ConnectionSet::release(std::uint8_t choice, std::uint8_t requester, TimePo
   if ((choice & ~options_.supported_choices) != 0) {
     return reply_error(GeneralStatus::kResourceUnavailable, kInvalidChoice);
   }
+  // Acknowledge suppression qualifies the connection it was allocated with;
+  // alone it names nothing to release, as it is refused alone in Allocate.
+  if ((choice & alloc::kAckSuppression) != 0 && (choice & kCosOrCyclic) == 0) {
+    return reply_error(GeneralStatus::kInvalidAttributeValue, kInvalidChoice);
+  }
   if ((choice & ~allocation_choice()) != 0) {
     return reply_error(GeneralStatus::kAlreadyInRequestedMode, kInvalidChoice);
   }
@@ -100,9 +105,8 @@ Reply ConnectionSet::release(std::uint8_t choice, std::uint8_t requester, TimePo
 }
 
 void ConnectionSet::delete_io(std::uint16_t instance, Connection& c, TimePoint now) noexcept {
-  const bool was_established = c.state == ConnectionState::kEstablished;
-  c = Connection{};
-  events_.on_io_released(instance, was_established, now);
+  const Connection before = std::exchange(c, Connection{});
+  events_.on_io_released(instance, before, now);
 }
 
 void ConnectionSet::drop() noexcept {
@@ -168,11 +172,14 @@ Reply ConnectionSet::set_expected_packet_rate(std::uint16_t instance, std::uint1
   actual = round_rate(requested_ms);
   c->expected_packet_rate_ms = actual;
   restart_watchdog(*c, now);
+  if (instance == connection_instance::kExplicit) return kReplyOk;
   // Setting the rate is what moves a Configuring I/O connection to
   // Established (bridge/PROTOCOL.md §7).
   if (c->state == ConnectionState::kConfiguring) {
     c->state = ConnectionState::kEstablished;
     events_.on_io_established(instance, now);
+  } else {
+    events_.on_io_rate_changed(instance, now);
   }
   return kReplyOk;
 }
@@ -225,8 +232,12 @@ Reply ConnectionSet::reset(std::uint16_t instance, TimePoint now) noexcept {
   if (c->state == ConnectionState::kDeferredDelete) {
     return reply_error(GeneralStatus::kObjectStateConflict);
   }
+  const bool was_established = c->state == ConnectionState::kEstablished;
   c->state = ConnectionState::kEstablished;
   restart_watchdog(*c, now);
+  if (!was_established && instance != connection_instance::kExplicit) {
+    events_.on_io_established(instance, now);
+  }
   return kReplyOk;
 }
 
@@ -253,7 +264,7 @@ void ConnectionSet::explicit_timeout() noexcept {
 }
 
 void ConnectionSet::io_timeout(std::uint16_t instance, Connection& c, TimePoint now) noexcept {
-  events_.on_io_timed_out(instance, now);
+  const Connection before = c;
   switch (c.watchdog_action) {
     case WatchdogAction::kTimedOut:
       c.state = ConnectionState::kTimedOut;
@@ -274,6 +285,7 @@ void ConnectionSet::io_timeout(std::uint16_t instance, Connection& c, TimePoint 
       }
       break;
   }
+  events_.on_io_timed_out(instance, before, now);
 }
 
 void ConnectionSet::on_timer(TimePoint now) noexcept {

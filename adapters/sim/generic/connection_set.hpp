@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "bridge/cip/general_status.hpp"
+#include "bridge/cip/objects.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/wire/explicit_message.hpp"
@@ -48,11 +49,12 @@ constexpr Reply reply_error(cip::GeneralStatus s,
   return Reply{s, additional};
 }
 
-// Connection object instances of the predefined master/slave set.
+// Connection object instances of the predefined master/slave set: the
+// explicit and poll ones are cip's; the master has no use for instance 4 yet,
+// so its number lives here.
 namespace connection_instance {
-inline constexpr std::uint16_t kExplicit = 1;
-inline constexpr std::uint16_t kPoll = 2;
-inline constexpr std::uint16_t kBitStrobe = 3;
+using cip::connection_instance::kExplicit;
+using cip::connection_instance::kPoll;
 inline constexpr std::uint16_t kChangeOfState = 4;  // change of state or cyclic
 }  // namespace connection_instance
 
@@ -75,17 +77,26 @@ struct Connection {
 inline constexpr unsigned kWatchdogMultiplier = 4;
 inline constexpr std::uint16_t kExplicitDefaultEprMs = 2500;
 
-// What a device does when its I/O connections change; each is called after
-// the change but before the connection's state says so where noted.
+// What a device does when its I/O connections change. Each is called after
+// the change, so the connection's state is the new one; where the change
+// deletes or alters it, `before` is the connection as it was (its state, its
+// assemblies). Together they tell the device every time an I/O connection
+// enters or leaves Established, so that what it produces can follow.
 class ConnectionEvents {
  public:
-  // An I/O connection has been established by its expected packet rate.
+  // An I/O connection has become Established: from Configuring by its
+  // expected packet rate, or from Timed Out by a Connection Reset.
   virtual void on_io_established(std::uint16_t instance, TimePoint now) noexcept = 0;
-  // Released by the master; `was_established` before the release.
-  virtual void on_io_released(std::uint16_t instance, bool was_established,
+  // The expected packet rate of an Established I/O connection was set again
+  // (attribute 9); it stays Established.
+  virtual void on_io_rate_changed(std::uint16_t instance, TimePoint now) noexcept = 0;
+  // Released by the master: now Non-existent.
+  virtual void on_io_released(std::uint16_t instance, const Connection& before,
                               TimePoint now) noexcept = 0;
-  // Its watchdog expired; called before the timeout action is taken.
-  virtual void on_io_timed_out(std::uint16_t instance, TimePoint now) noexcept = 0;
+  // Its watchdog expired and its timeout action has been taken: Timed Out,
+  // Non-existent, Deferred Delete, or still Established (Auto Reset).
+  virtual void on_io_timed_out(std::uint16_t instance, const Connection& before,
+                               TimePoint now) noexcept = 0;
 
  protected:
   ~ConnectionEvents() = default;
@@ -147,7 +158,7 @@ class ConnectionSet {
   void set_assembly(std::uint16_t instance, bool produced, std::uint16_t assembly) noexcept;
   void set_inhibit(std::uint16_t instance, std::uint16_t inhibit_ms) noexcept;
   // Connection Reset: restarts the watchdog; a timed-out I/O connection is
-  // Established again.
+  // Established again (on_io_established).
   Reply reset(std::uint16_t instance, TimePoint now) noexcept;
   // A message the connection consumed restarts its watchdog.
   void consumed(std::uint16_t instance, TimePoint now) noexcept;

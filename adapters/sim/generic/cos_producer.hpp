@@ -52,6 +52,10 @@ class CosProducer {
   std::optional<std::vector<std::uint8_t>> set_data(Bytes data, TimePoint now);
   // The master's acknowledgment (Group 2 message 2).
   void on_ack();
+  // The connection's EPR set again while it runs: the next heartbeat (or
+  // cycle) is this long after the last message.
+  void set_expected_packet_rate(Duration rate) noexcept { settings_.expected_packet_rate = rate; }
+  Duration expected_packet_rate() const noexcept { return settings_.expected_packet_rate; }
   // Call when now >= next_deadline(): a message to send, if any is due.
   std::optional<std::vector<std::uint8_t>> on_timer(TimePoint now);
   TimePoint next_deadline() const noexcept;

@@ -19,7 +19,6 @@ using devicenet::Group2Message;
 using devicenet::MacId;
 namespace alloc = devicenet::allocation;
 
-constexpr std::uint16_t kConnectionClass = 0x05;
 // The explicit connection's produced and consumed size (attributes 7/8):
 // the longest message it reassembles.
 constexpr std::uint16_t kExplicitMessageSize = devicenet::kMaxExplicitMessage;
@@ -32,39 +31,9 @@ std::uint16_t io_assembly(const eds::EdsFile& file, const eds::IoData* data) noe
   return static_cast<std::uint16_t>(*a->path.instance_id);
 }
 
-struct IoDefaults {
-  std::uint16_t poll_input = 0;
-  std::uint16_t poll_output = 0;
-  std::uint16_t cos_input = 0;
-  std::uint8_t choices = alloc::kExplicit | alloc::kPoll;
-};
-
-IoDefaults io_defaults(const eds::EdsFile& file) noexcept {
-  IoDefaults d;
-  const eds::IoInfo& io = file.io;
-  if (const auto* poll = io.connection(eds::ConnectionKind::kPoll)) {
-    d.poll_input = io_assembly(file, io.input(poll->input));
-    d.poll_output = io_assembly(file, io.output(poll->output));
-  }
-  const auto* cos = io.connection(eds::ConnectionKind::kChangeOfState);
-  const auto* cyclic = io.connection(eds::ConnectionKind::kCyclic);
-  if (cos != nullptr) d.choices |= alloc::kChangeOfState | alloc::kAckSuppression;
-  if (cyclic != nullptr) d.choices |= alloc::kCyclic | alloc::kAckSuppression;
-  if (const auto* produced = cos != nullptr ? cos : cyclic) {
-    d.cos_input = io_assembly(file, io.input(produced->input));
-  }
-  return d;
-}
-
-ConnectionSetOptions connection_options(const EdsSlaveOptions& o, const IoDefaults& d) noexcept {
-  ConnectionSetOptions c;
-  c.supported_choices = d.choices;
-  c.timer_resolution = o.timer_resolution;
-  c.poll_produced_assembly = d.poll_input;
-  c.poll_consumed_assembly = d.poll_output;
-  c.cos_produced_assembly = d.cos_input;
-  return c;
-}
+// What an I/O connection's assembly may be: 1..8 bytes, one frame (no I/O
+// fragmentation here).
+bool fits_one_frame(std::size_t size) noexcept { return size > 0 && size <= kMaxPollData; }
 
 // The parameters of the outputs' safe state, by this simulator's convention
 // (eds_slave.hpp), when the EDS has all four.
@@ -89,16 +58,50 @@ Group2Options wire_options(const eds::EdsFile& file, const EdsSlaveOptions& o) n
 
 }  // namespace
 
+// The defaults are checked as a path is (assembly_allowed): one that does
+// not fit a frame is none, rather than data cut short on the wire while
+// attributes 7/8 say its full size.
+EdsSlave::IoDefaults EdsSlave::io_defaults(const EdsObjects& objects) noexcept {
+  const eds::EdsFile& file = objects.file();
+  const auto fitting = [&](const eds::IoData* data) -> std::uint16_t {
+    const std::uint16_t a = io_assembly(file, data);
+    return a != 0 && fits_one_frame(objects.assembly_data(a).size()) ? a : 0;
+  };
+  IoDefaults d;
+  d.choices = alloc::kExplicit | alloc::kPoll;
+  const eds::IoInfo& io = file.io;
+  if (const auto* poll = io.connection(eds::ConnectionKind::kPoll)) {
+    d.poll_input = fitting(io.input(poll->input));
+    d.poll_output = fitting(io.output(poll->output));
+  }
+  const auto* cos = io.connection(eds::ConnectionKind::kChangeOfState);
+  const auto* cyclic = io.connection(eds::ConnectionKind::kCyclic);
+  if (cos != nullptr) d.choices |= alloc::kChangeOfState | alloc::kAckSuppression;
+  if (cyclic != nullptr) d.choices |= alloc::kCyclic | alloc::kAckSuppression;
+  if (const auto* produced = cos != nullptr ? cos : cyclic) {
+    d.cos_input = fitting(io.input(produced->input));
+  }
+  return d;
+}
+
+ConnectionSetOptions EdsSlave::connection_options(const EdsSlaveOptions& o,
+                                                  const IoDefaults& d) noexcept {
+  ConnectionSetOptions c;
+  c.supported_choices = d.choices;
+  c.timer_resolution = o.timer_resolution;
+  c.poll_produced_assembly = d.poll_input;
+  c.poll_consumed_assembly = d.poll_output;
+  c.cos_produced_assembly = d.cos_input;
+  return c;
+}
+
 EdsSlave::EdsSlave(can::FrameSink& sink, eds::EdsFile file, EdsSlaveOptions options, Logger log)
     : Group2Slave(sink, wire_options(file, options), std::move(log)),
       options_(options),
       objects_(std::move(file), options.serial_number),
       mac_(MacId::from_bits(options.mac)),
-      connections_(connection_options(options_, io_defaults(objects_.file())), *this) {
-  const IoDefaults d = io_defaults(objects_.file());
-  poll_input_ = d.poll_input;
-  poll_output_ = d.poll_output;
-  cos_input_ = d.cos_input;
+      defaults_(io_defaults(objects_)),
+      connections_(connection_options(options_, defaults_), *this) {
   if (auto n = safe_state_params(objects_.file())) {
     safe_state_params_ = SafeStateParams{(*n)[0], (*n)[1], (*n)[2], (*n)[3]};
   }
@@ -108,9 +111,9 @@ void EdsSlave::power_up_device(TimePoint, PowerUpCause) noexcept {
   connections_.drop();
   end_cos();
   objects_.ack_handler().cos_acknowledged = false;
-  if (poll_output_ != 0) {
-    const std::vector<std::uint8_t> zero(objects_.assembly_data(poll_output_).size(), 0);
-    (void)objects_.set_assembly_data(poll_output_, Bytes(zero.data(), zero.size()));
+  if (defaults_.poll_output != 0) {
+    const std::vector<std::uint8_t> zero(objects_.assembly_data(defaults_.poll_output).size(), 0);
+    (void)objects_.set_assembly_data(defaults_.poll_output, Bytes(zero.data(), zero.size()));
   }
 }
 
@@ -171,7 +174,43 @@ void EdsSlave::end_cos() noexcept {
 // --- the I/O connections' changes ------------------------------------------------
 
 void EdsSlave::on_io_established(std::uint16_t instance, TimePoint now) noexcept {
-  if (instance != connection_instance::kChangeOfState) return;
+  if (instance == connection_instance::kChangeOfState) start_cos(now);
+}
+
+void EdsSlave::on_io_rate_changed(std::uint16_t instance, TimePoint) noexcept {
+  if (instance != connection_instance::kChangeOfState || !cos_) return;
+  cos_->set_expected_packet_rate(
+      milliseconds(connections_.cos_connection().expected_packet_rate_ms));
+}
+
+void EdsSlave::on_io_released(std::uint16_t instance, const Connection& before,
+                              TimePoint) noexcept {
+  if (instance == connection_instance::kChangeOfState) {
+    end_cos();
+    objects_.ack_handler().cos_acknowledged = false;
+    return;
+  }
+  // The outputs of the assembly the released connection consumed, which
+  // its consumed path may have named (attribute 16).
+  if (before.state == ConnectionState::kEstablished) {
+    apply_output_action(false, before.consumed_assembly);
+  }
+}
+
+void EdsSlave::on_io_timed_out(std::uint16_t instance, const Connection& before,
+                               TimePoint) noexcept {
+  if (instance == connection_instance::kChangeOfState) {
+    // Auto Reset leaves it Established: it goes on producing.
+    if (!connections_.established(instance)) {
+      end_cos();
+      objects_.ack_handler().cos_acknowledged = false;
+    }
+    return;
+  }
+  apply_output_action(true, before.consumed_assembly);
+}
+
+void EdsSlave::start_cos(TimePoint now) noexcept {
   const Connection& c = connections_.cos_connection();
   const AckHandler& ack = objects_.ack_handler();
   CosProduction p;
@@ -187,35 +226,15 @@ void EdsSlave::on_io_established(std::uint16_t instance, TimePoint now) noexcept
   objects_.ack_handler().cos_acknowledged = !p.ack_suppressed;
 }
 
-void EdsSlave::on_io_released(std::uint16_t instance, bool was_established, TimePoint) noexcept {
-  if (instance == connection_instance::kChangeOfState) {
-    end_cos();
-    objects_.ack_handler().cos_acknowledged = false;
-    return;
-  }
-  if (was_established) apply_output_action(false);
-}
-
-void EdsSlave::on_io_timed_out(std::uint16_t instance, TimePoint) noexcept {
-  if (instance == connection_instance::kChangeOfState) {
-    end_cos();
-    objects_.ack_handler().cos_acknowledged = false;
-    return;
-  }
-  apply_output_action(true);
-}
-
 void EdsSlave::go_offline(TimePoint) noexcept {
   if (connections_.established(connection_instance::kPoll)) {
-    apply_output_action(true);
+    apply_output_action(true, connections_.poll_connection().consumed_assembly);
   }
   connections_.drop();
   end_cos();
 }
 
-void EdsSlave::apply_output_action(bool fault) noexcept {
-  const std::uint16_t assembly = connections_.poll_connection().consumed_assembly;
-  const std::uint16_t outputs = assembly != 0 ? assembly : poll_output_;
+void EdsSlave::apply_output_action(bool fault, std::uint16_t outputs) noexcept {
   if (outputs == 0) return;
   std::vector<std::uint8_t> data(objects_.assembly_data(outputs).size(), 0);
   if (safe_state_params_) {
@@ -247,7 +266,7 @@ PollResult EdsSlave::poll(Bytes command, TimePoint now) noexcept {
   const bool idle = command.size() < consumed;
   if (idle) {
     result.outcome = PollOutcome::kIdle;
-    apply_output_action(false);
+    apply_output_action(false, c.consumed_assembly);
   } else {
     result.outcome = PollOutcome::kApplied;
     if (consumed > 0 && !objects_.set_assembly_data(c.consumed_assembly, command)) {
@@ -270,11 +289,24 @@ std::uint16_t EdsSlave::connection_size(std::uint16_t instance, bool produced) c
   return static_cast<std::uint16_t>(objects_.assembly_data(assembly).size());
 }
 
-bool EdsSlave::assembly_allowed(std::uint16_t instance, bool,
+bool EdsSlave::assembly_allowed(std::uint16_t instance, bool produced,
                                 std::uint16_t assembly) const noexcept {
-  // The data must fit one frame (no I/O fragmentation here).
-  const std::size_t size = objects_.assembly_data(assembly).size();
-  return instance != connection_instance::kExplicit && size > 0 && size <= kMaxPollData;
+  if (instance == connection_instance::kExplicit) return false;
+  if (!produced) {
+    // The change-of-state connection consumes acknowledgments, no data; a
+    // poll command goes into an output assembly, never into the inputs'
+    // parameters.
+    if (instance == connection_instance::kChangeOfState || !is_output_assembly(assembly)) {
+      return false;
+    }
+  }
+  return fits_one_frame(objects_.assembly_data(assembly).size());
+}
+
+bool EdsSlave::is_output_assembly(std::uint16_t assembly) const noexcept {
+  const eds::EdsFile& file = objects_.file();
+  return std::any_of(file.io.outputs.begin(), file.io.outputs.end(),
+                     [&](const eds::IoData& out) { return io_assembly(file, &out) == assembly; });
 }
 
 // --- explicit requests -------------------------------------------------------------
@@ -286,7 +318,7 @@ std::size_t EdsSlave::execute(const devicenet::RequestMessage& request, std::uin
   switch (request.class_id) {
     case devicenet::kDeviceNetClass:
       return encode_reply(request.service, devicenet_object(request, requester, now, w), w, out);
-    case kConnectionClass:
+    case cip::class_id::kConnection:
       return encode_reply(request.service, connection_object(request, now, w), w, out);
     default: {
       const std::size_t n = objects_.execute(request, out);

@@ -15,7 +15,10 @@
 // answers each poll (EdsObjects::assembly_data), its consumed path the one
 // the poll command is unpacked into (EdsObjects::set_assembly_data: the
 // member parameters take the outputs). By default the EDS's PollInfo input
-// and output; attributes 7/8 are the sizes they pack to. A poll command
+// and output; attributes 7/8 are the sizes they pack to. A consumed path
+// names an assembly [IO_Info] lists as an output (an OutputN), never an
+// input: a poll command must not overwrite the inputs' (read only)
+// parameters. A poll command
 // shorter than the consumed size is the idle condition (bridge/PROTOCOL.md
 // §7): the idle action; Release of an established poll connection is idle
 // too; its watchdog expiring, or a duplicate MAC, the fault action. At
@@ -25,9 +28,16 @@
 // action" (0: the outputs take the value, 1: they hold) with "Output fault
 // value" and "Output idle value" (the output data, from its first byte, the
 // rest zero). Then what the master downloads to them is what the outputs do,
-// as on a device whose safe state is configured. I/O data longer than
-// one frame (8 bytes) is not fragmented here: such an assembly cannot be
-// chosen.
+// as on a device whose safe state is configured. The idle and fault actions
+// act on the assembly the connection consumed (as its path named it), also
+// once Release or the watchdog's Auto Delete has deleted it.
+//
+// I/O data longer than one frame (8 bytes) is not fragmented here: such an
+// assembly (or an empty one) cannot be chosen, neither by a path (0x09) nor
+// as a default. An [IO_Info] input or output larger than that is no default
+// at all: the connection is allocated with no assembly on that side (size
+// 0) until the master sets a path that fits; poll_input_assembly() and the
+// others say 0.
 //
 // Change of state / cyclic (instance 4), allocated with choice 0x10 or 0x20
 // (0x40 suppresses acknowledgment): produced path the COSInfo's (or
@@ -35,14 +45,19 @@
 // Group 1 message 13 through a CosProducer: on a change of its data
 // (inputs_changed(), explicit Sets), no sooner than its inhibit time
 // (attribute 17, settable while Configuring), and once per EPR (the
-// heartbeat, or the cycle), each message acknowledged by the master on
+// heartbeat, or the cycle; an EPR set again while Established takes effect
+// from the last message), each message acknowledged by the master on
 // Group 2 message 2 unless suppressed, retried at the Acknowledge Handler's
 // timer up to its retry limit (attributes 1 and 2, read when the connection
 // is established). An acknowledgment counts when the Acknowledge Handler's
 // COS producing connection instance (attribute 3) is 4; it may carry data,
 // which is ignored. The connection's watchdog (4 x EPR) is restarted by each
 // acknowledgment and does not run with acknowledgment suppressed (nothing
-// consumed): this simulator's reading.
+// consumed): this simulator's reading. It produces exactly while instance 4
+// is Established: from its EPR or a Connection Reset out of Timed Out, on
+// through a watchdog with Auto Reset, until Release, a timeout that leaves
+// it, or the set dropped. Its consumed path (attribute 16) is not settable
+// (0x0E).
 #include <cstdint>
 #include <optional>
 
@@ -102,14 +117,17 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
   // if it is due.
   void inputs_changed(TimePoint now) noexcept;
 
+  // Whether the change-of-state connection produces: exactly while instance
+  // 4 is Established.
+  bool cos_producing() const noexcept { return cos_.has_value(); }
   // The change-of-state connection's messages, every connection since
   // power-on added up (produced counts retries too).
   CosProducerCounters cos_counters() const noexcept;
   // The default assemblies of the poll and change-of-state connections, from
-  // [IO_Info]; 0 for none.
-  std::uint16_t poll_input_assembly() const noexcept { return poll_input_; }
-  std::uint16_t poll_output_assembly() const noexcept { return poll_output_; }
-  std::uint16_t cos_input_assembly() const noexcept { return cos_input_; }
+  // [IO_Info]; 0 for none, or for one that does not fit a frame.
+  std::uint16_t poll_input_assembly() const noexcept { return defaults_.poll_input; }
+  std::uint16_t poll_output_assembly() const noexcept { return defaults_.poll_output; }
+  std::uint16_t cos_input_assembly() const noexcept { return defaults_.cos_input; }
 
  private:
   // Group2Slave
@@ -133,9 +151,11 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
 
   // ConnectionEvents
   void on_io_established(std::uint16_t instance, TimePoint now) noexcept override;
-  void on_io_released(std::uint16_t instance, bool was_established,
+  void on_io_rate_changed(std::uint16_t instance, TimePoint now) noexcept override;
+  void on_io_released(std::uint16_t instance, const Connection& before,
                       TimePoint now) noexcept override;
-  void on_io_timed_out(std::uint16_t instance, TimePoint now) noexcept override;
+  void on_io_timed_out(std::uint16_t instance, const Connection& before,
+                       TimePoint now) noexcept override;
 
   // IoAssemblies
   std::uint16_t connection_size(std::uint16_t instance, bool produced) const noexcept override;
@@ -146,22 +166,36 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
                          ByteWriter& w) noexcept;
   Reply connection_object(const devicenet::RequestMessage& r, TimePoint now,
                           ByteWriter& w) noexcept;
-  // The outputs on idle (`fault` false) or on a fault.
-  void apply_output_action(bool fault) noexcept;
+  // The outputs of the consumed assembly `outputs` (0: none) on idle
+  // (`fault` false) or on a fault.
+  void apply_output_action(bool fault, std::uint16_t outputs) noexcept;
+  // An assembly [IO_Info] lists as an output.
+  bool is_output_assembly(std::uint16_t assembly) const noexcept;
   // The convention's parameters, when the EDS has all four (ParamN's N).
   struct SafeStateParams {
     unsigned fault_action = 0, fault_value = 0, idle_action = 0, idle_value = 0;
   };
   std::optional<SafeStateParams> safe_state_params_;
+  void start_cos(TimePoint now) noexcept;
   void end_cos() noexcept;
   void produce(const std::optional<std::vector<std::uint8_t>>& message, TimePoint now) noexcept;
+
+  // What [IO_Info] offers: the allocation choices and the default
+  // assemblies (0: none, or one that does not fit a frame).
+  struct IoDefaults {
+    std::uint16_t poll_input = 0;
+    std::uint16_t poll_output = 0;
+    std::uint16_t cos_input = 0;
+    std::uint8_t choices = 0;
+  };
+  static IoDefaults io_defaults(const EdsObjects& objects) noexcept;
+  static ConnectionSetOptions connection_options(const EdsSlaveOptions& o,
+                                                 const IoDefaults& d) noexcept;
 
   EdsSlaveOptions options_;
   EdsObjects objects_;
   devicenet::MacId mac_;
-  std::uint16_t poll_input_ = 0;
-  std::uint16_t poll_output_ = 0;
-  std::uint16_t cos_input_ = 0;
+  IoDefaults defaults_;
   ConnectionSet connections_;
   std::optional<CosProducer> cos_;
   CosProducerCounters cos_ended_;  // of the connections before the current one

@@ -1,0 +1,171 @@
+// The simulated device driven by an EDS file (EdsSlave, the example I/O
+// block of deploy/eds at MAC 1), driven by received frames in any order and
+// the passing of time from the input (support/session_records.hpp: op kStop
+// power-cycles it; op kSetOutputs is the device's own inputs changing, data
+// [digital inputs][status], then inputs_changed()). Frames it sends are
+// checked and dropped. Properties: no crash or sanitizer report; after
+// on_timer(now) the next deadline is after now; every frame sent is a valid
+// CAN 2.0A frame with a DeviceNet identifier of this device's MAC (Group 1
+// messages 13 and 15, Group 2 messages 3 and 7), and, in Communication
+// Fault, only the Offline Connection Set's; a poll response and a
+// change-of-state message carry the data of the assembly their connection
+// produces, whole (it fits one frame); a change-of-state message goes out
+// only while instance 4 produces, and it produces exactly while it is
+// Established; connections exist only while a master owns the set.
+#include "adapters/sim/generic/eds_slave.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+
+#include "bridge/devicenet/wire/identifier.hpp"
+#include "tests/fuzz/support/fuzz_check.hpp"
+#include "tests/fuzz/support/session_records.hpp"
+
+namespace {
+
+using namespace dnbridge;
+using devicenet::Group1Message;
+using devicenet::Group2Message;
+using devicenet::Group4Message;
+using devicenet::MacId;
+using sim::ConnectionState;
+using sim::EdsSlave;
+
+constexpr std::uint8_t kMac = 1;
+// The example I/O block's parameters the inputs are made of: digital inputs
+// (USINT) and module status (BYTE).
+constexpr unsigned kDigitalInputs = 3;
+constexpr unsigned kModuleStatus = 5;
+
+// deploy/eds/dnbridge-example-io-block.eds, read once.
+const eds::EdsFile& io_block() {
+  static const eds::EdsFile file = [] {
+    std::ifstream in(std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-io-block.eds");
+    std::stringstream text;
+    text << in.rdbuf();
+    auto parsed = eds::parse(text.str());
+    FUZZ_CHECK(parsed.file.has_value());
+    return std::move(*parsed.file);
+  }();
+  return file;
+}
+
+class CheckingSink final : public can::FrameSink {
+ public:
+  void send(const can::CanFrame& frame, TimePoint now) override {
+    FUZZ_CHECK(slave_ != nullptr);
+    FUZZ_CHECK(frame.id <= can::kMaxStandardId);
+    FUZZ_CHECK(frame.len <= can::kMaxDataLength);
+    FUZZ_CHECK(now >= last_);
+    last_ = now;
+    const EdsSlave& s = *slave_;
+    FUZZ_CHECK(s.network_state() != EdsSlave::NetworkState::kOff);
+    if (s.network_state() == EdsSlave::NetworkState::kCommunicationFault) {
+      FUZZ_CHECK(frame.id == devicenet::group4_id(Group4Message::kCommFaultedResponse) ||
+                 frame.id == devicenet::group4_id(Group4Message::kOfflineOwnershipResponse));
+      return;
+    }
+    const MacId mac = s.mac();
+    const Bytes payload = frame.payload();
+    if (frame.id == devicenet::group1_id(Group1Message::kSlaveCosCyclic, mac)) {
+      FUZZ_CHECK(s.network_state() == EdsSlave::NetworkState::kOnline);
+      FUZZ_CHECK(s.cos_producing());
+      FUZZ_CHECK(s.cos_state() == ConnectionState::kEstablished);
+      const auto data =
+          s.objects().assembly_data(s.connections().cos_connection().produced_assembly);
+      FUZZ_CHECK(payload.size() == data.size());
+      return;
+    }
+    if (frame.id == devicenet::group1_id(Group1Message::kSlavePollResponse, mac)) {
+      FUZZ_CHECK(s.network_state() == EdsSlave::NetworkState::kOnline);
+      FUZZ_CHECK(s.poll_state() == ConnectionState::kEstablished);
+      const auto data =
+          s.objects().assembly_data(s.connections().poll_connection().produced_assembly);
+      FUZZ_CHECK(payload.size() == data.size());
+      return;
+    }
+    FUZZ_CHECK(frame.id == devicenet::group2_id(mac, Group2Message::kSlaveExplicitResponse) ||
+               frame.id == devicenet::group2_id(mac, Group2Message::kDuplicateMacCheck));
+    if (s.network_state() == EdsSlave::NetworkState::kDuplicateMacCheck) {
+      FUZZ_CHECK(frame.id == devicenet::group2_id(mac, Group2Message::kDuplicateMacCheck));
+    }
+  }
+  const EdsSlave* slave_ = nullptr;
+
+ private:
+  TimePoint last_{};
+};
+
+void run_timers(EdsSlave& slave, TimePoint now) {
+  for (int i = 0; slave.next_deadline() <= now; ++i) {
+    FUZZ_CHECK(i < 8);  // a few chained rounds at one instant, more is a spin
+    slave.on_timer(now);
+  }
+}
+
+void check_consistent(const EdsSlave& slave) {
+  FUZZ_CHECK(slave.mac().value() == kMac);  // the MAC is the switches'
+  const std::uint8_t owner = slave.owner();
+  FUZZ_CHECK(owner == MacId::kNone || owner <= MacId::kMax);
+  if (owner == MacId::kNone) {
+    FUZZ_CHECK(slave.explicit_state() == ConnectionState::kNonExistent);
+    FUZZ_CHECK(slave.poll_state() == ConnectionState::kNonExistent);
+    FUZZ_CHECK(slave.cos_state() == ConnectionState::kNonExistent);
+  }
+  // Instance 4 produces exactly while it is Established.
+  FUZZ_CHECK(slave.cos_producing() == (slave.cos_state() == ConnectionState::kEstablished));
+  // What the I/O connections carry fits one frame (no I/O fragmentation).
+  for (const sim::Connection* c :
+       {&slave.connections().poll_connection(), &slave.connections().cos_connection()}) {
+    FUZZ_CHECK(slave.objects().assembly_data(c->produced_assembly).size() <= sim::kMaxPollData);
+    FUZZ_CHECK(slave.objects().assembly_data(c->consumed_assembly).size() <= sim::kMaxPollData);
+  }
+  // A poll command lands in an output assembly, never the inputs'.
+  const std::uint16_t consumed = slave.connections().poll_connection().consumed_assembly;
+  FUZZ_CHECK(consumed == 0 || consumed == slave.poll_output_assembly());
+  FUZZ_CHECK(slave.connections().cos_connection().consumed_assembly == 0);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  CheckingSink sink;
+  sim::EdsSlaveOptions options;
+  options.mac = kMac;
+  options.serial_number = 0xDB000101;
+  EdsSlave slave(sink, io_block(), options);
+  sink.slave_ = &slave;
+
+  TimePoint now = fuzz::kSessionStart;
+  slave.power_on(now);
+  ByteReader in(Bytes(data, size));
+  while (auto record = fuzz::next_record(in)) {
+    now += record->step;
+    run_timers(slave, now);
+    switch (record->op) {
+      case fuzz::Op::kFrame:
+        slave.on_frame(record->frame, now);
+        break;
+      case fuzz::Op::kStop:
+        slave.power_cycle(now);
+        break;
+      case fuzz::Op::kSetOutputs: {
+        const Bytes d = record->frame.payload();
+        if (!d.empty()) (void)slave.objects().set_param_value(kDigitalInputs, d.first(1));
+        if (d.size() > 1) (void)slave.objects().set_param_value(kModuleStatus, d.subspan(1, 1));
+        slave.inputs_changed(now);
+        break;
+      }
+      default:  // the master's other requests mean nothing here: time passes
+        break;
+    }
+    run_timers(slave, now);
+    check_consistent(slave);
+  }
+  return 0;
+}
