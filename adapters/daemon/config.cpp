@@ -671,7 +671,7 @@ void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems&
     }
   }
   std::string why;
-  if (!eds::make_node_profile(*e.file, s.eds_node, &why)) {
+  if (!eds::make_node_profile(e.file, s.eds_node, &why)) {
     // At the key the problem is about.
     const toml::node* at = key;
     if (why.starts_with("parameters") && parameters) at = parameters;

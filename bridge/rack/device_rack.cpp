@@ -24,7 +24,8 @@ devicenet::ScannerConfig DeviceRack::scanner_config(devicenet::ScannerConfig por
                                                     const std::vector<DeviceConfig>& devices) {
   for (const auto& d : devices) {
     std::string why;
-    auto profile = eds::make_node_profile(eds_of(d), d.settings, &why);
+    (void)eds_of(d);  // throws without a file
+    auto profile = eds::make_node_profile(d.eds, d.settings, &why);
     if (!profile) {
       throw std::invalid_argument(
           fmt::format("node {} ({}): {}: {}", d.node.mac.value(), d.node.name, d.eds_path, why));

@@ -182,6 +182,30 @@ TEST_F(DeviceRackTest, AfterALossTheOutputsTakeTheFaultValueAndComeBackIdle) {
   EXPECT_EQ(param(4), 0x80);
 }
 
+TEST_F(DeviceRackTest, ADeviceWhoseMemberListDiffersFromTheEdsIsAConfigurationFault) {
+  // The device's own EDS has the input assembly's first two members swapped.
+  eds::EdsFile differing = example_eds(kIoBlockEds);
+  for (auto& a : differing.assemblies) {
+    if (a.number == 100) std::swap(a.members[0], a.members[1]);
+  }
+  auto config = rack_config({});
+  config.devices = {io_block()};
+  config.create_devices = false;
+  rack_.emplace(config);
+  rack_->add_eds_device(differing, sim::default_eds_slave_options(mac(kIo)), std::nullopt);
+  rack_->start();
+  ASSERT_TRUE(world().run_until([&] { return view().state == NodeState::kConfigurationFault; },
+                                seconds(10)))
+      << view().reason;
+  EXPECT_EQ(view().reason,
+            "Assembly 100 member list (Assem100 Inputs and status) differs from what the "
+            "configuration expects: member 1: class 0x0F instance 0x05 attribute 0x01 on the "
+            "device, Param3 (Digital inputs), class 0x0F instance 0x03 attribute 0x01 in the EDS; "
+            "member 2: class 0x0F instance 0x03 attribute 0x01 on the device, Param5 (Module "
+            "status), class 0x0F instance 0x05 attribute 0x01 in the EDS");
+  EXPECT_FALSE(view().online);
+}
+
 TEST_F(DeviceRackTest, APumpAndADeviceShareAPortAndAReloadMovesANodeBetweenThem) {
   start({io_block()}, {1});
   ASSERT_TRUE(run_until_online());

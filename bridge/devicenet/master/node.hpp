@@ -134,6 +134,7 @@ class Node final : private ExplicitClient::Listener {
     kWriteSetting,            // Set only where it differs,
     kReleasePollForSetting,   // (a device that refuses while a poll connection exists)
     kVerifySetting,           // Get again
+    kCheckAttribute,          // the profile's checks: Get, compare
     kAllocatePoll,            // DeviceNet.Allocate(poll)
     kReleasePollForAllocate,  // DeviceNet.Release(poll) after "already allocated"
     kGetProducedPath,
@@ -197,6 +198,7 @@ class Node final : private ExplicitClient::Listener {
   Step after_write_setting(const ExplicitResult& r, TimePoint now);
   Step after_release_for_setting(const ExplicitResult& r, TimePoint now);
   Step after_verify_setting(const ExplicitResult& r, TimePoint now);
+  Step after_check(const ExplicitResult& r, TimePoint now);
   Step after_allocate_poll(const ExplicitResult& r, TimePoint now);
   Step after_get_path(const ExplicitResult& r, TimePoint now);
   Step after_set_path(const ExplicitResult& r, TimePoint now);
@@ -218,8 +220,10 @@ class Node final : private ExplicitClient::Listener {
 
   void attempt_allocate(TimePoint now);
   void release(Step step, std::uint8_t choice, TimePoint now);
-  // The setting in hand (setting_index_), or the poll connection after the last.
+  // The setting in hand (setting_index_), or the checks after the last.
   Step first_setting_step();
+  // The check in hand (check_index_), or the poll connection after the last.
+  Step next_check_step();
   // What a refused Get of the setting in hand was for, for the reason:
   // "; the configuration needs 03"; empty for other steps.
   std::string setting_expectation(Step step) const;
@@ -275,7 +279,9 @@ class Node final : private ExplicitClient::Listener {
   std::uint32_t jitter_state_ = 0;  // xorshift state, seeded from the MAC
   std::size_t setting_index_ = 0;
   std::vector<std::vector<std::uint8_t>> settings_in_force_;
-  bool setting_retried_ = false;     // a refused Set retried once after releasing the poll
+  bool setting_retried_ = false;
+  std::size_t check_index_ =
+      0;  // the check in hand     // a refused Set retried once after releasing the poll
   bool poll_release_tried_ = false;  // the poll Allocate retried once after a Release
   InlineBytes<16> setting_found_;    // what the device had before the Set
   unsigned step_timeouts_ = 0;       // consecutive timeouts of the current life-cycle step

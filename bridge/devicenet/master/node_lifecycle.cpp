@@ -31,6 +31,7 @@ namespace ident = cip::identity;
 // Targets a row cannot name itself: they come from the profile.
 constexpr cip::AttributeRef kProfileSetting{0, 0, 0, "(the profile's setting in hand)"};
 constexpr cip::AttributeRef kProfileSizeFallback{0, 0, 0, "(the profile's size fallback)"};
+constexpr cip::AttributeRef kProfileCheck{0, 0, 0, "(the profile's check in hand)"};
 constexpr cip::AttributeRef kDeviceNetObject{cip::devicenet_object::kClass, 1, 0, "DeviceNet"};
 
 }  // namespace
@@ -59,6 +60,7 @@ const Node::StepRow Node::kStartup[] = {
   {Step::kWriteSetting,     NodeState::kConfiguring,  Verb::kSet,      kProfileSetting,                       0,                     OnRefusal::kHandler,     Step::kVerifySetting,   &Node::after_write_setting},
   {Step::kReleasePollForSetting, NodeState::kConfiguring, Verb::kRelease, kDeviceNetObject,                   allocation::kPoll,     OnRefusal::kHandler,     Step::kWriteSetting,    &Node::after_release_for_setting},
   {Step::kVerifySetting,    NodeState::kConfiguring,  Verb::kGet,      kProfileSetting,                       0,                     OnRefusal::kFault,       Step::kNone,            &Node::after_verify_setting},
+  {Step::kCheckAttribute,   NodeState::kConfiguring,  Verb::kGet,      kProfileCheck,                         0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_check},
   {Step::kAllocatePoll,     NodeState::kConfiguring,  Verb::kAllocate, kDeviceNetObject,                      allocation::kPoll,     OnRefusal::kHandler,     Step::kGetProducedPath, &Node::after_allocate_poll},
   {Step::kReleasePollForAllocate, NodeState::kConfiguring, Verb::kRelease, kDeviceNetObject,                  allocation::kPoll,     OnRefusal::kGoOn,        Step::kAllocatePoll,    nullptr},
   {Step::kGetProducedPath,  NodeState::kConfiguring,  Verb::kGet,      conn::kPollProducedPath,               0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_get_path},
@@ -276,6 +278,10 @@ cip::AttributeRef Node::target_of(Step step) const {
   if (r.target.name == kProfileSetting.name) {
     const auto& s = config_.profile.settings[setting_index_];
     return {s.class_id, s.instance_id, s.attribute, s.name};
+  }
+  if (r.target.name == kProfileCheck.name) {
+    const auto& c = config_.profile.checks[check_index_];
+    return {c.class_id, c.instance_id, c.attribute, c.name};
   }
   if (r.target.name == kProfileSizeFallback.name) {
     const auto& fb = config_.profile.size_fallback;
@@ -590,8 +596,33 @@ std::string Node::setting_expectation(Step step) const {
 
 Node::Step Node::first_setting_step() {
   setting_retried_ = false;
-  return setting_index_ < config_.profile.settings.size() ? Step::kReadSetting
-                                                          : Step::kAllocatePoll;
+  if (setting_index_ < config_.profile.settings.size()) return Step::kReadSetting;
+  check_index_ = 0;
+  return next_check_step();
+}
+
+Node::Step Node::next_check_step() {
+  return check_index_ < config_.profile.checks.size() ? Step::kCheckAttribute : Step::kAllocatePoll;
+}
+
+Node::Step Node::after_check(const ExplicitResult& r, TimePoint now) {
+  const auto& c = config_.profile.checks[check_index_];
+  ++check_index_;
+  if (!r.ok()) {
+    log_.info("{} not offered ({}): not compared", c.name, status_text(r));
+    return next_check_step();
+  }
+  const auto differences =
+      c.verifier ? c.verifier->differences(r.data.view()) : std::vector<std::string>{};
+  if (!differences.empty()) {
+    std::string text;
+    for (const auto& d : differences) text += (text.empty() ? "" : "; ") + d;
+    enter_fault(NodeState::kConfigurationFault,
+                fmt::format("{} differs from what the configuration expects: {}", c.name, text),
+                now);
+    return Step::kNone;
+  }
+  return next_check_step();
 }
 
 Node::Step Node::after_read_setting(const ExplicitResult& r, TimePoint now) {

@@ -2,6 +2,7 @@
 // What the master is told to scan: per port, the master's own MAC and the
 // nodes it owns, each with what it must be and how it is configured.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,6 +41,36 @@ struct AttributeSetting {
   friend bool operator==(const AttributeSetting&, const AttributeSetting&) = default;
 };
 
+// What a profile expects an attribute to report, where the device offers
+// it: the differences, one sentence each (none when it agrees). `key()`
+// tells two expectations apart (configurations are compared by it).
+class AttributeVerifier {
+ public:
+  virtual ~AttributeVerifier() = default;
+  virtual std::vector<std::string> differences(Bytes reported) const = 0;
+  virtual std::string key() const = 0;
+};
+
+// An attribute the master reads after the settings and before the I/O
+// connection starts, and that must report what the profile expects (e.g. an
+// I/O assembly's member list against the EDS). A difference is a
+// configuration fault naming it; a device that refuses the Get (it need not
+// offer the attribute) is not compared, and that is logged.
+struct AttributeCheck {
+  std::uint16_t class_id = 0;
+  std::uint16_t instance_id = 0;
+  std::uint8_t attribute = 0;
+  std::string name;  // "Assembly 100 member list"
+  std::shared_ptr<const AttributeVerifier> verifier;
+
+  friend bool operator==(const AttributeCheck& a, const AttributeCheck& b) {
+    return a.class_id == b.class_id && a.instance_id == b.instance_id &&
+           a.attribute == b.attribute && a.name == b.name &&
+           (a.verifier && b.verifier ? a.verifier->key() == b.verifier->key()
+                                     : a.verifier == b.verifier);
+  }
+};
+
 // Where the device reports the poll connection's sizes: Connection instance 2
 // attributes 7/8, with a profile-specific fallback (the CDN127's Configuration
 // object attributes 16/17) for devices that refuse those.
@@ -59,6 +90,7 @@ struct SizeSource {
 struct NodeProfile {
   ExpectedIdentity identity;
   std::vector<AttributeSetting> settings;   // applied in order
+  std::vector<AttributeCheck> checks;       // then these read and compared
   std::vector<std::uint8_t> produced_path;  // Connection 2 attribute 14 (EPATH)
   std::vector<std::uint8_t> consumed_path;  // Connection 2 attribute 16 (EPATH)
   std::size_t produced_size = 0;            // poll response bytes expected

@@ -3,12 +3,15 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <optional>
 #include <set>
 #include <string_view>
 
+#include "bridge/cip/assembly.hpp"
 #include "bridge/cip/epath.hpp"
 #include "bridge/common/closest.hpp"
 #include "bridge/common/text.hpp"
+#include "bridge/profiles/eds/member_check.hpp"
 
 namespace dnbridge::eds {
 namespace {
@@ -90,6 +93,58 @@ Result<devicenet::AttributeSetting> setting_of(const EdsFile& file, const Parame
   return s;
 }
 
+// An assembly's member list on the device against its EDS entry.
+class MemberListVerifier final : public devicenet::AttributeVerifier {
+ public:
+  MemberListVerifier(std::shared_ptr<const EdsFile> file, const Assembly& assembly)
+      : file_(std::move(file)), assembly_(assembly) {}
+
+  std::vector<std::string> differences(Bytes reported) const override {
+    auto members = cip::decode_member_list(reported);
+    if (!members) {
+      return {
+          fmt::format("the device's member list does not decode ({})", members.error().message())};
+    }
+    return member_differences(*file_, assembly_, *members);
+  }
+
+  // What is compared: the assembly's size and members as the EDS gives them.
+  std::string key() const override {
+    std::string k = fmt::format("Assem{}:{}", assembly_.number, assembly_.size_bits());
+    for (const Member& m : assembly_.members) {
+      k += fmt::format(";{}/{}/{}/{}", m.bits, static_cast<int>(m.kind), m.number,
+                       cip::describe(m.path));
+      if (m.kind == Member::Kind::kParam) {
+        if (const Param* p = file_->param(m.number)) k += "@" + cip::describe(p->link);
+      }
+    }
+    return k;
+  }
+
+ private:
+  std::shared_ptr<const EdsFile> file_;
+  Assembly assembly_;
+};
+
+// The check of the member list of the assembly `data` names, when the EDS
+// lists its members.
+std::optional<devicenet::AttributeCheck> member_list_check(
+    const std::shared_ptr<const EdsFile>& file, const IoData* data) {
+  if (data == nullptr) return std::nullopt;
+  const Assembly* a = file->assembly_at(data->path);
+  if (a == nullptr || a->members.empty() || !a->path.instance_id || *a->path.instance_id > 0xFFFF) {
+    return std::nullopt;
+  }
+  devicenet::AttributeCheck c;
+  c.class_id = 4;
+  c.instance_id = static_cast<std::uint16_t>(*a->path.instance_id);
+  c.attribute = 2;
+  c.name = fmt::format("Assembly {} member list (Assem{}{})", c.instance_id, a->number,
+                       a->name.empty() ? "" : " " + a->name);
+  c.verifier = std::make_shared<MemberListVerifier>(file, *a);
+  return c;
+}
+
 }  // namespace
 
 Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::string* why) {
@@ -113,8 +168,9 @@ Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::stri
   return io;
 }
 
-Result<devicenet::NodeProfile> make_node_profile(const EdsFile& file, const EdsNode& node,
-                                                 std::string* why) {
+Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> shared,
+                                                 const EdsNode& node, std::string* why) {
+  const EdsFile& file = *shared;
   auto io = node_io(file, node.connection, why);
   if (!io) return io.error();
   if (node.connection != ConnectionKind::kPoll) {
@@ -153,6 +209,9 @@ Result<devicenet::NodeProfile> make_node_profile(const EdsFile& file, const EdsN
   const ConnectionInfo* c = file.io.connection(node.connection);
   if (const IoData* d = file.io.input(c->input)) p.produced_path = cip::encoded(d->path);
   if (const IoData* d = file.io.output(c->output)) p.consumed_path = cip::encoded(d->path);
+  for (const IoData* d : {file.io.input(c->input), file.io.output(c->output)}) {
+    if (auto check = member_list_check(shared, d)) p.checks.push_back(std::move(*check));
+  }
   p.produced_size = io->produced.size;
   p.consumed_size = io->consumed.size;
   p.format_description = fmt::format("{}, {}", describe_data(io->produced, "input"),

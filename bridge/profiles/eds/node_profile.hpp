@@ -12,6 +12,7 @@
 // standard names them). They are downloaded after the other parameters and
 // verified like them. Without them the node is refused, not run on the
 // device's factory actions.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -55,8 +56,13 @@ Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::stri
 // today), an unknown parameter (with the nearest name), one given twice, one
 // read only, one without a link path or of a string type, a value outside
 // its type or the EDS's limits, and outputs without a safe state.
-Result<devicenet::NodeProfile> make_node_profile(const EdsFile& file, const EdsNode& node,
-                                                 std::string* why = nullptr);
+//
+// Where the EDS lists the members of the connection's input or output
+// assembly, the profile checks the device's member list (Assembly attribute
+// 2, shared/seeds/003) against it at start-up (member_check.hpp): a device
+// that reports other members is a configuration fault saying which.
+Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> file,
+                                                 const EdsNode& node, std::string* why = nullptr);
 
 // The writable, linked parameters whose names speak of a fault or an idle
 // state ("fault", "idle", any case) that the node sets in neither list:

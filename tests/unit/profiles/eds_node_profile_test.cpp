@@ -4,8 +4,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <vector>
 
+#include "bridge/cip/assembly.hpp"
 #include "bridge/profiles/eds/node_profile.hpp"
 #include "tests/support/example_eds.hpp"
 
@@ -20,6 +22,12 @@ const std::vector<ParameterValue> kSafeState{{"Output fault action", 0},
                                              {"Output idle action", 0},
                                              {"output idle value", 0x80}};
 
+// The profile of `node` for a copy of `file`.
+Result<devicenet::NodeProfile> profile_of(const EdsFile& file, const EdsNode& node,
+                                          std::string* why = nullptr) {
+  return make_node_profile(std::make_shared<const EdsFile>(file), node, why);
+}
+
 EdsNode polled(std::vector<ParameterValue> parameters = {}) {
   EdsNode n;
   n.parameters = std::move(parameters);
@@ -30,7 +38,7 @@ EdsNode polled(std::vector<ParameterValue> parameters = {}) {
 TEST(EdsNodeProfile, TheIoBlockPolledWithItsParametersThenItsSafeState) {
   const EdsFile f = test::example_eds(test::kIoBlockEds);
   std::string why;
-  auto p = make_node_profile(f, polled({{"Input filter", 5}}), &why);
+  auto p = profile_of(f, polled({{"Input filter", 5}}), &why);
   ASSERT_TRUE(p.ok()) << why;
   EXPECT_EQ(p->identity, (devicenet::ExpectedIdentity{65001, 7, 1}));
   EXPECT_EQ(p->produced_path, (ByteVec{0x20, 0x04, 0x24, 0x64, 0x30, 0x03}));
@@ -55,11 +63,45 @@ TEST(EdsNodeProfile, TheIoBlockPolledWithItsParametersThenItsSafeState) {
   EXPECT_EQ(p->settings[4].value, (ByteVec{0x80}));
 }
 
+TEST(EdsNodeProfile, TheDevicesMemberListsAreCheckedAgainstTheEds) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  auto p = profile_of(f, polled());
+  ASSERT_TRUE(p.ok());
+  ASSERT_EQ(p->checks.size(), 2u);
+  const auto& in = p->checks[0];
+  EXPECT_EQ(in.class_id, 4);
+  EXPECT_EQ(in.instance_id, 100);
+  EXPECT_EQ(in.attribute, 2);
+  EXPECT_EQ(in.name, "Assembly 100 member list (Assem100 Inputs and status)");
+  EXPECT_EQ(p->checks[1].instance_id, 150);
+  // As the EDS lists them: Param3, Param5, Param2 at their link paths.
+  const auto member = [](std::uint16_t bits, std::uint8_t instance) {
+    cip::AssemblyMember m;
+    m.bits = bits;
+    m.path_bytes = {0x20, 0x0F, 0x24, instance, 0x30, 0x01};
+    m.path = cip::decode_epath(Bytes(m.path_bytes.data(), m.path_bytes.size())).value();
+    return m;
+  };
+  const auto agreeing = cip::encode_member_list({member(8, 3), member(8, 5), member(16, 2)});
+  EXPECT_TRUE(in.verifier->differences(Bytes(agreeing.data(), agreeing.size())).empty());
+  const auto swapped = cip::encode_member_list({member(8, 5), member(8, 3), member(16, 2)});
+  const auto d = in.verifier->differences(Bytes(swapped.data(), swapped.size()));
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0],
+            "member 1: class 0x0F instance 0x05 attribute 0x01 on the device, Param3 (Digital "
+            "inputs), class 0x0F instance 0x03 attribute 0x01 in the EDS");
+  const std::vector<std::uint8_t> cut{0x08, 0x00, 0x06};
+  EXPECT_EQ(in.verifier->differences(Bytes(cut.data(), cut.size())).at(0),
+            "the device's member list does not decode (input truncated)");
+  // Two profiles of one EDS compare equal (a reload sees no change).
+  EXPECT_EQ(*p, profile_of(f, polled()).value());
+}
+
 TEST(EdsNodeProfile, OutputsWithoutASafeStateAreRefused) {
   const EdsFile f = test::example_eds(test::kIoBlockEds);
   EdsNode n;
   std::string why;
-  EXPECT_EQ(make_node_profile(f, n, &why).error(), make_error_code(Errc::kMalformed));
+  EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kMalformed));
   EXPECT_EQ(why,
             "the node has outputs (output 2 B \"Outputs\" = Assem150 (Outputs)) and no safe "
             "state: give the parameters that set their fault and idle actions (safe_state)");
@@ -77,7 +119,7 @@ class EdsNodeProfileRefusal : public ::testing::TestWithParam<Refusal> {};
 TEST_P(EdsNodeProfileRefusal, NamesTheParameterAndWhatIsWrong) {
   const EdsFile f = test::example_eds(test::kIoBlockEds);
   std::string why;
-  auto p = make_node_profile(f, polled(GetParam().parameters), &why);
+  auto p = profile_of(f, polled(GetParam().parameters), &why);
   ASSERT_FALSE(p.ok()) << GetParam().what;
   EXPECT_EQ(p.error(), make_error_code(GetParam().code)) << GetParam().what;
   EXPECT_EQ(why, GetParam().why) << GetParam().what;
@@ -113,11 +155,11 @@ TEST(EdsNodeProfile, AConnectionTheEdsDoesNotOfferOrTheMasterDoesNotOpenIsRefuse
   EdsNode n = polled();
   std::string why;
   n.connection = ConnectionKind::kStrobe;
-  EXPECT_EQ(make_node_profile(f, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kUnsupported));
   EXPECT_EQ(why,
             "the EDS offers no bit-strobe connection (it offers: poll, change of state, cyclic)");
   n.connection = ConnectionKind::kChangeOfState;
-  EXPECT_EQ(make_node_profile(f, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kUnsupported));
   EXPECT_EQ(why, "connection \"change of state\": dnbridge's master opens poll connections only");
 }
 
@@ -133,17 +175,17 @@ TEST(EdsNodeProfile, AParameterWithoutALinkPathOrOfAStringTypeIsNotSet) {
   EdsNode n;
   n.parameters = {{"unlinked", 1}};
   std::string why;
-  EXPECT_EQ(make_node_profile(*parsed.file, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(profile_of(*parsed.file, n, &why).error(), make_error_code(Errc::kUnsupported));
   EXPECT_EQ(why,
             "parameters: Param1 \"unlinked\" has no link path to an attribute (its link path: "
             "none)");
   n.parameters = {{"label", 1}};
-  EXPECT_EQ(make_node_profile(*parsed.file, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(profile_of(*parsed.file, n, &why).error(), make_error_code(Errc::kUnsupported));
   EXPECT_EQ(why,
             "parameters: Param2 \"label\" is a SHORT_STRING: only numbers are set at start-up");
   // Inputs only: no safe state is needed.
   n.parameters.clear();
-  auto p = make_node_profile(*parsed.file, n, &why);
+  auto p = profile_of(*parsed.file, n, &why);
   ASSERT_TRUE(p.ok()) << why;
   EXPECT_EQ(p->consumed_size, 0u);
   EXPECT_TRUE(p->consumed_path.empty());
@@ -162,12 +204,12 @@ TEST(EdsNodeProfile, AParameterNameSeveralParametersHaveMustBeGivenAsParamN) {
   EdsNode n;
   n.parameters = {{"fault action", 1}};
   std::string why;
-  EXPECT_EQ(make_node_profile(*parsed.file, n, &why).error(), make_error_code(Errc::kMalformed));
+  EXPECT_EQ(profile_of(*parsed.file, n, &why).error(), make_error_code(Errc::kMalformed));
   EXPECT_EQ(why,
             "parameters: \"fault action\" names 2 parameters (Param1, Param2): name one as "
             "ParamN");
   n.parameters = {{"Param1", 1}, {"param2", 1}};
-  auto p = make_node_profile(*parsed.file, n, &why);
+  auto p = profile_of(*parsed.file, n, &why);
   ASSERT_TRUE(p.ok()) << why;
   ASSERT_EQ(p->settings.size(), 2u);
   EXPECT_EQ(p->settings[1].instance_id, 2);
