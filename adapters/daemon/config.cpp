@@ -373,9 +373,9 @@ void read_resume(const Layers& layers, NodeSettings& s, Problems& r) {
     const Found f = layers.find("resume");
     r.warning(f.value->source(),
               fmt::format("node {} drives its last outputs again after a loss without a new "
-                          "command (resume = \"last-command\"): a pump may start on its own "
+                          "command (resume = \"last-command\"): {} may start on its own "
                           "after a power cycle",
-                          s.pump.node.mac.value()));
+                          s.pump.node.mac.value(), s.is_eds() ? "what its outputs drive" : "a pump"));
   }
 }
 

@@ -22,7 +22,7 @@ extern "C" void on_interrupt(int) { g_interrupted = 1; }
 // Waits are cut into slices this long so that an interrupt is noticed.
 constexpr Duration kSlice = milliseconds(100);
 
-enum Token : dds::WaitSet::Token { kPumpData = 1, kNodeData = 2, kPortData = 3 };
+enum Token : dds::WaitSet::Token { kPumpData = 1, kNodeData = 2, kPortData = 3, kDeviceData = 4 };
 
 NodeKey node_key(std::string_view rack, std::string_view port, std::uint8_t mac) {
   return NodeKey{std::string(rack), std::string(port), mac};
@@ -79,6 +79,12 @@ Client::Client(std::uint32_t domain, const std::string& name, const dds::Propert
       port_data_(port_reader_, DDS_ANY_STATE),
       waitset_(participant_) {
   waitset_.attach(pump_data_, kPumpData);
+  try {
+    devices_in_.emplace(participant_);
+    waitset_.attach(devices_in_->data, kDeviceData);
+  } catch (const dds::Error& e) {
+    if (e.code() != DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) throw;
+  }
   waitset_.attach(node_data_, kNodeData);
   waitset_.attach(port_data_, kPortData);
 }
@@ -95,6 +101,16 @@ void Client::refresh(
         [&](const NodeKey& key, const Known<dnbridge_PumpState>& k) {
           if (on_pump) on_pump(key, k);
         });
+  }
+  while (devices_in_) {
+    auto samples = devices_in_->reader.take();
+    if (!samples || samples->empty()) break;
+    absorb(
+        *samples, devices_,
+        [](const dnbridge_DeviceState& s) {
+          return node_key(dds::view(s.rack), dds::view(s.port), s.mac);
+        },
+        [](const NodeKey&, const Known<dnbridge_DeviceState>&) {});
   }
   for (;;) {
     auto samples = node_reader_.take();
@@ -134,6 +150,16 @@ bool Client::wait_until(Deadline deadline, const std::function<bool()>& done) {
 const Known<dnbridge_PumpState>* Client::pump(const NodeKey& key) const {
   auto it = pumps_.find(key);
   return it == pumps_.end() ? nullptr : &it->second;
+}
+
+Client::DevicesIn::DevicesIn(const dds::Participant& participant)
+    : topic(participant),
+      reader(participant, topic, dds::state_reader_qos()),
+      data(reader, DDS_ANY_STATE) {}
+
+const Known<dnbridge_DeviceState>* Client::device(const NodeKey& key) const {
+  auto it = devices_.find(key);
+  return it == devices_.end() ? nullptr : &it->second;
 }
 
 const Known<dnbridge_NodeStatus>* Client::node(const NodeKey& key) const {

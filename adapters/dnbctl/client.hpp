@@ -1,6 +1,6 @@
 #pragma once
-// dnbctl's side of DDS: one participant with readers of the three state
-// topics (PumpState, NodeStatus, PortStatus), whose latest sample per
+// dnbctl's side of DDS: one participant with readers of the state topics
+// (PumpState, DeviceState, NodeStatus, PortStatus), whose latest sample per
 // instance is kept here; writers of PumpCommand and ExplicitRequest are made
 // by the commands that need them (commander.hpp, requester.hpp). All QoS
 // come from adapters/dds/topics.hpp, the contract the bridge uses too.
@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -73,10 +74,14 @@ class Client {
   void attach(const dds::Entity& entity, dds::WaitSet::Token token) { waitset_.attach(entity, token); }
 
   const std::map<NodeKey, Known<dnbridge_PumpState>>& pumps() const noexcept { return pumps_; }
+  const std::map<NodeKey, Known<dnbridge_DeviceState>>& devices() const noexcept {
+    return devices_;
+  }
   const std::map<NodeKey, Known<dnbridge_NodeStatus>>& nodes() const noexcept { return nodes_; }
   const std::map<PortKey, Known<dnbridge_PortStatus>>& ports() const noexcept { return ports_; }
 
   const Known<dnbridge_PumpState>* pump(const NodeKey& key) const;
+  const Known<dnbridge_DeviceState>* device(const NodeKey& key) const;
   const Known<dnbridge_NodeStatus>* node(const NodeKey& key) const;
 
  private:
@@ -91,7 +96,17 @@ class Client {
   dds::ReadCondition node_data_;
   dds::ReadCondition port_data_;
   dds::WaitSet waitset_;
+  // DeviceState; none when DDS Security does not grant it (permissions
+  // signed before the topic came): devices are then not shown.
+  struct DevicesIn {
+    explicit DevicesIn(const dds::Participant& participant);
+    dds::Topic<dnbridge_DeviceState> topic;
+    dds::Reader<dnbridge_DeviceState> reader;
+    dds::ReadCondition data;
+  };
+  std::optional<DevicesIn> devices_in_;
   std::map<NodeKey, Known<dnbridge_PumpState>> pumps_;
+  std::map<NodeKey, Known<dnbridge_DeviceState>> devices_;
   std::map<NodeKey, Known<dnbridge_NodeStatus>> nodes_;
   std::map<PortKey, Known<dnbridge_PortStatus>> ports_;
 };

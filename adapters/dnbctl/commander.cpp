@@ -5,20 +5,6 @@
 
 namespace dnbridge::dnbctl {
 
-Commander::Commander(Client& client, std::int32_t strength, const std::string& rack)
-    : topic_(client.participant()),
-      writer_(client.participant(), topic_,
-              dds::command_writer_qos(std::vector{dds::rack_partition(rack)}, strength, kLease)) {}
-
-bool Commander::wait_matched(Client& client, Deadline deadline) {
-  return client.wait_until(deadline, [&] {
-    auto n = writer_.matched_subscriptions();
-    return n.ok() && *n > 0;
-  });
-}
-
-std::uint32_t Commander::matched() const { return writer_.matched_subscriptions().value_or(0); }
-
 Status Commander::write(const NodeKey& key, const Outputs& outputs, const std::string& issuer) {
   dds::Owned<dnbridge_PumpCommand> c;
   dds::set_string(c->rack, key.rack);
@@ -27,6 +13,28 @@ Status Commander::write(const NodeKey& key, const Outputs& outputs, const std::s
   c->pump_on = outputs.pump_on;
   c->n2_ballast_on = outputs.n2_ballast_on;
   c->analog_output_raw = outputs.analog_output_raw;
+  dds::set_string(c->issuer, issuer);
+  return writer_.write(*c);
+}
+
+Status DeviceCommander::write(const NodeKey& key, const DeviceOutputs& outputs,
+                              const std::string& issuer) {
+  dds::Owned<dnbridge_DeviceCommand> c;
+  dds::set_string(c->rack, key.rack);
+  dds::set_string(c->port, key.port);
+  c->mac = key.mac;
+  dds::set_octets(c->outputs, outputs.bytes);
+  if (outputs.bytes.empty() && !outputs.fields.empty()) {
+    auto& seq = c->fields;
+    seq._length = seq._maximum = static_cast<std::uint32_t>(outputs.fields.size());
+    seq._release = true;
+    seq._buffer = dds_sequence_dnbridge_DeviceFieldValue_allocbuf(outputs.fields.size());
+    for (std::size_t i = 0; i < outputs.fields.size(); ++i) {
+      seq._buffer[i].name = nullptr;
+      dds::set_string(seq._buffer[i].name, outputs.fields[i].first);
+      seq._buffer[i].value = outputs.fields[i].second;
+    }
+  }
   dds::set_string(c->issuer, issuer);
   return writer_.write(*c);
 }

@@ -1,11 +1,13 @@
 #pragma once
-// A PumpCommand writer: dnbctl as a supervisor of one pump for as long as it
-// runs. Exclusive ownership: of the live writers of a pump's instance the
-// strongest commands it. When this writer goes (dnbctl exits), the pump
-// passes to the next strongest commander or, with none left, to the bridge's
-// no-commander policy (idle, or hold the last outputs).
+// A PumpCommand (DeviceCommand) writer: dnbctl as a supervisor of one pump
+// (device) for as long as it runs. Exclusive ownership: of the live writers of a pump's instance
+// the strongest commands it. When this writer goes (dnbctl exits), the pump passes to the next
+// strongest commander or, with none left, to the bridge's no-commander policy (idle, or hold the
+// last outputs).
 #include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "adapters/dds/topic.hpp"
 #include "adapters/dds/topics.hpp"
@@ -21,26 +23,53 @@ struct Outputs {
   bool operator==(const Outputs&) const = default;
 };
 
-class Commander {
- public:
-  // How long the bridge waits, after dnbctl stops renewing its liveliness
-  // (killed, frozen), before it takes the command as gone.
-  static constexpr Duration kLease = seconds(2);
+// How long the bridge waits, after dnbctl stops renewing its liveliness
+// (killed, frozen), before it takes a command as gone.
+inline constexpr Duration kCommandLease = seconds(2);
 
-  // Commands pumps of `rack` (in its partition: only its bridge gets them).
-  Commander(Client& client, std::int32_t strength, const std::string& rack);
+// A writer of command topic T for the nodes of `rack` (in its partition:
+// only its bridge gets them).
+template <class T>
+class CommandWriter {
+ public:
+  CommandWriter(Client& client, std::int32_t strength, const std::string& rack)
+      : topic_(client.participant()),
+        writer_(client.participant(), topic_,
+                dds::command_writer_qos(std::vector{dds::rack_partition(rack)}, strength,
+                                        kCommandLease)) {}
 
   // Until a command reader (a bridge) matched; false at the deadline.
   // Commands are volatile: one written before a bridge matched is lost.
-  bool wait_matched(Client& client, Deadline deadline);
+  bool wait_matched(Client& client, Deadline deadline) {
+    return client.wait_until(deadline, [&] {
+      auto n = writer_.matched_subscriptions();
+      return n.ok() && *n > 0;
+    });
+  }
   // Command readers (bridges) matched now: with partitions, its rack's only.
-  std::uint32_t matched() const;
+  std::uint32_t matched() const { return writer_.matched_subscriptions().value_or(0); }
 
+ protected:
+  dds::Topic<T> topic_;
+  dds::Writer<T> writer_;
+};
+
+class Commander : public CommandWriter<dnbridge_PumpCommand> {
+ public:
+  using CommandWriter::CommandWriter;
   Status write(const NodeKey& key, const Outputs& outputs, const std::string& issuer);
+};
 
- private:
-  dds::Topic<dnbridge_PumpCommand> topic_;
-  dds::Writer<dnbridge_PumpCommand> writer_;
+// A device's outputs (DeviceCommand): its bytes, or its fields by name.
+struct DeviceOutputs {
+  std::vector<std::uint8_t> bytes;
+  std::vector<std::pair<std::string, double>> fields;  // used when `bytes` is empty
+};
+
+class DeviceCommander : public CommandWriter<dnbridge_DeviceCommand> {
+ public:
+  using CommandWriter::CommandWriter;
+  Status write(const NodeKey& key, const DeviceOutputs& outputs, const std::string& issuer);
 };
 
 }  // namespace dnbridge::dnbctl

@@ -59,7 +59,7 @@ struct WatchArgs {
 CLI::App* add_watch(CLI::App& app, WatchArgs& args);
 Exit run_watch(const GlobalOptions& options, const WatchArgs& args);
 
-// --- output_commands.cpp: pump, ballast, aout --------------------------------------
+// --- output_commands.cpp: pump, ballast, aout, outputs ------------------------------
 enum class Output { kPump, kBallast, kAnalog };
 struct OutputArgs {
   Output output = Output::kPump;
@@ -71,6 +71,18 @@ struct OutputArgs {
 };
 CLI::App* add_output(CLI::App& app, Output output, OutputArgs& args);
 Exit run_output(const GlobalOptions& options, const OutputArgs& args);
+
+// outputs: a device's outputs (DeviceCommand), by field or as bytes.
+struct DeviceOutputArgs {
+  std::string node;                 // MAC ID or name
+  std::vector<std::string> fields;  // NAME=VALUE
+  std::string bytes;                // hex, instead of the fields
+  std::string issuer;
+  std::int32_t strength = 10;
+  double hold_for_seconds = 0;
+};
+CLI::App* add_device_outputs(CLI::App& app, DeviceOutputArgs& args);
+Exit run_device_outputs(const GlobalOptions& options, const DeviceOutputArgs& args);
 
 // --- explicit_commands.cpp: get, set, service --------------------------------------
 enum class ExplicitKind { kGet, kSet, kService };
@@ -86,6 +98,14 @@ struct ExplicitArgs {
 };
 CLI::App* add_explicit(CLI::App& app, ExplicitKind kind, ExplicitArgs& args);
 Exit run_explicit(const GlobalOptions& options, const ExplicitArgs& args);
+
+// --- assembly_command.cpp -----------------------------------------------------------------
+struct AssemblyArgs {
+  std::string node;      // MAC ID or name
+  std::string instance;  // one instance, or empty: every one up to the max
+};
+CLI::App* add_assembly(CLI::App& app, AssemblyArgs& args);
+Exit run_assembly(const GlobalOptions& options, const AssemblyArgs& args);
 
 // --- scan_command.cpp ------------------------------------------------------------------
 // scan: takes only the global options (--rack, --port, --json, --timeout).

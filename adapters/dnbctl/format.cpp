@@ -162,8 +162,28 @@ std::string ports_table(std::span<const PortRow> ports) {
   return table(kColumns, rows);
 }
 
+std::optional<bool> NodeRow::online() const {
+  if (pump) return pump->online;
+  if (device) return device->online;
+  return std::nullopt;
+}
+
+std::optional<bool> NodeRow::outputs_idle() const {
+  if (pump) return pump->outputs_idle;
+  if (device) return device->outputs_idle;
+  return std::nullopt;
+}
+
+std::string_view NodeRow::idle_reason() const {
+  return pump ? view(pump->idle_reason) : device ? view(device->idle_reason) : std::string_view{};
+}
+
+std::string_view NodeRow::commanded_by() const {
+  return pump ? view(pump->commanded_by) : device ? view(device->commanded_by) : std::string_view{};
+}
+
 bool node_online(const NodeRow& r) {
-  return r.alive && (r.pump ? r.pump->online : r.node->state == dnbridge_NODE_ONLINE);
+  return r.alive && r.online().value_or(r.node->state == dnbridge_NODE_ONLINE);
 }
 
 namespace {
@@ -383,7 +403,59 @@ Record counters_record(const dnbridge_NodeCounters& c) {
 std::string none_if_empty(std::string_view s) { return s.empty() ? "none" : std::string(s); }
 
 // A node as `show` shows it: its NodeStatus, with its PumpState if seen.
-Record node_record(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive) {
+// A device's fields as they read: "Digital inputs = 165; Analog input 1 =
+// -1000 mV" (with the EDS's scaling).
+std::string fields_text(const dds_sequence_dnbridge_DeviceField& fields) {
+  std::string text;
+  for (std::uint32_t i = 0; i < fields._length; ++i) {
+    const auto& f = fields._buffer[i];
+    text += fmt::format("{}{} = {:g}{}{}", text.empty() ? "" : "; ", view(f.name), f.shown,
+                        view(f.units).empty() ? "" : " ", view(f.units));
+  }
+  return text;
+}
+
+std::vector<Record> fields_records(const dds_sequence_dnbridge_DeviceField& fields) {
+  std::vector<Record> out;
+  for (std::uint32_t i = 0; i < fields._length; ++i) {
+    const auto& f = fields._buffer[i];
+    Record r;
+    r.json("name", view(f.name))
+        .json("type", view(f.type))
+        .json("units", view(f.units))
+        .json("bit_offset", f.bit_offset)
+        .json("bits", f.bits)
+        .json("value", f.value)
+        .json("shown", f.shown);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// What DeviceState says of a device's data, for show.
+void add_device_data(Record& r, const dnbridge_DeviceState& d) {
+  const auto bytes = [](const dds_sequence_octet& seq) {
+    return hex_bytes(std::span<const std::uint8_t>(dds::view(seq)));
+  };
+  r.add("product (EDS)", std::string(view(d.product)), "product", view(d.product));
+  r.add("inputs",
+        d.inputs_valid ? fmt::format("[{}] {}", bytes(d.inputs), fields_text(d.input_fields))
+                       : std::string("not valid"),
+        {{"inputs_valid", static_cast<bool>(d.inputs_valid)},
+         {"inputs", bytes(d.inputs)},
+         {"input_fields", Json::array(fields_records(d.input_fields))}});
+  r.add("outputs",
+        d.outputs_idle
+            ? (view(d.idle_reason).empty() ? std::string("idle") : std::string(view(d.idle_reason)))
+            : fmt::format("[{}] {}", bytes(d.outputs), fields_text(d.output_fields)),
+        {{"outputs_idle", static_cast<bool>(d.outputs_idle)},
+         {"outputs", bytes(d.outputs)},
+         {"output_fields", Json::array(fields_records(d.output_fields))}});
+  if (!d.outputs_idle) r.text("commanded by", std::string(view(d.commanded_by)));
+}
+
+Record node_record(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive,
+                   const dnbridge_DeviceState* device) {
   Record identity;
   identity
       .add("vendor", fmt::format("{} (0x{:04X})", n.vendor_id, n.vendor_id), "vendor_id",
@@ -419,6 +491,9 @@ Record node_record(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
            to_text(n.state))
       .add("reason", std::string(view(n.reason)), "reason", view(n.reason));
   if (pump) r.add("online", yes_no(alive && pump->online), "online", alive && pump->online);
+  if (device) {
+    r.add("online", yes_no(alive && device->online), "online", alive && device->online);
+  }
   r.nest("identity", std::move(identity))
       .add("device state",
            n.device_state_valid ? fmt::format("{} ({})", n.device_state, view(n.device_state_text))
@@ -450,6 +525,7 @@ Record node_record(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
     r.text("outputs", std::move(outputs));
     if (!pump->outputs_idle) r.text("commanded by", std::string(view(pump->commanded_by)));
   }
+  if (device) add_device_data(r, *device);
   r.add("safe state",
         fmt::format("{} ({})", view(n.safe_state.text),
                     n.safe_state.source == dnbridge_SAFE_STATE_DEVICE
@@ -469,13 +545,14 @@ constexpr std::size_t kDetailLabelWidth = 26;
 
 }  // namespace
 
-std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive) {
-  return node_record(n, pump, alive).lines(kDetailLabelWidth);
+std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive,
+                         const dnbridge_DeviceState* device) {
+  return node_record(n, pump, alive, device).lines(kDetailLabelWidth);
 }
 
 void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
-               bool alive) {
-  node_record(n, pump, alive).write(out);
+               bool alive, const dnbridge_DeviceState* device) {
+  node_record(n, pump, alive, device).write(out);
 }
 
 namespace {

@@ -59,12 +59,19 @@ struct PortRow {
 };
 struct NodeRow {
   const dnbridge_NodeStatus* node = nullptr;
-  const dnbridge_PumpState* pump = nullptr;  // none when not (yet) seen
+  const dnbridge_PumpState* pump = nullptr;  // none when not (yet) seen, or not a pump
   bool alive = true;
+  const dnbridge_DeviceState* device = nullptr;  // a device of profile "eds", when seen
+
+  // What the node's state topic (PumpState or DeviceState) says, when seen.
+  std::optional<bool> online() const;
+  std::optional<bool> outputs_idle() const;
+  std::string_view idle_reason() const;
+  std::string_view commanded_by() const;
 };
 
 // Whether a node is online as dnbctl shows it: its bridge is there, and it
-// is polled (PumpState's `online`, else the NodeStatus state).
+// is polled (PumpState's or DeviceState's `online`, else the NodeStatus state).
 bool node_online(const NodeRow& row);
 // A port's PortStatus as every command shows it.
 Record port_record(const dnbridge_PortStatus& p);
@@ -87,9 +94,11 @@ void pump_json(JsonWriter& out, const dnbridge_PumpState& s);
 std::string outputs_text(bool pump_on, bool n2_ballast_on, std::uint16_t analog_raw);
 
 // --- show -----------------------------------------------------------------------------
-std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive);
+// `device`: a device's DeviceState (profile "eds"), when seen: its data too.
+std::string node_details(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump, bool alive,
+                         const dnbridge_DeviceState* device = nullptr);
 void node_json(JsonWriter& out, const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
-               bool alive);
+               bool alive, const dnbridge_DeviceState* device = nullptr);
 
 // --- get, set, service --------------------------------------------------------------
 struct ExplicitExchange {

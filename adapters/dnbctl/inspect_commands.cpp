@@ -33,10 +33,12 @@ bool complete(const Client& client, const GlobalOptions& o) {
   for (const auto& [key, port] : client.ports()) {
     if (!o.matches(key.rack, key.port)) continue;
     std::size_t nodes = 0;
-    std::size_t pumps = 0;
+    std::size_t states = 0;  // PumpState and DeviceState
     for (const auto& [k, n] : client.nodes()) nodes += (k.rack == key.rack && k.port == key.port);
-    for (const auto& [k, p] : client.pumps()) pumps += (k.rack == key.rack && k.port == key.port);
-    if (nodes < port.data->nodes_configured || pumps < port.data->nodes_configured) return false;
+    for (const auto& [k, p] : client.pumps()) states += (k.rack == key.rack && k.port == key.port);
+    for (const auto& [k, d] : client.devices())
+      states += (k.rack == key.rack && k.port == key.port);
+    if (nodes < port.data->nodes_configured || states < port.data->nodes_configured) return false;
   }
   return true;
 }
@@ -93,7 +95,9 @@ std::vector<NodeRow> node_rows(const Client& client, const GlobalOptions& o) {
   for (const auto& [k, n] : client.nodes()) {
     if (!o.matches(k.rack, k.port)) continue;
     const auto* pump = client.pump(k);
-    nodes.push_back({n.data.get(), pump ? pump->data.get() : nullptr, n.alive});
+    const auto* device = client.device(k);
+    nodes.push_back({n.data.get(), pump ? pump->data.get() : nullptr, n.alive,
+                     device ? device->data.get() : nullptr});
   }
   return nodes;
 }
@@ -188,7 +192,8 @@ CLI::App* add_show(CLI::App& app, ShowArgs& args) {
       "show",
       "Show one node: identity (vendor, product type and code, revision, serial number, product "
       "name), life-cycle state and reason, device state, poll sizes, expected packet rate, last "
-      "error, last refused command, and counters (NodeStatus).");
+      "error, last refused command, and counters (NodeStatus); for a device of profile \"eds\" "
+      "also its inputs and outputs as bytes and as its EDS's fields (DeviceState).");
   cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
   return cmd;
 }
@@ -206,12 +211,14 @@ Exit run_show(const GlobalOptions& o, const ShowArgs& args) {
   const auto* node = client.node(key);
   const auto* pump = client.pump(key);
   const dnbridge_PumpState* state = pump ? pump->data.get() : nullptr;
+  const auto* device = client.device(key);
+  const dnbridge_DeviceState* data = device ? device->data.get() : nullptr;
   if (o.json) {
     JsonWriter out;
-    node_json(out, *node->data, state, node->alive);
+    node_json(out, *node->data, state, node->alive, data);
     print(out.str() + "\n");
   } else {
-    print(node_details(*node->data, state, node->alive));
+    print(node_details(*node->data, state, node->alive, data));
   }
   return Exit::kOk;
 }

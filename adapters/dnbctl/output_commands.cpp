@@ -1,9 +1,15 @@
 // pump, ballast, aout: command one output of a pump, keep the others as the
-// device applies them, and wait for the bridge's echo.
+// device applies them, and wait for the bridge's echo. outputs: command a
+// device's outputs (profile "eds"), by field or as bytes, and wait for the
+// echo in DeviceState.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <functional>
 
 #include "adapters/dds/fields.hpp"
 #include "adapters/dnbctl/commander.hpp"
@@ -11,6 +17,7 @@
 #include "adapters/dnbctl/format.hpp"
 #include "adapters/dnbctl/target.hpp"
 #include "adapters/dnbctl/values.hpp"
+#include "bridge/common/text.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
@@ -54,6 +61,82 @@ void outputs_json(JsonWriter& out, const Outputs& o) {
       .field("n2_ballast_on", o.n2_ballast_on)
       .field("analog_output_raw", unsigned{o.analog_output_raw})
       .end_object();
+}
+
+// Writes a command at once, then again every kRewritePeriod.
+class Rewriter {
+ public:
+  Rewriter(std::string name, std::function<Status()> write)
+      : name_(std::move(name)), write_(std::move(write)) {}
+  void when_due() {
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_) return;
+    if (auto s = write_(); !s) {
+      throw CommandError(Exit::kFailed, fmt::format("{}: writing the command failed: {}", name_,
+                                                    s.error().message()));
+    }
+    next_ = now + kRewritePeriod;
+  }
+
+ private:
+  std::string name_;
+  std::function<Status()> write_;
+  std::chrono::steady_clock::time_point next_ = std::chrono::steady_clock::now();
+};
+
+// Writes until the bridge's echo shows the command `applied` or NodeStatus
+// counts it refused, or the deadline. Empty when applied; else why not:
+// the refusal, an interrupt, or `not_applied()` (what the state shows).
+std::string command_until_applied(Client& client, const NodeKey& key, Deadline deadline,
+                                  Rewriter& rewriter, const std::function<bool()>& applied,
+                                  const std::function<std::string()>& not_applied) {
+  const auto* status = client.node(key);
+  const std::uint64_t refused_before = status ? status->data->counters.commands_refused : 0;
+  const auto refused = [&] {
+    const auto* n = client.node(key);
+    return n && n->data->counters.commands_refused > refused_before;
+  };
+  const bool ended = client.wait_until(deadline, [&] {
+    if (refused() || applied()) return true;
+    rewriter.when_due();
+    return false;
+  });
+  if (refused()) {
+    return fmt::format("refused by the bridge: {}",
+                       dds::view(client.node(key)->data->last_command_refused));
+  }
+  if (ended && applied()) return {};
+  if (interrupted()) return "interrupted before the bridge showed the outputs applied";
+  return not_applied();
+}
+
+// Why a node is not online, from its NodeStatus.
+std::string not_online(const Client& client, const NodeKey& key) {
+  const auto* node = client.node(key);
+  return node ? fmt::format("the node is not online ({}: {})", to_text(node->data->state),
+                            dds::view(node->data->reason))
+              : std::string("the node is not online");
+}
+
+// After a command applied: --hold-for keeps writing it; else a note that it
+// ends with dnbctl.
+void hold_or_note(Client& client, const GlobalOptions& o, double hold_for_seconds,
+                  Rewriter& rewriter) {
+  if (hold_for_seconds > 0) {
+    if (!o.json) print(fmt::format("holding for {:g} s (Ctrl-C to stop)\n", hold_for_seconds));
+    const Deadline hold_end = std::chrono::steady_clock::now() +
+                              std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                  std::chrono::duration<double>(hold_for_seconds));
+    client.wait_until(hold_end, [&] {
+      rewriter.when_due();
+      return false;
+    });
+  } else if (!o.json) {
+    std::fputs(
+        "dnbctl: note: the command ends when dnbctl exits, unless the bridge's policy for "
+        "the node is \"hold\" (see --hold-for)\n",
+        stderr);
+  }
 }
 
 }  // namespace
@@ -128,9 +211,6 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
     case Output::kBallast: wanted.n2_ballast_on = *on; break;
     case Output::kAnalog: wanted.analog_output_raw = analog->raw; break;
   }
-  const auto* status = client.node(key);
-  const std::uint64_t refused_before = status ? status->data->counters.commands_refused : 0;
-
   Commander commander(client, args.strength, key.rack);
   const Deadline deadline = deadline_after(o.timeout());
   if (!commander.wait_matched(client, deadline)) {
@@ -145,56 +225,31 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   // Written, then again every kRewritePeriod, until the echo shows it applied
   // or the bridge refused it.
   const std::uint64_t samples_before = client.pump(key)->samples;
-  auto next_write = std::chrono::steady_clock::now();
-  const auto write_when_due = [&] {
-    const auto now = std::chrono::steady_clock::now();
-    if (now < next_write) return;
-    if (auto s = commander.write(key, wanted, issuer); !s) {
-      throw CommandError(Exit::kFailed, fmt::format("{}: writing the command failed: {}", name,
-                                                    s.error().message()));
-    }
-    next_write = now + kRewritePeriod;
-  };
-  const auto refused = [&] {
-    const auto* n = client.node(key);
-    return n && n->data->counters.commands_refused > refused_before;
-  };
-  const auto applied = [&] {
-    const auto& p = *client.pump(key);
-    const auto& s = *p.data;
-    return p.samples > samples_before && p.alive && s.online && !s.outputs_idle &&
-           applied_outputs(s) == wanted && dds::view(s.commanded_by) == issuer;
-  };
-  const bool ended = client.wait_until(deadline, [&] {
-    if (refused() || applied()) return true;
-    write_when_due();
-    return false;
-  });
-
+  Rewriter rewriter(name, [&] { return commander.write(key, wanted, issuer); });
+  const std::string failure = command_until_applied(
+      client, key, deadline, rewriter,
+      [&] {
+        const auto& p = *client.pump(key);
+        const auto& s = *p.data;
+        return p.samples > samples_before && p.alive && s.online && !s.outputs_idle &&
+               applied_outputs(s) == wanted && dds::view(s.commanded_by) == issuer;
+      },
+      [&] {
+        const auto& state = *client.pump(key)->data;
+        if (!client.pump(key)->alive) return std::string("the bridge is gone");
+        if (!state.online) return not_online(client, key);
+        if (!state.outputs_idle && dds::view(state.commanded_by) != issuer &&
+            !dds::view(state.commanded_by).empty()) {
+          return fmt::format(
+              "\"{}\" commands this pump: a live commander stronger than {} "
+              "(ownership strength) takes precedence",
+              dds::view(state.commanded_by), args.strength);
+        }
+        return fmt::format("the bridge did not show the outputs applied within {:g} s",
+                           o.timeout_seconds);
+      });
   const auto& state = *client.pump(key)->data;
   const auto* node = client.node(key);
-  std::string failure;
-  if (refused()) {
-    failure = fmt::format("refused by the bridge: {}", dds::view(node->data->last_command_refused));
-  } else if (!ended || !applied()) {
-    if (interrupted()) {
-      failure = "interrupted before the bridge showed the outputs applied";
-    } else if (!client.pump(key)->alive) {
-      failure = "the bridge is gone";
-    } else if (!state.online) {
-      failure = node ? fmt::format("the node is not online ({}: {})", to_text(node->data->state),
-                                   dds::view(node->data->reason))
-                     : std::string("the node is not online");
-    } else if (!state.outputs_idle && dds::view(state.commanded_by) != issuer &&
-               !dds::view(state.commanded_by).empty()) {
-      failure = fmt::format("\"{}\" commands this pump: a live commander stronger than {} "
-                            "(ownership strength) takes precedence",
-                            dds::view(state.commanded_by), args.strength);
-    } else {
-      failure = fmt::format("the bridge did not show the outputs applied within {:g} s",
-                            o.timeout_seconds);
-    }
-  }
 
   if (o.json) {
     JsonWriter out;
@@ -219,23 +274,172 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
     return Exit::kFailed;
   }
 
-  if (args.hold_for_seconds > 0) {
-    if (!o.json) {
-      print(fmt::format("holding for {:g} s (Ctrl-C to stop)\n", args.hold_for_seconds));
-    }
-    const Deadline hold_end =
-        std::chrono::steady_clock::now() +
-        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-            std::chrono::duration<double>(args.hold_for_seconds));
-    client.wait_until(hold_end, [&] {
-      write_when_due();
-      return false;
-    });
-  } else if (!o.json) {
-    std::fputs("dnbctl: note: the command ends when dnbctl exits, unless the bridge's policy for "
-               "the node is \"hold\" (see --hold-for)\n",
-               stderr);
+  hold_or_note(client, o, args.hold_for_seconds, rewriter);
+  return Exit::kOk;
+}
+
+}  // namespace dnbridge::dnbctl
+
+namespace dnbridge::dnbctl {
+namespace {
+
+constexpr const char* kDeviceLifetimeNote =
+    "A device's outputs are given whole: every numeric field of its output data (dnbctl show "
+    "NODE lists them), or the data's bytes with --bytes. The bridge checks the command against "
+    "the device's EDS (types, limits, padding) and refuses it whole, with the reason, if any "
+    "part is wrong. A command stays in force only while a commander is live: when dnbctl exits "
+    "the device goes to its configured idle state, unless the node's no-commander policy is "
+    "\"hold\"; --hold-for SECONDS keeps commanding until the time is up or Ctrl-C.";
+
+// NAME=VALUE: the value a number (1, -2.5, 0x81).
+Parsed<std::pair<std::string, double>> parse_field(std::string_view text) {
+  const auto eq = text.rfind('=');
+  if (eq == std::string_view::npos || eq == 0) {
+    return Parsed<std::pair<std::string, double>>::failure(
+        fmt::format("\"{}\" is not NAME=VALUE (e.g. \"Digital outputs=0x81\")", text));
   }
+  const std::string value(text.substr(eq + 1));
+  char* end = nullptr;
+  const double v = std::strtod(value.c_str(), &end);
+  if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(v)) {
+    return Parsed<std::pair<std::string, double>>::failure(
+        fmt::format("\"{}\": {} is not a number", text, value));
+  }
+  return std::pair{std::string(text.substr(0, eq)), v};
+}
+
+// Whether DeviceState shows `wanted` applied: its bytes, or each named field.
+bool shows(const dnbridge_DeviceState& s, const DeviceOutputs& wanted) {
+  const auto out = dds::view(s.outputs);
+  if (!wanted.bytes.empty()) {
+    return std::equal(out.begin(), out.end(), wanted.bytes.begin(), wanted.bytes.end());
+  }
+  for (const auto& [name, value] : wanted.fields) {
+    for (std::uint32_t i = 0; i < s.output_fields._length; ++i) {
+      const auto& f = s.output_fields._buffer[i];
+      if (iequals(dds::view(f.name), name) && f.value != value) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+CLI::App* add_device_outputs(CLI::App& app, DeviceOutputArgs& args) {
+  auto* cmd = app.add_subcommand(
+      "outputs",
+      "Command a device's outputs (DeviceCommand): a node of profile \"eds\", by "
+      "its EDS fields (NAME=VALUE ...) or as bytes (--bytes).");
+  cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
+  cmd->add_option("FIELDS", args.fields,
+                  "Every numeric field of the outputs as NAME=VALUE (the EDS parameter's name, "
+                  "or ParamN where names repeat; the value as the device holds it, not scaled)");
+  cmd->add_option("--bytes", args.bytes, "The output data's bytes in hex (\"81 00\", 8100)");
+  cmd->footer(kDeviceLifetimeNote);
+  cmd->add_option("--issuer", args.issuer,
+                  "Who commands, as the bridge shows it (default \"dnbctl USER@HOST\")");
+  cmd->add_option("--strength", args.strength,
+                  "Ownership strength: the strongest live commander of a device commands it")
+      ->capture_default_str();
+  cmd->add_option("--hold-for", args.hold_for_seconds,
+                  "Keep commanding for SECONDS once applied (until Ctrl-C)")
+      ->check(CLI::NonNegativeNumber);
+  return cmd;
+}
+
+Exit run_device_outputs(const GlobalOptions& o, const DeviceOutputArgs& args) {
+  // Everything typed is checked before anything is sent.
+  auto ref = parse_node(args.node);
+  if (!ref) throw CommandError(Exit::kUsage, ref.error());
+  DeviceOutputs wanted;
+  if (!args.bytes.empty() && !args.fields.empty()) {
+    throw CommandError(Exit::kUsage, "give the outputs as FIELDS or as --bytes, not both");
+  }
+  if (!args.bytes.empty()) {
+    auto b = parse_hex_bytes(args.bytes);
+    if (!b) throw CommandError(Exit::kUsage, b.error());
+    if (b->empty()) throw CommandError(Exit::kUsage, "--bytes: no byte given");
+    wanted.bytes = *b;
+  } else if (args.fields.empty()) {
+    throw CommandError(Exit::kUsage, "give the outputs: FIELDS (NAME=VALUE ...) or --bytes");
+  }
+  for (const auto& text : args.fields) {
+    auto f = parse_field(text);
+    if (!f) throw CommandError(Exit::kUsage, f.error());
+    wanted.fields.push_back(*f);
+  }
+  const std::string issuer = args.issuer.empty() ? default_issuer() : args.issuer;
+  install_interrupt_handlers();
+
+  Client client = make_client(o);
+  const NodeKey key = find_node(client, o, *ref);
+  const std::string name = node_name(key.rack, key.port, key.mac);
+  if (!client.wait_until(deadline_after(o.timeout()), [&] {
+        return client.device(key) != nullptr || client.pump(key) != nullptr;
+      })) {
+    throw CommandError(Exit::kNotFound,
+                       fmt::format("{}: no DeviceState within {:g} s", name, o.timeout_seconds));
+  }
+  if (client.device(key) == nullptr) {
+    throw CommandError(Exit::kUsage, fmt::format("{} is a pump (a CDN127): pump, ballast and aout "
+                                                 "command it",
+                                                 name));
+  }
+  DeviceCommander commander(client, args.strength, key.rack);
+  const Deadline deadline = deadline_after(o.timeout());
+  if (!commander.wait_matched(client, deadline)) {
+    throw CommandError(Exit::kNotFound,
+                       fmt::format("{}: no bridge took device commands in rack {}'s partition "
+                                   "(dnbridge/{}) within {:g} s",
+                                   name, key.rack, key.rack, o.timeout_seconds));
+  }
+  const std::uint64_t samples_before = client.device(key)->samples;
+  Rewriter rewriter(name, [&] { return commander.write(key, wanted, issuer); });
+  const std::string failure = command_until_applied(
+      client, key, deadline, rewriter,
+      [&] {
+        const auto& d = *client.device(key);
+        const auto& s = *d.data;
+        return d.samples > samples_before && d.alive && s.online && !s.outputs_idle &&
+               dds::view(s.commanded_by) == issuer && shows(s, wanted);
+      },
+      [&] {
+        const auto& state = *client.device(key)->data;
+        if (!client.device(key)->alive) return std::string("the bridge is gone");
+        if (!state.online) return not_online(client, key);
+        if (!state.outputs_idle && dds::view(state.commanded_by) != issuer &&
+            !dds::view(state.commanded_by).empty()) {
+          return fmt::format(
+              "\"{}\" commands this device: a live commander stronger than {} "
+              "(ownership strength) takes precedence",
+              dds::view(state.commanded_by), args.strength);
+        }
+        return fmt::format("the bridge did not show the outputs applied within {:g} s",
+                           o.timeout_seconds);
+      });
+  const auto& state = *client.device(key)->data;
+  const auto applied_bytes = hex_bytes(std::span<const std::uint8_t>(dds::view(state.outputs)));
+  if (o.json) {
+    JsonWriter out;
+    out.begin_object();
+    key_json(out, key);
+    out.field("command", "outputs").field("issuer", issuer);
+    out.field("applied", failure.empty()).field("reason", failure);
+    out.field("outputs", applied_bytes);
+    if (const auto* node = client.node(key)) {
+      out.field("last_command_refused", dds::view(node->data->last_command_refused));
+    }
+    out.end_object();
+    print(out.str() + "\n");
+  } else if (failure.empty()) {
+    print(fmt::format("{} ({}): applied: [{}]; commanded by \"{}\"\n", name, dds::view(state.name),
+                      applied_bytes, issuer));
+  }
+  if (!failure.empty()) {
+    std::fputs(fmt::format("dnbctl: {}: not applied: {}\n", name, failure).c_str(), stderr);
+    return Exit::kFailed;
+  }
+  hold_or_note(client, o, args.hold_for_seconds, rewriter);
   return Exit::kOk;
 }
 

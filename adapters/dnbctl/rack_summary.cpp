@@ -79,8 +79,8 @@ NodeClass classify(const NodeRow& r) {
   if (!r.alive) return NodeClass::kUnknown;
   switch (r.node->state) {
     case dnbridge_NODE_ONLINE:
-      // PumpState says whether the device applies commanded or idle outputs.
-      return r.pump && r.pump->outputs_idle ? NodeClass::kIdle : NodeClass::kOnline;
+      // PumpState (DeviceState) says whether the device applies commanded or idle outputs.
+      return r.outputs_idle().value_or(false) ? NodeClass::kIdle : NodeClass::kOnline;
     case dnbridge_NODE_IDENTIFYING:
     case dnbridge_NODE_CONFIGURING:
     case dnbridge_NODE_VERIFYING:
@@ -104,9 +104,9 @@ std::string class_reason(const NodeRow& r) {
   const std::string reason(view(n.reason));
   switch (classify(r)) {
     case NodeClass::kIdle: {
-      // PumpState says why ("idle: no command yet", ...); an older bridge
-      // does not.
-      std::string_view why = r.pump ? view(r.pump->idle_reason) : std::string_view{};
+      // PumpState (DeviceState) says why ("idle: no command yet", ...); an
+      // older bridge does not.
+      std::string_view why = r.idle_reason();
       if (why.starts_with("idle: ")) why.remove_prefix(6);
       return fmt::format("{}: idle polls, the device holds its configured idle state",
                          why.empty() ? "no commander" : why);
@@ -122,8 +122,8 @@ std::string class_reason(const NodeRow& r) {
       return fmt::format("no longer published by a bridge; last reported {}: {}", to_text(n.state),
                          reason);
     case NodeClass::kOnline:
-      if (r.pump && !view(r.pump->commanded_by).empty()) {
-        return fmt::format("{}; commanded by {}", reason, view(r.pump->commanded_by));
+      if (!r.commanded_by().empty()) {
+        return fmt::format("{}; commanded by {}", reason, r.commanded_by());
       }
       return reason;
     default:
@@ -236,8 +236,8 @@ Record rack_node_record(const NodeRow& row) {
       .json("state_reason", view(n.reason))
       .json("last_error", view(n.last_error))
       .json("allocate_attempts", n.counters.allocate_attempts)
-      .json("outputs_idle", row.pump ? Json(static_cast<bool>(row.pump->outputs_idle)) : Json())
-      .json("commanded_by", row.pump ? Json(view(row.pump->commanded_by)) : Json());
+      .json("outputs_idle", row.outputs_idle() ? Json(*row.outputs_idle()) : Json())
+      .json("commanded_by", row.pump || row.device ? Json(row.commanded_by()) : Json());
   return r;
 }
 

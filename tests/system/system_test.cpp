@@ -500,7 +500,7 @@ TEST_F(SystemTest, UnsafeFactoryDevicesAreMadeSafeByTheBridge) {
 
   // The commanders die: once their lease is over, the bridge polls idle.
   using std::chrono::milliseconds;
-  const auto lease = std::chrono::duration_cast<milliseconds>(dnbctl::Commander::kLease);
+  const auto lease = std::chrono::duration_cast<milliseconds>(dnbctl::kCommandLease);
   const milliseconds idle_bound = lease + kPollPeriod + patience(kObservation);
   const auto left = std::chrono::steady_clock::now();
   for (Child* c : commanders) c->signal(SIGKILL);
