@@ -96,6 +96,16 @@ TEST(ConfigEds, SafeStateParametersLeftToTheDeviceAreWarnedOf) {
   EXPECT_TRUE(parse(ONE_PORT IO_BLOCK).warnings.empty());
 }
 
+TEST(ConfigEds, TheShippedExampleLoads) {
+  const DaemonConfig c =
+      load_config_file(std::string(DNBRIDGE_SOURCE_DIR) + "/deploy/config/eds-rack-example.toml");
+  EXPECT_TRUE(c.warnings.empty());
+  const rack::PortNodes nodes = to_port_nodes(c.ports.at(0));
+  ASSERT_EQ(nodes.pumps.size(), 1u);
+  ASSERT_EQ(nodes.devices.size(), 1u);
+  EXPECT_EQ(nodes.devices[0].eds->device.product_name, "Example IO block 8DI/8DO/1AI");
+}
+
 TEST(ConfigEds, APumpAndADeviceShareAPort) {
   const DaemonConfig c = parse(ONE_PORT "[[port.node]]\nmac = 1\nname = \"pump-1\"\n" IO_BLOCK);
   const rack::PortNodes nodes = to_port_nodes(c.ports.at(0));
