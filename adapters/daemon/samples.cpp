@@ -232,6 +232,7 @@ void set_fields(dds_sequence_dnbridge_DeviceField& seq, const eds::IoLayout& lay
     const eds::IoField& f = layout.fields[v.field];
     auto& o = seq._buffer[i];
     set_string(o.name, f.name);
+    o.param = f.param;
     set_string(o.type, f.type.name);
     set_string(o.units, f.units);
     o.bit_offset = f.offset;
@@ -366,6 +367,9 @@ void fill_reload_reply(dnbridge_ReloadReply& out, std::string_view rack, const R
 
 port::PortLoop::DeviceOutputs outputs_of(const dnbridge_DeviceCommand& c) {
   const auto bytes = dds::view(c.outputs);
+  if (!bytes.empty() && c.fields._length > 0) {
+    return rack::MalformedCommand{"outputs and fields both given: a command gives one"};
+  }
   if (!bytes.empty()) return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
   std::vector<eds::FieldSetting> fields;
   const std::span<const dnbridge_DeviceFieldValue> given(c.fields._buffer, c.fields._length);

@@ -34,7 +34,8 @@ void fill_reload_reply(dnbridge_ReloadReply& out, std::string_view rack, const R
 
 // A command sample's outputs, as the rack model takes them.
 profiles::cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& command);
-// A device command's outputs: its bytes, or its fields when it has none.
+// A device command's outputs: its bytes, or its fields when it has none;
+// refused when it has both.
 port::PortLoop::DeviceOutputs outputs_of(const dnbridge_DeviceCommand& command);
 // A request sample as the explicit gateway takes it.
 rack::ExplicitCall call_of(const dnbridge_ExplicitRequest& request);

@@ -24,9 +24,10 @@ constexpr std::uint8_t kObjectDoesNotExist = 0x16;
 // Instances asked for when none is named: at most up to this.
 constexpr std::uint16_t kMaxInstancesScanned = 255;
 
-// Reads one attribute; the exchange (its reply's status says how it went).
+// Reads one attribute, waiting `timeout` for its reply; the exchange (its
+// reply's status says how it went).
 ExplicitExchange get(Client& client, Requester& requester, const NodeKey& node,
-                     std::uint16_t instance, std::uint8_t attribute, Deadline deadline) {
+                     std::uint16_t instance, std::uint8_t attribute, Duration timeout) {
   ExplicitExchange x;
   x.rack = node.rack;
   x.port = node.port;
@@ -35,15 +36,20 @@ ExplicitExchange get(Client& client, Requester& requester, const NodeKey& node,
   x.class_id = kAssemblyClass;
   x.instance_id = instance;
   x.attribute = attribute;
-  if (!requester.execute(client, x, deadline)) {
-    throw CommandError(Exit::kNotFound, fmt::format("{}: no reply from the bridge of rack \"{}\"",
-                                                    node_name(x.rack, x.port, x.mac), x.rack));
+  if (!requester.execute(client, x, deadline_after(timeout))) {
+    if (interrupted()) throw CommandError(Exit::kFailed, "interrupted");
+    throw CommandError(Exit::kNotFound,
+                       fmt::format("{}: no reply from the bridge of rack \"{}\" to the Get of "
+                                   "instance {} attribute {}",
+                                   node_name(x.rack, x.port, x.mac), x.rack, instance, attribute));
   }
   return x;
 }
 
-// "the device answered 0x14 (attribute not supported)", or the bridge's status.
+// "the device answered 0x14 (attribute not supported)", the bridge's status,
+// or a reply of another size than a UINT's.
 std::string failure_text(const ExplicitExchange& x) {
+  if (x.succeeded()) return fmt::format("{} byte(s), a UINT expected", x.data.size());
   if (x.status != 1) {
     return fmt::format("status {} ({}){}", x.status, transaction_status_text(x.status),
                        x.message.empty() ? "" : ": " + x.message);
@@ -68,13 +74,13 @@ struct InstanceReport {
 // instance.
 std::optional<InstanceReport> read_instance(Client& client, Requester& requester,
                                             const NodeKey& node, std::uint16_t instance,
-                                            Deadline deadline) {
+                                            Duration timeout) {
   InstanceReport r;
   r.instance = instance;
-  const ExplicitExchange count = get(client, requester, node, instance, 1, deadline);
+  const ExplicitExchange count = get(client, requester, node, instance, 1, timeout);
   if (count.status == 1 && count.general_status == kObjectDoesNotExist) return std::nullopt;
   r.members = uint16_of(count);
-  const ExplicitExchange list = get(client, requester, node, instance, 2, deadline);
+  const ExplicitExchange list = get(client, requester, node, instance, 2, timeout);
   if (list.status == 1 && list.general_status == kObjectDoesNotExist) return std::nullopt;
   if (!list.succeeded()) {
     r.list_problem = fmt::format("member list not read: {}", failure_text(list));
@@ -145,17 +151,17 @@ Exit run_assembly(const GlobalOptions& o, const AssemblyArgs& args) {
   const NodeKey node = find_port(client, o, *ref);
   const std::string name = node_name(node.rack, node.port, node.mac);
   Requester requester(client, requester_name(), node.rack);
-  const Deadline deadline = deadline_after(o.timeout());
+  const Duration timeout = o.timeout();
 
-  const ExplicitExchange revision = get(client, requester, node, 0, 1, deadline);
-  const ExplicitExchange max = get(client, requester, node, 0, 2, deadline);
+  const ExplicitExchange revision = get(client, requester, node, 0, 1, timeout);
+  const ExplicitExchange max = get(client, requester, node, 0, 2, timeout);
   if (revision.status != 1 && max.status != 1) {
     throw CommandError(Exit::kFailed, fmt::format("{}: {}", name, failure_text(max)));
   }
   std::vector<InstanceReport> instances;
   std::vector<std::uint16_t> absent;  // named, and not there
   if (only) {
-    if (auto r = read_instance(client, requester, node, *only, deadline)) {
+    if (auto r = read_instance(client, requester, node, *only, timeout)) {
       instances.push_back(std::move(*r));
     } else {
       absent.push_back(*only);
@@ -163,7 +169,7 @@ Exit run_assembly(const GlobalOptions& o, const AssemblyArgs& args) {
   } else if (auto n = uint16_of(max)) {
     const std::uint16_t last = std::min(*n, kMaxInstancesScanned);
     for (std::uint16_t i = 1; i <= last && !interrupted(); ++i) {
-      if (auto r = read_instance(client, requester, node, i, deadline)) {
+      if (auto r = read_instance(client, requester, node, i, timeout)) {
         instances.push_back(std::move(*r));
       }
     }
@@ -191,6 +197,10 @@ Exit run_assembly(const GlobalOptions& o, const AssemblyArgs& args) {
     for (const auto& r : instances) text += instance_text(r);
     if (!only && !uint16_of(max)) {
       text += "no max instance read: name an INSTANCE to read its member list\n";
+    }
+    if (!only && uint16_of(max).value_or(0) > kMaxInstancesScanned) {
+      text +=
+          fmt::format("instances above {} not read: name one as INSTANCE\n", kMaxInstancesScanned);
     }
     print(text);
   }

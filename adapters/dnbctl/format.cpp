@@ -409,7 +409,7 @@ std::string fields_text(const dds_sequence_dnbridge_DeviceField& fields) {
   std::string text;
   for (std::uint32_t i = 0; i < fields._length; ++i) {
     const auto& f = fields._buffer[i];
-    text += fmt::format("{}{} = {:g}{}{}", text.empty() ? "" : "; ", view(f.name), f.shown,
+    text += fmt::format("{}{} = {}{}{}", text.empty() ? "" : "; ", view(f.name), f.shown,
                         view(f.units).empty() ? "" : " ", view(f.units));
   }
   return text;

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <span>
 
 #include "adapters/dds/fields.hpp"
 #include "adapters/dnbctl/commander.hpp"
@@ -18,6 +19,7 @@
 #include "adapters/dnbctl/target.hpp"
 #include "adapters/dnbctl/values.hpp"
 #include "bridge/common/text.hpp"
+#include "bridge/profiles/eds/eds_file.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
@@ -201,9 +203,17 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   const NodeKey key = find_node(client, o, *ref);
   const std::string name = node_name(key.rack, key.port, key.mac);
   // The outputs the device applies now (transient-local: at once).
-  if (!client.wait_until(deadline_after(o.timeout()), [&] { return client.pump(key) != nullptr; })) {
+  if (!client.wait_until(deadline_after(o.timeout()), [&] {
+        return client.pump(key) != nullptr || client.device(key) != nullptr;
+      })) {
     throw CommandError(Exit::kNotFound,
                        fmt::format("{}: no PumpState within {:g} s", name, o.timeout_seconds));
+  }
+  if (client.pump(key) == nullptr) {
+    throw CommandError(Exit::kUsage,
+                       fmt::format("{} is a device of profile \"eds\", not a pump: outputs "
+                                   "commands it",
+                                   name));
   }
   Outputs wanted = applied_outputs(*client.pump(key)->data);
   switch (args.output) {
@@ -308,17 +318,26 @@ Parsed<std::pair<std::string, double>> parse_field(std::string_view text) {
   return std::pair{std::string(text.substr(0, eq)), v};
 }
 
-// Whether DeviceState shows `wanted` applied: its bytes, or each named field.
+// Whether DeviceState shows `wanted` applied: its bytes, or each field
+// given, found by its name or its ParamN, with the value given (a REAL's as
+// the device holds it: single precision). A field given that DeviceState
+// does not have is not shown.
 bool shows(const dnbridge_DeviceState& s, const DeviceOutputs& wanted) {
   const auto out = dds::view(s.outputs);
   if (!wanted.bytes.empty()) {
     return std::equal(out.begin(), out.end(), wanted.bytes.begin(), wanted.bytes.end());
   }
+  const std::span<const dnbridge_DeviceField> fields(s.output_fields._buffer,
+                                                     s.output_fields._length);
   for (const auto& [name, value] : wanted.fields) {
-    for (std::uint32_t i = 0; i < s.output_fields._length; ++i) {
-      const auto& f = s.output_fields._buffer[i];
-      if (iequals(dds::view(f.name), name) && f.value != value) return false;
-    }
+    const auto number = eds::param_number(name);
+    const auto it = std::find_if(fields.begin(), fields.end(), [&](const dnbridge_DeviceField& f) {
+      return number ? f.param == *number : iequals(dds::view(f.name), name);
+    });
+    if (it == fields.end()) return false;
+    const double expected =
+        dds::view(it->type) == "REAL" ? static_cast<double>(static_cast<float>(value)) : value;
+    if (it->value != expected) return false;
   }
   return true;
 }

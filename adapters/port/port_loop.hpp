@@ -74,8 +74,10 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // From any thread: queued for the port's thread, which is woken.
   void command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
                std::string issuer);
-  // A device's (profile "eds") outputs, as bytes or as its fields.
-  using DeviceOutputs = std::variant<std::vector<std::uint8_t>, std::vector<eds::FieldSetting>>;
+  // A device's (profile "eds") outputs, as bytes or as its fields, or a
+  // command that is refused as it came.
+  using DeviceOutputs = std::variant<std::vector<std::uint8_t>, std::vector<eds::FieldSetting>,
+                                     rack::MalformedCommand>;
   void command(devicenet::MacId mac, DeviceOutputs outputs, std::string issuer);
   // No live commander left for the pump at `mac`; for the device at `mac`.
   void release_command(devicenet::MacId mac);

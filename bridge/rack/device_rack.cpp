@@ -124,4 +124,11 @@ Status DeviceRack::command(MacId mac, const std::vector<eds::FieldSetting>& fiel
   return command(mac, *data, issuer, now);
 }
 
+Status DeviceRack::command(MacId mac, const MalformedCommand& command, std::string_view issuer,
+                           TimePoint) {
+  DeviceView* v = find(mac);
+  if (!v) return Errc::kOutOfRange;
+  return refuse(*v, Errc::kMalformed, fmt::format("from {}: {}", issuer, command.why));
+}
+
 }  // namespace dnbridge::rack

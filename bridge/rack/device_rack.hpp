@@ -71,6 +71,12 @@ struct DeviceProfile {
   static void take_applied(DeviceView& view, const Slot& slot, Bytes outputs);
 };
 
+// A command that cannot be taken as it came (e.g. bytes and fields both):
+// refused whole, with `why`.
+struct MalformedCommand {
+  std::string why;
+};
+
 class DeviceRack final : public NodeRack<DeviceProfile> {
  public:
   // Adds the devices' nodes to the scan list, each profile made from its
@@ -90,6 +96,9 @@ class DeviceRack final : public NodeRack<DeviceProfile> {
   // The same, the outputs given field by field (every numeric field once).
   Status command(devicenet::MacId mac, const std::vector<eds::FieldSetting>& fields,
                  std::string_view issuer, TimePoint now);
+  // Refused, counted and its reason kept as any refusal.
+  Status command(devicenet::MacId mac, const MalformedCommand& command, std::string_view issuer,
+                 TimePoint now);
 
   const std::vector<DeviceView>& devices() const { return nodes(); }
   const DeviceView* device(devicenet::MacId mac) const { return node(mac); }

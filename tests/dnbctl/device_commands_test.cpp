@@ -137,6 +137,11 @@ TEST_F(DnbctlDevices, OutputsCommandsTheDeviceByFieldOrBytesAndReportsARefusal) 
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("\"applied\": true"), std::string::npos) << r.out;
 
+  // By its parameter number: the echo is found by it too.
+  r = dnbctl({"outputs", "20", "Param4=5"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("applied: [05 00]"), std::string::npos) << r.out;
+
   r = dnbctl({"outputs", "20", "Digital outputs=300"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("not applied: refused by the bridge: from dnbctl "), std::string::npos)
@@ -144,6 +149,9 @@ TEST_F(DnbctlDevices, OutputsCommandsTheDeviceByFieldOrBytesAndReportsARefusal) 
   EXPECT_NE(r.err.find("Digital outputs: 300 is outside 0..255"), std::string::npos) << r.err;
 
   // Usage errors: nothing is sent.
+  r = dnbctl({"pump", "20", "on"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("is a device of profile \"eds\", not a pump"), std::string::npos) << r.err;
   r = dnbctl({"outputs", "1", "--bytes", "0100"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("is a pump (a CDN127)"), std::string::npos) << r.err;

@@ -24,8 +24,13 @@ class DeviceCommander {
                 dds::command_writer_qos(dds::rack_partitions(kRack), strength, seconds(1))) {}
 
   bool write_fields(unsigned mac, const std::vector<std::pair<std::string, double>>& fields) {
+    return write_both(mac, {}, fields);
+  }
+  bool write_both(unsigned mac, const std::vector<std::uint8_t>& outputs,
+                  const std::vector<std::pair<std::string, double>>& fields) {
     dds::Owned<dnbridge_DeviceCommand> c;
     key(*c, mac);
+    dds::set_octets(c->outputs, outputs);
     auto& seq = c->fields;
     seq._length = seq._maximum = static_cast<std::uint32_t>(fields.size());
     seq._release = true;
@@ -167,6 +172,16 @@ TEST_F(DeviceTest, ADeviceCommandReachesTheDeviceAndItsDepartureLeavesTheIdleSta
   }));
   EXPECT_EQ(dds::view(nodes_.latest(pump_mac(kDevice))->last_command_refused),
             "from supervisor-d: Digital outputs: 300 is outside 0..255");
+  EXPECT_EQ(device_param(4), 0x03);
+
+  // Bytes and fields both: refused whole.
+  ASSERT_TRUE(supervisor->write_both(kDevice, {0x01, 0x00}, {{"Digital outputs", 1}}));
+  ASSERT_TRUE(nodes_.until([&] {
+    const auto* n = nodes_.latest(pump_mac(kDevice));
+    return n && n->counters.commands_refused == 2;
+  }));
+  EXPECT_EQ(dds::view(nodes_.latest(pump_mac(kDevice))->last_command_refused),
+            "from supervisor-d: outputs and fields both given: a command gives one");
   EXPECT_EQ(device_param(4), 0x03);
 
   // The commander goes: the device's configured idle state.

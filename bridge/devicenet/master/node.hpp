@@ -279,9 +279,8 @@ class Node final : private ExplicitClient::Listener {
   std::uint32_t jitter_state_ = 0;  // xorshift state, seeded from the MAC
   std::size_t setting_index_ = 0;
   std::vector<std::vector<std::uint8_t>> settings_in_force_;
-  bool setting_retried_ = false;
-  std::size_t check_index_ =
-      0;  // the check in hand     // a refused Set retried once after releasing the poll
+  bool setting_retried_ = false;     // a refused Set retried once after releasing the poll
+  std::size_t check_index_ = 0;      // the check in hand
   bool poll_release_tried_ = false;  // the poll Allocate retried once after a Release
   InlineBytes<16> setting_found_;    // what the device had before the Set
   unsigned step_timeouts_ = 0;       // consecutive timeouts of the current life-cycle step

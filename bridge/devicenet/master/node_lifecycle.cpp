@@ -609,8 +609,21 @@ Node::Step Node::after_check(const ExplicitResult& r, TimePoint now) {
   const auto& c = config_.profile.checks[check_index_];
   ++check_index_;
   if (!r.ok()) {
-    log_.info("{} not offered ({}): not compared", c.name, status_text(r));
-    return next_check_step();
+    // Not offered (service, attribute or object not there): not compared.
+    // Any other refusal leaves the device unchecked: a fault, not a guess.
+    using cip::GeneralStatus;
+    const auto g = r.general_status;
+    if (g == GeneralStatus::kServiceNotSupported || g == GeneralStatus::kAttributeNotSupported ||
+        g == GeneralStatus::kObjectDoesNotExist || g == GeneralStatus::kPathDestinationUnknown) {
+      log_.info("{} not offered ({}): not compared", c.name, status_text(r));
+      return next_check_step();
+    }
+    enter_fault(NodeState::kConfigurationFault,
+                fmt::format("{} could not be read ({}): the device is not checked against what "
+                            "the configuration expects",
+                            c.name, status_text(r)),
+                now);
+    return Step::kNone;
   }
   const auto differences =
       c.verifier ? c.verifier->differences(r.data.view()) : std::vector<std::string>{};

@@ -109,7 +109,7 @@ std::uint64_t read_bits(Bytes data, std::uint32_t offset, std::uint16_t bits) no
   std::uint64_t raw = 0;
   for (unsigned i = 0; i < bits; ++i) {
     const std::uint32_t at = offset + i;
-    if (((data[at / 8] >> (at % 8)) & 1U) != 0) raw |= std::uint64_t{1} << i;
+    if (((static_cast<unsigned>(data[at / 8]) >> (at % 8)) & 1U) != 0) raw |= std::uint64_t{1} << i;
   }
   return raw;
 }
@@ -302,7 +302,7 @@ Status check(const IoLayout& layout, Bytes data, std::string* why) {
       }
     }
     for (std::size_t b = 0; b < covered.size(); ++b) {
-      if (!covered[b] && ((data[b / 8] >> (b % 8)) & 1U) != 0) {
+      if (!covered[b] && ((static_cast<unsigned>(data[b / 8]) >> (b % 8)) & 1U) != 0) {
         return fail(Errc::kOutOfRange,
                     fmt::format("bit {} of byte {} is set, and the EDS gives it no field (padding, "
                                 "or a field that is not a number): it must be 0",

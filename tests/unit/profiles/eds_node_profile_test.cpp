@@ -93,8 +93,14 @@ TEST(EdsNodeProfile, TheDevicesMemberListsAreCheckedAgainstTheEds) {
   const std::vector<std::uint8_t> cut{0x08, 0x00, 0x06};
   EXPECT_EQ(in.verifier->differences(Bytes(cut.data(), cut.size())).at(0),
             "the device's member list does not decode (input truncated)");
-  // Two profiles of one EDS compare equal (a reload sees no change).
+  // Two profiles of one EDS compare equal (a reload sees no change); one
+  // whose EDS lists other members does not.
   EXPECT_EQ(*p, profile_of(f, polled()).value());
+  EdsFile other = f;
+  for (auto& a : other.assemblies) {
+    if (a.number == 100) std::swap(a.members[0], a.members[1]);
+  }
+  EXPECT_NE(*p, profile_of(other, polled()).value());
 }
 
 TEST(EdsNodeProfile, OutputsWithoutASafeStateAreRefused) {
