@@ -120,6 +120,35 @@ std::string not_online(const Client& client, const NodeKey& key) {
               : std::string("the node is not online");
 }
 
+// Whether the node's state sample (PumpState or DeviceState) is a new one
+// that shows this issuer's command in force: its outputs are then compared.
+template <class State>
+bool echoes_command(const Known<State>& k, std::uint64_t samples_before, std::string_view issuer) {
+  const State& s = *k.data;
+  return k.samples > samples_before && k.alive && s.online && !s.outputs_idle &&
+         dds::view(s.commanded_by) == issuer;
+}
+
+// Why the echo did not come, from the node's state sample: the bridge gone,
+// the node not online, a stronger commander (`what`: "pump", "device"), or
+// nothing shown in time.
+template <class State>
+std::string not_echoed(const Client& client, const NodeKey& key, const Known<State>& k,
+                       std::string_view issuer, std::int32_t strength, std::string_view what,
+                       double timeout_seconds) {
+  const State& state = *k.data;
+  if (!k.alive) return "the bridge is gone";
+  if (!state.online) return not_online(client, key);
+  if (!state.outputs_idle && dds::view(state.commanded_by) != issuer &&
+      !dds::view(state.commanded_by).empty()) {
+    return fmt::format(
+        "\"{}\" commands this {}: a live commander stronger than {} (ownership strength) takes "
+        "precedence",
+        dds::view(state.commanded_by), what, strength);
+  }
+  return fmt::format("the bridge did not show the outputs applied within {:g} s", timeout_seconds);
+}
+
 // After a command applied: --hold-for keeps writing it; else a note that it
 // ends with dnbctl.
 void hold_or_note(Client& client, const GlobalOptions& o, double hold_for_seconds,
@@ -240,23 +269,11 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
       client, key, deadline, rewriter,
       [&] {
         const auto& p = *client.pump(key);
-        const auto& s = *p.data;
-        return p.samples > samples_before && p.alive && s.online && !s.outputs_idle &&
-               applied_outputs(s) == wanted && dds::view(s.commanded_by) == issuer;
+        return echoes_command(p, samples_before, issuer) && applied_outputs(*p.data) == wanted;
       },
       [&] {
-        const auto& state = *client.pump(key)->data;
-        if (!client.pump(key)->alive) return std::string("the bridge is gone");
-        if (!state.online) return not_online(client, key);
-        if (!state.outputs_idle && dds::view(state.commanded_by) != issuer &&
-            !dds::view(state.commanded_by).empty()) {
-          return fmt::format(
-              "\"{}\" commands this pump: a live commander stronger than {} "
-              "(ownership strength) takes precedence",
-              dds::view(state.commanded_by), args.strength);
-        }
-        return fmt::format("the bridge did not show the outputs applied within {:g} s",
-                           o.timeout_seconds);
+        return not_echoed(client, key, *client.pump(key), issuer, args.strength, "pump",
+                          o.timeout_seconds);
       });
   const auto& state = *client.pump(key)->data;
   const auto* node = client.node(key);
@@ -418,23 +435,11 @@ Exit run_device_outputs(const GlobalOptions& o, const DeviceOutputArgs& args) {
       client, key, deadline, rewriter,
       [&] {
         const auto& d = *client.device(key);
-        const auto& s = *d.data;
-        return d.samples > samples_before && d.alive && s.online && !s.outputs_idle &&
-               dds::view(s.commanded_by) == issuer && shows(s, wanted);
+        return echoes_command(d, samples_before, issuer) && shows(*d.data, wanted);
       },
       [&] {
-        const auto& state = *client.device(key)->data;
-        if (!client.device(key)->alive) return std::string("the bridge is gone");
-        if (!state.online) return not_online(client, key);
-        if (!state.outputs_idle && dds::view(state.commanded_by) != issuer &&
-            !dds::view(state.commanded_by).empty()) {
-          return fmt::format(
-              "\"{}\" commands this device: a live commander stronger than {} "
-              "(ownership strength) takes precedence",
-              dds::view(state.commanded_by), args.strength);
-        }
-        return fmt::format("the bridge did not show the outputs applied within {:g} s",
-                           o.timeout_seconds);
+        return not_echoed(client, key, *client.device(key), issuer, args.strength, "device",
+                          o.timeout_seconds);
       });
   const auto& state = *client.device(key)->data;
   const auto applied_bytes = hex_bytes(std::span<const std::uint8_t>(dds::view(state.outputs)));
