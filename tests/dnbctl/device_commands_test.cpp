@@ -41,6 +41,9 @@ class DnbctlDevices : public ::testing::Test {
         "[[port.node]]\nmac = 1\nname = \"pump-1\"\n"
         "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
         "eds = \"dnbridge-example-io-block.eds\"\n"
+        // What one dnbctl run commanded stays applied when it exits, for the
+        // test to see (and for the next run to find).
+        "no_commander = \"hold\"\n"
         "safe_state = [ { name = \"Output fault action\", value = 0 },\n"
         "               { name = \"Output fault value\", value = 0 },\n"
         "               { name = \"Output idle action\", value = 0 },\n"
