@@ -170,6 +170,60 @@ void hold_or_note(Client& client, const GlobalOptions& o, double hold_for_second
   }
 }
 
+// Which kind of node a command is for: each has its own state and command
+// topics, and its own dnbctl commands.
+enum class NodeKind { kPump, kDevice };
+
+// The node named, once its state sample (PumpState or DeviceState,
+// transient-local: at once) is here. A node of the other kind is refused:
+// its own commands serve it.
+NodeKey node_of_kind(Client& client, const GlobalOptions& o, const NodeRef& ref, NodeKind kind) {
+  const NodeKey key = find_node(client, o, ref);
+  const std::string name = node_name(key.rack, key.port, key.mac);
+  const bool pump = kind == NodeKind::kPump;
+  if (!client.wait_until(deadline_after(o.timeout()), [&] {
+        return client.pump(key) != nullptr || client.device(key) != nullptr;
+      })) {
+    throw CommandError(Exit::kNotFound,
+                       fmt::format("{}: no {} within {:g} s", name,
+                                   pump ? "PumpState" : "DeviceState", o.timeout_seconds));
+  }
+  if (pump && client.pump(key) == nullptr) {
+    throw CommandError(Exit::kUsage, fmt::format("{} is a device of profile \"eds\", not a "
+                                                 "pump: outputs commands it",
+                                                 name));
+  }
+  if (!pump && client.device(key) == nullptr) {
+    throw CommandError(Exit::kUsage, fmt::format("{} is a pump (a CDN127): pump, ballast and "
+                                                 "aout command it",
+                                                 name));
+  }
+  return key;
+}
+
+// Waits until a bridge of the node's rack takes the writer's commands.
+template <class Writer>
+void wait_for_bridge(Client& client, Writer& writer, const NodeKey& key, Deadline deadline,
+                     std::string_view what, double timeout_seconds) {
+  if (writer.wait_matched(client, deadline)) return;
+  throw CommandError(Exit::kNotFound,
+                     fmt::format("{}: no bridge took {} in rack {}'s partition (dnbridge/{}) "
+                                 "within {:g} s",
+                                 node_name(key.rack, key.port, key.mac), what, key.rack, key.rack,
+                                 timeout_seconds));
+}
+
+// The end of an output command: the failure reported, or --hold-for.
+Exit report_or_hold(Client& client, const GlobalOptions& o, const std::string& name,
+                    const std::string& failure, double hold_for_seconds, Rewriter& rewriter) {
+  if (!failure.empty()) {
+    std::fputs(fmt::format("dnbctl: {}: not applied: {}\n", name, failure).c_str(), stderr);
+    return Exit::kFailed;
+  }
+  hold_or_note(client, o, hold_for_seconds, rewriter);
+  return Exit::kOk;
+}
+
 }  // namespace
 
 CLI::App* add_output(CLI::App& app, Output output, OutputArgs& args) {
@@ -229,21 +283,8 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   install_interrupt_handlers();
 
   Client client = make_client(o);
-  const NodeKey key = find_node(client, o, *ref);
+  const NodeKey key = node_of_kind(client, o, *ref, NodeKind::kPump);
   const std::string name = node_name(key.rack, key.port, key.mac);
-  // The outputs the device applies now (transient-local: at once).
-  if (!client.wait_until(deadline_after(o.timeout()), [&] {
-        return client.pump(key) != nullptr || client.device(key) != nullptr;
-      })) {
-    throw CommandError(Exit::kNotFound,
-                       fmt::format("{}: no PumpState within {:g} s", name, o.timeout_seconds));
-  }
-  if (client.pump(key) == nullptr) {
-    throw CommandError(Exit::kUsage,
-                       fmt::format("{} is a device of profile \"eds\", not a pump: outputs "
-                                   "commands it",
-                                   name));
-  }
   Outputs wanted = applied_outputs(*client.pump(key)->data);
   switch (args.output) {
     case Output::kPump: wanted.pump_on = *on; break;
@@ -252,14 +293,9 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   }
   Commander commander(client, args.strength, key.rack);
   const Deadline deadline = deadline_after(o.timeout());
-  if (!commander.wait_matched(client, deadline)) {
-    throw CommandError(
-        Exit::kNotFound,
-        fmt::format("{}: no bridge took commands in rack {}'s partition (dnbridge/{}) "
-                    "within {:g} s: a bridge of a version before partitions reads "
-                    "commands elsewhere",
-                    name, key.rack, key.rack, o.timeout_seconds));
-  }
+  wait_for_bridge(client, commander, key, deadline,
+                  "commands (a bridge of a version before partitions reads them elsewhere)",
+                  o.timeout_seconds);
 
   // Written, then again every kRewritePeriod, until the echo shows it applied
   // or the bridge refused it.
@@ -296,13 +332,7 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
                       outputs_text(wanted.pump_on, wanted.n2_ballast_on, wanted.analog_output_raw),
                       issuer));
   }
-  if (!failure.empty()) {
-    std::fputs(fmt::format("dnbctl: {}: not applied: {}\n", name, failure).c_str(), stderr);
-    return Exit::kFailed;
-  }
-
-  hold_or_note(client, o, args.hold_for_seconds, rewriter);
-  return Exit::kOk;
+  return report_or_hold(client, o, name, failure, args.hold_for_seconds, rewriter);
 }
 
 }  // namespace dnbridge::dnbctl
@@ -408,27 +438,11 @@ Exit run_device_outputs(const GlobalOptions& o, const DeviceOutputArgs& args) {
   install_interrupt_handlers();
 
   Client client = make_client(o);
-  const NodeKey key = find_node(client, o, *ref);
+  const NodeKey key = node_of_kind(client, o, *ref, NodeKind::kDevice);
   const std::string name = node_name(key.rack, key.port, key.mac);
-  if (!client.wait_until(deadline_after(o.timeout()), [&] {
-        return client.device(key) != nullptr || client.pump(key) != nullptr;
-      })) {
-    throw CommandError(Exit::kNotFound,
-                       fmt::format("{}: no DeviceState within {:g} s", name, o.timeout_seconds));
-  }
-  if (client.device(key) == nullptr) {
-    throw CommandError(Exit::kUsage, fmt::format("{} is a pump (a CDN127): pump, ballast and aout "
-                                                 "command it",
-                                                 name));
-  }
   DeviceCommander commander(client, args.strength, key.rack);
   const Deadline deadline = deadline_after(o.timeout());
-  if (!commander.wait_matched(client, deadline)) {
-    throw CommandError(Exit::kNotFound,
-                       fmt::format("{}: no bridge took device commands in rack {}'s partition "
-                                   "(dnbridge/{}) within {:g} s",
-                                   name, key.rack, key.rack, o.timeout_seconds));
-  }
+  wait_for_bridge(client, commander, key, deadline, "device commands", o.timeout_seconds);
   const std::uint64_t samples_before = client.device(key)->samples;
   Rewriter rewriter(name, [&] { return commander.write(key, wanted, issuer); });
   const std::string failure = command_until_applied(
@@ -459,12 +473,7 @@ Exit run_device_outputs(const GlobalOptions& o, const DeviceOutputArgs& args) {
     print(fmt::format("{} ({}): applied: [{}]; commanded by \"{}\"\n", name, dds::view(state.name),
                       applied_bytes, issuer));
   }
-  if (!failure.empty()) {
-    std::fputs(fmt::format("dnbctl: {}: not applied: {}\n", name, failure).c_str(), stderr);
-    return Exit::kFailed;
-  }
-  hold_or_note(client, o, args.hold_for_seconds, rewriter);
-  return Exit::kOk;
+  return report_or_hold(client, o, name, failure, args.hold_for_seconds, rewriter);
 }
 
 }  // namespace dnbridge::dnbctl

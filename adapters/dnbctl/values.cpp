@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "bridge/cip/data_types.hpp"
+#include "bridge/common/bytes.hpp"
 #include "bridge/common/text.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 
@@ -166,8 +167,7 @@ Parsed<std::string> decode_data(std::span<const std::uint8_t> data, Decoding as)
         return Parsed<std::string>::failure(
             fmt::format("{} byte(s) are not an integer of 1, 2, 4 or 8 bytes", n));
       }
-      std::uint64_t v = 0;
-      for (std::size_t i = n; i-- > 0;) v = (v << 8) | data[i];  // little-endian (CIP)
+      std::uint64_t v = little_endian(data);
       if (as == Decoding::kUint) return fmt::format("{}", v);
       // Sign-extend from the integer's own width.
       const unsigned bits = static_cast<unsigned>(n * 8);

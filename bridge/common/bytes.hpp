@@ -63,6 +63,14 @@ class ByteReader {
   bool failed_ = false;
 };
 
+// The unsigned integer of up to 8 little-endian bytes (CIP's order); bytes
+// beyond the eighth are ignored.
+inline std::uint64_t little_endian(Bytes b) noexcept {
+  std::uint64_t v = 0;
+  for (std::size_t i = b.size() < 8 ? b.size() : 8; i-- > 0;) v = (v << 8) | b[i];
+  return v;
+}
+
 // Writes into a caller-provided span; a write that does not fit marks the writer
 // failed and writes nothing.
 class ByteWriter {

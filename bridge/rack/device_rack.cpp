@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 
+#include "bridge/common/bytes.hpp"
+
 namespace dnbridge::rack {
 
 using devicenet::MacId;
@@ -68,10 +70,7 @@ void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::
     const eds::Param* p = slot.eds->param(slot.settings.safe_state[i].name);
     if (p == nullptr || first + i >= in_force.size()) continue;
     const auto& bytes = in_force[first + i];
-    std::uint64_t raw = 0;
-    for (std::size_t b = 0; b < bytes.size() && b < 8; ++b) {
-      raw |= std::uint64_t{bytes[b]} << (8 * b);
-    }
+    const std::uint64_t raw = little_endian(bytes);
     const auto bits = static_cast<std::uint16_t>(std::min<std::size_t>(bytes.size() * 8, 64));
     text += fmt::format("{}Param{} {} = {}{}", text.empty() ? "" : "; ", p->number, p->name,
                         eds::from_raw(p->type, bits, raw), p->units.empty() ? "" : " " + p->units);

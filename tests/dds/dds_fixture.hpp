@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,6 +33,22 @@ inline bool wait_for(const Participant& participant, const Entity& entity,
   waitset.attach(entity, 1);
   auto triggered = waitset.wait(timeout);
   return triggered.ok() && !triggered->empty();
+}
+
+// Waits until `writer` (of `participant`) has matched `count` readers;
+// false on timeout.
+template <class T>
+bool until_matched(const Participant& participant, const Writer<T>& writer,
+                   std::uint32_t count = 1) {
+  if (!writer.set_status_mask(DDS_PUBLICATION_MATCHED_STATUS).ok()) return false;
+  const auto deadline = std::chrono::steady_clock::now() + kEventTimeout;
+  for (;;) {
+    auto m = writer.publication_matched();
+    if (m.ok() && m->current_count >= count) return true;
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline) return false;
+    (void)wait_for(participant, writer, deadline - now);
+  }
 }
 
 class DdsTest : public ::testing::Test {

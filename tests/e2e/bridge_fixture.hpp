@@ -304,15 +304,7 @@ class BridgeTest : public ::testing::Test {
 
   template <class T>
   bool writer_matched(const dds::Writer<T>& writer, std::uint32_t count = 1) {
-    if (!writer.set_status_mask(DDS_PUBLICATION_MATCHED_STATUS).ok()) return false;
-    const auto deadline = SteadyClock::now() + kEventTimeout;
-    for (;;) {
-      auto m = writer.publication_matched();
-      if (m.ok() && m->current_count >= count) return true;
-      const auto now = SteadyClock::now();
-      if (now >= deadline) return false;
-      (void)dds::testing::wait_for(supervisor_, writer, deadline - now);
-    }
+    return dds::testing::until_matched(supervisor_, writer, count);
   }
 
   // Runs `fn` with the port's simulated backend on the port's thread

@@ -131,15 +131,7 @@ class CarelessClientTest : public ::testing::Test {
 
   template <class T>
   bool writer_matched(const dds::Writer<T>& writer) {
-    if (!writer.set_status_mask(DDS_PUBLICATION_MATCHED_STATUS).ok()) return false;
-    const auto deadline = SteadyClock::now() + kEventTimeout;
-    for (;;) {
-      auto m = writer.publication_matched();
-      if (m.ok() && m->current_count >= 1) return true;
-      const auto now = SteadyClock::now();
-      if (now >= deadline) return false;
-      (void)dds::testing::wait_for(supervisor_, writer, deadline - now);
-    }
+    return dds::testing::until_matched(supervisor_, writer);
   }
 
   // The vendor of node `mac` (one not in the scan list is refused at once).

@@ -36,17 +36,7 @@ class Commander {
     return writer_.write(*c).ok();
   }
   // Until the bridge has matched this commander.
-  bool matched() {
-    if (!writer_.set_status_mask(DDS_PUBLICATION_MATCHED_STATUS).ok()) return false;
-    const auto deadline = SteadyClock::now() + kEventTimeout;
-    for (;;) {
-      auto m = writer_.publication_matched();
-      if (m.ok() && m->current_count >= 1) return true;
-      const auto now = SteadyClock::now();
-      if (now >= deadline) return false;
-      (void)dds::testing::wait_for(participant_, writer_, deadline - now);
-    }
-  }
+  bool matched() { return dds::testing::until_matched(participant_, writer_); }
   bool acked() { return writer_.wait_for_acks(kEventTimeout).ok(); }
 
  private:

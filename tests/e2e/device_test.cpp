@@ -48,17 +48,7 @@ class DeviceCommander {
     dds::set_octets(c->outputs, outputs);
     return writer_.write(*c).ok();
   }
-  bool matched() {
-    if (!writer_.set_status_mask(DDS_PUBLICATION_MATCHED_STATUS).ok()) return false;
-    const auto deadline = SteadyClock::now() + kEventTimeout;
-    for (;;) {
-      auto m = writer_.publication_matched();
-      if (m.ok() && m->current_count >= 1) return true;
-      const auto now = SteadyClock::now();
-      if (now >= deadline) return false;
-      (void)dds::testing::wait_for(participant_, writer_, deadline - now);
-    }
-  }
+  bool matched() { return dds::testing::until_matched(participant_, writer_); }
 
  private:
   void key(dnbridge_DeviceCommand& c, unsigned mac) {

@@ -24,14 +24,12 @@
 
 #include "bridge/devicenet/wire/identifier.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
-#include "tests/fuzz/support/session_records.hpp"
+#include "tests/fuzz/support/slave_session.hpp"
 
 namespace {
 
 using namespace dnbridge;
 using devicenet::Group1Message;
-using devicenet::Group2Message;
-using devicenet::Group4Message;
 using devicenet::MacId;
 using sim::ConnectionState;
 using sim::EdsSlave;
@@ -59,17 +57,8 @@ class CheckingSink final : public can::FrameSink {
  public:
   void send(const can::CanFrame& frame, TimePoint now) override {
     FUZZ_CHECK(slave_ != nullptr);
-    FUZZ_CHECK(frame.id <= can::kMaxStandardId);
-    FUZZ_CHECK(frame.len <= can::kMaxDataLength);
-    FUZZ_CHECK(now >= last_);
-    last_ = now;
     const EdsSlave& s = *slave_;
-    FUZZ_CHECK(s.network_state() != EdsSlave::NetworkState::kOff);
-    if (s.network_state() == EdsSlave::NetworkState::kCommunicationFault) {
-      FUZZ_CHECK(frame.id == devicenet::group4_id(Group4Message::kCommFaultedResponse) ||
-                 frame.id == devicenet::group4_id(Group4Message::kOfflineOwnershipResponse));
-      return;
-    }
+    if (!common_.check(s, frame, now)) return;
     const MacId mac = s.mac();
     const Bytes payload = frame.payload();
     if (frame.id == devicenet::group1_id(Group1Message::kSlaveCosCyclic, mac)) {
@@ -89,24 +78,13 @@ class CheckingSink final : public can::FrameSink {
       FUZZ_CHECK(payload.size() == data.size());
       return;
     }
-    FUZZ_CHECK(frame.id == devicenet::group2_id(mac, Group2Message::kSlaveExplicitResponse) ||
-               frame.id == devicenet::group2_id(mac, Group2Message::kDuplicateMacCheck));
-    if (s.network_state() == EdsSlave::NetworkState::kDuplicateMacCheck) {
-      FUZZ_CHECK(frame.id == devicenet::group2_id(mac, Group2Message::kDuplicateMacCheck));
-    }
+    fuzz::check_group2_frame(s, mac, frame);
   }
   const EdsSlave* slave_ = nullptr;
 
  private:
-  TimePoint last_{};
+  fuzz::SentFrameCheck common_;
 };
-
-void run_timers(EdsSlave& slave, TimePoint now) {
-  for (int i = 0; slave.next_deadline() <= now; ++i) {
-    FUZZ_CHECK(i < 8);  // a few chained rounds at one instant, more is a spin
-    slave.on_timer(now);
-  }
-}
 
 void check_consistent(const EdsSlave& slave) {
   FUZZ_CHECK(slave.mac().value() == kMac);  // the MAC is the switches'
@@ -141,31 +119,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   EdsSlave slave(sink, io_block(), options);
   sink.slave_ = &slave;
 
-  TimePoint now = fuzz::kSessionStart;
-  slave.power_on(now);
-  ByteReader in(Bytes(data, size));
-  while (auto record = fuzz::next_record(in)) {
-    now += record->step;
-    run_timers(slave, now);
-    switch (record->op) {
-      case fuzz::Op::kFrame:
-        slave.on_frame(record->frame, now);
-        break;
-      case fuzz::Op::kStop:
-        slave.power_cycle(now);
-        break;
-      case fuzz::Op::kSetOutputs: {
-        const Bytes d = record->frame.payload();
+  fuzz::run_session(
+      slave, Bytes(data, size),
+      [&](const fuzz::Record& record, TimePoint now) {
+        if (record.op != fuzz::Op::kSetOutputs) return;  // the master's other requests: time passes
+        const Bytes d = record.frame.payload();
         if (!d.empty()) (void)slave.objects().set_param_value(kDigitalInputs, d.first(1));
         if (d.size() > 1) (void)slave.objects().set_param_value(kModuleStatus, d.subspan(1, 1));
         slave.inputs_changed(now);
-        break;
-      }
-      default:  // the master's other requests mean nothing here: time passes
-        break;
-    }
-    run_timers(slave, now);
-    check_consistent(slave);
-  }
+      },
+      [&] { check_consistent(slave); });
   return 0;
 }
