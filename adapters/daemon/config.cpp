@@ -66,7 +66,8 @@ constexpr std::array<std::string_view, 9> kCdn127OnlyKeys{"io",
                                                           "analog_output_on_fault",
                                                           "analog_output_on_idle",
                                                           "analog_deadband_volts"};
-constexpr std::array<std::string_view, 3> kEdsOnlyKeys{"eds", "connection", "parameters"};
+constexpr std::array<std::string_view, 6> kEdsOnlyKeys{
+    "eds", "connection", "parameters", "heartbeat_ms", "inhibit_ms", "acknowledged"};
 
 enum class Level { kBuiltIn, kDefaults, kNode };
 
@@ -638,8 +639,43 @@ void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems&
     }
   }
   const toml::node* connection = nt.get("connection");
+  bool connection_known = true;
   if (connection) {
-    if (auto v = read_connection(*connection, r)) s.eds_node.connection = *v;
+    auto v = read_connection(*connection, r);
+    if (v) s.eds_node.connection = *v;
+    connection_known = v.has_value();
+  }
+  // The change-of-state or cyclic connection's own settings.
+  const bool cos = s.eds_node.connection == eds::ConnectionKind::kChangeOfState ||
+                   s.eds_node.connection == eds::ConnectionKind::kCyclic;
+  for (std::string_view k : {"heartbeat_ms", "inhibit_ms", "acknowledged"}) {
+    const toml::node* n = nt.get(k);
+    if (n == nullptr || !connection_known) continue;
+    if (!cos) {
+      r.error(n->source(), fmt::format("{} is for connection = \"change-of-state\" or "
+                                       "\"cyclic\" (this node's is \"{}\")",
+                                       k, to_string(s.eds_node.connection)));
+    } else if (k == "heartbeat_ms") {
+      if (auto v = read_ms(*n, k, 1, kMaxPacketRateMs, r)) s.eds_node.heartbeat = *v;
+    } else if (k == "inhibit_ms") {
+      if (s.eds_node.connection == eds::ConnectionKind::kCyclic) {
+        r.error(n->source(),
+                "inhibit_ms is for connection = \"change-of-state\": a cyclic "
+                "connection produces every heartbeat_ms, changes or not");
+      } else if (auto v = read_ms(*n, k, 0, kMaxPacketRateMs, r)) {
+        s.eds_node.inhibit = *v;
+        if (*v >= s.eds_node.heartbeat) {
+          r.error(
+              n->source(),
+              fmt::format("inhibit_ms = {} is not shorter than heartbeat_ms ({}): "
+                          "changes could never be sent sooner than heartbeats",
+                          std::chrono::duration_cast<milliseconds>(*v).count(),
+                          std::chrono::duration_cast<milliseconds>(s.eds_node.heartbeat).count()));
+        }
+      }
+    } else if (auto v = read_bool(*n, k, r)) {
+      s.eds_node.acknowledged = *v;
+    }
   }
   const toml::node* parameters = nt.get("parameters");
   if (parameters) {

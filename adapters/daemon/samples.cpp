@@ -173,6 +173,11 @@ void fill_node_common(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.counters.allocate_attempts = c.allocate_attempts;
   out.counters.idle_empty_responses = c.idle_empty_responses;
   out.counters.settings_written = c.settings_written;
+  out.counters.cos_messages = c.cos_messages;
+  out.counters.cos_acks = c.cos_acks;
+  out.counters.cos_retries = c.cos_retries;
+  out.counters.cos_errors = c.cos_errors;
+  out.counters.heartbeats_missed = c.heartbeats_missed;
   out.counters.explicit_retries = c.explicit_retries;
   out.counters.explicit_responses_before_final_ack = e.responses_before_final_ack;
   out.counters.explicit_requests = e.requests;

@@ -186,6 +186,16 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
                   labels, static_cast<double>(c.errors));
         f.counter("dnbridge_node_reconnects_total", "Returns from online to allocation", labels,
                   static_cast<double>(c.reconnects));
+        f.counter("dnbridge_node_cos_messages_total",
+                  "Change-of-state or cyclic messages taken (the device's retries included)",
+                  labels, static_cast<double>(c.cos_messages));
+        f.counter("dnbridge_node_cos_retries_total",
+                  "Change-of-state or cyclic messages the device sent again (an acknowledgment "
+                  "it missed)",
+                  labels, static_cast<double>(c.cos_retries));
+        f.counter("dnbridge_node_heartbeats_missed_total",
+                  "Change-of-state or cyclic connections lost: 4 x EPR without a message", labels,
+                  static_cast<double>(c.heartbeats_missed));
         f.counter("dnbridge_node_explicit_requests_total",
                   "Explicit requests sent to the node (the bridge's own and remote ones)", labels,
                   static_cast<double>(node.explicit_counters.requests));

@@ -15,6 +15,8 @@
 //              dnbridge_port_loop_longest_pass_seconds
 //   per node   dnbridge_node_online, dnbridge_node_state{state}, dnbridge_node_polls_total,
 //              dnbridge_node_poll_timeouts_total, dnbridge_node_poll_errors_total,
+//              dnbridge_node_cos_messages_total, dnbridge_node_cos_retries_total,
+//              dnbridge_node_heartbeats_missed_total,
 //              dnbridge_node_reconnects_total, dnbridge_node_commands_accepted_total,
 //              dnbridge_node_commands_refused_total, dnbridge_node_explicit_requests_total,
 //              dnbridge_node_explicit_timeouts_total

@@ -33,6 +33,8 @@ inline constexpr std::uint16_t kDiscreteInputPoint = 0x08;
 inline constexpr std::uint16_t kDiscreteOutputPoint = 0x09;
 inline constexpr std::uint16_t kAnalogInputPoint = 0x0A;
 inline constexpr std::uint16_t kAnalogOutputPoint = 0x0B;
+inline constexpr std::uint16_t kParameter = 0x0F;
+inline constexpr std::uint16_t kAcknowledgeHandler = 0x2B;
 }  // namespace class_id
 
 // "Identity", "Discrete Output Point", ...; empty for a class not above.
@@ -73,6 +75,7 @@ inline constexpr std::uint8_t kMacId = 1, kBaudRate = 2, kBusOffInterrupt = 3, k
 }
 namespace connection_instance {
 inline constexpr std::uint16_t kExplicit = 1, kPoll = 2;
+inline constexpr std::uint16_t kChangeOfState = 4;  // change of state or cyclic
 }
 namespace connection_attr {
 inline constexpr std::uint8_t kState = 1, kInstanceType = 2, kTransportClassTrigger = 3,
@@ -141,6 +144,31 @@ inline constexpr AttributeRef kPollProducedPath{kClass, kPollInstance,
 inline constexpr AttributeRef kPollConsumedPath{kClass, kPollInstance,
                                                 connection_attr::kConsumedPath,
                                                 "Connection 2 (poll).ConsumedConnectionPath"};
+
+// Instance 4: change of state or cyclic, as allocated.
+inline constexpr std::uint16_t kCosInstance = connection_instance::kChangeOfState;
+inline constexpr AttributeRef kCosProducedSize{
+    kClass, kCosInstance, connection_attr::kProducedSize,
+    "Connection 4 (change of state).ProducedConnectionSize"};
+inline constexpr AttributeRef kCosExpectedPacketRate{
+    kClass, kCosInstance, connection_attr::kExpectedPacketRate,
+    "Connection 4 (change of state).ExpectedPacketRate"};
+inline constexpr AttributeRef kCosProducedPath{
+    kClass, kCosInstance, connection_attr::kProducedPath,
+    "Connection 4 (change of state).ProducedConnectionPath"};
+inline constexpr AttributeRef kCosInhibitTime{kClass, kCosInstance, connection_attr::kInhibitTime,
+                                              "Connection 4 (change of state).InhibitTime"};
 }  // namespace connection
+
+// The Acknowledge Handler (instance 1): how long the device waits for an
+// acknowledgment of a change-of-state or cyclic message before it sends it
+// again (UINT ms), and how often it does (USINT).
+namespace acknowledge_handler {
+inline constexpr std::uint16_t kClass = class_id::kAcknowledgeHandler;
+inline constexpr AttributeRef kAckTimer{kClass, 1, 1, "Acknowledge Handler.AcknowledgeTimer"};
+inline constexpr AttributeRef kRetryLimit{kClass, 1, 2, "Acknowledge Handler.RetryLimit"};
+inline constexpr AttributeRef kProducingInstance{kClass, 1, 3,
+                                                 "Acknowledge Handler.ProducingConnectionInstance"};
+}  // namespace acknowledge_handler
 
 }  // namespace dnbridge::cip

@@ -102,8 +102,11 @@ TEST(ConfigEds, TheShippedExampleLoads) {
   EXPECT_TRUE(c.warnings.empty());
   const rack::PortNodes nodes = to_port_nodes(c.ports.at(0));
   ASSERT_EQ(nodes.pumps.size(), 1u);
-  ASSERT_EQ(nodes.devices.size(), 1u);
+  ASSERT_EQ(nodes.devices.size(), 2u);
   EXPECT_EQ(nodes.devices[0].eds->device.product_name, "Example IO block 8DI/8DO/1AI");
+  EXPECT_EQ(nodes.devices[0].settings.connection, eds::ConnectionKind::kPoll);
+  EXPECT_EQ(nodes.devices[1].settings.connection, eds::ConnectionKind::kChangeOfState);
+  EXPECT_EQ(nodes.devices[1].settings.heartbeat, milliseconds(500));
 }
 
 TEST(ConfigEds, APumpAndADeviceShareAPort) {
@@ -176,6 +179,34 @@ TEST(ConfigEds, WhatTheMasterWouldRefuseIsAnErrorAtItsKey) {
               HasSubstr("t.toml:15:14: connection = \"strobe\" is not a connection"));
   EXPECT_THAT(problems(ONE_PORT IO_BLOCK "parameters = [ { name = \"Input filter\" } ]\n"),
               HasSubstr("t.toml:15:16: missing required key 'value' in parameters"));
+}
+
+TEST(ConfigEds, AChangeOfStateNodeTakesItsHeartbeatInhibitAndAcknowledgment) {
+  const DaemonConfig c = parse(ONE_PORT IO_BLOCK
+                               "connection = \"change-of-state\"\n"
+                               "heartbeat_ms = 250\n"
+                               "inhibit_ms = 15\n"
+                               "acknowledged = false\n");
+  const NodeSettings& n = c.ports.at(0).nodes.at(0);
+  EXPECT_EQ(n.eds_node.connection, eds::ConnectionKind::kChangeOfState);
+  EXPECT_EQ(n.eds_node.heartbeat, milliseconds(250));
+  EXPECT_EQ(n.eds_node.inhibit, milliseconds(15));
+  EXPECT_FALSE(n.eds_node.acknowledged);
+  const auto nodes = to_port_nodes(c.ports[0]);
+  const auto list = rack::RackPort::scan_list(to_scanner_config(c.ports[0], "host"), nodes);
+  ASSERT_TRUE(list.nodes.at(0).profile.cos.has_value());
+  EXPECT_EQ(list.nodes[0].profile.cos->expected_packet_rate, milliseconds(250));
+
+  // Only for the connections they are about.
+  EXPECT_THAT(problems(ONE_PORT IO_BLOCK "heartbeat_ms = 250\n"),
+              HasSubstr("t.toml:15:16: heartbeat_ms is for connection = \"change-of-state\" or "
+                        "\"cyclic\" (this node's is \"poll\")"));
+  EXPECT_THAT(problems(ONE_PORT IO_BLOCK "connection = \"cyclic\"\ninhibit_ms = 5\n"),
+              HasSubstr("t.toml:16:14: inhibit_ms is for connection = \"change-of-state\""));
+  EXPECT_THAT(problems(ONE_PORT IO_BLOCK "connection = \"cyclic\"\nheartbeat_ms = 0\n"),
+              HasSubstr("t.toml:16:16: heartbeat_ms"));
+  EXPECT_THAT(problems(ONE_PORT "[[port.node]]\nmac = 1\nname = \"p\"\nacknowledged = true\n"),
+              HasSubstr("t.toml:9:16: acknowledged is for profile = \"eds\" nodes"));
 }
 
 TEST(ConfigEds, TheKeysOfOneProfileAreRefusedOnTheOther) {

@@ -49,13 +49,11 @@ constexpr Reply reply_error(cip::GeneralStatus s,
   return Reply{s, additional};
 }
 
-// Connection object instances of the predefined master/slave set: the
-// explicit and poll ones are cip's; the master has no use for instance 4 yet,
-// so its number lives here.
+// Connection object instances of the predefined master/slave set (cip's).
 namespace connection_instance {
+using cip::connection_instance::kChangeOfState;
 using cip::connection_instance::kExplicit;
 using cip::connection_instance::kPoll;
-inline constexpr std::uint16_t kChangeOfState = 4;  // change of state or cyclic
 }  // namespace connection_instance
 
 struct Connection {

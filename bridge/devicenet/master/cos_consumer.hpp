@@ -74,10 +74,15 @@ class CosConsumer {
   // connection is lost.
   bool check_watchdog(TimePoint now);
   bool lost() const noexcept { return lost_; }
+  // The last message taken (the connection's establishment before one).
+  TimePoint last_message() const noexcept { return last_; }
 
   // The master's acknowledgment: Group 2 message 2 to the slave, no data
   // (the ack carries none; a device that wanted some is UNVERIFIED).
   can::CanFrame ack_frame() const noexcept;
+
+  // The EPR the device returned for the one asked (the watchdog runs on it).
+  void set_expected_packet_rate(Duration epr) noexcept { settings_.expected_packet_rate = epr; }
 
   const CosSettings& settings() const noexcept { return settings_; }
   const CosCounters& counters() const noexcept { return counters_; }

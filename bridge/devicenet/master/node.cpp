@@ -106,6 +106,7 @@ void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
   poll_deadline_ = kNever;
   keepalive_at_ = kNever;
   poll_outstanding_ = false;
+  cos_.reset();
   set_state(fault, std::move(reason), now);
   retry_at_ = now + port_.fault_recheck;
   // Leave a device that is not ours to poll unowned, so that its own
@@ -173,6 +174,9 @@ void Node::forget_connections(Errc why, TimePoint now) {
   connected_ = false;
   poll_allocated_ = false;
   poll_requested_ = false;
+  cos_allocated_ = false;
+  cos_requested_ = false;
+  cos_.reset();
   client_.cancel_all(why, now);
 }
 
@@ -234,6 +238,24 @@ void Node::on_timer(TimePoint now) {
          now);
     return;
   }
+  // Likewise 4 x EPR without a change-of-state or cyclic message, heartbeats
+  // included.
+  if (cos_ && now >= cos_->watchdog_deadline() && cos_->check_watchdog(now)) {
+    ++counters_.heartbeats_missed;
+    record(NodeError::Kind::kHeartbeatMissed, now);
+    const Duration epr = cos_->settings().expected_packet_rate;
+    lose_and_release(
+        fmt::format("no {} message for {} ms (4 x EPR of {} ms){}",
+                    config_.profile.cos->cyclic ? "cyclic" : "change-of-state",
+                    std::chrono::duration_cast<milliseconds>(now - cos_->last_message()).count(),
+                    to_ms(epr),
+                    cos_consecutive_errors_ > 0
+                        ? fmt::format("; the last {} were refused: {}", cos_consecutive_errors_,
+                                      last_error_.describe())
+                        : std::string()),
+        now);
+    return;
+  }
   if (now >= next_poll_) {
     next_poll_ = next_poll_slot(now + Duration(1));
     if (!poll_outstanding_) send_poll(now);
@@ -268,6 +290,7 @@ TimePoint Node::deadline() const {
   t = std::min(t, retry_at_);
   if (state_ == NodeState::kOnline) {
     t = std::min({t, next_poll_, deferred_poll_, keepalive_at_, last_response_ + 4 * poll_epr_});
+    if (cos_) t = std::min(t, cos_->watchdog_deadline());
   }
   return t;
 }

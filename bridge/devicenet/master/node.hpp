@@ -16,6 +16,7 @@
 #include "bridge/common/log.hpp"
 #include "bridge/common/result.hpp"
 #include "bridge/common/time.hpp"
+#include "bridge/devicenet/master/cos_consumer.hpp"
 #include "bridge/devicenet/master/explicit_client.hpp"
 #include "bridge/devicenet/master/node_state.hpp"
 #include "bridge/devicenet/master/scan_list.hpp"
@@ -62,6 +63,7 @@ class Node final : private ExplicitClient::Listener {
 
   void on_explicit_frame(Bytes payload, TimePoint now);  // Group 2 message 3
   void on_poll_response(Bytes payload, TimePoint now);   // Group 1 message 15
+  void on_cos_message(Bytes payload, TimePoint now);     // Group 1 message 13
   // The node sent a duplicate MAC check request: it is powering up.
   void on_duplicate_mac_request(TimePoint now);
   void on_timer(TimePoint now);
@@ -109,6 +111,12 @@ class Node final : private ExplicitClient::Listener {
   // The wait for an explicit answer that requests from now on get.
   Duration explicit_response_timeout() const { return client_.response_timeout(); }
   Duration explicit_epr() const { return explicit_epr_; }
+  // The change-of-state or cyclic connection's settings as the device gave
+  // them (EPR, acknowledge timer, retry limit); empty without one.
+  std::optional<CosSettings> cos_settings() const {
+    if (!cos_) return std::nullopt;
+    return cos_->settings();
+  }
   bool stopped() const { return state_ == NodeState::kStopped; }
   // start() was called (a node never started holds no connection).
   bool started() const { return started_; }
@@ -121,7 +129,7 @@ class Node final : private ExplicitClient::Listener {
     kAllocateExplicit,  // DeviceNet.Allocate(explicit)
     kReleaseStale,      // DeviceNet.Release(explicit) after "already allocated"
     kAllocationInfo,    // what the device has allocated besides
-    kReleaseStalePoll,  // DeviceNet.Release(poll) left from before
+    kReleaseStalePoll,  // DeviceNet.Release(poll, change of state) left from before
     kVendor,
     kProductType,
     kProductCode,
@@ -147,6 +155,15 @@ class Node final : private ExplicitClient::Listener {
     kFallbackConsumedSize,
     kExplicitEpr,
     kPollEpr,
+    // With a change-of-state or cyclic connection (NodeProfile::cos):
+    kAllocateCos,            // DeviceNet.Allocate(change of state or cyclic)
+    kReleaseCosForAllocate,  // DeviceNet.Release(it) after "already allocated"
+    kSetCosPath,             // Connection 4's produced path, where the profile names one
+    kCosInhibit,             // its production inhibit time (change of state, when configured)
+    kCosSize,                // its produced size, checked
+    kAckTimer,               // the Acknowledge Handler's timer and retry limit (acknowledged)
+    kRetryLimit,
+    kCosEpr,  // its EPR: the connection starts producing
     kOnline,  // not a request: the poll connection starts
     // Outside start-up.
     kKeepAlive,
@@ -204,6 +221,20 @@ class Node final : private ExplicitClient::Listener {
   Step after_set_path(const ExplicitResult& r, TimePoint now);
   Step after_size(const ExplicitResult& r, TimePoint now);
   Step after_epr(const ExplicitResult& r, TimePoint now);
+  Step after_allocate_cos(const ExplicitResult& r, TimePoint now);
+  Step after_cos_step(const ExplicitResult& r, TimePoint now);
+  // The change-of-state steps in order, those that do not apply skipped.
+  Step cos_step_after(Step step) const;
+  std::uint8_t cos_choice() const;
+  // Its allocation bits without acknowledgment suppression (for Release).
+  std::uint8_t cos_connection_bits() const;
+  // A connection lost while the others live (the change-of-state
+  // watchdog): the outputs idle with one poll, every connection released,
+  // then absent as after any loss.
+  void lose_and_release(std::string reason, TimePoint now);
+  // One idle poll now, whatever the outputs in force, before the
+  // connections go (its answer comes once the node has left online).
+  void idle_poll_before_leaving(TimePoint now);
   void on_keepalive_result(const ExplicitResult& r, TimePoint now);
   // The Identity Status and State read last: a major fault takes the node to
   // kDeviceFault (false); a minor one is warned of when it appears.
@@ -255,6 +286,8 @@ class Node final : private ExplicitClient::Listener {
   void poll_on_change(TimePoint now);
   void accept_poll_response(Bytes data, TimePoint now);
   void bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now);
+  void take_cos_message(Bytes data, TimePoint now);
+  void bad_cos_message(NodeError::Kind kind, std::uint32_t got, TimePoint now);
   TimePoint next_poll_slot(TimePoint after) const;
 
   const NodeConfig config_;
@@ -282,6 +315,7 @@ class Node final : private ExplicitClient::Listener {
   bool setting_retried_ = false;     // a refused Set retried once after releasing the poll
   std::size_t check_index_ = 0;      // the check in hand
   bool poll_release_tried_ = false;  // the poll Allocate retried once after a Release
+  std::uint8_t stale_choice_ = 0;    // I/O connections left from before, to release
   InlineBytes<16> setting_found_;    // what the device had before the Set
   unsigned step_timeouts_ = 0;       // consecutive timeouts of the current life-cycle step
   Step last_step_ = Step::kNone;
@@ -337,6 +371,18 @@ class Node final : private ExplicitClient::Listener {
   InlineBytes<kMaxIoSize> applied_outputs_;
   bool applied_idle_ = true;
   IoReassembler io_reassembler_{kMaxIoSize};
+
+  // Change-of-state or cyclic connection: what the start-up learnt, then the
+  // consumer of its messages (from its Set of EPR on).
+  bool cos_allocated_ = false;
+  bool cos_requested_ = false;
+  bool cos_release_tried_ = false;  // its Allocate retried once after a Release
+  unsigned cos_consecutive_errors_ = 0;
+  bool ack_handler_unread_ = false;  // its timer or retry limit refused: defaults taken
+  std::string cos_path_refusal_;
+  CosSettings cos_asked_;
+  std::optional<CosConsumer> cos_;
+  IoReassembler cos_reassembler_{kMaxIoSize};
 
   NodeCounters counters_;
   NodeError last_error_;

@@ -26,6 +26,7 @@ using namespace node_detail;
 namespace {
 
 namespace conn = cip::connection;
+namespace ack = cip::acknowledge_handler;
 namespace ident = cip::identity;
 
 // Targets a row cannot name itself: they come from the profile.
@@ -73,6 +74,15 @@ const Node::StepRow Node::kStartup[] = {
   {Step::kFallbackConsumedSize, NodeState::kVerifying, Verb::kGet,     kProfileSizeFallback,                  0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_size},
   {Step::kExplicitEpr,      NodeState::kVerifying,    Verb::kSet,      conn::kExplicitExpectedPacketRate,     0,                     OnRefusal::kFault,       Step::kPollEpr,         &Node::after_epr},
   {Step::kPollEpr,          NodeState::kVerifying,    Verb::kSet,      conn::kPollExpectedPacketRate,         0,                     OnRefusal::kFault,       Step::kNone,            &Node::after_epr},
+  // The choice of kAllocateCos is the profile's (cos_choice()).
+  {Step::kAllocateCos,      NodeState::kVerifying,    Verb::kAllocate, kDeviceNetObject,                      0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_allocate_cos},
+  {Step::kReleaseCosForAllocate, NodeState::kVerifying, Verb::kRelease, kDeviceNetObject,              0,                     OnRefusal::kGoOn,        Step::kAllocateCos,     nullptr},
+  {Step::kSetCosPath,       NodeState::kVerifying,    Verb::kSet,      conn::kCosProducedPath,                0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
+  {Step::kCosInhibit,       NodeState::kVerifying,    Verb::kSet,      conn::kCosInhibitTime,                 0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
+  {Step::kCosSize,          NodeState::kVerifying,    Verb::kGet,      conn::kCosProducedSize,                0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
+  {Step::kAckTimer,         NodeState::kVerifying,    Verb::kGet,      ack::kAckTimer,                        0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
+  {Step::kRetryLimit,       NodeState::kVerifying,    Verb::kGet,      ack::kRetryLimit,                      0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
+  {Step::kCosEpr,           NodeState::kVerifying,    Verb::kSet,      conn::kCosExpectedPacketRate,          0,                     OnRefusal::kFault,       Step::kNone,            &Node::after_cos_step},
 };
 // clang-format on
 
@@ -114,6 +124,13 @@ std::string_view verb_name(std::uint8_t service) {
     default:
       return "request";
   }
+}
+
+// The EPR a Set of it returned (the device rounds it to its timer
+// resolution), or the one asked when it returned none.
+Duration returned_epr(const ExplicitResult& r, Duration asked) {
+  const auto actual = read_uint(r.data.view());
+  return actual && *actual > 0 ? milliseconds(*actual) : asked;
 }
 
 std::array<std::uint8_t, 2> uint_le(std::uint16_t v) {
@@ -167,8 +184,22 @@ std::uint8_t Node::held_connections() const {
   // A poll connection asked for but not yet confirmed may be the device's
   // already: released with the rest (a device without it refuses that
   // Release with 0x0B, and the explicit connection is released alone).
+  // The same holds of a change-of-state connection.
   return static_cast<std::uint8_t>((connected_ ? allocation::kExplicit : 0) |
-                                   (poll_allocated_ || poll_requested_ ? allocation::kPoll : 0));
+                                   (poll_allocated_ || poll_requested_ ? allocation::kPoll : 0) |
+                                   (cos_allocated_ || cos_requested_ ? cos_connection_bits() : 0));
+}
+
+std::uint8_t Node::cos_connection_bits() const {
+  return static_cast<std::uint8_t>(cos_choice() & ~allocation::kAckSuppression);
+}
+
+std::uint8_t Node::cos_choice() const {
+  const auto& cos = config_.profile.cos;
+  if (!cos) return 0;
+  return static_cast<std::uint8_t>(
+      (cos->cyclic ? allocation::kCyclic : allocation::kChangeOfState) |
+      (cos->acknowledged ? 0 : allocation::kAckSuppression));
 }
 
 void Node::release(Step step, std::uint8_t choice, TimePoint now) {
@@ -185,19 +216,30 @@ void Node::release_after_loss(TimePoint now) {
   if (state_ == NodeState::kStopped) return;
   shutting_down_ = true;
   reports_data_ = false;
-  release(Step::kReleaseShutdown, allocation::kExplicit | allocation::kPoll, now);
+  release(
+      Step::kReleaseShutdown,
+      static_cast<std::uint8_t>(allocation::kExplicit | allocation::kPoll | cos_connection_bits()),
+      now);
 }
 
 void Node::attempt_allocate(TimePoint now) {
   retry_at_ = kNever;
   step_timeouts_ = 0;
   poll_release_tried_ = false;
+  cos_release_tried_ = false;
+  ack_handler_unread_ = false;
   setting_retried_ = false;
   // What an attempt learns is its own: paths and refusals from an earlier one
   // would otherwise pile up in the reasons.
   path_refusal_.clear();
   produced_path_in_force_.clear();
   consumed_path_in_force_.clear();
+  cos_path_refusal_.clear();
+  cos_asked_ = CosSettings{};
+  if (const auto& cos = config_.profile.cos) {
+    cos_asked_.expected_packet_rate = cos->expected_packet_rate;
+    cos_asked_.ack_suppressed = !cos->acknowledged;
+  }
   ++counters_.allocate_attempts;
   run(Step::kAllocateExplicit, now);
 }
@@ -208,9 +250,16 @@ void Node::run(Step step, TimePoint now) {
     set_state(r.phase, std::string(phase_reason(r.phase)), now);
   }
   if (step == Step::kAllocatePoll) poll_requested_ = true;
+  if (step == Step::kAllocateCos) cos_requested_ = true;
+  if (step == Step::kCosEpr) {
+    // Setting EPR starts production: a message may come before the answer.
+    cos_.emplace(config_.mac, cos_asked_, now);
+    cos_reassembler_.reset();
+  }
   switch (r.verb) {
     case Verb::kAllocate: {
-      const std::array<std::uint8_t, 2> data{r.choice, port_.master_mac.value()};
+      const std::uint8_t choice = step == Step::kAllocateCos ? cos_choice() : r.choice;
+      const std::array<std::uint8_t, 2> data{choice, port_.master_mac.value()};
       RequestMessage m;
       m.service = static_cast<std::uint8_t>(cip::Service::kAllocateMasterSlave);
       m.class_id = kDeviceNetObject.class_id;
@@ -220,7 +269,11 @@ void Node::run(Step step, TimePoint now) {
       return;
     }
     case Verb::kRelease:
-      release(step, r.choice, now);
+      release(step,
+              step == Step::kReleaseStalePoll        ? stale_choice_
+              : step == Step::kReleaseCosForAllocate ? cos_connection_bits()
+                                                     : r.choice,
+              now);
       return;
     case Verb::kGet:
       get(step, target_of(step), now);
@@ -245,6 +298,17 @@ void Node::run(Step step, TimePoint now) {
           // device's 4 x EPR watchdog, so the first poll follows at once. A
           // lost answer is retried after 2 x EPR, while the connection lives.
           value.assign(Bytes(uint_le(to_ms(config_.expected_packet_rate))));
+          timeout = std::min(client_.response_timeout(), 2 * config_.expected_packet_rate);
+          break;
+        case Step::kSetCosPath:
+          value.assign(Bytes(config_.profile.cos->produced_path));
+          break;
+        case Step::kCosInhibit:
+          value.assign(Bytes(uint_le(to_ms(*config_.profile.cos->inhibit))));
+          break;
+        case Step::kCosEpr:
+          // Right after the poll connection's start, bounded as its Set was.
+          value.assign(Bytes(uint_le(to_ms(config_.profile.cos->expected_packet_rate))));
           timeout = std::min(client_.response_timeout(), 2 * config_.expected_packet_rate);
           break;
         default:
@@ -319,16 +383,23 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
       return;
     case Step::kReleaseFault:
     case Step::kReleaseShutdown:
-      // Released both where the device had only the explicit connection:
-      // refused whole (0x0B); the explicit connection alone, then.
+      // Released with a connection the device did not have: refused whole
+      // (0x0B). Without the change-of-state connection, then without the
+      // poll connection: the explicit connection alone.
       if (r.error == Errc::kDeviceError &&
           r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode &&
           !last_request_data_.empty() && last_request_data_.view()[0] != allocation::kExplicit &&
           (last_request_data_.view()[0] & allocation::kExplicit) != 0) {
-        release(step, allocation::kExplicit, now);
+        constexpr std::uint8_t kCos = allocation::kChangeOfState | allocation::kCyclic;
+        const std::uint8_t asked = last_request_data_.view()[0];
+        release(
+            step,
+            (asked & kCos) != 0 ? static_cast<std::uint8_t>(asked & ~kCos) : allocation::kExplicit,
+            now);
         return;
       }
-      connected_ = poll_allocated_ = poll_requested_ = false;
+      connected_ = poll_allocated_ = poll_requested_ = cos_allocated_ = cos_requested_ = false;
+      cos_.reset();
       // Whatever the answer, a faulted node is left alone until the re-check.
       if (step == Step::kReleaseShutdown) {
         set_state(NodeState::kStopped, "released by " + shutdown_why_, now);
@@ -431,10 +502,13 @@ Node::Step Node::after_allocate_explicit(const ExplicitResult& r, TimePoint now)
 }
 
 Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint) {
-  // A poll connection left from before (this master's, restarted) is
-  // released: it is made afresh once the configuration is in place.
-  if (r.ok() && !r.data.empty() && (r.data[0] & allocation::kPoll) != 0) {
-    log_.info("a poll connection is still allocated from before: releasing it");
+  // I/O connections left from before (this master's, restarted) are
+  // released: they are made afresh once the configuration is in place.
+  constexpr std::uint8_t kIo = allocation::kPoll | allocation::kChangeOfState | allocation::kCyclic;
+  if (r.ok() && !r.data.empty() && (r.data[0] & kIo) != 0) {
+    stale_choice_ = static_cast<std::uint8_t>(r.data[0] & kIo);
+    log_.info("I/O connections are still allocated from before (0x{:02X}): releasing them",
+              stale_choice_);
     return Step::kReleaseStalePoll;
   }
   return Step::kVendor;
@@ -834,7 +908,7 @@ Node::Step Node::check_sizes(TimePoint now) {
     log_.info("{}; the paths in force give the sizes the configuration needs: going on",
               path_refusal_);
   }
-  return Step::kExplicitEpr;
+  return config_.profile.cos ? Step::kAllocateCos : Step::kExplicitEpr;
 }
 
 Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
@@ -843,8 +917,7 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
   // uses; every timeout that depends on EPR uses that value. A device that
   // returns nothing keeps the value asked.
   const Duration asked = poll ? config_.expected_packet_rate : config_.explicit_packet_rate;
-  const auto actual = read_uint(r.data.view());
-  const Duration epr = actual && *actual > 0 ? milliseconds(*actual) : asked;
+  const Duration epr = returned_epr(r, asked);
   if (!poll) {
     explicit_epr_ = epr;
     return Step::kPollEpr;
@@ -860,7 +933,131 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
         "poll period of {} ms: a lost connection is noticed only after {} ms",
         to_ms(epr), to_ms(asked), to_ms(config_.poll_period), 4 * to_ms(epr));
   }
-  return Step::kOnline;
+  return config_.profile.cos ? Step::kCosEpr : Step::kOnline;
+}
+
+// --- change of state or cyclic ---------------------------------------------------
+
+// The change-of-state connection is set up once the poll connection's sizes
+// are verified, and started (its EPR) right after the poll connection's:
+// nothing runs between the poll connection's start and its first poll but
+// that one Set.
+Node::Step Node::cos_step_after(Step step) const {
+  if (step == Step::kCosEpr) return Step::kOnline;
+  static constexpr Step kOrder[] = {Step::kAllocateCos, Step::kSetCosPath, Step::kCosInhibit,
+                                    Step::kCosSize,     Step::kAckTimer,   Step::kRetryLimit,
+                                    Step::kExplicitEpr};
+  const CosConnection& cos = *config_.profile.cos;
+  const auto applies = [&](Step s) {
+    switch (s) {
+      case Step::kSetCosPath:
+        return !cos.produced_path.empty();
+      case Step::kCosInhibit:
+        return !cos.cyclic && cos.inhibit.has_value();
+      case Step::kAckTimer:
+      case Step::kRetryLimit:
+        return cos.acknowledged;
+      default:
+        return true;
+    }
+  };
+  const auto* at = std::find(std::begin(kOrder), std::end(kOrder), step);
+  for (++at; at != std::end(kOrder); ++at) {
+    if (applies(*at)) return *at;
+  }
+  return Step::kExplicitEpr;
+}
+
+Node::Step Node::after_allocate_cos(const ExplicitResult& r, TimePoint now) {
+  const std::string what =
+      fmt::format("Allocate of the {} connection (choice 0x{:02X})",
+                  config_.profile.cos->cyclic ? "cyclic" : "change-of-state", cos_choice());
+  if (r.ok()) {
+    cos_allocated_ = true;
+    return cos_step_after(Step::kAllocateCos);
+  }
+  // Held already (its answer to an Allocate lost on the bus, or left from
+  // before): released, then allocated once more, as the poll connection.
+  if (r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode && !cos_release_tried_) {
+    cos_release_tried_ = true;
+    return Step::kReleaseCosForAllocate;
+  }
+  cos_requested_ = false;  // refused: the device did not give it
+  if (r.general_status == cip::GeneralStatus::kObjectStateConflict && r.additional_status == 0x01) {
+    enter_fault(NodeState::kOwnedByOtherMaster,
+                fmt::format("{} refused: owned by another master (0x0C/0x01)", what), now);
+    return Step::kNone;
+  }
+  enter_fault(
+      NodeState::kConfigurationFault,
+      fmt::format("{} refused: {}; the node's connection = \"{}\" needs it", what, status_text(r),
+                  config_.profile.cos->cyclic ? "cyclic" : "change-of-state"),
+      now);
+  return Step::kNone;
+}
+
+// The answers to the change-of-state connection's set-up: what the device
+// refuses but can do without is logged and the set-up goes on; a produced
+// size other than the configuration's is a fault.
+Node::Step Node::after_cos_step(const ExplicitResult& r, TimePoint now) {
+  const Step step = last_step_;
+  const cip::AttributeRef target = target_of(step);
+  const CosConnection& cos = *config_.profile.cos;
+  switch (step) {
+    case Step::kSetCosPath:
+      if (!r.ok()) {
+        cos_path_refusal_ = fmt::format("; Set of {} to {} refused: {}", target.name,
+                                        hex(Bytes(cos.produced_path)), status_text(r));
+        log_.info("{}: the size tells whether the device's own path serves",
+                  cos_path_refusal_.substr(2));
+      }
+      break;
+    case Step::kCosInhibit:
+      if (!r.ok()) {
+        log_.warn("the device refused {} = {} ms ({}): it keeps its own", target.name,
+                  to_ms(*cos.inhibit), status_text(r));
+      }
+      break;
+    case Step::kCosSize: {
+      const auto size = r.ok() ? read_uint(r.data.view()) : std::nullopt;
+      if (!r.ok()) {
+        log_.info("{} not read ({}): every message's size is checked", target.name, status_text(r));
+      } else if (!size || *size != cos.produced_size) {
+        enter_fault(NodeState::kConfigurationFault,
+                    fmt::format("{} is {}, the configuration expects {} bytes{}", target.name,
+                                size ? fmt::format("{} bytes", *size) : hex(r.data.view()),
+                                cos.produced_size, cos_path_refusal_),
+                    now);
+        return Step::kNone;
+      }
+      break;
+    }
+    case Step::kAckTimer:
+    case Step::kRetryLimit: {
+      const auto v = r.ok() ? read_uint(r.data.view()) : std::nullopt;
+      if (!v) {
+        ack_handler_unread_ = true;
+        log_.info("{} not read ({}): taking the default, {}", target.name,
+                  r.ok() ? hex(r.data.view()) : status_text(r),
+                  step == Step::kAckTimer ? "20 ms" : "1 retry");
+      } else if (step == Step::kAckTimer) {
+        cos_asked_.ack_timer = milliseconds(*v);
+      } else {
+        cos_asked_.retry_limit = static_cast<std::uint8_t>(std::min<std::uint32_t>(*v, 255));
+      }
+      break;
+    }
+    case Step::kCosEpr: {
+      // As the poll's: the value the device returned is the one it uses.
+      const Duration epr = returned_epr(r, cos.expected_packet_rate);
+      cos_asked_.expected_packet_rate = epr;
+      if (cos_) cos_->set_expected_packet_rate(epr);
+      break;
+    }
+    default:
+      break;
+  }
+  return cos_step_after(step);
 }
 
 void Node::on_keepalive_result(const ExplicitResult& r, TimePoint now) {
@@ -913,24 +1110,39 @@ bool Node::check_health(TimePoint now) {
   return false;
 }
 
+void Node::idle_poll_before_leaving(TimePoint now) {
+  // The answers to it, and to a poll outstanding, arrive once the node has
+  // left online.
+  stray_poll_responses_ = poll_outstanding_ ? 2 : 1;
+  const bool idle = idle_;
+  idle_ = true;
+  send_poll(now);
+  idle_ = idle;
+}
+
 void Node::device_fault(std::string reason, TimePoint now) {
   if (state_ == NodeState::kOnline) {
     ++counters_.reconnects;
-    // Outputs to the device's idle state before the connections go: one idle
-    // poll now, whatever the outputs in force (the answers to it, and to a
-    // poll outstanding, arrive once the node has left online).
-    stray_poll_responses_ = poll_outstanding_ ? 2 : 1;
-    const bool idle = idle_;
-    idle_ = true;
-    send_poll(now);
-    idle_ = idle;
+    // Outputs to the device's idle state before the connections go.
+    idle_poll_before_leaving(now);
   }
   enter_fault(NodeState::kDeviceFault, std::move(reason), now);
+}
+
+void Node::lose_and_release(std::string reason, TimePoint now) {
+  // The poll connection lives: the outputs go to the device's idle state at
+  // once rather than after its own watchdog, and what the device holds is
+  // released (the node is allocated afresh after the back-off).
+  if (state_ == NodeState::kOnline) idle_poll_before_leaving(now);
+  const std::uint8_t held = held_connections();
+  lose(std::move(reason), now);
+  if (held != 0) release(Step::kReleaseFault, held, now);
 }
 
 void Node::go_online(TimePoint now) {
   retry_delay_ = port_.allocate_retry_min;
   stray_poll_responses_ = 0;
+  cos_consecutive_errors_ = 0;
   poll_outstanding_ = false;
   poll_unanswered_ = false;
   consecutive_errors_ = 0;
@@ -950,6 +1162,19 @@ void Node::go_online(TimePoint now) {
     reason +=
         fmt::format(" (sizes read from {} and {})", size_attribute(true, produced_from_fallback_),
                     size_attribute(false, consumed_from_fallback_));
+  }
+  if (cos_) {
+    const CosSettings& c = cos_->settings();
+    reason += fmt::format(
+        "; inputs {} (EPR {} ms, {})",
+        config_.profile.cos->cyclic ? "cyclic" : "on change of state",
+        to_ms(c.expected_packet_rate),
+        c.ack_suppressed ? std::string("acknowledgment suppressed")
+                         : fmt::format("acknowledged: the device retries after {} ms, {} time(s){}",
+                                       to_ms(c.ack_timer), unsigned{c.retry_limit},
+                                       ack_handler_unread_ ? " (defaults: its Acknowledge "
+                                                             "Handler not read)"
+                                                           : ""));
   }
   if (!identity_state_supported_) reason += "; Identity.State not supported: state unknown";
   set_state(NodeState::kOnline, std::move(reason), now);

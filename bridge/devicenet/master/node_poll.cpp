@@ -176,6 +176,80 @@ void Node::bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint 
   }
 }
 
+// --- change of state or cyclic --------------------------------------------------
+
+void Node::on_cos_message(Bytes payload, TimePoint now) {
+  // From the Set of its EPR on (a first message may come before the answer).
+  if (!cos_ || (state_ != NodeState::kOnline && step_ != Step::kCosEpr)) {
+    bad_cos_message(NodeError::Kind::kCosUnexpected, static_cast<std::uint32_t>(payload.size()),
+                    now);
+    return;
+  }
+  const std::size_t size = config_.profile.cos->produced_size;
+  if (size <= can::kMaxDataLength) {
+    if (payload.size() != size) {
+      bad_cos_message(NodeError::Kind::kCosLength, static_cast<std::uint32_t>(payload.size()), now);
+      return;
+    }
+    take_cos_message(payload, now);
+    return;
+  }
+  switch (cos_reassembler_.on_fragment(payload)) {
+    case IoReassembler::Outcome::kIncomplete:
+      return;
+    case IoReassembler::Outcome::kComplete: {
+      const Bytes message = cos_reassembler_.message();
+      if (message.size() != size) {
+        bad_cos_message(NodeError::Kind::kCosLength, static_cast<std::uint32_t>(message.size()),
+                        now);
+      } else {
+        take_cos_message(message, now);
+      }
+      cos_reassembler_.reset();
+      return;
+    }
+    default:
+      bad_cos_message(NodeError::Kind::kCosMalformed, static_cast<std::uint32_t>(payload.size()),
+                      now);
+      return;
+  }
+}
+
+void Node::take_cos_message(Bytes data, TimePoint now) {
+  const CosConsumer::Taken taken = cos_->on_message(data, now);
+  ++counters_.cos_messages;
+  if (taken.repeat) ++counters_.cos_retries;
+  if (taken.acknowledge) {
+    sink_.send(cos_->ack_frame(), now);
+    ++counters_.cos_acks;
+  }
+  cos_consecutive_errors_ = 0;
+  // A retry carries nothing new.
+  if (state_ == NodeState::kOnline && reports_data_ && !taken.repeat) {
+    observer_.on_poll_response(config_.mac, data, now);
+  }
+}
+
+void Node::bad_cos_message(NodeError::Kind kind, std::uint32_t got, TimePoint now) {
+  // Neither taken nor acknowledged: the device sends it again, or the
+  // watchdog ends the connection.
+  // A straggler of a connection just released is no news.
+  if (!cos_ && kind == NodeError::Kind::kCosUnexpected && state_ != NodeState::kOnline) {
+    ++counters_.cos_errors;
+    return;
+  }
+  ++counters_.cos_errors;
+  const std::size_t expected = config_.profile.cos ? config_.profile.cos->produced_size : 0;
+  record(kind, now, got, static_cast<std::uint32_t>(expected));
+  error_log_limit_.warn(log_, now, "{}", last_error_.describe());
+  if (state_ != NodeState::kOnline) return;
+  if (++cos_consecutive_errors_ >= port_.max_consecutive_errors) {
+    lose_and_release(fmt::format("{} bad change-of-state messages in a row: {}",
+                                 cos_consecutive_errors_, last_error_.describe()),
+                     now);
+  }
+}
+
 Status Node::set_outputs(Bytes data, TimePoint now) {
   if (data.size() != config_.profile.consumed_size) return Errc::kOutOfRange;
   const bool changed = idle_ || !std::equal(data.begin(), data.end(), outputs_.view().begin(),

@@ -56,6 +56,14 @@ std::string NodeError::describe() const {
     }
     case Kind::kConnectionLost:
       return "connection lost: no poll response for 4 x EPR";
+    case Kind::kCosLength:
+      return fmt::format("change-of-state message of {} bytes, expected {}", got, expected);
+    case Kind::kCosUnexpected:
+      return "change-of-state message with no change-of-state connection";
+    case Kind::kCosMalformed:
+      return "fragmented change-of-state message out of order";
+    case Kind::kHeartbeatMissed:
+      return "connection lost: no change-of-state message for 4 x EPR";
   }
   return "?";
 }

@@ -46,6 +46,10 @@ struct NodeError {
     kExplicitMalformed,  // unparsable explicit response
     kDeviceError,        // CIP error status (general/additional)
     kConnectionLost,     // silence for 4 x EPR
+    kCosLength,          // change-of-state/cyclic message of the wrong size (got/expected)
+    kCosUnexpected,      // change-of-state/cyclic message with no such connection
+    kCosMalformed,       // fragmented change-of-state/cyclic message out of order
+    kHeartbeatMissed,    // no change-of-state/cyclic message for 4 x EPR
   };
   Kind kind = Kind::kNone;
   TimePoint at{};
@@ -69,6 +73,12 @@ struct NodeCounters {
   std::uint64_t idle_empty_responses = 0;  // idle polls answered with no data (valid)
   std::uint64_t explicit_retries = 0;      // life-cycle requests sent again after no answer
   std::uint64_t settings_written = 0;      // attributes the start-up had to change
+  // Change-of-state or cyclic connection (instance 4), where the node has one.
+  std::uint64_t cos_messages = 0;       // messages taken, the device's retries included
+  std::uint64_t cos_acks = 0;           // acknowledgments sent
+  std::uint64_t cos_retries = 0;        // the device's retries seen (an acknowledgment it missed)
+  std::uint64_t cos_errors = 0;         // messages not taken (size, order, no connection)
+  std::uint64_t heartbeats_missed = 0;  // 4 x EPR without a message: the node lost
 };
 
 }  // namespace dnbridge::devicenet

@@ -85,6 +85,26 @@ struct SizeSource {
   friend bool operator==(const SizeSource&, const SizeSource&) = default;
 };
 
+// A change-of-state or cyclic connection (Connection instance 4) beside the
+// poll connection: the device produces its inputs on it, on a change (no
+// sooner than the inhibit time after the last) and at least once per EPR as
+// a heartbeat, or every EPR (cyclic); the master acknowledges each message
+// unless acknowledgment is suppressed. The outputs, and the device's answer
+// to them, stay on the poll connection (which then keeps the connections
+// alive at the node's poll period). Nothing for 4 x EPR is the node's loss.
+struct CosConnection {
+  bool cyclic = false;       // allocation choice 0x20 rather than 0x10
+  bool acknowledged = true;  // false: allocated with 0x40, nothing acknowledged or retried
+  Duration expected_packet_rate = milliseconds(1000);  // heartbeat or cycle, as asked
+  // Production inhibit time (attribute 17, change of state only); none: the
+  // device's own is left.
+  std::optional<Duration> inhibit;
+  std::vector<std::uint8_t> produced_path;  // attribute 14; empty: the device's default
+  std::size_t produced_size = 0;            // message bytes expected
+
+  friend bool operator==(const CosConnection&, const CosConnection&) = default;
+};
+
 // Device-specific knowledge the node life cycle needs, as data: built by a
 // profile (profiles/cdn127/node_profile.hpp).
 struct NodeProfile {
@@ -98,6 +118,7 @@ struct NodeProfile {
   std::string format_description;           // e.g. "request 4 B [DOUT PAD AOUT] ..."
   bool has_size_fallback = false;
   SizeSource size_fallback;
+  std::optional<CosConnection> cos;  // inputs also on change of state or cyclic
 
   friend bool operator==(const NodeProfile&, const NodeProfile&) = default;
 };

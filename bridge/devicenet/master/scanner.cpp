@@ -369,6 +369,17 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
     }
     return;
   }
+  if (id->group == MessageGroup::k1 &&
+      id->message_id == static_cast<std::uint8_t>(Group1Message::kSlaveCosCyclic)) {
+    if (Node* n = route(id->mac)) {
+      n->on_cos_message(payload, rx_time);
+    } else {
+      ++counters_.unknown_nodes;
+      answering_other_master_.set(id->mac.value());  // producing: another master holds it
+      heard_unconfigured(id->mac, "producing for another master (change of state)", rx_time);
+    }
+    return;
+  }
   if (id->group == MessageGroup::k2 &&
       id->message_id == static_cast<std::uint8_t>(Group2Message::kSlaveExplicitResponse)) {
     if (Node* n = route(id->mac)) {

@@ -147,24 +147,56 @@ std::optional<devicenet::AttributeCheck> member_list_check(
 
 }  // namespace
 
-Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::string* why) {
-  const ConnectionInfo* c = file.io.connection(connection);
-  if (c == nullptr) {
-    std::string offered;
+namespace {
+
+// The EDS entries a node on `connection` uses (node_io()).
+struct IoEntries {
+  const IoData* input = nullptr;
+  const IoData* output = nullptr;
+};
+
+Result<IoEntries> io_entries(const EdsFile& file, ConnectionKind connection, std::string* why) {
+  const auto offered = [&](ConnectionKind kind) -> Result<const ConnectionInfo*> {
+    if (const ConnectionInfo* c = file.io.connection(kind)) return c;
+    std::string list;
     for (const auto& o : file.io.connections) {
-      offered += fmt::format("{}{}", offered.empty() ? "" : ", ", to_string(o.kind));
+      list += fmt::format("{}{}", list.empty() ? "" : ", ", to_string(o.kind));
     }
-    return explain(why, Errc::kUnsupported,
-                   fmt::format("the EDS offers no {} connection (it offers: {})",
-                               to_string(connection), offered.empty() ? "none" : offered));
+    return explain(
+        why, Errc::kUnsupported,
+        fmt::format("the EDS offers no {} connection (it offers: {}){}", to_string(kind),
+                    list.empty() ? "none" : list,
+                    kind == connection ? ""
+                                       : fmt::format(": a node on {} has its outputs and keeps its "
+                                                     "connections on a poll connection beside it",
+                                                     to_string(connection))));
+  };
+  auto c = offered(connection);
+  if (!c) return c.error();
+  IoEntries e;
+  e.input = (*c)->input != 0 ? file.io.input((*c)->input) : nullptr;
+  const ConnectionInfo* out = *c;
+  if (connection == ConnectionKind::kChangeOfState || connection == ConnectionKind::kCyclic) {
+    auto poll = offered(ConnectionKind::kPoll);
+    if (!poll) return poll.error();
+    out = *poll;
   }
+  e.output = out->output != 0 ? file.io.output(out->output) : nullptr;
+  return e;
+}
+
+bool is_cos(ConnectionKind k) {
+  return k == ConnectionKind::kChangeOfState || k == ConnectionKind::kCyclic;
+}
+
+}  // namespace
+
+Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::string* why) {
+  auto e = io_entries(file, connection, why);
+  if (!e) return e.error();
   NodeIo io;
-  if (c->input != 0) {
-    if (const IoData* d = file.io.input(c->input)) io.produced = layout_of(file, *d);
-  }
-  if (c->output != 0) {
-    if (const IoData* d = file.io.output(c->output)) io.consumed = layout_of(file, *d);
-  }
+  if (e->input) io.produced = layout_of(file, *e->input);
+  if (e->output) io.consumed = layout_of(file, *e->output);
   return io;
 }
 
@@ -173,9 +205,10 @@ Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> 
   const EdsFile& file = *shared;
   auto io = node_io(file, node.connection, why);
   if (!io) return io.error();
-  if (node.connection != ConnectionKind::kPoll) {
+  if (node.connection == ConnectionKind::kStrobe) {
     return explain(why, Errc::kUnsupported,
-                   fmt::format("connection \"{}\": dnbridge's master opens poll connections only",
+                   fmt::format("connection \"{}\": dnbridge's master does not open bit-strobe "
+                               "connections",
                                to_string(node.connection)));
   }
   if (io->consumed.size > 0 && node.safe_state.empty()) {
@@ -206,14 +239,26 @@ Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> 
   if (auto s = add(node.parameters, "parameters"); !s) return s.error();
   if (auto s = add(node.safe_state, "safe_state"); !s) return s.error();
 
-  const ConnectionInfo* c = file.io.connection(node.connection);
-  if (const IoData* d = file.io.input(c->input)) p.produced_path = cip::encoded(d->path);
-  if (const IoData* d = file.io.output(c->output)) p.consumed_path = cip::encoded(d->path);
-  for (const IoData* d : {file.io.input(c->input), file.io.output(c->output)}) {
+  const IoEntries e = *io_entries(file, node.connection, why);
+  // On change of state or cyclic the poll response carries the same data as
+  // the connection's messages.
+  if (e.input) p.produced_path = cip::encoded(e.input->path);
+  if (e.output) p.consumed_path = cip::encoded(e.output->path);
+  for (const IoData* d : {e.input, e.output}) {
     if (auto check = member_list_check(shared, d)) p.checks.push_back(std::move(*check));
   }
   p.produced_size = io->produced.size;
   p.consumed_size = io->consumed.size;
+  if (is_cos(node.connection)) {
+    devicenet::CosConnection cos;
+    cos.cyclic = node.connection == ConnectionKind::kCyclic;
+    cos.acknowledged = node.acknowledged;
+    cos.expected_packet_rate = node.heartbeat;
+    if (!cos.cyclic) cos.inhibit = node.inhibit;
+    cos.produced_path = p.produced_path;
+    cos.produced_size = io->produced.size;
+    p.cos = std::move(cos);
+  }
   p.format_description = fmt::format("{}, {}", describe_data(io->produced, "input"),
                                      describe_data(io->consumed, "output"));
   return p;

@@ -36,6 +36,12 @@ struct EdsNode {
   ConnectionKind connection = ConnectionKind::kPoll;
   std::vector<ParameterValue> parameters;  // set in this order
   std::vector<ParameterValue> safe_state;  // then these
+  // Change of state or cyclic: the connection's EPR (the heartbeat, or the
+  // cycle), its production inhibit time (change of state; none leaves the
+  // device's), and whether its messages are acknowledged.
+  Duration heartbeat = milliseconds(1000);
+  std::optional<Duration> inhibit;
+  bool acknowledged = true;
 
   friend bool operator==(const EdsNode&, const EdsNode&) = default;
 };
@@ -46,14 +52,17 @@ struct NodeIo {
   IoLayout consumed;  // its outputs (OutputN); size 0: none
 };
 
-// The chosen connection's InputN and OutputN. kUnsupported when the EDS
-// does not offer the connection, `why` saying so.
+// The chosen connection's InputN and OutputN; on change of state or cyclic,
+// that connection's InputN and the poll connection's OutputN (the master
+// commands the outputs on the poll connection beside it). kUnsupported when
+// the EDS does not offer the connection (or, then, a poll connection), `why`
+// saying so.
 Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::string* why = nullptr);
 
 // The scan-list profile of `node`. Fails (kUnsupported, kMalformed,
 // kOutOfRange), `why` naming the parameter and what is wrong, for: a
-// connection the EDS does not offer or the master does not open (only poll
-// today), an unknown parameter (with the nearest name), one given twice, one
+// connection the EDS does not offer or the master does not open (bit-strobe),
+// an unknown parameter (with the nearest name), one given twice, one
 // read only, one without a link path or of a string type, a value outside
 // its type or the EDS's limits, and outputs without a safe state.
 //

@@ -164,9 +164,62 @@ TEST(EdsNodeProfile, AConnectionTheEdsDoesNotOfferOrTheMasterDoesNotOpenIsRefuse
   EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kUnsupported));
   EXPECT_EQ(why,
             "the EDS offers no bit-strobe connection (it offers: poll, change of state, cyclic)");
+  // The valve manifold offers bit-strobe, which the master does not open;
+  // and no change of state.
+  const EdsFile manifold = test::example_eds(test::kValveManifoldEds);
+  EdsNode m;
+  m.connection = ConnectionKind::kStrobe;
+  EXPECT_EQ(profile_of(manifold, m, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why,
+            "connection \"bit-strobe\": dnbridge's master does not open bit-strobe "
+            "connections");
+  m.connection = ConnectionKind::kChangeOfState;
+  EXPECT_EQ(profile_of(manifold, m, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why, "the EDS offers no change of state connection (it offers: poll, bit-strobe)");
+}
+
+TEST(EdsNodeProfile, ChangeOfStateNeedsThePollConnectionBesideItForTheOutputs) {
+  auto parsed = parse(
+      "[Device]\nVendCode = 1; ProdType = 0; ProdCode = 2; MajRev = 1; MinRev = 1;\n"
+      "[IO_Info]\nCOSInfo = 4, 1, 0;\n"
+      "Input1 = 1, 0, 4, \"in\", 6, \"20 04 24 64 30 03\", \"\";\n");
+  ASSERT_TRUE(parsed.file.has_value());
+  EdsNode n;
   n.connection = ConnectionKind::kChangeOfState;
-  EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kUnsupported));
-  EXPECT_EQ(why, "connection \"change of state\": dnbridge's master opens poll connections only");
+  std::string why;
+  EXPECT_EQ(profile_of(*parsed.file, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why,
+            "the EDS offers no poll connection (it offers: change of state): a node on change "
+            "of state has its outputs and keeps its connections on a poll connection beside it");
+}
+
+TEST(EdsNodeProfile, AChangeOfStateNodeProducesTheInputsOnInstance4AndIsPolledForItsOutputs) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  EdsNode n = polled();
+  n.connection = ConnectionKind::kChangeOfState;
+  n.heartbeat = milliseconds(250);
+  n.inhibit = milliseconds(15);
+  n.acknowledged = false;
+  std::string why;
+  auto p = profile_of(f, n, &why);
+  ASSERT_TRUE(p.ok()) << why;
+  ASSERT_TRUE(p->cos.has_value());
+  EXPECT_FALSE(p->cos->cyclic);
+  EXPECT_FALSE(p->cos->acknowledged);
+  EXPECT_EQ(p->cos->expected_packet_rate, milliseconds(250));
+  EXPECT_EQ(p->cos->inhibit, milliseconds(15));
+  // Input1 (Assembly 100) on both connections; Output1 (Assembly 150) polled.
+  const std::vector<std::uint8_t> assembly100{0x20, 0x04, 0x24, 0x64, 0x30, 0x03};
+  EXPECT_EQ(p->cos->produced_path, assembly100);
+  EXPECT_EQ(p->produced_path, assembly100);
+  EXPECT_EQ(p->cos->produced_size, 4u);
+  EXPECT_EQ(p->consumed_size, 2u);
+
+  n.connection = ConnectionKind::kCyclic;
+  p = profile_of(f, n, &why);
+  ASSERT_TRUE(p.ok()) << why;
+  EXPECT_TRUE(p->cos->cyclic);
+  EXPECT_FALSE(p->cos->inhibit.has_value());  // a cyclic connection has none
 }
 
 TEST(EdsNodeProfile, AParameterWithoutALinkPathOrOfAStringTypeIsNotSet) {
