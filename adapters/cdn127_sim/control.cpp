@@ -4,6 +4,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <vector>
 
 #include "bridge/profiles/cdn127/io_data.hpp"
@@ -120,8 +121,27 @@ ParseResult parse_control(std::string_view line) {
   }
   if (verb != "set") return fmt::format("unknown command \"{}\" (help lists them)", verb);
 
-  if (w.size() != 4) return std::string("usage: set MAC INPUT VALUE");
   c.verb = Verb::kSet;
+  if (w.size() == 5 && w[2] == "param") {
+    auto t = target(w[1], false);
+    if (auto* e = std::get_if<std::string>(&t)) return *e;
+    c.mac = std::get<std::optional<std::uint8_t>>(t);
+    c.input = Input::kParam;
+    const std::string n(w[3]);
+    const std::string v(w[4]);
+    char* end = nullptr;
+    const unsigned long number = std::strtoul(n.c_str(), &end, 10);
+    if (n.empty() || *end != '\0' || number == 0 || number > 0xFFFF) {
+      return fmt::format("\"{}\" is not a parameter number (1..65535)", n);
+    }
+    c.param = static_cast<unsigned>(number);
+    c.value = std::strtod(v.c_str(), &end);
+    if (v.empty() || *end != '\0' || !std::isfinite(c.value)) {
+      return fmt::format("\"{}\" is not a number", v);
+    }
+    return c;
+  }
+  if (w.size() != 4) return std::string("usage: set MAC INPUT VALUE, or set MAC param N VALUE");
   auto t = target(w[1], false);
   if (auto* e = std::get_if<std::string>(&t)) return *e;
   c.mac = std::get<std::optional<std::uint8_t>>(t);
@@ -158,6 +178,8 @@ std::string_view control_help() noexcept {
   set MAC n2-flow on|off      N2 purge flow present (on = ok)
   set MAC interlock on|off    interlock satisfied (on = ok)
   set MAC ain1|ain2 VALUE     analog input: volts ("2.5V", 0..10) or counts (0..4095)
+  set MAC param N VALUE       a device driven by its EDS: its ParamN (1, 0x5A, -2.5),
+                              then a change-of-state message if one is due
   fault MAC|all FAULT on|off  Identity fault on or off; FAULT: minor-recoverable (DOP
                               short), minor-unrecoverable, major-recoverable (+24 V lost;
                               State 4), major-unrecoverable (checksum, A/D; State 5).

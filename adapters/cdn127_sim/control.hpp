@@ -9,6 +9,9 @@
 //   set MAC interlock on|off      interlock satisfied (on = ok)
 //   set MAC ain1|ain2 VALUE       analog input: volts with a V ("2.5V",
 //                                 0..10) or raw counts (0..4095)
+//   set MAC param N VALUE         a device driven by its EDS: its ParamN (an
+//                                 input, as the device's own process sets
+//                                 it), then a change-of-state message if due
 //   fault MAC|all FAULT on|off    an Identity fault (attribute 5 bits 8..11):
 //                                 minor-recoverable, minor-unrecoverable,
 //                                 major-recoverable (State 4) or
@@ -46,7 +49,15 @@ enum class Verb : std::uint8_t {
   kHelp,
   kQuit
 };
-enum class Input : std::uint8_t { kAlarm, kWarning, kN2Flow, kInterlock, kAnalog1, kAnalog2 };
+enum class Input : std::uint8_t {
+  kAlarm,
+  kWarning,
+  kN2Flow,
+  kInterlock,
+  kAnalog1,
+  kAnalog2,
+  kParam,  // an EDS-driven device's ParamN
+};
 // The Identity faults (sim::IdentityFaults).
 enum class Fault : std::uint8_t {
   kMinorRecoverable,
@@ -62,6 +73,8 @@ struct ControlCommand {
   bool on = false;                  // kSet of a digital input; kFault: set or cleared
   Fault fault = Fault::kMinorRecoverable;  // kFault
   std::uint16_t raw = 0;            // kSet of an analog input, 12-bit counts
+  unsigned param = 0;               // kSet of kParam: N
+  double value = 0;                 // kSet of kParam: the value
 };
 
 // An empty or comment line ("# ...") parses to nothing; an error is a

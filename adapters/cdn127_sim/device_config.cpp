@@ -67,7 +67,37 @@ DeviceSettings read_settings(TableReader& t) {
   return s;
 }
 
-DeviceConfig read(const toml::table& table, Problems& p) {
+// eds = "FILE": read and parsed; its problems at the key, with the EDS's
+// own FILE:LINE.
+std::optional<EdsDevice> read_eds(const toml::node& key, const std::filesystem::path& base_dir,
+                                  Problems& p) {
+  const toml::value<std::string>* given = key.as_string();
+  if (given == nullptr) {
+    p.error(key.source(),
+            fmt::format("eds must be a string (a file), not {}", type_name(key.type())));
+    return std::nullopt;
+  }
+  std::filesystem::path path(given->get());
+  if (path.is_relative() && !base_dir.empty()) path = base_dir / path;
+  EdsDevice d;
+  d.path = path.lexically_normal().string();
+  auto text = toml_config::read_file(d.path, "an EDS file");
+  if (!text.text) {
+    p.error(key.source(), fmt::format("eds: {}", text.error));
+    return std::nullopt;
+  }
+  const eds::Parsed parsed = eds::parse(*text.text);
+  for (const auto& problem : parsed.problems) {
+    if (problem.severity == eds::Problem::Severity::kError) {
+      p.error(key.source(), fmt::format("eds: {}", eds::format_problem(d.path, problem)));
+    }
+  }
+  if (!parsed.file || parsed.errors > 0) return std::nullopt;
+  d.file = std::make_shared<const eds::EdsFile>(*parsed.file);
+  return d;
+}
+
+DeviceConfig read(const toml::table& table, Problems& p, const std::filesystem::path& base_dir) {
   DeviceConfig config;
   TableReader root(table, "the device configuration", p);
   if (const toml::node* n = root.get("defaults")) {
@@ -88,12 +118,32 @@ DeviceConfig read(const toml::table& table, Problems& p) {
   for (const toml::node& n : *list) {
     TableReader t(*n.as_table(), "[[device]]", p);
     DeviceEntry entry;
-    entry.settings = read_settings(t);
+    const toml::node* eds_key = t.get("eds");
+    if (eds_key != nullptr) {
+      const toml::node* e = eds_key;
+      // A device driven by its EDS: the CDN127's readings are not its own.
+      entry.eds = read_eds(*e, base_dir, p);
+      if (const toml::node* s = t.get("serial_number")) {
+        if (auto v = toml_config::read_integer(*s, "serial_number", {0, 0xFFFFFFFF}, p)) {
+          if (entry.eds) entry.eds->serial_number = static_cast<std::uint32_t>(*v);
+        }
+      }
+      for (const auto& [key, value] : *n.as_table()) {
+        if (key == "eds" || key == "serial_number" || key == "mac") continue;
+        (void)t.get(key.str());  // refused here, not as unknown
+        p.error(value.source(), fmt::format("{} is a CDN127 reading: this device runs its EDS "
+                                            "file",
+                                            key.str()));
+      }
+    } else {
+      entry.settings = read_settings(t);
+    }
     const toml::node* mac = t.require("mac");
     if (mac == nullptr) continue;
     auto v = toml_config::read_integer(*mac, "mac", {0, devicenet::MacId::kMax}, p);
     if (!v) continue;
     entry.mac = MacId::from_bits(static_cast<std::uint8_t>(*v));
+    if (eds_key != nullptr && !entry.eds) continue;  // its problems are reported
     const auto [it, added] = first_line.try_emplace(entry.mac.value(), mac->source().begin.line);
     if (!added) {
       p.error(mac->source(),
@@ -135,11 +185,12 @@ void DeviceSettings::apply_to(sim::SlaveOptions& o) const {
 DeviceConfigError::DeviceConfigError(std::vector<std::string> problems)
     : std::runtime_error(toml_config::join_lines(problems)), problems_(std::move(problems)) {}
 
-DeviceConfig parse_device_config(std::string_view text, std::string_view source_name) {
+DeviceConfig parse_device_config(std::string_view text, std::string_view source_name,
+                                 const std::filesystem::path& base_dir) {
   Problems problems{std::string(source_name)};
   const auto root = toml_config::parse(text, problems);
   if (!root) throw DeviceConfigError(problems.errors());
-  DeviceConfig config = read(*root, problems);
+  DeviceConfig config = read(*root, problems, base_dir);
   if (problems.has_errors()) throw DeviceConfigError(problems.errors());
   return config;
 }
@@ -147,11 +198,11 @@ DeviceConfig parse_device_config(std::string_view text, std::string_view source_
 DeviceConfig load_device_config(const std::filesystem::path& path) {
   auto file = toml_config::read_file(path, "a device configuration");
   if (!file.text) throw DeviceConfigError({std::move(file.error)});
-  return parse_device_config(*file.text, path.string());
+  return parse_device_config(*file.text, path.string(), path.parent_path());
 }
 
-std::vector<sim::SlaveOptions> device_options(const std::vector<MacId>& macs,
-                                              const DeviceConfig& config, Reading reading) {
+std::vector<DeviceSpec> device_options(const std::vector<MacId>& macs, const DeviceConfig& config,
+                                       Reading reading) {
   std::vector<MacId> all;
   auto add = [&all](MacId mac) {
     if (std::find(all.begin(), all.end(), mac) == all.end()) all.push_back(mac);
@@ -159,15 +210,24 @@ std::vector<sim::SlaveOptions> device_options(const std::vector<MacId>& macs,
   for (MacId m : macs) add(m);
   for (const auto& d : config.devices) add(d.mac);
 
-  std::vector<sim::SlaveOptions> out;
+  std::vector<DeviceSpec> out;
   for (MacId mac : all) {
-    sim::SlaveOptions o = sim::default_slave_options(mac);
+    DeviceSpec spec;
+    const auto entry = std::find_if(config.devices.begin(), config.devices.end(),
+                                    [&](const DeviceEntry& d) { return d.mac == mac; });
+    if (entry != config.devices.end() && entry->eds) {
+      spec.eds = entry->eds;
+      spec.eds_options = sim::default_eds_slave_options(mac);
+      if (entry->eds->serial_number) spec.eds_options.serial_number = *entry->eds->serial_number;
+      out.push_back(std::move(spec));
+      continue;
+    }
+    sim::SlaveOptions& o = spec.cdn127;
+    o = sim::default_slave_options(mac);
     if (reading == Reading::kField) sim::apply_field_reading(o);
     config.defaults.apply_to(o);
-    for (const auto& d : config.devices) {
-      if (d.mac == mac) d.settings.apply_to(o);
-    }
-    out.push_back(std::move(o));
+    if (entry != config.devices.end()) entry->settings.apply_to(o);
+    out.push_back(std::move(spec));
   }
   return out;
 }

@@ -11,8 +11,15 @@
 //   mac = 5
 //   poll_paths_fixed = true
 //
-// Keys of [defaults] and [[device]] (all optional; mac required in, and only
-// in, [[device]]):
+// A [[device]] with `eds = "FILE"` (relative to the configuration's
+// directory) is not a CDN127 but a device driven by that EDS file
+// (sim::EdsSlave: Identity, Assembly, Parameter, Acknowledge Handler, poll
+// and change-of-state or cyclic production); the CDN127's keys below are
+// not for it, and [defaults] does not reach it. Its other key:
+//   serial_number = 0..0xFFFFFFFF   (default: the simulator's, from its MAC)
+//
+// Keys of [defaults] and CDN127 [[device]]s (all optional; mac required in,
+// and only in, [[device]]):
 //   configuration_locked_while_poll_allocated = true|false
 //   poll_paths_fixed = true|false
 //   idle_poll_answered_empty = true|false
@@ -33,6 +40,7 @@
 // problem as "FILE:LINE:COLUMN: what is wrong".
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -40,6 +48,7 @@
 #include <vector>
 
 #include "adapters/sim/cdn127/cdn127_device.hpp"
+#include "adapters/sim/generic/eds_slave.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/wire/mac_id.hpp"
 
@@ -63,9 +72,17 @@ struct DeviceSettings {
   void apply_to(sim::SlaveOptions& options) const;
 };
 
+// A device driven by an EDS file.
+struct EdsDevice {
+  std::string path;  // as resolved, for the log
+  std::shared_ptr<const eds::EdsFile> file;
+  std::optional<std::uint32_t> serial_number;
+};
+
 struct DeviceEntry {
   devicenet::MacId mac;
   DeviceSettings settings;
+  std::optional<EdsDevice> eds;
 };
 
 struct DeviceConfig {
@@ -87,16 +104,26 @@ class DeviceConfigError : public std::runtime_error {
 };
 
 // Parses and checks a device configuration; `source_name` names it in
-// messages. Throws DeviceConfigError.
-DeviceConfig parse_device_config(std::string_view text, std::string_view source_name);
+// messages, EDS files are found relative to `base_dir`. Throws
+// DeviceConfigError.
+DeviceConfig parse_device_config(std::string_view text, std::string_view source_name,
+                                 const std::filesystem::path& base_dir = {});
 // Reads and checks a device configuration file. Throws DeviceConfigError.
 DeviceConfig load_device_config(const std::filesystem::path& path);
+
+// One device to simulate: a CDN127 with its options, or a device driven by
+// an EDS file.
+struct DeviceSpec {
+  sim::SlaveOptions cdn127;
+  std::optional<EdsDevice> eds;
+  sim::EdsSlaveOptions eds_options;  // with `eds`
+};
 
 // The devices to simulate: those given with --mac, in that order, then those
 // only the file names, in its order; each with its options as the header
 // says. A MAC given both ways is one device.
-std::vector<sim::SlaveOptions> device_options(const std::vector<devicenet::MacId>& macs,
-                                              const DeviceConfig& config, Reading reading);
+std::vector<DeviceSpec> device_options(const std::vector<devicenet::MacId>& macs,
+                                       const DeviceConfig& config, Reading reading);
 
 // The readings a device takes, and its factory output actions when they
 // are not the default, for the log: "lenient" when it has none of them, else

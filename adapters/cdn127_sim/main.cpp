@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
                        "Print the version and source revision, and exit");
   CLI11_PARSE(app, argc, argv);
 
-  std::vector<sim::SlaveOptions> devices;
+  std::vector<cdn127_sim::DeviceSpec> devices;
   try {
     cdn127_sim::DeviceConfig config;
     if (!device_config_file.empty()) config = cdn127_sim::load_device_config(device_config_file);

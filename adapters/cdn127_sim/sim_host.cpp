@@ -1,6 +1,7 @@
 #include "adapters/cdn127_sim/sim_host.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <signal.h>
 #include <sys/epoll.h>
 #include <sys/signalfd.h>
@@ -70,10 +71,31 @@ bool& fault_flag(sim::IdentityFaults& f, Fault which) {
 
 // --- one device ------------------------------------------------------------
 
-SocketDevice::SocketDevice(sim::SlaveOptions options, Logger log)
-    : mac_(devicenet::MacId::from_bits(options.stored_mac)),
-      log_(log),
-      slave_(*this, std::move(options), std::move(log)) {}
+namespace {
+
+devicenet::MacId device_mac(const sim::SlaveOptions& o) {
+  return devicenet::MacId::from_bits(o.mac_switch <= devicenet::MacId::kMax ? o.mac_switch
+                                                                            : o.stored_mac);
+}
+
+devicenet::MacId device_mac(const DeviceSpec& d) {
+  return d.eds ? devicenet::MacId::from_bits(d.eds_options.mac) : device_mac(d.cdn127);
+}
+
+}  // namespace
+
+SocketDevice::SocketDevice(DeviceSpec spec, Logger log) : mac_(device_mac(spec)), log_(log) {
+  if (spec.eds) {
+    auto slave =
+        std::make_unique<sim::EdsSlave>(*this, *spec.eds->file, spec.eds_options, std::move(log));
+    eds_ = slave.get();
+    slave_ = std::move(slave);
+  } else {
+    auto slave = std::make_unique<sim::Cdn127Slave>(*this, std::move(spec.cdn127), std::move(log));
+    cdn127_ = slave.get();
+    slave_ = std::move(slave);
+  }
+}
 
 std::error_code SocketDevice::open(const std::string& interface) {
   socketcan::SocketOptions o;
@@ -89,7 +111,7 @@ void SocketDevice::power_on(TimePoint now) {
   powered_ = true;
   queue_.clear();
   retry_at_ = kNever;
-  slave_.power_on(now);
+  slave_->power_on(now);
 }
 
 void SocketDevice::power_off() {
@@ -138,16 +160,15 @@ void SocketDevice::flush(TimePoint now) {
 
 namespace {
 
-std::vector<sim::SlaveOptions> factory_options(const std::vector<devicenet::MacId>& macs) {
-  std::vector<sim::SlaveOptions> out;
-  out.reserve(macs.size());
-  for (auto mac : macs) out.push_back(sim::default_slave_options(mac));
+std::vector<DeviceSpec> factory_options(const std::vector<devicenet::MacId>& macs) {
+  std::vector<DeviceSpec> out(macs.size());
+  for (std::size_t i = 0; i < macs.size(); ++i) out[i].cdn127 = sim::default_slave_options(macs[i]);
   return out;
 }
 
-devicenet::MacId device_mac(const sim::SlaveOptions& o) {
-  return devicenet::MacId::from_bits(o.mac_switch <= devicenet::MacId::kMax ? o.mac_switch
-                                                                            : o.stored_mac);
+std::string describe(const DeviceSpec& d) {
+  if (!d.eds) return describe_readings(d.cdn127);
+  return fmt::format("\"{}\" driven by {}", d.eds->file->device.product_name, d.eds->path);
 }
 
 }  // namespace
@@ -155,7 +176,7 @@ devicenet::MacId device_mac(const sim::SlaveOptions& o) {
 SimHost::SimHost(std::string interface, const std::vector<devicenet::MacId>& macs, LogSink& log)
     : SimHost(std::move(interface), factory_options(macs), log) {}
 
-SimHost::SimHost(std::string interface, std::vector<sim::SlaveOptions> devices, LogSink& log)
+SimHost::SimHost(std::string interface, std::vector<DeviceSpec> devices, LogSink& log)
     : interface_(std::move(interface)), log_(log, "cdn127-sim") {
   if (auto e = socketcan::can_support()) {
     throw std::system_error(e, "this kernel has no SocketCAN (socket(AF_CAN))");
@@ -174,7 +195,7 @@ SimHost::SimHost(std::string interface, std::vector<sim::SlaveOptions> devices, 
 
   const TimePoint t = now();
   for (std::size_t i = 0; i < macs.size(); ++i) {
-    log_.info("device {}: {}", macs[i].value(), describe_readings(devices[i]));
+    log_.info("device {}: {}", macs[i].value(), describe(devices[i]));
     auto d = std::make_unique<SocketDevice>(std::move(devices[i]),
                                             Logger(log, fmt::format("sim {}", macs[i].value())));
     if (auto e = d->open(interface_)) {
@@ -190,7 +211,7 @@ SimHost::SimHost(std::string interface, std::vector<sim::SlaveOptions> devices, 
     devices_.push_back(std::move(d));
   }
   for (auto& d : devices_) d->power_on(t);
-  log_.info("{} CDN127(s) powered on {}", devices_.size(), interface_);
+  log_.info("{} device(s) powered on {}", devices_.size(), interface_);
 }
 
 SimHost::~SimHost() = default;
@@ -256,7 +277,8 @@ void SimHost::on_socket(std::size_t index, TimePoint now) {
 }
 
 std::string SimHost::status_line(SocketDevice& d, TimePoint now) {
-  auto& s = d.slave();
+  if (d.eds() != nullptr) return eds_status_line(d);
+  auto& s = *d.cdn127();
   s.pump().advance(now);
   const auto& out = s.outputs();
   const auto& ain = s.pump().analog_inputs_raw();
@@ -272,6 +294,31 @@ std::string SimHost::status_line(SocketDevice& d, TimePoint now) {
       on_off(s.pump().warning_active()), on_off(s.pump().n2_flow_ok()),
       on_off(s.pump().interlock_ok()), ain[0], ain[1], s.device().identity_state(),
       s.device().identity_status(), fault_list(s.device().faults()));
+}
+
+// A device driven by its EDS: its connections, its data and what its
+// change-of-state connection did.
+std::string SimHost::eds_status_line(SocketDevice& d) {
+  const sim::EdsSlave& s = *d.eds();
+  const auto established = [](sim::ConnectionState c) {
+    return c == sim::ConnectionState::kEstablished ? "established" : "not-established";
+  };
+  const auto data = [&](std::uint16_t assembly) {
+    // One word of hex digits, as read on the wire.
+    return assembly == 0
+               ? std::string("none")
+               : fmt::format("{:02X}", fmt::join(s.objects().assembly_data(assembly), ""));
+  };
+  const auto& cos = s.cos_counters();
+  return fmt::format(
+      "mac {} power {} network {} owner {} poll {} cos {} | eds \"{}\" | inputs {} outputs {} | "
+      "cos produced {} acks {} retries {} given-up {}",
+      d.mac().value(), on_off(d.powered()), sim::to_string(s.network_state()),
+      s.owner() == 255 ? std::string("none") : std::to_string(s.owner()),
+      established(s.poll_state()), established(s.cos_state()),
+      s.objects().file().device.product_name,
+      data(s.connections().poll_connection().produced_assembly), data(s.poll_output_assembly()),
+      cos.produced, cos.acks_received, cos.retries, cos.given_up);
 }
 
 std::string SimHost::execute(const ControlCommand& c, TimePoint now) {
@@ -314,8 +361,14 @@ std::string SimHost::execute(const ControlCommand& c, TimePoint now) {
       }
       return "ok";
     case Verb::kFault:
+      // "all": the CDN127s (a device run by its EDS has no faults simulated).
+      if (c.mac && targets.front()->cdn127() == nullptr) {
+        return fmt::format("error: device {} runs its EDS file: its faults are not simulated",
+                           *c.mac);
+      }
       for (auto* d : targets) {
-        auto& device = d->slave().device();
+        if (d->cdn127() == nullptr) continue;
+        auto& device = d->cdn127()->device();
         sim::IdentityFaults f = device.faults();
         fault_flag(f, c.fault) = c.on;
         device.set_faults(f, now);
@@ -325,8 +378,34 @@ std::string SimHost::execute(const ControlCommand& c, TimePoint now) {
     case Verb::kSet:
       break;
   }
-  auto& pump = targets.front()->slave().pump();
+  return set_input(*targets.front(), c, now);
+}
+
+std::string SimHost::set_input(SocketDevice& d, const ControlCommand& c, TimePoint now) {
+  if (c.input == Input::kParam) {
+    if (d.eds() == nullptr) {
+      return fmt::format(
+          "error: device {} is a CDN127: alarm, warning, n2-flow, interlock, "
+          "ain1, ain2",
+          d.mac().value());
+    }
+    sim::EdsSlave& s = *d.eds();
+    const eds::Param* p = s.objects().file().param(c.param);
+    if (p == nullptr) return fmt::format("error: the EDS has no Param{}", c.param);
+    if (!s.objects().set_param_number(c.param, c.value)) {
+      return fmt::format("error: {} is not a value of Param{} \"{}\"", c.value, c.param, p->name);
+    }
+    s.inputs_changed(now);
+    return fmt::format("ok Param{} \"{}\" = {}", c.param, p->name, c.value);
+  }
+  if (d.cdn127() == nullptr) {
+    return fmt::format("error: device {} runs its EDS file: set MAC param N VALUE",
+                       d.mac().value());
+  }
+  auto& pump = d.cdn127()->pump();
   switch (c.input) {
+    case Input::kParam:
+      break;
     case Input::kAlarm:
       pump.set_alarm(c.on, now);
       break;

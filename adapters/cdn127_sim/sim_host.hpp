@@ -1,9 +1,9 @@
 #pragma once
-// Simulated CDN127s on a SocketCAN interface: each device is the sans-IO
-// sim::Cdn127Slave of the in-process tests, unchanged, on a CAN_RAW socket
-// of its own (so the devices hear each other as on a real bus: duplicate MAC
-// checks included), driven by one epoll loop with a timerfd, the control
-// input and SIGINT/SIGTERM.
+// Simulated CDN127s, and devices driven by their EDS files, on a SocketCAN
+// interface: each device is the sans-IO sim::Cdn127Slave or sim::EdsSlave of
+// the in-process tests, unchanged, on a CAN_RAW socket of its own (so the devices hear each other
+// as on a real bus: duplicate MAC checks included), driven by one epoll loop with a timerfd, the
+// control input and SIGINT/SIGTERM.
 #include <cstdio>
 #include <deque>
 #include <map>
@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "adapters/cdn127_sim/control.hpp"
+#include "adapters/cdn127_sim/device_config.hpp"
 #include "adapters/sim/cdn127/cdn127_slave.hpp"
+#include "adapters/sim/generic/eds_slave.hpp"
 #include "adapters/socketcan/can_socket.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/wire/mac_id.hpp"
@@ -23,12 +25,16 @@ namespace dnbridge::cdn127_sim {
 // One device: its socket, its slave and its power.
 class SocketDevice final : public can::FrameSink {
  public:
-  SocketDevice(sim::SlaveOptions options, Logger log);
+  // A CDN127, or a device driven by its EDS file.
+  SocketDevice(DeviceSpec spec, Logger log);
   SocketDevice(const SocketDevice&) = delete;
   SocketDevice& operator=(const SocketDevice&) = delete;
 
-  sim::Cdn127Slave& slave() { return slave_; }
-  const sim::Cdn127Slave& slave() const { return slave_; }
+  sim::Group2Slave& slave() { return *slave_; }
+  const sim::Group2Slave& slave() const { return *slave_; }
+  // The one of the two it is; the other is null.
+  sim::Cdn127Slave* cdn127() { return cdn127_; }
+  sim::EdsSlave* eds() { return eds_; }
   socketcan::CanSocket& socket() { return socket_; }
   devicenet::MacId mac() const { return mac_; }
   bool powered() const { return powered_; }
@@ -49,7 +55,9 @@ class SocketDevice final : public can::FrameSink {
   devicenet::MacId mac_;
   Logger log_;
   socketcan::CanSocket socket_;
-  sim::Cdn127Slave slave_;
+  std::unique_ptr<sim::Group2Slave> slave_;
+  sim::Cdn127Slave* cdn127_ = nullptr;
+  sim::EdsSlave* eds_ = nullptr;
   bool powered_ = false;
   bool lost_ = false;  // the interface went down under this device
   std::deque<can::CanFrame> queue_;
@@ -63,9 +71,9 @@ class SimHost {
   // interface cannot be opened, std::invalid_argument for a repeated MAC.
   // Each device as sim::default_slave_options(mac) has it:
   SimHost(std::string interface, const std::vector<devicenet::MacId>& macs, LogSink& log);
-  // Each device with its own options (the MAC of its switch, or its stored
-  // MAC when the switch is in the program position):
-  SimHost(std::string interface, std::vector<sim::SlaveOptions> devices, LogSink& log);
+  // Each device as `devices` describes it (a CDN127's MAC is that of its
+  // switch, or its stored MAC when the switch is in the program position):
+  SimHost(std::string interface, std::vector<DeviceSpec> devices, LogSink& log);
   ~SimHost();
   SimHost(const SimHost&) = delete;
   SimHost& operator=(const SimHost&) = delete;
@@ -80,6 +88,8 @@ class SimHost {
 
  private:
   std::string status_line(SocketDevice& d, TimePoint now);
+  std::string eds_status_line(SocketDevice& d);
+  std::string set_input(SocketDevice& d, const ControlCommand& c, TimePoint now);
   void on_socket(std::size_t index, TimePoint now);
   void interface_lost(const std::error_code& why, TimePoint now);
   void try_reopen(TimePoint now);

@@ -73,6 +73,17 @@ TEST(Control, IdentityFaults) {
   EXPECT_EQ(ok("fault 63 minor-unrecoverable on").fault, Fault::kMinorUnrecoverable);
 }
 
+TEST(Control, AParameterOfADeviceDrivenByItsEds) {
+  auto c = ok("set 21 param 3 90");
+  EXPECT_EQ(c.verb, Verb::kSet);
+  EXPECT_EQ(c.mac, 21);
+  EXPECT_EQ(c.input, Input::kParam);
+  EXPECT_EQ(c.param, 3u);
+  EXPECT_EQ(c.value, 90.0);
+  EXPECT_EQ(ok("set 21 param 2 -2.5").value, -2.5);
+  EXPECT_EQ(ok("set 21 param 3 0x5A").value, 90.0);
+}
+
 TEST(Control, BlankAndCommentLinesAreNothing) {
   EXPECT_TRUE(std::holds_alternative<std::monostate>(parse_control("")));
   EXPECT_TRUE(std::holds_alternative<std::monostate>(parse_control("   \t")));
@@ -88,7 +99,9 @@ TEST(Control, ErrorsSayWhatIsWrong) {
   EXPECT_EQ(error("set 5 ain1 xV"), "\"xV\" is not a voltage");
   EXPECT_EQ(error("set 5 fan on"),
             "unknown input \"fan\": alarm, warning, n2-flow, interlock, ain1, ain2");
-  EXPECT_EQ(error("set 5 alarm"), "usage: set MAC INPUT VALUE");
+  EXPECT_EQ(error("set 5 alarm"), "usage: set MAC INPUT VALUE, or set MAC param N VALUE");
+  EXPECT_EQ(error("set 21 param 0 1"), "\"0\" is not a parameter number (1..65535)");
+  EXPECT_EQ(error("set 21 param 3 x"), "\"x\" is not a number");
   EXPECT_EQ(error("power-cycle"), "usage: power-cycle MAC|all");
   EXPECT_EQ(error("reboot 5"), "unknown command \"reboot\" (help lists them)");
   EXPECT_EQ(error("power-on 5 6"), "usage: power-on MAC|all");

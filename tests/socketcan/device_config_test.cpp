@@ -54,7 +54,7 @@ unsafe_factory_output_actions = true
   EXPECT_EQ(c.devices[0].mac, mac(5));
   const auto all = device_options({}, c, Reading::kLenient);
   ASSERT_EQ(all.size(), 1u);
-  const sim::SlaveOptions& o = all[0];
+  const sim::SlaveOptions& o = all[0].cdn127;
   EXPECT_EQ(o.mac_switch, 5);
   EXPECT_EQ(o.serial_number, 0x10005u);
   EXPECT_TRUE(o.configuration_locked_while_poll_allocated);
@@ -78,7 +78,8 @@ TEST(DeviceConfig, WithoutAFileEveryDeviceIsLenient) {
   const auto all = device_options({mac(1), mac(2)}, DeviceConfig{}, Reading::kLenient);
   ASSERT_EQ(all.size(), 2u);
   const sim::SlaveOptions lenient;
-  for (const auto& o : all) {
+  for (const auto& spec : all) {
+    const sim::SlaveOptions& o = spec.cdn127;
     EXPECT_FALSE(o.configuration_locked_while_poll_allocated);
     EXPECT_FALSE(o.poll_paths_fixed);
     EXPECT_FALSE(o.idle_poll_answered_empty);
@@ -113,28 +114,29 @@ explicit_response_delay_ms = 0
                                              "sim.toml");
   const auto all = device_options({mac(2), mac(3)}, c, Reading::kField);
   ASSERT_EQ(all.size(), 3u);
-  EXPECT_EQ(all[0].mac_switch, 2);
-  EXPECT_EQ(all[1].mac_switch, 3);
-  EXPECT_EQ(all[2].mac_switch, 7);
-  for (const auto& o : all) {
+  EXPECT_EQ(all[0].cdn127.mac_switch, 2);
+  EXPECT_EQ(all[1].cdn127.mac_switch, 3);
+  EXPECT_EQ(all[2].cdn127.mac_switch, 7);
+  for (const auto& spec : all) {
+    const sim::SlaveOptions& o = spec.cdn127;
     EXPECT_TRUE(o.configuration_locked_while_poll_allocated);  // the reading
     EXPECT_TRUE(o.idle_poll_answered_empty);
     EXPECT_EQ(o.timer_resolution, milliseconds(100));
     EXPECT_EQ(o.poll_response_delay, milliseconds(5));  // [defaults] over the reading
     EXPECT_TRUE(has_identity_state(o));
   }
-  EXPECT_EQ(all[0].explicit_response_delay, Duration::zero());  // [[device]] over both
-  EXPECT_EQ(all[1].explicit_response_delay, milliseconds(300));
-  EXPECT_TRUE(all[1].poll_paths_fixed);
-  EXPECT_FALSE(all[2].poll_paths_fixed);
-  EXPECT_FALSE(all[1].serial_number_udint);
-  EXPECT_TRUE(all[2].serial_number_udint);
+  EXPECT_EQ(all[0].cdn127.explicit_response_delay, Duration::zero());  // [[device]] over both
+  EXPECT_EQ(all[1].cdn127.explicit_response_delay, milliseconds(300));
+  EXPECT_TRUE(all[1].cdn127.poll_paths_fixed);
+  EXPECT_FALSE(all[2].cdn127.poll_paths_fixed);
+  EXPECT_FALSE(all[1].cdn127.serial_number_udint);
+  EXPECT_TRUE(all[2].cdn127.serial_number_udint);
 }
 
 TEST(DeviceConfig, FieldReadingIsTheStrictestDevice) {
   const auto all = device_options({mac(4)}, DeviceConfig{}, Reading::kField);
   ASSERT_EQ(all.size(), 1u);
-  const sim::SlaveOptions& o = all[0];
+  const sim::SlaveOptions& o = all[0].cdn127;
   EXPECT_TRUE(o.configuration_locked_while_poll_allocated);
   EXPECT_TRUE(o.poll_paths_fixed);
   EXPECT_TRUE(o.idle_poll_answered_empty);
@@ -162,11 +164,11 @@ unsafe_factory_output_actions = false
                                              "sim.toml");
   const auto all = device_options({mac(1)}, c, Reading::kField);
   ASSERT_EQ(all.size(), 2u);
-  EXPECT_EQ(all[0].factory_output_actions, sim::kUnsafeFactoryOutputActions);
-  EXPECT_EQ(all[1].factory_output_actions, sim::OutputActions{});
+  EXPECT_EQ(all[0].cdn127.factory_output_actions, sim::kUnsafeFactoryOutputActions);
+  EXPECT_EQ(all[1].cdn127.factory_output_actions, sim::OutputActions{});
   const auto lenient = device_options({mac(1)}, DeviceConfig{}, Reading::kLenient);
   ASSERT_EQ(lenient.size(), 1u);
-  EXPECT_EQ(describe_readings(lenient[0]), "lenient");
+  EXPECT_EQ(describe_readings(lenient[0].cdn127), "lenient");
   EXPECT_EQ(problems("[defaults]\nunsafe_factory_output_actions = 1\n"),
             (std::vector<std::string>{
                 "sim.toml:2:33: unsafe_factory_output_actions must be true or false, not an "
@@ -178,9 +180,31 @@ TEST(DeviceConfig, TheShippedExampleLoads) {
       load_device_config(DNBRIDGE_SOURCE_DIR "/deploy/config/cdn127-sim-example.toml");
   EXPECT_FALSE(c.devices.empty());
   const auto all = device_options({}, c, Reading::kLenient);
-  EXPECT_TRUE(std::any_of(all.begin(), all.end(), [](const sim::SlaveOptions& o) {
-    return o.factory_output_actions == sim::kUnsafeFactoryOutputActions;
+  EXPECT_TRUE(std::any_of(all.begin(), all.end(), [](const DeviceSpec& d) {
+    return d.cdn127.factory_output_actions == sim::kUnsafeFactoryOutputActions;
   }));
+}
+
+TEST(DeviceConfig, ADeviceWithAnEdsFileRunsIt) {
+  const DeviceConfig c = parse_device_config(
+      "[defaults]\npoll_paths_fixed = true\n"
+      "[[device]]\nmac = 21\neds = \"dnbridge-example-io-block.eds\"\nserial_number = 7\n",
+      "sim.toml", DNBRIDGE_SOURCE_DIR "/deploy/eds");
+  const auto all = device_options({mac(1)}, c, Reading::kLenient);
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_FALSE(all[0].eds.has_value());
+  ASSERT_TRUE(all[1].eds.has_value());
+  EXPECT_EQ(all[1].eds->file->device.product_name, "Example IO block 8DI/8DO/1AI");
+  EXPECT_EQ(all[1].eds->path, DNBRIDGE_SOURCE_DIR "/deploy/eds/dnbridge-example-io-block.eds");
+  EXPECT_EQ(all[1].eds_options.mac, 21);
+  EXPECT_EQ(all[1].eds_options.serial_number, 7u);
+
+  // The CDN127's readings are not its own; its EDS's problems have their lines.
+  EXPECT_EQ(problems("[[device]]\nmac = 21\neds = \"x.eds\"\npoll_paths_fixed = true\n"),
+            (std::vector<std::string>{
+                "sim.toml:3:7: eds: x.eds: cannot open: No such file or directory",
+                "sim.toml:4:20: poll_paths_fixed is a CDN127 reading: this device runs its EDS "
+                "file"}));
 }
 
 TEST(DeviceConfig, EmptyFileIsNoChange) {

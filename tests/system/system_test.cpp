@@ -327,6 +327,122 @@ TEST_F(SystemTest, RackOnlineWithFieldReadingDevices) {
   expect_clean_under_tshark(pcap, frames);
 }
 
+// A CDN127 and a device driven by its EDS file (the example I/O block) on
+// change of state, both simulated by cdn127-sim on one bus: both online, the
+// device's connection 4 allocated (choice 0x10) beside its poll connection,
+// a change of its inputs produced at once and every message acknowledged by
+// the bridge, its counters in NodeStatus (dnbctl show), the pump commanded
+// as ever, and the whole traffic clean under tshark.
+TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
+  constexpr unsigned kPump = 1, kIo = 21;
+  const fs::path pcap = dir_ / "vcan0.pcap";
+  auto capture = std::make_unique<Capture>("vcan0", pcap);
+  const fs::path devices = dir_ / "devices.toml";
+  std::ofstream(devices) << fmt::format(
+      "[[device]]\nmac = {}\neds = \"{}/dnbridge-example-io-block.eds\"\n", kIo, DNBRIDGE_EDS_DIR);
+  Child& sim = start_sim("vcan0", {kPump}, {"--device-config", devices.string()});
+  const std::string io_node = fmt::format(
+      "  profile = \"eds\"\n  eds = \"{}/dnbridge-example-io-block.eds\"\n"
+      "  connection = \"change-of-state\"\n  heartbeat_ms = 200\n  inhibit_ms = 10\n"
+      "  safe_state = [ {{ name = \"Output fault action\", value = 0 }},\n"
+      "    {{ name = \"Output fault value\", value = 0 }},\n"
+      "    {{ name = \"Output idle action\", value = 0 }},\n"
+      "    {{ name = \"Output idle value\", value = 0 }} ]",
+      DNBRIDGE_EDS_DIR);
+  Child& bridge = start_bridge({{"A", "vcan0", {kPump, kIo}, {{kIo, io_node}}}});
+  ASSERT_TRUE(wait_online("A", {kPump})) << "the pump did not come online";
+
+  // The device, as cdn127-sim shows it: owned, both connections established.
+  static const std::regex eds_line(
+      R"(^ok mac (\d+) power on network online owner (\d+) poll (\S+) cos (\S+) \| eds .* \| )"
+      R"(inputs (\S+) outputs \S+ \| cos produced (\d+) acks (\d+) retries (\d+))");
+  struct EdsSeen {
+    bool established = false;
+    std::string inputs;
+    unsigned long produced = 0, acks = 0;
+  };
+  const auto eds_status = [&] {
+    EdsSeen seen;
+    const auto from = static_cast<std::streamoff>(fs::file_size(sim.log()));
+    sim.send(fmt::format("status {}", kIo));
+    const auto until = std::chrono::steady_clock::now() + patience(2000ms);
+    while (std::chrono::steady_clock::now() < until) {
+      std::ifstream in(sim.log());
+      in.seekg(from);
+      std::smatch m;
+      for (std::string l; std::getline(in, l);) {
+        if (!std::regex_search(l, m, eds_line)) continue;
+        seen.established = m[3] == "established" && m[4] == "established";
+        seen.inputs = m[5];
+        seen.produced = std::stoul(m[6]);
+        seen.acks = std::stoul(m[7]);
+        return seen;
+      }
+      std::this_thread::sleep_for(5ms);
+    }
+    return seen;
+  };
+  const auto until = [&](const std::function<bool(const EdsSeen&)>& done,
+                         std::chrono::milliseconds timeout) {
+    const auto end = std::chrono::steady_clock::now() + patience(timeout);
+    while (std::chrono::steady_clock::now() < end) {
+      if (done(eds_status())) return true;
+      std::this_thread::sleep_for(50ms);
+    }
+    return false;
+  };
+  ASSERT_TRUE(until([](const EdsSeen& s) { return s.established; }, 20000ms))
+      << "the EDS device's connections were not established";
+
+  // Its digital inputs change: produced at once, acknowledged; heartbeats
+  // every 200 ms meanwhile.
+  sim.send(fmt::format("set {} param 3 90", kIo));
+  ASSERT_TRUE(until([](const EdsSeen& s) { return s.inputs.rfind("5A", 0) == 0; }, 5000ms));
+  ASSERT_TRUE(
+      until([](const EdsSeen& s) { return s.produced >= 5 && s.acks == s.produced; }, 5000ms))
+      << "not every change-of-state message was acknowledged";
+
+  // What the bridge counted, as dnbctl shows it.
+  const std::string shown = run_output(fmt::format(
+      "'{}' --rack '{}' --port A --timeout 10 show {} --json 2>&1", DNBCTL_BIN, rack_, kIo));
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(shown, m, std::regex(R"("cos_acks":\s*(\d+))"))) << shown;
+  EXPECT_GE(std::stoul(m[1]), 5u) << shown;
+  EXPECT_NE(shown.find("inputs on change of state (EPR 200 ms, acknowledged"), std::string::npos)
+      << shown;
+
+  // The pump is commanded as ever.
+  ASSERT_TRUE(supervisor().command("A", kPump, true));
+  ASSERT_TRUE(supervisor().wait_until([&] { return pump("A", kPump).pump_on; }, 10s));
+
+  const int status = bridge.stop(10000ms);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "dnbridge status " << status;
+  (void)sim.stop();
+  const std::uint64_t frames = capture->stop();
+  // On the wire: Allocate of connection 4 (choice 0x10) to MAC 21 once, its
+  // messages on Group 1 message 13 and the bridge's acknowledgments on
+  // Group 2 message 2, each after the message it acknowledges.
+  unsigned cos_allocations = 0, messages = 0, acks = 0, acks_without_message = 0;
+  bool change_seen = false;
+  for (const can::CanFrame& f : capture->frames()) {
+    if (f.id == 0x406u + (kIo << 3) && f.len == 6 && f.data[1] == 0x4B) {
+      cos_allocations += f.data[4] == 0x10;
+    } else if (f.id == 0x340u + kIo) {
+      ++messages;
+      change_seen = change_seen || (f.len == 4 && f.data[0] == 0x5A);
+    } else if (f.id == 0x402u + (kIo << 3)) {
+      ++acks;
+      acks_without_message += acks > messages;
+    }
+  }
+  EXPECT_EQ(cos_allocations, 1u);
+  EXPECT_TRUE(change_seen);
+  EXPECT_GE(messages, 5u);
+  EXPECT_GE(acks + 1, messages);  // the last may have gone with the stop
+  EXPECT_EQ(acks_without_message, 0u);
+  expect_clean_under_tshark(pcap, frames);
+}
+
 // One bridge, two ports, each on its own interface and bus.
 TEST_F(SystemTest, TwoPortsServedByOneBridge) {
   start_sim("vcan0", {5, 6});

@@ -12,14 +12,15 @@
 #include "bridge/cip/data_types.hpp"
 #include "bridge/cip/objects.hpp"
 #include "bridge/cip/service.hpp"
+#include "bridge/profiles/eds/io_layout.hpp"
 
 namespace dnbridge::sim {
 namespace {
 
 using cip::GeneralStatus;
 
-constexpr std::uint16_t kParameterClass = 0x0F;
-constexpr std::uint16_t kAckHandlerClass = 0x2B;
+constexpr std::uint16_t kParameterClass = cip::class_id::kParameter;
+constexpr std::uint16_t kAckHandlerClass = cip::class_id::kAcknowledgeHandler;
 
 // A parameter's value as bytes (little-endian, its data size) from a number.
 std::vector<std::uint8_t> encode_value(const eds::Param& p, double v) {
@@ -53,10 +54,7 @@ std::vector<std::uint8_t> encode_value(const eds::Param& p, double v) {
 // The number `value` holds, as its type reads it.
 std::optional<double> decode_value(const eds::Param& p, Bytes value) {
   if (value.size() != p.size || p.type.size == 0) return std::nullopt;
-  std::uint64_t bits = 0;
-  for (std::size_t i = 0; i < value.size() && i < 8; ++i) {
-    bits |= static_cast<std::uint64_t>(value[i]) << (8 * i);
-  }
+  std::uint64_t bits = little_endian(value);
   if (p.type.is_float) {
     if (p.size == 4) return std::bit_cast<float>(static_cast<std::uint32_t>(bits));
     return std::bit_cast<double>(bits);
@@ -102,6 +100,14 @@ bool EdsObjects::set_param_value(unsigned number, Bytes value) {
   if (it == values_.end() || it->second.size() != value.size()) return false;
   it->second.assign(value.begin(), value.end());
   return true;
+}
+
+bool EdsObjects::set_param_number(unsigned number, double value) {
+  const eds::Param* p = file_.param(number);
+  if (p == nullptr || p->type.size == 0) return false;
+  if (!eds::to_raw(p->type, static_cast<std::uint16_t>(p->size * 8), value)) return false;
+  const auto bytes = encode_value(*p, value);
+  return set_param_value(number, Bytes(bytes.data(), bytes.size()));
 }
 
 const eds::Assembly* EdsObjects::assembly(unsigned instance) const noexcept {

@@ -70,6 +70,9 @@ class EdsObjects {
   // Sets it as the device itself would (an input changing), limits unchecked;
   // false if no such parameter or the size differs.
   bool set_param_value(unsigned number, Bytes value);
+  // The same from a number, as the parameter's type holds it; false if no
+  // such numeric parameter or the type cannot hold `value`.
+  bool set_param_number(unsigned number, double value);
   // The data of the assembly at `instance`: its members packed, least
   // significant bit first; empty if no such assembly.
   std::vector<std::uint8_t> assembly_data(unsigned instance) const;

@@ -77,7 +77,7 @@ void devices(std::string_view text) {
   }
   const auto options = cdn127_sim::device_options({}, config, cdn127_sim::Reading::kLenient);
   FUZZ_CHECK(options.size() == config.devices.size());
-  for (const auto& o : options) (void)cdn127_sim::describe_readings(o);
+  for (const auto& o : options) (void)cdn127_sim::describe_readings(o.cdn127);
 }
 
 void security_table(std::string_view text) {
