@@ -53,13 +53,23 @@ constexpr milliseconds kCommanderLost{5000};
 // for the reply.
 constexpr milliseconds kReply{20000};
 
-// The rack's configuration: the embedded default with pumps 9..16 on port A.
+// The rack's configuration: the embedded default with pumps 9..16 on port A,
+// and the example I/O block (deploy/eds) at MAC 20 on change of state.
 std::string rack_config() {
   std::string text = support::simulated_rack_config(kDomain, "sim-rack", "warn");
   for (int mac = 9; mac <= kPumps; ++mac) {
     text += "  [[port.node]]\n  mac = " + std::to_string(mac) + "\n  name = \"pump-" +
             std::to_string(mac) + "\"\n";
   }
+  text +=
+      "  [[port.node]]\n  mac = 20\n  name = \"io-1\"\n  profile = \"eds\"\n"
+      "  eds = \"" DNBRIDGE_SOURCE_DIR
+      "/deploy/eds/dnbridge-example-io-block.eds\"\n"
+      "  connection = \"change-of-state\"\n"
+      "  safe_state = [ { name = \"Output fault action\", value = 0 },\n"
+      "                 { name = \"Output fault value\", value = 0 },\n"
+      "                 { name = \"Output idle action\", value = 0 },\n"
+      "                 { name = \"Output idle value\", value = 0 } ]\n";
   return text;
 }
 
@@ -171,7 +181,18 @@ TEST_F(FastDdsInteropTest, AFastDdsReaderSeesEveryPumpNodeAndPort) {
     return "node sim-rack A " + std::to_string(mac) +
            " state=4 product=CDN127 vendor=59 polls=1 safe=pump: fault off, idle off";
   })) << sup_->transcript();
-  EXPECT_TRUE(sup_->printed({"port sim-rack A state=2 online=16/16"}, kRackSeen))
+  EXPECT_TRUE(sup_->printed({"port sim-rack A state=2 online=17/17"}, kRackSeen))
+      << sup_->transcript();
+}
+
+TEST_F(FastDdsInteropTest, AFastDdsReaderSeesADevicesBytesAndNamedFields) {
+  // DeviceState of the example I/O block: its four input bytes and its
+  // fields (names, values, units, CIP types) from the EDS, deserialized by
+  // Fast DDS: sequences of octets and of a nested struct.
+  EXPECT_TRUE(sup_->printed({"device sim-rack A 20 online=1 idle=1 inputs=00000000 "
+                             "fields=Digital inputs=0 USINT;Module status=0 BYTE;"
+                             "Analog input 1=0 mV INT;"},
+                            kRackSeen))
       << sup_->transcript();
 }
 

@@ -19,6 +19,9 @@
 //        a NodeStatus whose state, product or safe state changed; polls=1
 //        once its counters show polls
 //   port RACK PORT state=N online=N/M     a PortStatus that changed
+//   device RACK PORT MAC online=0|1 idle=0|1 inputs=HEX fields=NAME=VALUE UNITS TYPE;...
+//        a DeviceState (a device described by its EDS) that changed: its
+//        input bytes and each input field with its value, units and type
 //
 // What it answers:
 //
@@ -55,6 +58,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <iomanip>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -130,8 +134,8 @@ class Peer {
     participant_.reset(fdds::DomainParticipantFactory::get_instance()->create_participant(
         static_cast<fdds::DomainId_t>(domain), pqos));
     ensure(participant_.get(), "the participant");
-    for (auto* type :
-         {&state_type_, &command_type_, &node_type_, &port_type_, &request_type_, &reply_type_}) {
+    for (auto* type : {&state_type_, &command_type_, &node_type_, &port_type_, &request_type_,
+                       &reply_type_, &device_type_}) {
       if (type->register_type(participant_.get()) != ReturnCode::RETCODE_OK)
         throw std::runtime_error("cannot register " + type->get_type_name());
     }
@@ -150,6 +154,7 @@ class Peer {
     state_reader_ = reader(topic("dnbridge/PumpState", state_type_), state_qos);
     node_reader_ = reader(topic("dnbridge/NodeStatus", node_type_), state_qos);
     port_reader_ = reader(topic("dnbridge/PortStatus", port_type_), state_qos);
+    device_reader_ = reader(topic("dnbridge/DeviceState", device_type_), state_qos);
     command_topic_ = topic("dnbridge/PumpCommand", command_type_);
     request_topic_ = topic("dnbridge/ExplicitRequest", request_type_);
     reply_topic_ = topic("dnbridge/ExplicitReply", reply_type_);
@@ -162,6 +167,7 @@ class Peer {
     dnbridge::support::StdinLines input;
     for (;;) {
       look();
+      look_at_devices();
       rewrite();
       if (!input.read(20, [this](const std::string& line) { answer(line); })) return;
     }
@@ -232,6 +238,29 @@ class Peer {
       if (o.str() != line) {
         line = o.str();
         say("port " + port.rack() + " " + port.port() + " " + line);
+      }
+    }
+  }
+
+  // Devices described by their EDS files: their bytes and named fields.
+  void look_at_devices() {
+    dnbridge::DeviceState device;
+    fdds::SampleInfo info;
+    while (device_reader_->take_next_sample(&device, &info) == ReturnCode::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      std::ostringstream o;
+      o << "online=" << device.online() << " idle=" << device.outputs_idle() << " inputs=";
+      for (auto b : device.inputs())
+        o << std::hex << std::setw(2) << std::setfill('0') << unsigned{b};
+      o << std::dec << " fields=";
+      for (const auto& f : device.input_fields()) {
+        o << f.name() << "=" << f.value() << (f.units().empty() ? "" : " " + f.units()) << " "
+          << f.type() << ";";
+      }
+      auto& line = devices_[Key{device.rack(), device.port(), device.mac()}];
+      if (o.str() != line) {
+        line = o.str();
+        say("device " + key_text(device.rack(), device.port(), device.mac()) + " " + line);
       }
     }
   }
@@ -426,11 +455,13 @@ class Peer {
   fdds::TypeSupport port_type_{new dnbridge::PortStatusPubSubType()};
   fdds::TypeSupport request_type_{new dnbridge::ExplicitRequestPubSubType()};
   fdds::TypeSupport reply_type_{new dnbridge::ExplicitReplyPubSubType()};
+  fdds::TypeSupport device_type_{new dnbridge::DeviceStatePubSubType()};
   ParticipantPtr participant_;
   fdds::Subscriber* subscriber_ = nullptr;
   fdds::DataReader* state_reader_ = nullptr;
   fdds::DataReader* node_reader_ = nullptr;
   fdds::DataReader* port_reader_ = nullptr;
+  fdds::DataReader* device_reader_ = nullptr;
   fdds::Topic* command_topic_ = nullptr;
   fdds::Topic* request_topic_ = nullptr;
   fdds::Topic* reply_topic_ = nullptr;
@@ -444,6 +475,7 @@ class Peer {
   std::map<Key, Seen> pumps_;
   std::map<Key, std::string> nodes_;
   std::map<std::string, std::string> ports_;
+  std::map<Key, std::string> devices_;
 };
 
 }  // namespace
