@@ -48,14 +48,9 @@ ExplicitExchange get(Client& client, Requester& requester, const NodeKey& node,
 
 // "the device answered 0x14 (attribute not supported)", the bridge's status,
 // or a reply of another size than a UINT's.
-std::string failure_text(const ExplicitExchange& x) {
+std::string uint_failure_text(const ExplicitExchange& x) {
   if (x.succeeded()) return fmt::format("{} byte(s), a UINT expected", x.data.size());
-  if (x.status != 1) {
-    return fmt::format("status {} ({}){}", x.status, transaction_status_text(x.status),
-                       x.message.empty() ? "" : ": " + x.message);
-  }
-  return fmt::format("the device answered 0x{:02X} ({})", x.general_status,
-                     general_status_text(x.general_status));
+  return failure_text(x);
 }
 
 std::optional<std::uint16_t> uint16_of(const ExplicitExchange& x) {
@@ -156,7 +151,7 @@ Exit run_assembly(const GlobalOptions& o, const AssemblyArgs& args) {
   const ExplicitExchange revision = get(client, requester, node, 0, 1, timeout);
   const ExplicitExchange max = get(client, requester, node, 0, 2, timeout);
   if (revision.status != 1 && max.status != 1) {
-    throw CommandError(Exit::kFailed, fmt::format("{}: {}", name, failure_text(max)));
+    throw CommandError(Exit::kFailed, fmt::format("{}: {}", name, uint_failure_text(max)));
   }
   std::vector<InstanceReport> instances;
   std::vector<std::uint16_t> absent;  // named, and not there
@@ -177,7 +172,7 @@ Exit run_assembly(const GlobalOptions& o, const AssemblyArgs& args) {
 
   const auto class_attribute = [&](const ExplicitExchange& x) {
     const auto v = uint16_of(x);
-    return v ? fmt::format("{}", *v) : fmt::format("not read ({})", failure_text(x));
+    return v ? fmt::format("{}", *v) : fmt::format("not read ({})", uint_failure_text(x));
   };
   if (o.json) {
     JsonWriter out;

@@ -11,6 +11,7 @@
 #include "adapters/dnbctl/client.hpp"
 #include "adapters/dnbctl/format.hpp"
 #include "adapters/dnbctl/options.hpp"
+#include "bridge/profiles/eds/eds_file.hpp"
 
 namespace dnbridge::dnbctl {
 
@@ -125,5 +126,20 @@ struct EdsArgs {
 };
 CLI::App* add_eds(CLI::App& app, EdsArgs& args);
 Exit run_eds(const GlobalOptions& options, const EdsArgs& args);
+// The EDS file at `path`, as the bridge reads it; CommandError (usage) with
+// its errors when it is not usable.
+eds::EdsFile read_eds(const std::string& path);
+
+// --- param_command.cpp: param --------------------------------------------------------------
+// A device's parameter (Parameter object, class 0x0F) read or written by its
+// name in the device's EDS, through the bridge's explicit gateway.
+struct ParamArgs {
+  std::string node;   // MAC ID or name
+  std::string param;  // the EDS's name, ParamN or N
+  std::string value;  // empty: read
+  std::string eds;    // the device's EDS file
+};
+CLI::App* add_param(CLI::App& app, ParamArgs& args);
+Exit run_param(const GlobalOptions& options, const ParamArgs& args);
 
 }  // namespace dnbridge::dnbctl

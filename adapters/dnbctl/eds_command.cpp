@@ -182,6 +182,20 @@ std::string json(const std::string& path, const eds::Parsed& parsed) {
 
 }  // namespace
 
+eds::EdsFile read_eds(const std::string& path) {
+  eds::Parsed parsed = eds::parse(read_text(path));
+  if (!parsed.file) {
+    std::string problems;
+    for (const Problem& p : parsed.problems) {
+      if (p.severity == Problem::Severity::kError) problems += "\n" + eds::format_problem(path, p);
+    }
+    throw CommandError(Exit::kUsage,
+                       fmt::format("{}: not usable, {} error{}{}", path, parsed.errors,
+                                   parsed.errors == 1 ? "" : "s", problems));
+  }
+  return std::move(*parsed.file);
+}
+
 CLI::App* add_eds(CLI::App& app, EdsArgs& args) {
   auto* eds = app.add_subcommand("eds", "Electronic Data Sheets (EDS files) of DeviceNet devices");
   eds->require_subcommand(1);

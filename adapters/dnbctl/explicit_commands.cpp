@@ -135,13 +135,8 @@ Exit run_explicit(const GlobalOptions& o, const ExplicitArgs& args) {
   if (!x.succeeded()) {
     // The bridge's own refusal says why (e.g. which [explicit_policy] key
     // would allow the request): on stderr too, for whoever reads only that.
-    std::string why =
-        x.status != 1 ? fmt::format("status {} ({}){}", x.status, transaction_status_text(x.status),
-                                    x.message.empty() ? "" : ": " + x.message)
-                      : fmt::format("the device answered 0x{:02X} ({})", x.general_status,
-                                    general_status_text(x.general_status));
     std::fputs(fmt::format("dnbctl: {}: {} failed: {}\n", node_name(x.rack, x.port, x.mac),
-                           service_text(x.service), why)
+                           service_text(x.service), failure_text(x))
                    .c_str(),
                stderr);
     return Exit::kFailed;

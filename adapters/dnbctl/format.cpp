@@ -715,4 +715,13 @@ std::string reload_text(const dnbridge_ReloadReply& r) { return reload_record(r)
 
 void reload_json(JsonWriter& out, const dnbridge_ReloadReply& r) { reload_record(r).write(out); }
 
+std::string failure_text(const ExplicitExchange& x) {
+  if (x.status != 1) {
+    return fmt::format("status {} ({}){}", x.status, transaction_status_text(x.status),
+                       x.message.empty() ? "" : ": " + x.message);
+  }
+  return fmt::format("the device answered 0x{:02X} ({})", x.general_status,
+                     general_status_text(x.general_status));
+}
+
 }  // namespace dnbridge::dnbctl

@@ -122,6 +122,11 @@ struct ExplicitExchange {
   bool succeeded() const noexcept { return status == 1 && general_status == 0; }
 };
 
+// Why an exchange that did not succeed failed: the bridge's status with its
+// message (e.g. the [explicit_policy] key that would allow it), or the
+// device's general status.
+std::string failure_text(const ExplicitExchange& x);
+
 // `decoded`: the data decoded as asked with --as (none without --as).
 std::string explicit_text(const ExplicitExchange& x, Decoding as,
                           const std::optional<Parsed<std::string>>& decoded);

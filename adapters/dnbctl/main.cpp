@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
   ExplicitArgs service;
   EdsArgs eds;
   AssemblyArgs assembly;
+  ParamArgs param;
   auto* list_cmd = add_list(app, list);
   auto* racks_cmd = add_racks(app);
   auto* watch_cmd = add_watch(app, watch);
@@ -85,6 +86,7 @@ int main(int argc, char** argv) {
   auto* scan_cmd = add_scan(app);
   auto* reload_cmd = add_reload(app);
   auto* eds_cmd = add_eds(app, eds);
+  auto* param_cmd = add_param(app, param);
 
   try {
     app.parse(argc, argv);
@@ -129,6 +131,7 @@ int main(int argc, char** argv) {
     if (scan_cmd->parsed()) rc = run_scan(options);
     if (reload_cmd->parsed()) rc = run_reload(options);
     if (eds_cmd->parsed()) rc = run_eds(options, eds);
+    if (param_cmd->parsed()) rc = run_param(options, param);
     return code(rc);
   } catch (const CommandError& e) {
     std::fprintf(stderr, "dnbctl: %s\n", e.what());

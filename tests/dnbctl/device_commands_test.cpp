@@ -166,6 +166,44 @@ TEST_F(DnbctlDevices, OutputsCommandsTheDeviceByFieldOrBytesAndReportsARefusal) 
   EXPECT_NE(r.err.find("not both"), std::string::npos) << r.err;
 }
 
+TEST_F(DnbctlDevices, ParamReadsAndWritesByNameUnderTheGatewayPolicy) {
+  const std::string eds = std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-io-block.eds";
+  // Read by name: the value in its type and units, decoded from the EDS.
+  auto r = dnbctl({"param", "io-1", "Analog input 1", "--eds", eds});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "eds-rack/A/20: Param2 \"Analog input 1\" = 0 mV (INT, 00 00)\n");
+
+  // Written and read back: a parameter the bridge does not manage.
+  r = dnbctl({"param", "20", "Input filter", "12", "--eds", eds, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"written\": true"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"value\": 12"), std::string::npos) << r.out;
+  r = dnbctl({"param", "20", "Param1", "--eds", eds});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("= 12 ms (UINT, 0C 00)"), std::string::npos) << r.out;
+
+  // One of its safe state: the gateway refuses it, naming the key.
+  r = dnbctl({"param", "io-1", "Output idle value", "1", "--eds", eds});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("allow_managed_attribute_writes = true in [explicit_policy] allows it"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("Param9 \"Output idle value\" (class 0x0F instance 0x09 attribute 0x01)"),
+            std::string::npos)
+      << r.err;
+
+  // Checked against the EDS before anything is sent.
+  r = dnbctl({"param", "io-1", "Input filter", "70000", "--eds", eds});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("70000 is outside the EDS's limits 0..100"), std::string::npos) << r.err;
+  r = dnbctl({"param", "io-1", "Input filtr", "--eds", eds});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("(did you mean \"Input filter\"?)"), std::string::npos) << r.err;
+  r = dnbctl({"param", "io-1", "Analog input 1", "1", "--eds", eds});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("is read only"), std::string::npos) << r.err;
+}
+
 TEST_F(DnbctlDevices, AssemblyShowsTheMemberLists) {
   auto r = dnbctl({"assembly", "io-1"});
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -29,70 +29,6 @@ std::string describe_data(const IoLayout& io, std::string_view what) {
   return text;
 }
 
-// The setting that makes `param` hold `value` on the device.
-Result<devicenet::AttributeSetting> setting_of(const EdsFile& file, const ParameterValue& given,
-                                               std::string_view list, std::string* why) {
-  const Param* p = file.param(given.name);
-  if (const auto named = file.params_named(given.name); p == nullptr && named.size() > 1) {
-    std::string numbers;
-    for (unsigned n : named) numbers += fmt::format("{}Param{}", numbers.empty() ? "" : ", ", n);
-    return explain(why, Errc::kMalformed,
-                   fmt::format("{}: \"{}\" names {} parameters ({}): name one as ParamN", list,
-                               given.name, named.size(), numbers));
-  }
-  if (p == nullptr) {
-    std::vector<std::string_view> names;
-    for (const auto& q : file.params) names.push_back(q.name);
-    const auto near = closest(given.name, names, std::max<std::size_t>(2, given.name.size() / 4));
-    return explain(why, Errc::kMalformed,
-                   fmt::format("{}: the EDS has no parameter \"{}\"{}", list, given.name,
-                               near ? fmt::format(" (did you mean \"{}\"?)", *near) : ""));
-  }
-  const std::string label = fmt::format("{}: Param{} \"{}\"", list, p->number, p->name);
-  if (p->read_only()) {
-    return explain(why, Errc::kMalformed, fmt::format("{} is read only", label));
-  }
-  const cip::EPath& link = p->link;
-  if (!link.class_id || !link.instance_id || !link.attribute || link.connection_point ||
-      *link.class_id > 0xFFFF || *link.instance_id > 0xFFFF || *link.attribute > 0xFF) {
-    return explain(why, Errc::kUnsupported,
-                   fmt::format("{} has no link path to an attribute (its link path: {})", label,
-                               link.empty() ? "none" : "not class/instance/attribute"));
-  }
-  if (p->type.size == 0) {
-    return explain(
-        why, Errc::kUnsupported,
-        fmt::format("{} is a {}: only numbers are set at start-up", label, p->type.name));
-  }
-  if (!within_limits(p->minimum, p->maximum, given.value)) {
-    return explain(why, Errc::kOutOfRange,
-                   fmt::format("{}: {} is outside the EDS's limits {}", label, given.value,
-                               limits_text(p->minimum, p->maximum)));
-  }
-  const auto bits = static_cast<std::uint16_t>(p->size * 8);
-  const auto raw = to_raw(p->type, bits, given.value);
-  if (!raw) {
-    return explain(why, Errc::kOutOfRange,
-                   fmt::format("{}: {} is not a {} value", label, given.value, p->type.name));
-  }
-  // The limits hold for the value as the device gets it, too (a REAL in
-  // single precision).
-  if (!within_limits(p->minimum, p->maximum, from_raw(p->type, bits, *raw))) {
-    return explain(why, Errc::kOutOfRange,
-                   fmt::format("{}: {} is outside the EDS's limits {}", label, given.value,
-                               limits_text(p->minimum, p->maximum)));
-  }
-  devicenet::AttributeSetting s;
-  s.class_id = static_cast<std::uint16_t>(*link.class_id);
-  s.instance_id = static_cast<std::uint16_t>(*link.instance_id);
-  s.attribute = static_cast<std::uint8_t>(*link.attribute);
-  for (unsigned i = 0; i < p->size; ++i) {
-    s.value.push_back(static_cast<std::uint8_t>(*raw >> (8 * i)));
-  }
-  s.name = fmt::format("Param{} {}", p->number, p->name);
-  return s;
-}
-
 // An assembly's member list on the device against its EDS entry.
 class MemberListVerifier final : public devicenet::AttributeVerifier {
  public:
@@ -146,6 +82,78 @@ std::optional<devicenet::AttributeCheck> member_list_check(
 }
 
 }  // namespace
+
+Result<const Param*> find_param(const EdsFile& file, std::string_view name, std::string_view list,
+                                std::string* why) {
+  const Param* p = file.param(name);
+  if (const auto named = file.params_named(name); p == nullptr && named.size() > 1) {
+    std::string numbers;
+    for (unsigned n : named) numbers += fmt::format("{}Param{}", numbers.empty() ? "" : ", ", n);
+    return explain(why, Errc::kMalformed,
+                   fmt::format("{}: \"{}\" names {} parameters ({}): name one as ParamN", list,
+                               name, named.size(), numbers));
+  }
+  if (p == nullptr) {
+    std::vector<std::string_view> names;
+    for (const auto& q : file.params) names.push_back(q.name);
+    const auto near = closest(name, names, std::max<std::size_t>(2, name.size() / 4));
+    return explain(why, Errc::kMalformed,
+                   fmt::format("{}: the EDS has no parameter \"{}\"{}", list, name,
+                               near ? fmt::format(" (did you mean \"{}\"?)", *near) : ""));
+  }
+  return p;
+}
+
+Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
+                                                      const ParameterValue& given,
+                                                      std::string_view list, std::string* why) {
+  auto found = find_param(file, given.name, list, why);
+  if (!found) return found.error();
+  const Param* p = *found;
+  const std::string label = fmt::format("{}: Param{} \"{}\"", list, p->number, p->name);
+  if (p->read_only()) {
+    return explain(why, Errc::kMalformed, fmt::format("{} is read only", label));
+  }
+  const cip::EPath& link = p->link;
+  if (!link.class_id || !link.instance_id || !link.attribute || link.connection_point ||
+      *link.class_id > 0xFFFF || *link.instance_id > 0xFFFF || *link.attribute > 0xFF) {
+    return explain(why, Errc::kUnsupported,
+                   fmt::format("{} has no link path to an attribute (its link path: {})", label,
+                               link.empty() ? "none" : "not class/instance/attribute"));
+  }
+  if (p->type.size == 0) {
+    return explain(
+        why, Errc::kUnsupported,
+        fmt::format("{} is a {}: only numbers are set at start-up", label, p->type.name));
+  }
+  if (!within_limits(p->minimum, p->maximum, given.value)) {
+    return explain(why, Errc::kOutOfRange,
+                   fmt::format("{}: {} is outside the EDS's limits {}", label, given.value,
+                               limits_text(p->minimum, p->maximum)));
+  }
+  const auto bits = static_cast<std::uint16_t>(p->size * 8);
+  const auto raw = to_raw(p->type, bits, given.value);
+  if (!raw) {
+    return explain(why, Errc::kOutOfRange,
+                   fmt::format("{}: {} is not a {} value", label, given.value, p->type.name));
+  }
+  // The limits hold for the value as the device gets it, too (a REAL in
+  // single precision).
+  if (!within_limits(p->minimum, p->maximum, from_raw(p->type, bits, *raw))) {
+    return explain(why, Errc::kOutOfRange,
+                   fmt::format("{}: {} is outside the EDS's limits {}", label, given.value,
+                               limits_text(p->minimum, p->maximum)));
+  }
+  devicenet::AttributeSetting s;
+  s.class_id = static_cast<std::uint16_t>(*link.class_id);
+  s.instance_id = static_cast<std::uint16_t>(*link.instance_id);
+  s.attribute = static_cast<std::uint8_t>(*link.attribute);
+  for (unsigned i = 0; i < p->size; ++i) {
+    s.value.push_back(static_cast<std::uint8_t>(*raw >> (8 * i)));
+  }
+  s.name = fmt::format("Param{} {}", p->number, p->name);
+  return s;
+}
 
 namespace {
 
@@ -224,7 +232,7 @@ Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> 
   std::set<unsigned> seen;
   const auto add = [&](const std::vector<ParameterValue>& list, std::string_view label) -> Status {
     for (const ParameterValue& v : list) {
-      auto s = setting_of(file, v, label, why);
+      auto s = parameter_setting(file, v, label, why);
       if (!s) return s.error();
       const Param* param = file.param(v.name);
       if (!seen.insert(param->number).second) {

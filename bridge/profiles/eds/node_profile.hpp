@@ -59,6 +59,22 @@ struct NodeIo {
 // saying so.
 Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::string* why = nullptr);
 
+// The parameter `name` names: its name, or ParamN. Fails (kMalformed), `why`
+// saying so after `list` ("parameters: ..."), for a name the EDS does not
+// have (with the nearest) or that several parameters share.
+Result<const Param*> find_param(const EdsFile& file, std::string_view name, std::string_view list,
+                                std::string* why = nullptr);
+
+// The attribute setting that makes the parameter `given` names hold its
+// value on the device: its link path, the value in its type and size.
+// Fails as find_param, and for a parameter read only, without a link path
+// to an attribute, of a string type, or a value outside its type or the
+// EDS's limits (a REAL's as single precision).
+Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
+                                                      const ParameterValue& given,
+                                                      std::string_view list,
+                                                      std::string* why = nullptr);
+
 // The scan-list profile of `node`. Fails (kUnsupported, kMalformed,
 // kOutOfRange), `why` naming the parameter and what is wrong, for: a
 // connection the EDS does not offer or the master does not open (bit-strobe),
