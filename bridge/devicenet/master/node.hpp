@@ -287,6 +287,16 @@ class Node final : private ExplicitClient::Listener {
   void accept_poll_response(Bytes data, TimePoint now);
   void bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now);
   void take_cos_message(Bytes data, TimePoint now);
+  // One frame of an I/O message of `size` bytes: whole in it when it fits
+  // one frame, else a fragment for `reassembler` (reset it after a complete
+  // message, of the right size or not: `message` is its buffer).
+  struct IoFrame {
+    enum Outcome : std::uint8_t { kIncomplete, kComplete, kWrongSize, kOutOfOrder };
+    Outcome outcome = kComplete;
+    Bytes message;
+    std::uint32_t got = 0;  // the size received (kWrongSize, kOutOfOrder)
+  };
+  static IoFrame io_frame(IoReassembler& reassembler, Bytes payload, std::size_t size);
   void bad_cos_message(NodeError::Kind kind, std::uint32_t got, TimePoint now);
   TimePoint next_poll_slot(TimePoint after) const;
 

@@ -84,6 +84,29 @@ void Node::poll_on_change(TimePoint now) {
   deferred_poll_ = earliest;
 }
 
+Node::IoFrame Node::io_frame(IoReassembler& reassembler, Bytes payload, std::size_t size) {
+  IoFrame f;
+  if (size <= can::kMaxDataLength) {
+    f.message = payload;
+  } else {
+    switch (reassembler.on_fragment(payload)) {
+      case IoReassembler::Outcome::kIncomplete:
+        f.outcome = IoFrame::kIncomplete;
+        return f;
+      case IoReassembler::Outcome::kComplete:
+        f.message = reassembler.message();
+        break;
+      default:
+        f.outcome = IoFrame::kOutOfOrder;
+        f.got = static_cast<std::uint32_t>(payload.size());
+        return f;
+    }
+  }
+  f.got = static_cast<std::uint32_t>(f.message.size());
+  f.outcome = f.message.size() == size ? IoFrame::kComplete : IoFrame::kWrongSize;
+  return f;
+}
+
 void Node::on_poll_response(Bytes payload, TimePoint now) {
   if (state_ != NodeState::kOnline && stray_poll_responses_ > 0) {
     --stray_poll_responses_;  // the answer to the idle poll of a device fault
@@ -105,35 +128,15 @@ void Node::on_poll_response(Bytes payload, TimePoint now) {
     accept_poll_response(payload, now);
     return;
   }
-  if (size <= can::kMaxDataLength) {
-    if (payload.size() != size) {
-      bad_poll_response(NodeError::Kind::kPollLength, static_cast<std::uint32_t>(payload.size()),
-                        now);
-      return;
-    }
-    accept_poll_response(payload, now);
-    return;
+  const IoFrame f = io_frame(io_reassembler_, payload, size);
+  if (f.outcome == IoFrame::kComplete) {
+    accept_poll_response(f.message, now);
+  } else if (f.outcome != IoFrame::kIncomplete) {
+    bad_poll_response(f.outcome == IoFrame::kWrongSize ? NodeError::Kind::kPollLength
+                                                       : NodeError::Kind::kPollMalformed,
+                      f.got, now);
   }
-  switch (io_reassembler_.on_fragment(payload)) {
-    case IoReassembler::Outcome::kIncomplete:
-      return;
-    case IoReassembler::Outcome::kComplete: {
-      const Bytes message = io_reassembler_.message();
-      if (message.size() != size) {
-        bad_poll_response(NodeError::Kind::kPollLength, static_cast<std::uint32_t>(message.size()),
-                          now);
-        io_reassembler_.reset();
-        return;
-      }
-      accept_poll_response(message, now);
-      io_reassembler_.reset();
-      return;
-    }
-    default:
-      bad_poll_response(NodeError::Kind::kPollMalformed, static_cast<std::uint32_t>(payload.size()),
-                        now);
-      return;
-  }
+  if (f.outcome == IoFrame::kComplete || f.outcome == IoFrame::kWrongSize) io_reassembler_.reset();
 }
 
 void Node::accept_poll_response(Bytes data, TimePoint now) {
@@ -185,34 +188,15 @@ void Node::on_cos_message(Bytes payload, TimePoint now) {
                     now);
     return;
   }
-  const std::size_t size = config_.profile.cos->produced_size;
-  if (size <= can::kMaxDataLength) {
-    if (payload.size() != size) {
-      bad_cos_message(NodeError::Kind::kCosLength, static_cast<std::uint32_t>(payload.size()), now);
-      return;
-    }
-    take_cos_message(payload, now);
-    return;
+  const IoFrame f = io_frame(cos_reassembler_, payload, config_.profile.cos->produced_size);
+  if (f.outcome == IoFrame::kComplete) {
+    take_cos_message(f.message, now);
+  } else if (f.outcome != IoFrame::kIncomplete) {
+    bad_cos_message(f.outcome == IoFrame::kWrongSize ? NodeError::Kind::kCosLength
+                                                     : NodeError::Kind::kCosMalformed,
+                    f.got, now);
   }
-  switch (cos_reassembler_.on_fragment(payload)) {
-    case IoReassembler::Outcome::kIncomplete:
-      return;
-    case IoReassembler::Outcome::kComplete: {
-      const Bytes message = cos_reassembler_.message();
-      if (message.size() != size) {
-        bad_cos_message(NodeError::Kind::kCosLength, static_cast<std::uint32_t>(message.size()),
-                        now);
-      } else {
-        take_cos_message(message, now);
-      }
-      cos_reassembler_.reset();
-      return;
-    }
-    default:
-      bad_cos_message(NodeError::Kind::kCosMalformed, static_cast<std::uint32_t>(payload.size()),
-                      now);
-      return;
-  }
+  if (f.outcome == IoFrame::kComplete || f.outcome == IoFrame::kWrongSize) cos_reassembler_.reset();
 }
 
 void Node::take_cos_message(Bytes data, TimePoint now) {
