@@ -128,8 +128,15 @@ DeviceConfig read(const toml::table& table, Problems& p, const std::filesystem::
           if (entry.eds) entry.eds->serial_number = static_cast<std::uint32_t>(*v);
         }
       }
+      if (const toml::node* m = t.get("member_lists")) {
+        if (auto v = toml_config::read_bool(*m, "member_lists", p); v && entry.eds) {
+          entry.eds->member_lists = *v;
+        }
+      }
       for (const auto& [key, value] : *n.as_table()) {
-        if (key == "eds" || key == "serial_number" || key == "mac") continue;
+        if (key == "eds" || key == "serial_number" || key == "mac" || key == "member_lists") {
+          continue;
+        }
         (void)t.get(key.str());  // refused here, not as unknown
         p.error(value.source(), fmt::format("{} is a CDN127 reading: this device runs its EDS "
                                             "file",
@@ -219,6 +226,7 @@ std::vector<DeviceSpec> device_options(const std::vector<MacId>& macs, const Dev
       spec.eds = entry->eds;
       spec.eds_options = sim::default_eds_slave_options(mac);
       if (entry->eds->serial_number) spec.eds_options.serial_number = *entry->eds->serial_number;
+      spec.eds_options.member_lists = entry->eds->member_lists;
       out.push_back(std::move(spec));
       continue;
     }

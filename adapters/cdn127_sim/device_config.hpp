@@ -15,8 +15,11 @@
 // directory) is not a CDN127 but a device driven by that EDS file
 // (sim::EdsSlave: Identity, Assembly, Parameter, Acknowledge Handler, poll
 // and change-of-state or cyclic production); the CDN127's keys below are
-// not for it, and [defaults] does not reach it. Its other key:
+// not for it, and [defaults] does not reach it. Its other keys:
 //   serial_number = 0..0xFFFFFFFF   (default: the simulator's, from its MAC)
+//   member_lists = true|false       false: Assembly attributes 1 and 2 answer
+//                                   0x14 (a device that describes its
+//                                   assemblies only in its EDS)
 //
 // Keys of [defaults] and CDN127 [[device]]s (all optional; mac required in,
 // and only in, [[device]]):
@@ -77,6 +80,7 @@ struct EdsDevice {
   std::string path;  // as resolved, for the log
   std::shared_ptr<const eds::EdsFile> file;
   std::optional<std::uint32_t> serial_number;
+  bool member_lists = true;
 };
 
 struct DeviceEntry {

@@ -206,6 +206,25 @@ TEST_F(DeviceRackTest, ADeviceWhoseMemberListDiffersFromTheEdsIsAConfigurationFa
   EXPECT_FALSE(view().online);
 }
 
+TEST_F(DeviceRackTest, ADeviceWithoutMemberListsIsNotComparedAndComesOnline) {
+  // A device that describes its assemblies only in its EDS: Assembly
+  // attributes 1 and 2 answer 0x14. Nothing to compare: online, its inputs
+  // read as the EDS lays them out.
+  auto config = rack_config({});
+  config.devices = {io_block()};
+  config.create_devices = false;
+  rack_.emplace(config);
+  auto options = sim::default_eds_slave_options(mac(kIo));
+  options.member_lists = false;
+  rack_->add_eds_device(example_eds(kIoBlockEds), options, std::nullopt);
+  rack_->start();
+  ASSERT_TRUE(run_until_online()) << view().reason;
+  ASSERT_TRUE(device().objects().set_param_value(3, Bytes(ByteVec{0x3C})));
+  world().run_for(milliseconds(120));
+  ASSERT_TRUE(view().has_inputs);
+  EXPECT_EQ(view().input_values[0].value, 0x3C);
+}
+
 TEST_F(DeviceRackTest, APumpAndADeviceShareAPortAndAReloadMovesANodeBetweenThem) {
   start({io_block()}, {1});
   ASSERT_TRUE(run_until_online());

@@ -188,7 +188,8 @@ TEST(DeviceConfig, TheShippedExampleLoads) {
 TEST(DeviceConfig, ADeviceWithAnEdsFileRunsIt) {
   const DeviceConfig c = parse_device_config(
       "[defaults]\npoll_paths_fixed = true\n"
-      "[[device]]\nmac = 21\neds = \"dnbridge-example-io-block.eds\"\nserial_number = 7\n",
+      "[[device]]\nmac = 21\neds = \"dnbridge-example-io-block.eds\"\nserial_number = 7\n"
+      "member_lists = false\n",
       "sim.toml", DNBRIDGE_SOURCE_DIR "/deploy/eds");
   const auto all = device_options({mac(1)}, c, Reading::kLenient);
   ASSERT_EQ(all.size(), 2u);
@@ -198,6 +199,7 @@ TEST(DeviceConfig, ADeviceWithAnEdsFileRunsIt) {
   EXPECT_EQ(all[1].eds->path, DNBRIDGE_SOURCE_DIR "/deploy/eds/dnbridge-example-io-block.eds");
   EXPECT_EQ(all[1].eds_options.mac, 21);
   EXPECT_EQ(all[1].eds_options.serial_number, 7u);
+  EXPECT_FALSE(all[1].eds_options.member_lists);
 
   // The CDN127's readings are not its own; its EDS's problems have their lines.
   EXPECT_EQ(problems("[[device]]\nmac = 21\neds = \"x.eds\"\npoll_paths_fixed = true\n"),

@@ -328,7 +328,8 @@ TEST_F(SystemTest, RackOnlineWithFieldReadingDevices) {
 }
 
 // A CDN127 and a device driven by its EDS file (the example I/O block) on
-// change of state, both simulated by cdn127-sim on one bus: both online, the
+// change of state, both simulated by cdn127-sim on one bus, the device
+// without member lists (the start-up check tolerates it): both online, the
 // device's connection 4 allocated (choice 0x10) beside its poll connection,
 // a change of its inputs produced at once and every message acknowledged by
 // the bridge, its counters in NodeStatus (dnbctl show), the pump commanded
@@ -339,7 +340,8 @@ TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
   auto capture = std::make_unique<Capture>("vcan0", pcap);
   const fs::path devices = dir_ / "devices.toml";
   std::ofstream(devices) << fmt::format(
-      "[[device]]\nmac = {}\neds = \"{}/dnbridge-example-io-block.eds\"\n", kIo, DNBRIDGE_EDS_DIR);
+      "[[device]]\nmac = {}\neds = \"{}/dnbridge-example-io-block.eds\"\nmember_lists = false\n",
+      kIo, DNBRIDGE_EDS_DIR);
   Child& sim = start_sim("vcan0", {kPump}, {"--device-config", devices.string()});
   const std::string io_node = fmt::format(
       "  profile = \"eds\"\n  eds = \"{}/dnbridge-example-io-block.eds\"\n"
@@ -419,6 +421,11 @@ TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "dnbridge status " << status;
   (void)sim.stop();
   const std::uint64_t frames = capture->stop();
+  // Its member lists refused (0x14), not compared: logged, and no fault.
+  EXPECT_EQ(count_lines(bridge.log(),
+                        "Assembly 100 member list (Assem100 Inputs and status) not "
+                        "offered (attribute not supported (0x14/0xFF)): not compared"),
+            1u);
   // On the wire: Allocate of connection 4 (choice 0x10) to MAC 21 once, its
   // messages on Group 1 message 13 and the bridge's acknowledgments on
   // Group 2 message 2, each after the message it acknowledges.

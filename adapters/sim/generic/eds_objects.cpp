@@ -76,8 +76,8 @@ std::vector<std::uint8_t> encode_path(const cip::EPath& path) {
 
 }  // namespace
 
-EdsObjects::EdsObjects(eds::EdsFile file, std::uint32_t serial_number)
-    : file_(std::move(file)), serial_number_(serial_number) {
+EdsObjects::EdsObjects(eds::EdsFile file, std::uint32_t serial_number, bool member_lists)
+    : file_(std::move(file)), serial_number_(serial_number), member_lists_(member_lists) {
   for (const auto& p : file_.params) {
     values_[p.number] = encode_value(p, p.default_value.value_or(0.0));
   }
@@ -271,6 +271,9 @@ EdsObjects::Outcome EdsObjects::get_assembly(std::uint16_t instance, std::uint8_
   }
   const eds::Assembly* a = assembly(instance);
   if (a == nullptr) return {GeneralStatus::kObjectDoesNotExist};
+  if (!member_lists_ && attribute != cip::assembly_attr::kData) {
+    return {GeneralStatus::kAttributeNotSupported};
+  }
   switch (attribute) {
     case cip::assembly_attr::kMemberCount:
       out.u16le(static_cast<std::uint16_t>(a->members.size()));

@@ -55,7 +55,10 @@ struct AckHandler {
 
 class EdsObjects {
  public:
-  EdsObjects(eds::EdsFile file, std::uint32_t serial_number);
+  // `member_lists`: false, the Assembly object's attributes 1 and 2 are not
+  // supported (0x14), as on a device that describes its assemblies only in
+  // its EDS.
+  EdsObjects(eds::EdsFile file, std::uint32_t serial_number, bool member_lists = true);
 
   // Runs `request` and writes the response message (service byte first,
   // success or error) into `out` (devicenet::kMaxExplicitMessage bytes);
@@ -109,6 +112,7 @@ class EdsObjects {
 
   eds::EdsFile file_;
   std::uint32_t serial_number_;
+  bool member_lists_ = true;
   std::map<unsigned, std::vector<std::uint8_t>> values_;  // per ParamN
   AckHandler ack_;
 };

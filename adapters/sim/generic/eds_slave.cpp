@@ -98,7 +98,7 @@ ConnectionSetOptions EdsSlave::connection_options(const EdsSlaveOptions& o,
 EdsSlave::EdsSlave(can::FrameSink& sink, eds::EdsFile file, EdsSlaveOptions options, Logger log)
     : Group2Slave(sink, wire_options(file, options), std::move(log)),
       options_(options),
-      objects_(std::move(file), options.serial_number),
+      objects_(std::move(file), options.serial_number, options.member_lists),
       mac_(MacId::from_bits(options.mac)),
       defaults_(io_defaults(objects_)),
       connections_(connection_options(options_, defaults_), *this) {

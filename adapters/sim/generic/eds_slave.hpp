@@ -89,6 +89,9 @@ struct EdsSlaveOptions {
   bool idle_poll_answered_empty = false;
   // Expected packet rates are rounded up to this (bridge/PROTOCOL.md §7).
   Duration timer_resolution = milliseconds(10);
+  // False: no member lists (Assembly attributes 1 and 2 answer 0x14), as a
+  // device that describes its assemblies only in its EDS.
+  bool member_lists = true;
   // The wire's readings and delays; its vendor ID and serial number are the
   // EDS's VendCode and serial_number above.
   Group2Options wire{};
