@@ -232,6 +232,32 @@ TEST_F(CosRackTest, ALostAnswerToTheAllocateOfConnection4IsNotAFault) {
   EXPECT_GT(counters().cos_messages, 0u);
 }
 
+TEST_F(CosRackTest, IdlePollsAnsweredEmptyLeaveTheInputsOfTheChangeOfStateConnection) {
+  // A device that answers an idle poll with no data: the inputs stay those
+  // its change-of-state messages carry, not withheld at every poll.
+  auto config = rack_config({});
+  auto d = cos_block();
+  d.node.poll_period = milliseconds(100);
+  config.devices = {d};
+  config.create_devices = false;
+  rack_.emplace(config);
+  auto options = sim::default_eds_slave_options(mac(kIo));
+  options.idle_poll_answered_empty = true;
+  rack_->add_eds_device(example_eds(kIoBlockEds), options, std::nullopt);
+  rack_->start();
+  ASSERT_TRUE(run_until_online()) << node().reason();
+  set_inputs(0x66);
+  world().run_for(milliseconds(50));
+  ASSERT_TRUE(view().has_inputs);
+  const auto status_changes = view().status_changes;
+  const auto before = counters();
+  world().run_for(milliseconds(1000));
+  EXPECT_GE(counters().idle_empty_responses - before.idle_empty_responses, 9u);
+  EXPECT_TRUE(view().has_inputs);
+  EXPECT_EQ(view().inputs[0], 0x66);
+  EXPECT_EQ(view().status_changes, status_changes);
+}
+
 TEST_F(CosRackTest, ACyclicDeviceProducesEveryCycleAndAChangeWaitsForIt) {
   start(cos_block(eds::ConnectionKind::kCyclic));
   ASSERT_TRUE(run_until_online()) << node().reason();

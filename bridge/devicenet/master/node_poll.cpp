@@ -153,6 +153,11 @@ void Node::accept_poll_response(Bytes data, TimePoint now) {
   ++counters_.responses;
   applied_idle_ = sent_idle_;
   applied_outputs_ = sent_outputs_;
+  // An idle poll answered with no data says nothing of the inputs; where a
+  // change-of-state connection produces them, they are its last message's.
+  if (data.empty() && cos_ && !cos_->last_data().empty()) {
+    data = Bytes(cos_->last_data().data(), cos_->last_data().size());
+  }
   if (reports_data_) observer_.on_poll_response(config_.mac, data, now);
   if (shutting_down_) {
     if (outputs_dirty_) {
