@@ -32,6 +32,19 @@ constexpr std::int64_t kMaxResolutionMs = 0xFFFF;
 
 constexpr sim::ClassAttribute kIdentityState{profiles::cdn127::class_id::kIdentity, 8};
 
+// The keys of a CDN127's readings (read_settings), refused by name on a
+// device that runs its EDS file.
+constexpr std::array<std::string_view, 10> kReadingKeys{"configuration_locked_while_poll_allocated",
+                                                        "poll_paths_fixed",
+                                                        "idle_poll_answered_empty",
+                                                        "no_ack_of_last_request_fragment",
+                                                        "identity_state_supported",
+                                                        "unsafe_factory_output_actions",
+                                                        "explicit_response_delay_ms",
+                                                        "poll_response_delay_ms",
+                                                        "epr_resolution_ms",
+                                                        "serial_number_bytes"};
+
 // The settings a [[device]] and [defaults] both hold.
 DeviceSettings read_settings(TableReader& t) {
   Problems& p = t.problems();
@@ -134,8 +147,8 @@ DeviceConfig read(const toml::table& table, Problems& p, const std::filesystem::
         }
       }
       for (const auto& [key, value] : *n.as_table()) {
-        if (key == "eds" || key == "serial_number" || key == "mac" || key == "member_lists") {
-          continue;
+        if (std::find(kReadingKeys.begin(), kReadingKeys.end(), key.str()) == kReadingKeys.end()) {
+          continue;  // its own keys, or unknown (the table reader says so)
         }
         (void)t.get(key.str());  // refused here, not as unknown
         p.error(value.source(), fmt::format("{} is a CDN127 reading: this device runs its EDS "

@@ -202,11 +202,12 @@ TEST(DeviceConfig, ADeviceWithAnEdsFileRunsIt) {
   EXPECT_FALSE(all[1].eds_options.member_lists);
 
   // The CDN127's readings are not its own; its EDS's problems have their lines.
-  EXPECT_EQ(problems("[[device]]\nmac = 21\neds = \"x.eds\"\npoll_paths_fixed = true\n"),
+  EXPECT_EQ(problems("[[device]]\nmac = 21\neds = \"x.eds\"\npoll_paths_fixed = true\nfoo = 1\n"),
             (std::vector<std::string>{
                 "sim.toml:3:7: eds: x.eds: cannot open: No such file or directory",
                 "sim.toml:4:20: poll_paths_fixed is a CDN127 reading: this device runs its EDS "
-                "file"}));
+                "file",
+                "sim.toml:5:1: unknown key 'foo' in [[device]]"}));
 }
 
 TEST(DeviceConfig, EmptyFileIsNoChange) {
