@@ -41,6 +41,16 @@ void validate_node(const ScannerConfig& c, const NodeConfig& n) {
     throw std::invalid_argument(
         fmt::format("node {}: poll messages over {} bytes", mac, Node::kMaxIoSize));
   }
+  if (const auto& cos = n.profile.cos) {
+    if (cos->expected_packet_rate <= Duration::zero()) {
+      throw std::invalid_argument(
+          fmt::format("node {}: change-of-state expected packet rate must be positive", mac));
+    }
+    if (cos->produced_size > Node::kMaxIoSize) {
+      throw std::invalid_argument(
+          fmt::format("node {}: change-of-state messages over {} bytes", mac, Node::kMaxIoSize));
+    }
+  }
 }
 
 }  // namespace

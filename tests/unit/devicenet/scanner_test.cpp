@@ -96,6 +96,19 @@ TEST(Scanner, ABusBackDuringTheMacCheckStartsTheCheckAgain) {
   EXPECT_EQ(sink.checks.size(), 3u);
 }
 
+TEST(Scanner, AChangeOfStateConnectionWithoutARateOrTooLargeIsRefused) {
+  DiscardSink sink;
+  StateTimes observer;
+  ScannerConfig config = three_nodes();
+  config.nodes[1].profile.cos = CosConnection{};
+  EXPECT_NO_THROW(Scanner(config, sink, observer, Logger()));
+  config.nodes[1].profile.cos->expected_packet_rate = Duration::zero();
+  EXPECT_THROW(Scanner(config, sink, observer, Logger()), std::invalid_argument);
+  config.nodes[1].profile.cos->expected_packet_rate = milliseconds(100);
+  config.nodes[1].profile.cos->produced_size = Node::kMaxIoSize + 1;
+  EXPECT_THROW(Scanner(config, sink, observer, Logger()), std::invalid_argument);
+}
+
 TEST(Scanner, ANegativeImmediatePollGapIsRefused) {
   DiscardSink sink;
   StateTimes observer;
