@@ -189,6 +189,8 @@ TEST_F(CosRackTest, FourHeartbeatsMissedLoseTheNodeAndItComesBackWhenHeardAgain)
   world().run_for(milliseconds(20));
   EXPECT_EQ(*device().objects().param_number(4), 0x80);
   EXPECT_EQ(device().owner(), devicenet::MacId::kNone);
+  // The Release's answer is no news: the loss stays the last error.
+  EXPECT_EQ(node().last_error().kind, devicenet::NodeError::Kind::kHeartbeatMissed);
 
   // Heard again: allocated afresh, online, producing.
   world().bus().faults().remove(rule);
@@ -198,6 +200,24 @@ TEST_F(CosRackTest, FourHeartbeatsMissedLoseTheNodeAndItComesBackWhenHeardAgain)
   EXPECT_GT(counters().cos_messages, messages);
   EXPECT_EQ(counters().heartbeats_missed, 1u);
   EXPECT_EQ(counters().reconnects, 1u);
+}
+
+TEST_F(CosRackTest, MessagesOfTheWrongSizeAreNeitherTakenNorAcknowledgedAndTheLossSaysWhy) {
+  start();
+  ASSERT_TRUE(run_until_online()) << node().reason();
+  world().run_for(milliseconds(300));
+  const auto before = counters();
+  // Every message from now on arrives a byte short.
+  world().bus().faults().add(sim::FaultRule::corrupt(cos_id(), sim::Corruption::kTruncate, 1));
+  ASSERT_TRUE(world().run_until([&] { return node().state() != devicenet::NodeState::kOnline; },
+                                seconds(2)));
+  EXPECT_EQ(counters().cos_messages, before.cos_messages);
+  EXPECT_EQ(counters().cos_acks, before.cos_acks);
+  EXPECT_GT(counters().cos_errors, before.cos_errors);
+  EXPECT_EQ(counters().heartbeats_missed, 1u);
+  EXPECT_NE(node().reason().find("were refused: change-of-state message of 3 bytes, expected 4"),
+            std::string::npos)
+      << node().reason();
 }
 
 TEST_F(CosRackTest, ALostAnswerToTheAllocateOfConnection4IsNotAFault) {

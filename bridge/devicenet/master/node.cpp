@@ -241,18 +241,18 @@ void Node::on_timer(TimePoint now) {
   // Likewise 4 x EPR without a change-of-state or cyclic message, heartbeats
   // included.
   if (cos_ && now >= cos_->watchdog_deadline() && cos_->check_watchdog(now)) {
+    // Messages that came but were refused say why none was taken.
+    const std::string refused = cos_consecutive_errors_ > 0
+                                    ? fmt::format("; the last {} were refused: {}",
+                                                  cos_consecutive_errors_, last_error_.describe())
+                                    : std::string();
     ++counters_.heartbeats_missed;
     record(NodeError::Kind::kHeartbeatMissed, now);
-    const Duration epr = cos_->settings().expected_packet_rate;
     lose_and_release(
         fmt::format("no {} message for {} ms (4 x EPR of {} ms){}",
                     config_.profile.cos->cyclic ? "cyclic" : "change-of-state",
                     std::chrono::duration_cast<milliseconds>(now - cos_->last_message()).count(),
-                    to_ms(epr),
-                    cos_consecutive_errors_ > 0
-                        ? fmt::format("; the last {} were refused: {}", cos_consecutive_errors_,
-                                      last_error_.describe())
-                        : std::string()),
+                    to_ms(cos_->settings().expected_packet_rate), refused),
         now);
     return;
   }

@@ -227,6 +227,7 @@ void Node::attempt_allocate(TimePoint now) {
   step_timeouts_ = 0;
   poll_release_tried_ = false;
   cos_release_tried_ = false;
+  stray_poll_responses_ = 0;  // what did not come by now is not coming
   ack_handler_unread_ = false;
   setting_retried_ = false;
   // What an attempt learns is its own: paths and refusals from an earlier one
@@ -309,7 +310,7 @@ void Node::run(Step step, TimePoint now) {
         case Step::kCosEpr:
           // Right after the poll connection's start, bounded as its Set was.
           value.assign(Bytes(uint_le(to_ms(config_.profile.cos->expected_packet_rate))));
-          timeout = std::min(client_.response_timeout(), 2 * config_.expected_packet_rate);
+          timeout = std::min(client_.response_timeout(), 2 * poll_epr_);
           break;
         default:
           break;
@@ -372,10 +373,16 @@ void Node::on_explicit_result(std::uint32_t tag, const ExplicitResult& result, T
 
 void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
   if (r.error == Errc::kStopped) return;  // cancelled by shutdown or halt
-  if (r.error == Errc::kDeviceError) record_device_error(r, now);
-  if (r.error == Errc::kTimeout) record(NodeError::Kind::kExplicitTimeout, now);
-  if (r.error == Errc::kAborted) record(NodeError::Kind::kExplicitAborted, now);
-  if (r.error == Errc::kMalformed) record(NodeError::Kind::kExplicitMalformed, now);
+  // What a Release after a loss or a fault answers (a refusal of what the
+  // device no longer holds, or nothing from a device gone) is not news: the
+  // last error stays the one that made the node leave.
+  const bool releasing = step == Step::kReleaseFault || step == Step::kReleaseShutdown;
+  if (!releasing) {
+    if (r.error == Errc::kDeviceError) record_device_error(r, now);
+    if (r.error == Errc::kTimeout) record(NodeError::Kind::kExplicitTimeout, now);
+    if (r.error == Errc::kAborted) record(NodeError::Kind::kExplicitAborted, now);
+    if (r.error == Errc::kMalformed) record(NodeError::Kind::kExplicitMalformed, now);
+  }
 
   switch (step) {
     case Step::kKeepAlive:

@@ -109,7 +109,14 @@ Node::IoFrame Node::io_frame(IoReassembler& reassembler, Bytes payload, std::siz
 
 void Node::on_poll_response(Bytes payload, TimePoint now) {
   if (state_ != NodeState::kOnline && stray_poll_responses_ > 0) {
-    --stray_poll_responses_;  // the answer to the idle poll of a device fault
+    // The answer to the idle poll sent on leaving online (and to a poll
+    // outstanding then): one message each, whatever its frames.
+    const bool fragmented = config_.profile.produced_size > can::kMaxDataLength;
+    const FragmentType type =
+        payload.empty() ? FragmentType::kLast : decode_fragment_byte(payload[0]).type;
+    if (!fragmented || (type != FragmentType::kFirst && type != FragmentType::kMiddle)) {
+      --stray_poll_responses_;
+    }
     return;
   }
   if (state_ != NodeState::kOnline) {
@@ -222,8 +229,10 @@ void Node::take_cos_message(Bytes data, TimePoint now) {
 void Node::bad_cos_message(NodeError::Kind kind, std::uint32_t got, TimePoint now) {
   // Neither taken nor acknowledged: the device sends it again, or the
   // watchdog ends the connection.
-  // A straggler of a connection just released is no news.
-  if (!cos_ && kind == NodeError::Kind::kCosUnexpected && state_ != NodeState::kOnline) {
+  // A straggler of a connection just released, or a message for another
+  // master's connection of a node this one polls, is no news.
+  if (kind == NodeError::Kind::kCosUnexpected &&
+      (!config_.profile.cos || (!cos_ && state_ != NodeState::kOnline))) {
     ++counters_.cos_errors;
     return;
   }
