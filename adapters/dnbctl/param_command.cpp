@@ -6,6 +6,8 @@
 // allow_managed_attribute_writes).
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -27,12 +29,13 @@ constexpr std::uint8_t kGetAttributeSingle = 0x0E;
 constexpr std::uint8_t kSetAttributeSingle = 0x10;
 
 constexpr const char* kParamNote =
-    "The parameter's attribute is its EDS link path (the Parameter object's instance N "
-    "attribute 1 where it has none). A value is given as the device holds it (the EDS's limits "
-    "are in these units) and checked against the parameter's type and limits before it is "
-    "sent; the bridge's [explicit_policy] decides whether it may be written (a parameter the "
-    "bridge sets at start-up needs allow_managed_attribute_writes). After a write the value is "
-    "read back.";
+    "The parameter's attribute is its EDS link path (read through the Parameter object's "
+    "instance N attribute 1 where it has none; only a numeric parameter with a link path is "
+    "written). A value is given as the device holds it, unscaled (the EDS's limits are in these "
+    "units), and checked against the parameter's type and limits, and the node's identity "
+    "against the EDS's, before it is sent; the bridge's [explicit_policy] decides whether it may "
+    "be written (a parameter the bridge sets at start-up needs allow_managed_attribute_writes). "
+    "After a write the value is read back: another value than the one written is an error.";
 
 // The attribute that holds parameter `p`.
 devicenet::AttributeSetting target_of(const eds::Param& p) {
@@ -51,12 +54,34 @@ devicenet::AttributeSetting target_of(const eds::Param& p) {
   return t;
 }
 
-// "5 ms", "-2.5", or the bytes when they are not the parameter's size.
+// The value `data` holds as the parameter's type reads it: a number (a REAL
+// as the single-precision value it is), exactly for 64-bit integers; empty
+// when it is not a finite number of the parameter's size.
+std::optional<std::string> raw_text(const eds::Param& p, Bytes data) {
+  if (p.type.size == 0 || data.size() != p.size) return std::nullopt;
+  const std::uint64_t raw = little_endian(data);
+  const auto bits = static_cast<std::uint16_t>(p.size * 8);
+  if (!p.type.is_float) {
+    if (!p.type.is_signed) return fmt::format("{}", raw);
+    if (p.size >= 8) return fmt::format("{}", static_cast<std::int64_t>(raw));
+    return fmt::format("{}", static_cast<std::int64_t>(eds::from_raw(p.type, bits, raw)));
+  }
+  const double v = eds::from_raw(p.type, bits, raw);
+  if (!std::isfinite(v)) return std::nullopt;
+  return p.size == 4 ? fmt::format("{}", static_cast<float>(v)) : fmt::format("{}", v);
+}
+
+// "5 ms"; with the EDS's scaling "5.0 ms (raw 50)"; the bytes when they are
+// not a number of the parameter's size.
 std::string value_text(const eds::Param& p, Bytes data) {
-  if (p.type.size == 0 || data.size() != p.size) return hex_bytes(data);
+  const auto raw = raw_text(p, data);
+  if (!raw) return hex_bytes(data);
+  const std::string units = p.units.empty() ? "" : " " + p.units;
+  if (p.multiplier == 1 && p.divisor == 1 && p.base == 1 && p.offset == 0) return *raw + units;
   const double v =
       eds::from_raw(p.type, static_cast<std::uint16_t>(p.size * 8), little_endian(data));
-  return fmt::format("{}{}", v, p.units.empty() ? "" : " " + p.units);
+  const double shown = (v + p.offset) * p.multiplier * p.base / p.divisor;
+  return fmt::format("{:.{}f}{} (raw {})", shown, p.decimals, units, *raw);
 }
 
 }  // namespace
@@ -130,9 +155,36 @@ Exit run_param(const GlobalOptions& o, const ParamArgs& args) {
     }
     return x;
   };
-  if (write) (void)exchange(kSetAttributeSingle, write->value);
-  const ExplicitExchange read = exchange(kGetAttributeSingle, {});
+  if (write) {
+    // Not on a node of another identity: another device's EDS names other
+    // attributes, and other types.
+    if (const auto* node = client.node(key)) {
+      const auto& n = *node->data;
+      const auto& d = file.device;
+      if (n.vendor_id != 0 && (n.vendor_id != d.vendor_code || n.product_type != d.product_type ||
+                               n.product_code != d.product_code)) {
+        throw CommandError(
+            Exit::kUsage,
+            fmt::format(
+                "{} is vendor {}, product type {}, product code {}; {} describes vendor {}, "
+                "product type {}, product code {}: not written",
+                name, n.vendor_id, n.product_type, n.product_code, args.eds, d.vendor_code,
+                d.product_type, d.product_code));
+      }
+    }
+    (void)exchange(kSetAttributeSingle, write->value);
+  }
+  ExplicitExchange read;
+  try {
+    read = exchange(kGetAttributeSingle, {});
+  } catch (const CommandError& e) {
+    if (!write) throw;
+    throw CommandError(e.code(), fmt::format("written; reading it back failed: {}", e.what()));
+  }
   const Bytes data(read.data.data(), read.data.size());
+  // A device that rounds or bounds what it was given holds something else.
+  const bool holds_written =
+      !write || std::equal(data.begin(), data.end(), write->value.begin(), write->value.end());
 
   if (o.json) {
     JsonWriter out;
@@ -146,13 +198,12 @@ Exit run_param(const GlobalOptions& o, const ParamArgs& args) {
         .field("units", p.units)
         .field("written", write.has_value())
         .field("data", hex_bytes(data));
+    out.field("holds_written", holds_written);
     out.key("value");
-    if (p.type.size != 0 && data.size() == p.size) {
-      out.number_text(fmt::format(
-          "{}",
-          eds::from_raw(p.type, static_cast<std::uint16_t>(p.size * 8), little_endian(data))));
+    if (const auto raw = raw_text(p, data)) {
+      out.number_text(*raw);
     } else {
-      out.null();
+      out.null();  // not a finite number of the parameter's size
     }
     out.end_object();
     print(out.str() + "\n");
@@ -160,6 +211,13 @@ Exit run_param(const GlobalOptions& o, const ParamArgs& args) {
     print(fmt::format("{}: Param{} \"{}\" = {} ({}, {}){}\n", name, p.number, p.name,
                       value_text(p, data), p.type.name, hex_bytes(data),
                       write ? " (written, read back)" : ""));
+  }
+  if (!holds_written) {
+    std::fputs(fmt::format("dnbctl: {}: Param{} was written [{}] but holds [{}]\n", name, p.number,
+                           hex_bytes(write->value), hex_bytes(data))
+                   .c_str(),
+               stderr);
+    return Exit::kFailed;
   }
   return Exit::kOk;
 }

@@ -177,6 +177,7 @@ TEST_F(DnbctlDevices, ParamReadsAndWritesByNameUnderTheGatewayPolicy) {
   r = dnbctl({"param", "20", "Input filter", "12", "--eds", eds, "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("\"written\": true"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"holds_written\": true"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"value\": 12"), std::string::npos) << r.out;
   r = dnbctl({"param", "20", "Param1", "--eds", eds});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -191,6 +192,14 @@ TEST_F(DnbctlDevices, ParamReadsAndWritesByNameUnderTheGatewayPolicy) {
   EXPECT_NE(r.err.find("Param9 \"Output idle value\" (class 0x0F instance 0x09 attribute 0x01)"),
             std::string::npos)
       << r.err;
+
+  // Another device's EDS: not written to this one.
+  r = dnbctl({"param", "io-1", "Low pressure limit", "300", "--eds",
+              std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-valve-manifold.eds"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("is vendor 65001, product type 7, product code 1; "), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(": not written"), std::string::npos) << r.err;
 
   // Checked against the EDS before anything is sent.
   r = dnbctl({"param", "io-1", "Input filter", "70000", "--eds", eds});

@@ -122,9 +122,8 @@ Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
                                link.empty() ? "none" : "not class/instance/attribute"));
   }
   if (p->type.size == 0) {
-    return explain(
-        why, Errc::kUnsupported,
-        fmt::format("{} is a {}: only numbers are set at start-up", label, p->type.name));
+    return explain(why, Errc::kUnsupported,
+                   fmt::format("{} is a {}: only numbers are set", label, p->type.name));
   }
   if (!within_limits(p->minimum, p->maximum, given.value)) {
     return explain(why, Errc::kOutOfRange,

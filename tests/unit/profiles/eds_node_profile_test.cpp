@@ -240,8 +240,7 @@ TEST(EdsNodeProfile, AParameterWithoutALinkPathOrOfAStringTypeIsNotSet) {
             "none)");
   n.parameters = {{"label", 1}};
   EXPECT_EQ(profile_of(*parsed.file, n, &why).error(), make_error_code(Errc::kUnsupported));
-  EXPECT_EQ(why,
-            "parameters: Param2 \"label\" is a SHORT_STRING: only numbers are set at start-up");
+  EXPECT_EQ(why, "parameters: Param2 \"label\" is a SHORT_STRING: only numbers are set");
   // Inputs only: no safe state is needed.
   n.parameters.clear();
   auto p = profile_of(*parsed.file, n, &why);
