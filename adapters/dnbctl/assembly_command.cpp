@@ -12,12 +12,13 @@
 #include "adapters/dnbctl/target.hpp"
 #include "adapters/dnbctl/values.hpp"
 #include "bridge/cip/assembly.hpp"
+#include "bridge/cip/service.hpp"
 #include "bridge/common/bytes.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
 
-constexpr std::uint8_t kGetAttributeSingle = 0x0E;
+constexpr auto kGetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
 constexpr std::uint16_t kAssemblyClass = 0x04;
 // CIP general status "object does not exist": an instance the device has not.
 constexpr std::uint8_t kObjectDoesNotExist = 0x16;

@@ -9,12 +9,13 @@
 #include "adapters/dnbctl/requester.hpp"
 #include "adapters/dnbctl/target.hpp"
 #include "adapters/dnbctl/values.hpp"
+#include "bridge/cip/service.hpp"
 
 namespace dnbridge::dnbctl {
 namespace {
 
-constexpr std::uint8_t kGetAttributeSingle = 0x0E;
-constexpr std::uint8_t kSetAttributeSingle = 0x10;
+constexpr auto kGetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
+constexpr auto kSetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kSetAttributeSingle);
 
 constexpr const char* kStatusNote =
     "Numbers are decimal or hex with 0x. The bridge's transaction status is printed with its "

@@ -18,6 +18,7 @@
 #include "adapters/dnbctl/values.hpp"
 #include "bridge/cip/assembly.hpp"
 #include "bridge/cip/objects.hpp"
+#include "bridge/cip/service.hpp"
 #include "bridge/common/bytes.hpp"
 #include "bridge/profiles/eds/io_layout.hpp"
 #include "bridge/profiles/eds/node_profile.hpp"
@@ -25,8 +26,8 @@
 namespace dnbridge::dnbctl {
 namespace {
 
-constexpr std::uint8_t kGetAttributeSingle = 0x0E;
-constexpr std::uint8_t kSetAttributeSingle = 0x10;
+constexpr auto kGetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
+constexpr auto kSetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kSetAttributeSingle);
 
 constexpr const char* kParamNote =
     "The parameter's attribute is its EDS link path (read through the Parameter object's "

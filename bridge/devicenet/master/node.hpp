@@ -222,6 +222,12 @@ class Node final : private ExplicitClient::Listener {
   Step after_size(const ExplicitResult& r, TimePoint now);
   Step after_epr(const ExplicitResult& r, TimePoint now);
   Step after_allocate_cos(const ExplicitResult& r, TimePoint now);
+  // A refused Allocate of an I/O connection (`what`): "already allocated"
+  // released (`release_step`) and allocated once more; owned by another
+  // master, or another refusal (with `needed_by` after the status), a fault.
+  Step io_allocate_refused(const ExplicitResult& r, TimePoint now, std::string_view what,
+                           std::string_view needed_by, bool& release_tried, bool& requested,
+                           Step release_step);
   Step after_cos_step(const ExplicitResult& r, TimePoint now);
   // The change-of-state steps in order, those that do not apply skipped.
   Step cos_step_after(Step step) const;

@@ -528,19 +528,27 @@ Node::Step Node::after_allocate_poll(const ExplicitResult& r, TimePoint now) {
     if (!config_.profile.consumed_path.empty()) return Step::kGetConsumedPath;
     return begin_verify(now);
   }
-  if (r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode && !poll_release_tried_) {
-    poll_release_tried_ = true;
-    return Step::kReleasePollForAllocate;
+  return io_allocate_refused(r, now, "Allocate of the poll connection", "", poll_release_tried_,
+                             poll_requested_, Step::kReleasePollForAllocate);
+}
+
+Node::Step Node::io_allocate_refused(const ExplicitResult& r, TimePoint now, std::string_view what,
+                                     std::string_view needed_by, bool& release_tried,
+                                     bool& requested, Step release_step) {
+  // Held already (its answer to an Allocate lost on the bus, or left from
+  // before): released, then allocated once more.
+  if (r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode && !release_tried) {
+    release_tried = true;
+    return release_step;
   }
-  poll_requested_ = false;  // refused: the device did not give it
+  requested = false;  // refused: the device did not give it
   if (r.general_status == cip::GeneralStatus::kObjectStateConflict && r.additional_status == 0x01) {
     enter_fault(NodeState::kOwnedByOtherMaster,
-                "Allocate of the poll connection refused: owned by another master (0x0C/0x01)",
-                now);
+                fmt::format("{} refused: owned by another master (0x0C/0x01)", what), now);
     return Step::kNone;
   }
   enter_fault(NodeState::kConfigurationFault,
-              fmt::format("Allocate of the poll connection refused: {}", status_text(r)), now);
+              fmt::format("{} refused: {}{}", what, status_text(r), needed_by), now);
   return Step::kNone;
 }
 
@@ -976,31 +984,15 @@ Node::Step Node::cos_step_after(Step step) const {
 }
 
 Node::Step Node::after_allocate_cos(const ExplicitResult& r, TimePoint now) {
-  const std::string what =
-      fmt::format("Allocate of the {} connection (choice 0x{:02X})",
-                  config_.profile.cos->cyclic ? "cyclic" : "change-of-state", cos_choice());
   if (r.ok()) {
     cos_allocated_ = true;
     return cos_step_after(Step::kAllocateCos);
   }
-  // Held already (its answer to an Allocate lost on the bus, or left from
-  // before): released, then allocated once more, as the poll connection.
-  if (r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode && !cos_release_tried_) {
-    cos_release_tried_ = true;
-    return Step::kReleaseCosForAllocate;
-  }
-  cos_requested_ = false;  // refused: the device did not give it
-  if (r.general_status == cip::GeneralStatus::kObjectStateConflict && r.additional_status == 0x01) {
-    enter_fault(NodeState::kOwnedByOtherMaster,
-                fmt::format("{} refused: owned by another master (0x0C/0x01)", what), now);
-    return Step::kNone;
-  }
-  enter_fault(
-      NodeState::kConfigurationFault,
-      fmt::format("{} refused: {}; the node's connection = \"{}\" needs it", what, status_text(r),
-                  config_.profile.cos->cyclic ? "cyclic" : "change-of-state"),
-      now);
-  return Step::kNone;
+  const char* kind = config_.profile.cos->cyclic ? "cyclic" : "change-of-state";
+  return io_allocate_refused(
+      r, now, fmt::format("Allocate of the {} connection (choice 0x{:02X})", kind, cos_choice()),
+      fmt::format("; the node's connection = \"{}\" needs it", kind), cos_release_tried_,
+      cos_requested_, Step::kReleaseCosForAllocate);
 }
 
 // The answers to the change-of-state connection's set-up: what the device
