@@ -18,7 +18,6 @@
 namespace dnbridge::dnbctl {
 namespace {
 
-constexpr auto kGetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
 constexpr std::uint16_t kAssemblyClass = 0x04;
 // CIP general status "object does not exist": an instance the device has not.
 constexpr std::uint8_t kObjectDoesNotExist = 0x16;
@@ -33,7 +32,7 @@ ExplicitExchange get(Client& client, Requester& requester, const NodeKey& node,
   x.rack = node.rack;
   x.port = node.port;
   x.mac = node.mac;
-  x.service = kGetAttributeSingle;
+  x.service = cip::code(cip::Service::kGetAttributeSingle);
   x.class_id = kAssemblyClass;
   x.instance_id = instance;
   x.attribute = attribute;

@@ -14,9 +14,6 @@
 namespace dnbridge::dnbctl {
 namespace {
 
-constexpr auto kGetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
-constexpr auto kSetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kSetAttributeSingle);
-
 constexpr const char* kStatusNote =
     "Numbers are decimal or hex with 0x. The bridge's transaction status is printed with its "
     "name (1 transaction completed, 2 in progress, 3 slave not in scan list, 4 slave off-line, "
@@ -88,8 +85,12 @@ Exit run_explicit(const GlobalOptions& o, const ExplicitArgs& args) {
   if (!ref) throw CommandError(Exit::kUsage, ref.error());
   ExplicitExchange x;
   switch (args.kind) {
-    case ExplicitKind::kGet: x.service = kGetAttributeSingle; break;
-    case ExplicitKind::kSet: x.service = kSetAttributeSingle; break;
+    case ExplicitKind::kGet:
+      x.service = cip::code(cip::Service::kGetAttributeSingle);
+      break;
+    case ExplicitKind::kSet:
+      x.service = cip::code(cip::Service::kSetAttributeSingle);
+      break;
     case ExplicitKind::kService:
       // Bit 7 of the service byte is the response flag.
       x.service = number<std::uint8_t>(args.service, 0x7F, "service");

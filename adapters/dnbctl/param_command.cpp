@@ -26,9 +26,6 @@
 namespace dnbridge::dnbctl {
 namespace {
 
-constexpr auto kGetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
-constexpr auto kSetAttributeSingle = static_cast<std::uint8_t>(cip::Service::kSetAttributeSingle);
-
 constexpr const char* kParamNote =
     "The parameter's attribute is its EDS link path (read through the Parameter object's "
     "instance N attribute 1 where it has none; only a numeric parameter with a link path is "
@@ -173,11 +170,11 @@ Exit run_param(const GlobalOptions& o, const ParamArgs& args) {
                 d.product_type, d.product_code));
       }
     }
-    (void)exchange(kSetAttributeSingle, write->value);
+    (void)exchange(cip::code(cip::Service::kSetAttributeSingle), write->value);
   }
   ExplicitExchange read;
   try {
-    read = exchange(kGetAttributeSingle, {});
+    read = exchange(cip::code(cip::Service::kGetAttributeSingle), {});
   } catch (const CommandError& e) {
     if (!write) throw;
     throw CommandError(e.code(), fmt::format("written; reading it back failed: {}", e.what()));

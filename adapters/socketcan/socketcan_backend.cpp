@@ -65,9 +65,9 @@ std::vector<CanFilter> master_filters() {
   const auto g2 = [](Group2Message m) {
     return CanFilter{0x400u | static_cast<std::uint32_t>(m), 0x607};
   };
-  return {g1(Group1Message::kSlavePollResponse), g1(Group1Message::kSlaveCosCyclic),
-          g2(Group2Message::kSlaveExplicitResponse), g2(Group2Message::kDuplicateMacCheck),
-          CanFilter{0x7C0, 0x7C0}};
+  return {g1(Group1Message::kSlavePollResponse),      g1(Group1Message::kSlaveCosCyclic),
+          g1(Group1Message::kSlaveBitStrobeResponse), g2(Group2Message::kSlaveExplicitResponse),
+          g2(Group2Message::kDuplicateMacCheck),      CanFilter{0x7C0, 0x7C0}};
 }
 
 std::optional<BusState> SocketCanBackend::state_from_netlink() {

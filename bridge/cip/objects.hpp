@@ -74,7 +74,7 @@ inline constexpr std::uint8_t kMacId = 1, kBaudRate = 2, kBusOffInterrupt = 3, k
                               kMacSwitchValue = 8, kBaudSwitchValue = 9;
 }
 namespace connection_instance {
-inline constexpr std::uint16_t kExplicit = 1, kPoll = 2;
+inline constexpr std::uint16_t kExplicit = 1, kPoll = 2, kBitStrobe = 3;
 inline constexpr std::uint16_t kChangeOfState = 4;  // change of state or cyclic
 }
 namespace connection_attr {
@@ -158,6 +158,18 @@ inline constexpr AttributeRef kCosProducedPath{
     "Connection 4 (change of state).ProducedConnectionPath"};
 inline constexpr AttributeRef kCosInhibitTime{kClass, kCosInstance, connection_attr::kInhibitTime,
                                               "Connection 4 (change of state).InhibitTime"};
+
+// Instance 3: bit-strobe.
+inline constexpr std::uint16_t kStrobeInstance = connection_instance::kBitStrobe;
+inline constexpr AttributeRef kStrobeProducedSize{
+    kClass, kStrobeInstance, connection_attr::kProducedSize,
+    "Connection 3 (bit-strobe).ProducedConnectionSize"};
+inline constexpr AttributeRef kStrobeExpectedPacketRate{
+    kClass, kStrobeInstance, connection_attr::kExpectedPacketRate,
+    "Connection 3 (bit-strobe).ExpectedPacketRate"};
+inline constexpr AttributeRef kStrobeProducedPath{
+    kClass, kStrobeInstance, connection_attr::kProducedPath,
+    "Connection 3 (bit-strobe).ProducedConnectionPath"};
 }  // namespace connection
 
 // The Acknowledge Handler (instance 1): how long the device waits for an

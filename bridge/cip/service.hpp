@@ -23,6 +23,9 @@ enum class Service : std::uint8_t {
 inline constexpr std::uint8_t kResponseFlag = 0x80;
 inline constexpr std::uint8_t kServiceMask = 0x7F;
 
+// The service byte of a request.
+constexpr std::uint8_t code(Service s) noexcept { return static_cast<std::uint8_t>(s); }
+
 std::string_view to_string(Service service) noexcept;
 
 // Services whose request body begins with an attribute number.

@@ -102,11 +102,13 @@ TEST(ConfigEds, TheShippedExampleLoads) {
   EXPECT_TRUE(c.warnings.empty());
   const rack::PortNodes nodes = to_port_nodes(c.ports.at(0));
   ASSERT_EQ(nodes.pumps.size(), 1u);
-  ASSERT_EQ(nodes.devices.size(), 2u);
+  ASSERT_EQ(nodes.devices.size(), 3u);
   EXPECT_EQ(nodes.devices[0].eds->device.product_name, "Example IO block 8DI/8DO/1AI");
   EXPECT_EQ(nodes.devices[0].settings.connection, eds::ConnectionKind::kPoll);
   EXPECT_EQ(nodes.devices[1].settings.connection, eds::ConnectionKind::kChangeOfState);
   EXPECT_EQ(nodes.devices[1].settings.heartbeat, milliseconds(500));
+  EXPECT_EQ(nodes.devices[2].eds->device.product_name, "Example valve manifold 16");
+  EXPECT_EQ(nodes.devices[2].settings.connection, eds::ConnectionKind::kStrobe);
 }
 
 TEST(ConfigEds, APumpAndADeviceShareAPort) {
@@ -194,8 +196,8 @@ TEST(ConfigEds, AChangeOfStateNodeTakesItsHeartbeatInhibitAndAcknowledgment) {
   EXPECT_FALSE(n.eds_node.acknowledged);
   const auto nodes = to_port_nodes(c.ports[0]);
   const auto list = rack::RackPort::scan_list(to_scanner_config(c.ports[0], "host"), nodes);
-  ASSERT_TRUE(list.nodes.at(0).profile.cos.has_value());
-  EXPECT_EQ(list.nodes[0].profile.cos->expected_packet_rate, milliseconds(250));
+  ASSERT_TRUE(list.nodes.at(0).profile.input_connection.has_value());
+  EXPECT_EQ(list.nodes[0].profile.input_connection->expected_packet_rate, milliseconds(250));
 
   // Only for the connections they are about.
   EXPECT_THAT(problems(ONE_PORT IO_BLOCK "heartbeat_ms = 250\n"),

@@ -586,19 +586,26 @@ class EdsSlaveByFrames : public ::testing::Test {
   static std::vector<std::uint8_t> assembly_path(std::uint16_t instance) {
     return {0x20, 0x04, 0x24, static_cast<std::uint8_t>(instance), 0x30, 0x03};
   }
-  // A poll command; the poll response heard, if any.
-  std::optional<std::vector<std::uint8_t>> poll(const std::vector<std::uint8_t>& command) {
+  // An I/O message to the slave; its answer (`answer` of the slave's MAC)
+  // heard within 5 ms, if any.
+  std::optional<std::vector<std::uint8_t>> io(std::uint32_t to,
+                                              const std::vector<std::uint8_t>& data,
+                                              devicenet::Group1Message answer) {
     const std::size_t from = tester_.heard.size();
-    tester_.send(TestNode::frame(id(devicenet::Group2Message::kMasterIoPoll), command));
+    tester_.send(TestNode::frame(to, data));
     world_.run_for(milliseconds(5));
     std::optional<std::vector<std::uint8_t>> out;
-    const auto response_id =
-        devicenet::group1_id(devicenet::Group1Message::kSlavePollResponse, mac(kSlaveMac));
+    const auto response_id = devicenet::group1_id(answer, mac(kSlaveMac));
     for (std::size_t i = from; i < tester_.heard.size(); ++i) {
       const can::CanFrame& f = tester_.heard[i].first;
       if (f.id == response_id) out.emplace(f.payload().begin(), f.payload().end());
     }
     return out;
+  }
+  // A poll command; the poll response heard, if any.
+  std::optional<std::vector<std::uint8_t>> poll(const std::vector<std::uint8_t>& command) {
+    return io(id(devicenet::Group2Message::kMasterIoPoll), command,
+              devicenet::Group1Message::kSlavePollResponse);
   }
   // Change-of-state messages heard in [from, to).
   std::size_t cos_messages(TimePoint from, TimePoint to) const {
@@ -676,6 +683,54 @@ TEST_F(EdsSlaveByFrames, AConsumedPathNamesAnOutputAssemblyOnly) {
   EXPECT_EQ(set(kInstance4, 16, assembly_path(kOutputs)), (Reply{0x94, 0x0E, 0xFF}));
   EXPECT_EQ(set(kInstance4, 16, assembly_path(kInputs)), (Reply{0x94, 0x0E, 0xFF}));
   EXPECT_EQ(get(kInstance4, 15), (Reply{0x8E, 0x00}));
+}
+
+// The valve manifold's bit-strobe connection (instance 3): allocated with
+// 0x04, its produced path the StrobeInfo input (Assembly 102, the status
+// byte), its consumed size the command's 8 bytes, its IDs Group 1 message 14
+// and the owning master's Group 2 message 0. Established by its EPR, each
+// command of its master is answered with the status; a command of another
+// master is not; its watchdog times it out and then nothing is answered.
+TEST_F(EdsSlaveByFrames, TheBitStrobeConnectionAnswersItsMastersCommands) {
+  start(test::example_eds(test::kValveManifoldEds));
+  constexpr std::uint8_t kInstance3 = 3;
+  EXPECT_EQ(slave().strobe_input_assembly(), 102u);
+  ASSERT_EQ(allocate(0x05), (Reply{0xCB, 0x00}));
+  EXPECT_EQ(slave().connections().allocation_choice(), 0x05);
+  EXPECT_EQ(get(kInstance3, 7), (Reply{0x8E, 0x01, 0x00}));
+  EXPECT_EQ(get(kInstance3, 8), (Reply{0x8E, 0x08, 0x00}));
+  EXPECT_EQ(get(kInstance3, 4), (Reply{0x8E, 0x85, 0x03}));  // 0x380 + 5
+  EXPECT_EQ(get(kInstance3, 5), (Reply{0x8E, 0x00, 0x04}));  // 0x400 + (0 << 3)
+  EXPECT_EQ(get(kInstance3, 14), (Reply{0x8E, 0x20, 0x04, 0x24, 0x66, 0x30, 0x03}));
+  EXPECT_EQ(set(kInstance3, 16, assembly_path(102)), (Reply{0x94, 0x0E, 0xFF}));
+
+  const auto strobe = [&](unsigned master) {
+    return io(devicenet::group2_id(mac(master), devicenet::Group2Message::kMasterBitStrobeCommand),
+              {0x20, 0, 0, 0, 0, 0, 0, 0},  // bit 5: this device's
+              devicenet::Group1Message::kSlaveBitStrobeResponse);
+  };
+  // Configuring: not answered.
+  EXPECT_EQ(strobe(kMasterMac), std::nullopt);
+  ASSERT_EQ(set_epr(kInstance3, 100), (Reply{0x90, 100, 0}));
+  EXPECT_EQ(slave().strobe_state(), sim::ConnectionState::kEstablished);
+  ASSERT_TRUE(slave().objects().set_assembly_data(102, Bytes(Reply{0x03})));
+  EXPECT_EQ(strobe(kMasterMac), Reply{0x03});
+  EXPECT_TRUE(slave().strobe_counters().last_bit);
+  // Another master's command is not for it.
+  EXPECT_EQ(strobe(9), std::nullopt);
+  EXPECT_EQ(slave().strobe_counters().commands, 1u);
+  // Each command restarts the watchdog; without them it times out (4 x 100 ms).
+  world_.run_for(milliseconds(300));
+  EXPECT_EQ(strobe(kMasterMac), Reply{0x03});
+  world_.run_for(milliseconds(350));
+  EXPECT_EQ(slave().strobe_state(), sim::ConnectionState::kEstablished);
+  world_.run_for(milliseconds(100));
+  EXPECT_EQ(slave().strobe_state(), sim::ConnectionState::kTimedOut);
+  EXPECT_EQ(strobe(kMasterMac), std::nullopt);
+  EXPECT_EQ(slave().strobe_counters().responses, 2u);
+  // Released with the explicit connection: the set is unowned.
+  EXPECT_EQ(release(0x05), (Reply{0xCC}));
+  EXPECT_EQ(slave().owner(), devicenet::MacId::kNone);
 }
 
 // Acknowledge suppression alone names no connection: refused in Release as in

@@ -50,7 +50,7 @@ class MasterSlave : public ::testing::Test {
 
   static RequestMessage get(std::uint16_t cls, std::uint16_t inst, std::uint8_t attr) {
     RequestMessage r;
-    r.service = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
+    r.service = cip::code(cip::Service::kGetAttributeSingle);
     r.class_id = cls;
     r.instance_id = inst;
     r.attribute = attr;
@@ -58,7 +58,7 @@ class MasterSlave : public ::testing::Test {
   }
   static RequestMessage set(std::uint16_t cls, std::uint16_t inst, std::uint8_t attr, Bytes data) {
     RequestMessage r = get(cls, inst, attr);
-    r.service = static_cast<std::uint8_t>(cip::Service::kSetAttributeSingle);
+    r.service = cip::code(cip::Service::kSetAttributeSingle);
     r.data = data;
     return r;
   }

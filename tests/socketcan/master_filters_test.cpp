@@ -16,6 +16,7 @@ bool passes(std::uint32_t id) {
 TEST(MasterFilters, PassWhatTheMasterReads) {
   EXPECT_TRUE(passes(0x3C0 | 5));              // Group 1 msg 15: poll response of MAC 5
   EXPECT_TRUE(passes(0x340 | 5));              // Group 1 msg 13: COS/cyclic of MAC 5
+  EXPECT_TRUE(passes(0x380 | 5));              // Group 1 msg 14: bit-strobe response of MAC 5
   EXPECT_TRUE(passes(0x400 | (5 << 3) | 3));   // Group 2 msg 3: explicit response of MAC 5
   EXPECT_TRUE(passes(0x400 | (0 << 3) | 7));   // Group 2 msg 7: duplicate MAC check, MAC 0
   EXPECT_TRUE(passes(0x400 | (63 << 3) | 7));  // ... and of any other MAC
@@ -24,7 +25,8 @@ TEST(MasterFilters, PassWhatTheMasterReads) {
 }
 
 TEST(MasterFilters, KeepOutWhatItDoesNotRead) {
-  EXPECT_FALSE(passes(0x380 | 5));             // Group 1 msg 14: bit-strobe response
+  EXPECT_FALSE(passes(0x300 | 5));             // Group 1 msg 12: multicast poll response
+  EXPECT_FALSE(passes(0x400 | (5 << 3)));      // Group 2 msg 0: a bit-strobe command
   EXPECT_FALSE(passes(0x400 | (5 << 3) | 5));  // Group 2 msg 5: another master's poll
   EXPECT_FALSE(passes(0x400 | (5 << 3) | 4));  // Group 2 msg 4: explicit request
   EXPECT_FALSE(passes(0x400 | (5 << 3) | 6));  // Group 2 msg 6: Allocate

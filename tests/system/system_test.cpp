@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -327,21 +328,25 @@ TEST_F(SystemTest, RackOnlineWithFieldReadingDevices) {
   expect_clean_under_tshark(pcap, frames);
 }
 
-// A CDN127 and a device driven by its EDS file (the example I/O block) on
-// change of state, both simulated by cdn127-sim on one bus, the device
-// without member lists (the start-up check tolerates it): both online, the
-// device's connection 4 allocated (choice 0x10) beside its poll connection,
-// a change of its inputs produced at once and every message acknowledged by
-// the bridge, its counters in NodeStatus (dnbctl show), the pump commanded
+// A CDN127 and two devices driven by their EDS files, all simulated by
+// cdn127-sim on one bus: the example I/O block on change of state, without
+// member lists (the start-up check tolerates it), and the example valve
+// manifold on bit-strobe. All online; the I/O block's connection 4
+// allocated (choice 0x10) beside its poll connection, a change of its
+// inputs produced at once and every message acknowledged by the bridge; the
+// manifold's connection 3 allocated (choice 0x04), the bridge's bit-strobe
+// commands answered one by one (through the SocketCAN receive filter); the
+// counters in NodeStatus (dnbctl show), the pump commanded
 // as ever, and the whole traffic clean under tshark.
-TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
-  constexpr unsigned kPump = 1, kIo = 21;
+TEST_F(SystemTest, ACdn127AndEdsDevicesOnChangeOfStateAndBitStrobeShareABus) {
+  constexpr unsigned kPump = 1, kIo = 21, kValves = 22;
   const fs::path pcap = dir_ / "vcan0.pcap";
   auto capture = std::make_unique<Capture>("vcan0", pcap);
   const fs::path devices = dir_ / "devices.toml";
   std::ofstream(devices) << fmt::format(
-      "[[device]]\nmac = {}\neds = \"{}/dnbridge-example-io-block.eds\"\nmember_lists = false\n",
-      kIo, DNBRIDGE_EDS_DIR);
+      "[[device]]\nmac = {}\neds = \"{}/dnbridge-example-io-block.eds\"\nmember_lists = false\n"
+      "[[device]]\nmac = {}\neds = \"{}/dnbridge-example-valve-manifold.eds\"\n",
+      kIo, DNBRIDGE_EDS_DIR, kValves, DNBRIDGE_EDS_DIR);
   Child& sim = start_sim("vcan0", {kPump}, {"--device-config", devices.string()});
   const std::string io_node = fmt::format(
       "  profile = \"eds\"\n  eds = \"{}/dnbridge-example-io-block.eds\"\n"
@@ -351,33 +356,47 @@ TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
       "    {{ name = \"Output idle action\", value = 0 }},\n"
       "    {{ name = \"Output idle value\", value = 0 }} ]",
       DNBRIDGE_EDS_DIR);
-  Child& bridge = start_bridge({{"A", "vcan0", {kPump, kIo}, {{kIo, io_node}}}});
+  const std::string valves_node = fmt::format(
+      "  profile = \"eds\"\n  eds = \"{}/dnbridge-example-valve-manifold.eds\"\n"
+      "  connection = \"bit-strobe\"\n"
+      "  safe_state = [ {{ name = \"Output fault action\", value = 0 }},\n"
+      "    {{ name = \"Output fault value\", value = 0 }},\n"
+      "    {{ name = \"Output idle action\", value = 0 }},\n"
+      "    {{ name = \"Output idle value\", value = 0 }} ]",
+      DNBRIDGE_EDS_DIR);
+  Child& bridge = start_bridge(
+      {{"A", "vcan0", {kPump, kIo, kValves}, {{kIo, io_node}, {kValves, valves_node}}}});
   ASSERT_TRUE(wait_online("A", {kPump})) << "the pump did not come online";
 
-  // The device, as cdn127-sim shows it: owned, both connections established.
+  // The devices, as cdn127-sim shows them: owned, their connections
+  // established.
   static const std::regex eds_line(
       R"(^ok mac (\d+) power on network online owner (\d+) poll (\S+) cos (\S+) \| eds .* \| )"
-      R"(inputs (\S+) outputs \S+ \| cos produced (\d+) acks (\d+) retries (\d+))");
+      R"(inputs (\S+) outputs \S+ \| cos produced (\d+) acks (\d+) retries (\d+) .*)"
+      R"(\| strobe (\S+) commands (\d+) responses (\d+))");
   struct EdsSeen {
-    bool established = false;
+    bool established = false;  // poll and change of state, or poll and bit-strobe
     std::string inputs;
     unsigned long produced = 0, acks = 0;
+    unsigned long strobes = 0, strobe_responses = 0;
   };
-  const auto eds_status = [&] {
+  const auto eds_status = [&](unsigned mac) {
     EdsSeen seen;
     const auto from = static_cast<std::streamoff>(fs::file_size(sim.log()));
-    sim.send(fmt::format("status {}", kIo));
+    sim.send(fmt::format("status {}", mac));
     const auto until = std::chrono::steady_clock::now() + patience(2000ms);
     while (std::chrono::steady_clock::now() < until) {
       std::ifstream in(sim.log());
       in.seekg(from);
       std::smatch m;
       for (std::string l; std::getline(in, l);) {
-        if (!std::regex_search(l, m, eds_line)) continue;
-        seen.established = m[3] == "established" && m[4] == "established";
+        if (!std::regex_search(l, m, eds_line) || std::stoul(m[1]) != mac) continue;
+        seen.established = m[3] == "established" && (mac == kIo ? m[4] : m[9]) == "established";
         seen.inputs = m[5];
         seen.produced = std::stoul(m[6]);
         seen.acks = std::stoul(m[7]);
+        seen.strobes = std::stoul(m[10]);
+        seen.strobe_responses = std::stoul(m[11]);
         return seen;
       }
       std::this_thread::sleep_for(5ms);
@@ -385,23 +404,28 @@ TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
     return seen;
   };
   const auto until = [&](const std::function<bool(const EdsSeen&)>& done,
-                         std::chrono::milliseconds timeout) {
+                         std::chrono::milliseconds timeout, unsigned mac) {
     const auto end = std::chrono::steady_clock::now() + patience(timeout);
     while (std::chrono::steady_clock::now() < end) {
-      if (done(eds_status())) return true;
+      if (done(eds_status(mac))) return true;
       std::this_thread::sleep_for(50ms);
     }
     return false;
   };
-  ASSERT_TRUE(until([](const EdsSeen& s) { return s.established; }, 20000ms))
+  ASSERT_TRUE(until([](const EdsSeen& s) { return s.established; }, 20000ms, kIo))
       << "the EDS device's connections were not established";
+  // The valve manifold: strobed every 100 ms (its poll period), each
+  // command answered.
+  ASSERT_TRUE(until([](const EdsSeen& s) { return s.established && s.strobe_responses >= 10; },
+                    20000ms, kValves))
+      << "the valve manifold's bit-strobe connection did not answer";
 
   // Its digital inputs change: produced at once, acknowledged; heartbeats
   // every 200 ms meanwhile.
   sim.send(fmt::format("set {} param 3 90", kIo));
-  ASSERT_TRUE(until([](const EdsSeen& s) { return s.inputs.rfind("5A", 0) == 0; }, 5000ms));
+  ASSERT_TRUE(until([](const EdsSeen& s) { return s.inputs.rfind("5A", 0) == 0; }, 5000ms, kIo));
   ASSERT_TRUE(
-      until([](const EdsSeen& s) { return s.produced >= 5 && s.acks == s.produced; }, 5000ms))
+      until([](const EdsSeen& s) { return s.produced >= 5 && s.acks == s.produced; }, 5000ms, kIo))
       << "not every change-of-state message was acknowledged";
 
   // What the bridge counted, as dnbctl shows it.
@@ -412,6 +436,11 @@ TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
   EXPECT_GE(std::stoul(m[1]), 5u) << shown;
   EXPECT_NE(shown.find("inputs on change of state (EPR 200 ms, acknowledged"), std::string::npos)
       << shown;
+  const std::string valves = run_output(fmt::format(
+      "'{}' --rack '{}' --port A --timeout 10 show {} --json 2>&1", DNBCTL_BIN, rack_, kValves));
+  EXPECT_NE(valves.find("inputs bit-strobed"), std::string::npos) << valves;
+  ASSERT_TRUE(std::regex_search(valves, m, std::regex(R"("cos_messages":\s*(\d+))"))) << valves;
+  EXPECT_GE(std::stoul(m[1]), 10u) << valves;
 
   // The pump is commanded as ever.
   ASSERT_TRUE(supervisor().command("A", kPump, true));
@@ -429,10 +458,23 @@ TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
   // On the wire: Allocate of connection 4 (choice 0x10) to MAC 21 once, its
   // messages on Group 1 message 13 and the bridge's acknowledgments on
   // Group 2 message 2, each after the message it acknowledges.
+  // The bit-strobe commands of the bridge (master MAC 0: Group 2 message
+  // 0, 0x400), 8 bytes of 0, each answered by the manifold on Group 1
+  // message 14 before the next.
   unsigned cos_allocations = 0, messages = 0, acks = 0, acks_without_message = 0;
+  unsigned strobe_allocations = 0, strobes = 0, odd_strobes = 0, responses = 0, unanswered = 0;
   bool change_seen = false;
   for (const can::CanFrame& f : capture->frames()) {
-    if (f.id == 0x406u + (kIo << 3) && f.len == 6 && f.data[1] == 0x4B) {
+    if (f.id == 0x406u + (kValves << 3) && f.len == 6 && f.data[1] == 0x4B) {
+      strobe_allocations += f.data[4] == 0x04;
+    } else if (f.id == 0x400u) {
+      unanswered += strobes > responses;
+      ++strobes;
+      odd_strobes += f.len != 8 || std::any_of(f.data.begin(), f.data.end(),
+                                               [](std::uint8_t b) { return b != 0; });
+    } else if (f.id == 0x380u + kValves) {
+      ++responses;
+    } else if (f.id == 0x406u + (kIo << 3) && f.len == 6 && f.data[1] == 0x4B) {
       cos_allocations += f.data[4] == 0x10;
     } else if (f.id == 0x340u + kIo) {
       ++messages;
@@ -447,6 +489,11 @@ TEST_F(SystemTest, ACdn127AndAnEdsDeviceOnChangeOfStateShareABus) {
   EXPECT_GE(messages, 5u);
   EXPECT_GE(acks + 1, messages);  // the last may have gone with the stop
   EXPECT_EQ(acks_without_message, 0u);
+  EXPECT_EQ(strobe_allocations, 1u);
+  EXPECT_GE(strobes, 10u);
+  EXPECT_EQ(odd_strobes, 0u);
+  EXPECT_EQ(unanswered, 0u);
+  EXPECT_GE(responses + 1, strobes);  // the last may have gone with the stop
   expect_clean_under_tshark(pcap, frames);
 }
 

@@ -141,7 +141,7 @@ class Wire : public ::testing::Test {
     rack_->world().run_for(milliseconds(250));
 
     devicenet::RequestMessage get;
-    get.service = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
+    get.service = cip::code(cip::Service::kGetAttributeSingle);
     get.class_id = cdn127::class_id::kDeviceSupervisor;
     get.instance_id = 1;
     get.attribute = cdn127::supervisor_attr::kManufacturerName;

@@ -22,9 +22,16 @@ bool is_explicit(std::uint16_t instance) noexcept {
   return instance == connection_instance::kExplicit;
 }
 
-// Produced and consumed connection IDs of each instance (bridge/PROTOCOL.md §1).
-std::uint16_t connection_id(devicenet::MacId mac, std::uint16_t instance, bool produced) noexcept {
+// Produced and consumed connection IDs of each instance (bridge/PROTOCOL.md
+// §1); the bit-strobe command carries its master's MAC (`owner`).
+std::uint16_t connection_id(devicenet::MacId mac, std::uint8_t owner, std::uint16_t instance,
+                            bool produced) noexcept {
   switch (instance) {
+    case connection_instance::kBitStrobe:
+      return static_cast<std::uint16_t>(
+          produced ? devicenet::group1_id(Group1Message::kSlaveBitStrobeResponse, mac)
+                   : devicenet::group2_id(devicenet::MacId::from_bits(owner),
+                                          Group2Message::kMasterBitStrobeCommand));
     case connection_instance::kExplicit:
       return static_cast<std::uint16_t>(
           devicenet::group2_id(mac, produced ? Group2Message::kSlaveExplicitResponse
@@ -114,8 +121,10 @@ bool connection_attribute_settable(std::uint16_t instance, std::uint8_t attribut
       return true;
     case attr::kConsumedPath:
       // The change-of-state connection consumes the master's
-      // acknowledgments, no data: there is no consumed path to choose.
-      return instance != connection_instance::kChangeOfState;
+      // acknowledgments, no data, and the bit-strobe connection the
+      // command's bitmap: there is no consumed path to choose.
+      return instance != connection_instance::kChangeOfState &&
+             instance != connection_instance::kBitStrobe;
     case attr::kInhibitTime:
       return instance == connection_instance::kChangeOfState;
     default:
@@ -136,9 +145,9 @@ Reply get_connection_attribute(const ConnectionSet& set, devicenet::MacId mac,
     case attr::kTransportClassTrigger:
       return put_u8(w, transport_class_trigger(*c, instance));
     case attr::kProducedConnectionId:
-      return put_u16(w, connection_id(mac, instance, true));
+      return put_u16(w, connection_id(mac, set.owner(), instance, true));
     case attr::kConsumedConnectionId:
-      return put_u16(w, connection_id(mac, instance, false));
+      return put_u16(w, connection_id(mac, set.owner(), instance, false));
     case attr::kInitialCommCharacteristics:
       return put_u8(w, is_explicit(instance) ? 0x21 : 0x01);
     case attr::kProducedSize:

@@ -24,7 +24,8 @@ ConnectionSet::ConnectionSet(ConnectionSetOptions options, ConnectionEvents& eve
     : options_(options), events_(events) {}
 
 std::uint8_t ConnectionSet::allocation_choice() const noexcept {
-  return static_cast<std::uint8_t>(explicit_.allocated_as | poll_.allocated_as | cos_.allocated_as);
+  return static_cast<std::uint8_t>(explicit_.allocated_as | poll_.allocated_as |
+                                   strobe_.allocated_as | cos_.allocated_as);
 }
 
 Reply ConnectionSet::allocate(std::uint8_t choice, std::uint8_t allocator, TimePoint now) noexcept {
@@ -64,6 +65,9 @@ Reply ConnectionSet::allocate(std::uint8_t choice, std::uint8_t allocator, TimeP
   if ((choice & alloc::kPoll) != 0) {
     open(poll_, alloc::kPoll, options_.poll_produced_assembly, options_.poll_consumed_assembly);
   }
+  if ((choice & alloc::kBitStrobe) != 0) {
+    open(strobe_, alloc::kBitStrobe, options_.strobe_produced_assembly, 0);
+  }
   if (cos != 0) {
     open(cos_, static_cast<std::uint8_t>(choice & (kCosOrCyclic | alloc::kAckSuppression)),
          options_.cos_produced_assembly, options_.cos_consumed_assembly);
@@ -98,6 +102,7 @@ Reply ConnectionSet::release(std::uint8_t choice, std::uint8_t requester, TimePo
     return reply_error(GeneralStatus::kAlreadyInRequestedMode, kInvalidChoice);
   }
   if ((choice & alloc::kPoll) != 0) delete_io(connection_instance::kPoll, poll_, now);
+  if ((choice & alloc::kBitStrobe) != 0) delete_io(connection_instance::kBitStrobe, strobe_, now);
   if ((choice & kCosOrCyclic) != 0) delete_io(connection_instance::kChangeOfState, cos_, now);
   if ((choice & alloc::kExplicit) != 0) explicit_ = Connection{};
   if (allocation_choice() == 0) owner_ = MacId::kNone;
@@ -113,6 +118,7 @@ void ConnectionSet::drop() noexcept {
   explicit_ = Connection{};
   poll_ = Connection{};
   cos_ = Connection{};
+  strobe_ = Connection{};
   owner_ = MacId::kNone;
 }
 
@@ -122,6 +128,8 @@ const Connection* ConnectionSet::connection(std::uint16_t instance) const noexce
       return &explicit_;
     case connection_instance::kPoll:
       return &poll_;
+    case connection_instance::kBitStrobe:
+      return &strobe_;
     case connection_instance::kChangeOfState:
       return &cos_;
     default:
@@ -246,16 +254,18 @@ void ConnectionSet::consumed(std::uint16_t instance, TimePoint now) noexcept {
   if (c != nullptr && c->state == ConnectionState::kEstablished) restart_watchdog(*c, now);
 }
 
-bool ConnectionSet::anything_established() const noexcept {
-  return explicit_.state == ConnectionState::kEstablished ||
-         poll_.state == ConnectionState::kEstablished ||
+bool ConnectionSet::io_established() const noexcept {
+  return poll_.state == ConnectionState::kEstablished ||
+         strobe_.state == ConnectionState::kEstablished ||
          cos_.state == ConnectionState::kEstablished;
 }
 
+bool ConnectionSet::anything_established() const noexcept {
+  return explicit_.state == ConnectionState::kEstablished || io_established();
+}
+
 void ConnectionSet::explicit_timeout() noexcept {
-  const bool io_established =
-      poll_.state == ConnectionState::kEstablished || cos_.state == ConnectionState::kEstablished;
-  if (explicit_.watchdog_action == WatchdogAction::kDeferredDelete && io_established) {
+  if (explicit_.watchdog_action == WatchdogAction::kDeferredDelete && io_established()) {
     explicit_.state = ConnectionState::kDeferredDelete;
     explicit_.watchdog_deadline = kNever;
     return;
@@ -300,10 +310,14 @@ void ConnectionSet::on_timer(TimePoint now) noexcept {
     ++watchdog_timeouts_;
     expired = true;
   }
-  if (cos_.state == ConnectionState::kEstablished && now >= cos_.watchdog_deadline) {
-    io_timeout(connection_instance::kChangeOfState, cos_, now);
-    ++watchdog_timeouts_;
-    expired = true;
+  for (const std::uint16_t instance :
+       {connection_instance::kBitStrobe, connection_instance::kChangeOfState}) {
+    Connection& c = *mutable_connection(instance);
+    if (c.state == ConnectionState::kEstablished && now >= c.watchdog_deadline) {
+      io_timeout(instance, c, now);
+      ++watchdog_timeouts_;
+      expired = true;
+    }
   }
   // With nothing left established the slave drops the whole set; the master
   // must allocate again (bridge/PROTOCOL.md §7).
@@ -312,7 +326,7 @@ void ConnectionSet::on_timer(TimePoint now) noexcept {
 
 TimePoint ConnectionSet::next_deadline() const noexcept {
   TimePoint t = kNever;
-  for (const Connection* c : {&explicit_, &poll_, &cos_}) {
+  for (const Connection* c : {&explicit_, &poll_, &strobe_, &cos_}) {
     if (c->state == ConnectionState::kEstablished) t = std::min(t, c->watchdog_deadline);
   }
   return t;

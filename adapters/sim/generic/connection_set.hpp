@@ -1,8 +1,8 @@
 #pragma once
 // The predefined master/slave connection set of a simulated Group 2 only
 // slave, as the DeviceNet and Connection objects see it: who owns it, which
-// connections Allocate made (instance 1 explicit, 2 poll, 4 change of state
-// or cyclic), their states, expected packet rates, watchdogs and timeout
+// connections Allocate made (instance 1 explicit, 2 poll, 3 bit-strobe, 4
+// change of state or cyclic), their states, expected packet rates, watchdogs and timeout
 // actions (bridge/PROTOCOL.md §3, §7, §8). No frames and no data here: the
 // device decides what its I/O connections carry and what its outputs do when
 // one of them goes (ConnectionEvents).
@@ -51,6 +51,7 @@ constexpr Reply reply_error(cip::GeneralStatus s,
 
 // Connection object instances of the predefined master/slave set (cip's).
 namespace connection_instance {
+using cip::connection_instance::kBitStrobe;
 using cip::connection_instance::kChangeOfState;
 using cip::connection_instance::kExplicit;
 using cip::connection_instance::kPoll;
@@ -67,7 +68,7 @@ struct Connection {
   // Production inhibit time (attribute 17), ms.
   std::uint16_t inhibit_ms = 0;
   // The allocation choice bits that made it (attribute 5 of the DeviceNet
-  // object ORs them): 0x01, 0x02, or 0x10 / 0x20 with 0x40.
+  // object ORs them): 0x01, 0x02, 0x04, or 0x10 / 0x20 with 0x40.
   std::uint8_t allocated_as = 0;
   TimePoint watchdog_deadline = kNever;
 };
@@ -115,6 +116,7 @@ struct ConnectionSetOptions {
   std::uint16_t poll_consumed_assembly = 0;
   std::uint16_t cos_produced_assembly = 0;
   std::uint16_t cos_consumed_assembly = 0;
+  std::uint16_t strobe_produced_assembly = 0;  // a bit-strobe connection consumes the bitmap
 };
 
 class ConnectionSet {
@@ -137,7 +139,8 @@ class ConnectionSet {
   const Connection& explicit_connection() const noexcept { return explicit_; }
   const Connection& poll_connection() const noexcept { return poll_; }
   const Connection& cos_connection() const noexcept { return cos_; }
-  // Instances 1, 2 and 4; nullptr for others.
+  const Connection& strobe_connection() const noexcept { return strobe_; }
+  // Instances 1 to 4; nullptr for others.
   const Connection* connection(std::uint16_t instance) const noexcept;
   bool exists(std::uint16_t instance) const noexcept;
   bool established(std::uint16_t instance) const noexcept;
@@ -176,6 +179,7 @@ class ConnectionSet {
   void explicit_timeout() noexcept;
   void io_timeout(std::uint16_t instance, Connection& c, TimePoint now) noexcept;
   bool anything_established() const noexcept;
+  bool io_established() const noexcept;
   void restart_watchdog(Connection& c, TimePoint now) const noexcept;
   std::uint16_t round_rate(std::uint16_t requested_ms) const noexcept;
 
@@ -185,6 +189,7 @@ class ConnectionSet {
   Connection explicit_;
   Connection poll_;
   Connection cos_;
+  Connection strobe_;
   std::uint32_t watchdog_timeouts_ = 0;
 };
 

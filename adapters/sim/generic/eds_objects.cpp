@@ -140,6 +140,11 @@ std::vector<std::uint8_t> EdsObjects::packed(const eds::Assembly& assembly, unsi
   };
   for (const auto& m : a->members) {
     if (m.kind == eds::Member::Kind::kParam) put(param_value(m.number), m.bits);
+    if (m.kind == eds::Member::Kind::kPath) {
+      if (auto it = path_values_.find(cip::encoded(m.path)); it != path_values_.end()) {
+        put(it->second, m.bits);
+      }
+    }
     // Nested assemblies, kMaxNesting deep (the EDS reader refuses cycles).
     if (m.kind == eds::Member::Kind::kAssembly && depth < kMaxNesting) {
       if (const eds::Assembly* nested = assembly_numbered(m.number)) {
@@ -175,6 +180,15 @@ void EdsObjects::unpack(const eds::Assembly& assembly, Bytes data, std::uint32_t
           value[i / 8] =
               static_cast<std::uint8_t>(bit(at + i) ? value[i / 8] | mask : value[i / 8] & ~mask);
         }
+      }
+    }
+    if (m.kind == eds::Member::Kind::kPath) {
+      auto& value = path_values_[cip::encoded(m.path)];
+      value.resize(std::max<std::size_t>(value.size(), (m.bits + 7u) / 8u), 0);
+      for (std::uint32_t i = 0; i < m.bits; ++i) {
+        const auto mask = static_cast<std::uint8_t>(1u << (i % 8));
+        value[i / 8] =
+            static_cast<std::uint8_t>(bit(at + i) ? value[i / 8] | mask : value[i / 8] & ~mask);
       }
     }
     if (m.kind == eds::Member::Kind::kAssembly && depth < kMaxNesting) {

@@ -80,9 +80,12 @@ class EdsObjects {
   // significant bit first; empty if no such assembly.
   std::vector<std::uint8_t> assembly_data(unsigned instance) const;
   // Unpacks `data` into the parameters the assembly at `instance` names
-  // (nested assemblies too; padding and paths taken as they are), limits
-  // unchecked, as the device takes its outputs from a connection; false if
-  // no such assembly or `data` is not its size.
+  // (nested assemblies too; padding taken as it is), limits unchecked, as
+  // the device takes its outputs from a connection; false if no such
+  // assembly or `data` is not its size. A member named by a path (an object
+  // the simulator does not have, e.g. a Discrete Input Point) keeps the bits
+  // it is given here, the same for every assembly that names it (zero
+  // before): so a test sets such inputs.
   bool set_assembly_data(unsigned instance, Bytes data);
   // How deep nested assemblies are packed.
   static constexpr unsigned kMaxNesting = 8;
@@ -114,6 +117,8 @@ class EdsObjects {
   std::uint32_t serial_number_;
   bool member_lists_ = true;
   std::map<unsigned, std::vector<std::uint8_t>> values_;  // per ParamN
+  // Path members' bits, per encoded path.
+  std::map<std::vector<std::uint8_t>, std::vector<std::uint8_t>> path_values_;
   AckHandler ack_;
 };
 

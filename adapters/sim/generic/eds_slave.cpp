@@ -81,6 +81,10 @@ EdsSlave::IoDefaults EdsSlave::io_defaults(const EdsObjects& objects) noexcept {
   if (const auto* produced = cos != nullptr ? cos : cyclic) {
     d.cos_input = fitting(io.input(produced->input));
   }
+  if (const auto* strobe = io.connection(eds::ConnectionKind::kStrobe)) {
+    d.choices |= alloc::kBitStrobe;
+    d.strobe_input = fitting(io.input(strobe->input));
+  }
   return d;
 }
 
@@ -92,6 +96,7 @@ ConnectionSetOptions EdsSlave::connection_options(const EdsSlaveOptions& o,
   c.poll_produced_assembly = d.poll_input;
   c.poll_consumed_assembly = d.poll_output;
   c.cos_produced_assembly = d.cos_input;
+  c.strobe_produced_assembly = d.strobe_input;
   return c;
 }
 
@@ -141,13 +146,30 @@ void EdsSlave::produce(const std::optional<std::vector<std::uint8_t>>& message,
        Bytes(message->data(), std::min(message->size(), kMaxPollData)), now);
 }
 
-bool EdsSlave::on_io_message(Group2Message message, const can::CanFrame&, TimePoint now) noexcept {
+bool EdsSlave::on_io_message(Group2Message message, const can::CanFrame& frame,
+                             TimePoint now) noexcept {
+  if (message == Group2Message::kMasterBitStrobeCommand) return on_strobe(frame, now);
   if (message != Group2Message::kMasterCosCyclicAck || !cos_ ||
       objects_.ack_handler().cos_producing_instance != connection_instance::kChangeOfState) {
     return false;
   }
   cos_->on_ack();
   connections_.consumed(connection_instance::kChangeOfState, now);
+  return true;
+}
+
+bool EdsSlave::on_strobe(const can::CanFrame& frame, TimePoint now) noexcept {
+  const Connection& c = connections_.strobe_connection();
+  if (c.state != ConnectionState::kEstablished) return false;
+  connections_.consumed(connection_instance::kBitStrobe, now);
+  ++strobe_counters_.commands;
+  // The device's bit of the bitmap; a shorter command leaves it clear.
+  const unsigned bit = mac_.value();
+  strobe_counters_.last_bit = frame.len > bit / 8 && ((frame.data[bit / 8] >> (bit % 8)) & 1) != 0;
+  const auto data = objects_.assembly_data(c.produced_assembly);
+  send(devicenet::group1_id(Group1Message::kSlaveBitStrobeResponse, mac_),
+       Bytes(data.data(), std::min(data.size(), kMaxPollData)), now);
+  ++strobe_counters_.responses;
   return true;
 }
 
@@ -282,6 +304,7 @@ PollResult EdsSlave::poll(Bytes command, TimePoint now) noexcept {
 
 std::uint16_t EdsSlave::connection_size(std::uint16_t instance, bool produced) const noexcept {
   if (instance == connection_instance::kExplicit) return kExplicitMessageSize;
+  if (instance == connection_instance::kBitStrobe && !produced) return kStrobeCommandSize;
   const Connection* c = connections_.connection(instance);
   if (c == nullptr) return 0;
   const std::uint16_t assembly = produced ? c->produced_assembly : c->consumed_assembly;
@@ -293,10 +316,11 @@ bool EdsSlave::assembly_allowed(std::uint16_t instance, bool produced,
                                 std::uint16_t assembly) const noexcept {
   if (instance == connection_instance::kExplicit) return false;
   if (!produced) {
-    // The change-of-state connection consumes acknowledgments, no data; a
-    // poll command goes into an output assembly, never into the inputs'
-    // parameters.
-    if (instance == connection_instance::kChangeOfState || !is_output_assembly(assembly)) {
+    // The change-of-state connection consumes acknowledgments and the
+    // bit-strobe connection the command's bitmap, no data; a poll command
+    // goes into an output assembly, never into the inputs' parameters.
+    if (instance == connection_instance::kChangeOfState ||
+        instance == connection_instance::kBitStrobe || !is_output_assembly(assembly)) {
       return false;
     }
   }

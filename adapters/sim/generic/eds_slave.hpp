@@ -8,8 +8,9 @@
 // Besides the EDS's objects it has the DeviceNet object (class 0x03,
 // instance 1: 1 MAC, 2 baud rate, 5 allocation information, Get only;
 // Allocate and Release) and the Connection object (class 0x05,
-// connection_object.hpp) of instances 1 (explicit), 2 (poll) and 4 (change
-// of state or cyclic, when the EDS's [IO_Info] offers either).
+// connection_object.hpp) of instances 1 (explicit), 2 (poll), 3 (bit-strobe,
+// when the EDS's [IO_Info] offers it) and 4 (change of state or cyclic, when
+// it offers either).
 //
 // Poll (instance 2): its produced path names the assembly whose packed data
 // answers each poll (EdsObjects::assembly_data), its consumed path the one
@@ -58,6 +59,14 @@
 // through a watchdog with Auto Reset, until Release, a timeout that leaves
 // it, or the set dropped. Its consumed path (attribute 16) is not settable
 // (0x0E).
+//
+// Bit-strobe (instance 3), allocated with choice 0x04: produced path the
+// StrobeInfo's input, consumed the command's 8 bytes (attribute 8; no
+// consumed path, 0x0E). Once its EPR is set, each bit-strobe command (Group
+// 2 message 0) of the master that owns the set restarts its watchdog and is
+// answered at once on Group 1 message 14 with the produced assembly's data;
+// the device's bit is kept (strobe_counters()), not applied: the example
+// EDS's strobe consumes no output. Timed out or released, it answers none.
 #include <cstdint>
 #include <optional>
 
@@ -131,6 +140,20 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
   std::uint16_t poll_input_assembly() const noexcept { return defaults_.poll_input; }
   std::uint16_t poll_output_assembly() const noexcept { return defaults_.poll_output; }
   std::uint16_t cos_input_assembly() const noexcept { return defaults_.cos_input; }
+  std::uint16_t strobe_input_assembly() const noexcept { return defaults_.strobe_input; }
+
+  // The bit-strobe connection (instance 3, where [IO_Info] offers it): each
+  // bit-strobe command of the owning master, while it is Established,
+  // restarts its watchdog and is answered with its produced assembly on
+  // Group 1 message 14. The device's bit is kept, not applied (the EDS's
+  // strobe consumes no output).
+  struct StrobeCounters {
+    std::uint32_t commands = 0;
+    std::uint32_t responses = 0;
+    bool last_bit = false;
+  };
+  ConnectionState strobe_state() const noexcept { return connections_.strobe_connection().state; }
+  const StrobeCounters& strobe_counters() const noexcept { return strobe_counters_; }
 
  private:
   // Group2Slave
@@ -179,6 +202,8 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
     unsigned fault_action = 0, fault_value = 0, idle_action = 0, idle_value = 0;
   };
   std::optional<SafeStateParams> safe_state_params_;
+  bool on_strobe(const can::CanFrame& frame, TimePoint now) noexcept;
+  static constexpr std::uint16_t kStrobeCommandSize = 8;
   void start_cos(TimePoint now) noexcept;
   void end_cos() noexcept;
   void produce(const std::optional<std::vector<std::uint8_t>>& message, TimePoint now) noexcept;
@@ -189,6 +214,7 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
     std::uint16_t poll_input = 0;
     std::uint16_t poll_output = 0;
     std::uint16_t cos_input = 0;
+    std::uint16_t strobe_input = 0;
     std::uint8_t choices = 0;
   };
   static IoDefaults io_defaults(const EdsObjects& objects) noexcept;
@@ -202,6 +228,7 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
   ConnectionSet connections_;
   std::optional<CosProducer> cos_;
   CosProducerCounters cos_ended_;  // of the connections before the current one
+  StrobeCounters strobe_counters_;
 };
 
 }  // namespace dnbridge::sim

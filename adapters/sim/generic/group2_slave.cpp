@@ -201,11 +201,22 @@ void Group2Slave::on_frame(const can::CanFrame& frame, TimePoint now) noexcept {
     ++counters_.frames_ignored;
     return;
   }
+  const auto message = static_cast<Group2Message>(id->message_id);
+  if (message == Group2Message::kMasterBitStrobeCommand) {
+    // Its MAC is the master's: the device's when the master owns its set.
+    const bool ours = network_ == NetworkState::kOnline && connection_set().owned() &&
+                      id->mac.value() == connection_set().owner();
+    if (!ours) {
+      ++counters_.frames_not_addressed;
+    } else if (!on_io_message(message, frame, now)) {
+      ++counters_.frames_ignored;
+    }
+    return;
+  }
   if (id->mac != device_mac()) {
     ++counters_.frames_not_addressed;
     return;
   }
-  const auto message = static_cast<Group2Message>(id->message_id);
   if (message == Group2Message::kDuplicateMacCheck) {
     on_duplicate_mac(frame, now);
     return;
@@ -224,7 +235,7 @@ void Group2Slave::on_frame(const can::CanFrame& frame, TimePoint now) noexcept {
     case Group2Message::kMasterIoPoll:
       on_poll(frame, now);
       break;
-    default:  // bit strobe, multicast poll, COS ack: the device's, if it has them
+    default:  // multicast poll, COS ack: the device's, if it has them
       if (!on_io_message(message, frame, now)) ++counters_.frames_ignored;
       break;
   }
@@ -255,9 +266,8 @@ void Group2Slave::on_unconnected(const can::CanFrame& frame, TimePoint now) noex
   std::size_t n = 0;
   auto request = devicenet::decode_request(p.subspan(1), BodyFormat::k8_8);
   const std::uint8_t service = p[1];
-  const bool allocation_service =
-      service == static_cast<std::uint8_t>(cip::Service::kAllocateMasterSlave) ||
-      service == static_cast<std::uint8_t>(cip::Service::kReleaseMasterSlave);
+  const bool allocation_service = service == cip::code(cip::Service::kAllocateMasterSlave) ||
+                                  service == cip::code(cip::Service::kReleaseMasterSlave);
   if (!allocation_service || !request.ok() || request->class_id != devicenet::kDeviceNetClass ||
       request->instance_id != 1) {
     auto e = devicenet::encode_error_response(cip::GeneralStatus::kResourceUnavailable,
@@ -266,8 +276,7 @@ void Group2Slave::on_unconnected(const can::CanFrame& frame, TimePoint now) noex
   } else {
     n = execute(*request, static_cast<std::uint8_t>(header & 0x3F), now, out);
   }
-  if (n > 0 &&
-      out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
+  if (n > 0 && out[0] == (cip::code(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
     ++counters_.requests_refused;
   }
   respond(true, header, Bytes(out.data(), n), now);
@@ -357,8 +366,7 @@ void Group2Slave::handle_explicit_message(std::uint8_t header, Bytes message,
                                               cip::kNoAdditionalCode, out);
     n = e.ok() ? *e : 0;
   }
-  if (n > 0 &&
-      out[0] == (static_cast<std::uint8_t>(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
+  if (n > 0 && out[0] == (cip::code(cip::Service::kErrorResponse) | cip::kResponseFlag)) {
     ++counters_.requests_refused;
   }
   respond(false, header, Bytes(out.data(), n), now);

@@ -12,9 +12,11 @@
 // 4 (explicit request), 5 (poll command), 6 (Allocate/Release) and 7
 // (duplicate MAC check) for its MAC, and answers on Group 2 message 3
 // (explicit and unconnected responses), Group 1 message 15 (poll response)
-// and Group 2 message 7. Group 2 messages 0..2 go to the device
-// (on_io_message: a change-of-state acknowledgment); everything else (UCMM,
-// Group 1/3) is ignored and counted.
+// and Group 2 message 7. Group 2 messages 1 and 2 for its MAC go to the
+// device (on_io_message: a change-of-state acknowledgment), and so does
+// message 0, the bit-strobe command, from the master that owns its
+// connection set (its MAC is the master's); everything else (UCMM, Group
+// 1/3) is ignored and counted.
 // - Duplicate MAC ID check at power-up (§6); a duplicate is Communication
 //   Fault.
 // - The unconnected port (message 6) takes Allocate and Release of the
@@ -174,8 +176,8 @@ class Group2Slave {
   virtual void go_offline(TimePoint now) noexcept = 0;
   // The offline set's MAC change, as the DeviceNet object's attribute 1.
   virtual Reply set_mac(std::uint8_t mac) noexcept = 0;
-  // Group 2 messages 0..2 for this node, online; false: not taken (ignored
-  // and counted).
+  // Group 2 messages 1 and 2 for this node, and 0 from its master, online;
+  // false: not taken (ignored and counted).
   virtual bool on_io_message(devicenet::Group2Message message, const can::CanFrame& frame,
                              TimePoint now) noexcept;
 

@@ -196,7 +196,7 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
     }
     const cip::AttributeRef& target = kIdentityReads[static_cast<std::size_t>(step_)];
     RequestMessage m;
-    m.service = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
+    m.service = cip::code(cip::Service::kGetAttributeSingle);
     m.class_id = target.class_id;
     m.instance_id = target.instance_id;
     m.attribute = target.attribute;

@@ -238,8 +238,8 @@ void Node::on_timer(TimePoint now) {
          now);
     return;
   }
-  // Likewise 4 x EPR without a change-of-state or cyclic message, heartbeats
-  // included.
+  // Likewise 4 x EPR without a message of the input connection (change of
+  // state or cyclic, heartbeats included; bit-strobe responses).
   if (cos_ && now >= cos_->watchdog_deadline() && cos_->check_watchdog(now)) {
     // Messages that came but were refused say why none was taken.
     const std::string refused = cos_consecutive_errors_ > 0
@@ -247,10 +247,13 @@ void Node::on_timer(TimePoint now) {
                                                   cos_consecutive_errors_, last_error_.describe())
                                     : std::string();
     ++counters_.heartbeats_missed;
-    record(NodeError::Kind::kHeartbeatMissed, now);
+    record(config_.profile.input_connection->strobed() ? NodeError::Kind::kStrobeMissed
+                                                       : NodeError::Kind::kHeartbeatMissed,
+           now);
     lose_and_release(
-        fmt::format("no {} message for {} ms (4 x EPR of {} ms){}",
-                    config_.profile.cos->cyclic ? "cyclic" : "change-of-state",
+        fmt::format("no {} {} for {} ms (4 x EPR of {} ms){}",
+                    to_string(config_.profile.input_connection->kind),
+                    config_.profile.input_connection->strobed() ? "response" : "message",
                     std::chrono::duration_cast<milliseconds>(now - cos_->last_message()).count(),
                     to_ms(cos_->settings().expected_packet_rate), refused),
         now);

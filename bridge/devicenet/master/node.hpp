@@ -64,6 +64,7 @@ class Node final : private ExplicitClient::Listener {
   void on_explicit_frame(Bytes payload, TimePoint now);  // Group 2 message 3
   void on_poll_response(Bytes payload, TimePoint now);   // Group 1 message 15
   void on_cos_message(Bytes payload, TimePoint now);     // Group 1 message 13
+  void on_strobe_response(Bytes payload, TimePoint now);  // Group 1 message 14
   // The node sent a duplicate MAC check request: it is powering up.
   void on_duplicate_mac_request(TimePoint now);
   void on_timer(TimePoint now);
@@ -111,8 +112,13 @@ class Node final : private ExplicitClient::Listener {
   // The wait for an explicit answer that requests from now on get.
   Duration explicit_response_timeout() const { return client_.response_timeout(); }
   Duration explicit_epr() const { return explicit_epr_; }
-  // The change-of-state or cyclic connection's settings as the device gave
-  // them (EPR, acknowledge timer, retry limit); empty without one.
+  // The input connection's settings as the device gave them (EPR,
+  // acknowledge timer, retry limit); empty without one.
+  // A bit-strobe connection: the node answers the port's bit-strobe
+  // commands (from the Set of its EPR on; the scanner sends them).
+  bool strobed() const {
+    return cos_.has_value() && config_.profile.input_connection->strobed() && !shutting_down_;
+  }
   std::optional<CosSettings> cos_settings() const {
     if (!cos_) return std::nullopt;
     return cos_->settings();
@@ -155,13 +161,14 @@ class Node final : private ExplicitClient::Listener {
     kFallbackConsumedSize,
     kExplicitEpr,
     kPollEpr,
-    // With a change-of-state or cyclic connection (NodeProfile::cos):
-    kAllocateCos,            // DeviceNet.Allocate(change of state or cyclic)
+    // With an input connection (NodeProfile::input_connection): change of
+    // state or cyclic (Connection 4), or bit-strobe (Connection 3; target_of()).
+    kAllocateCos,            // DeviceNet.Allocate(change of state, cyclic or bit-strobe)
     kReleaseCosForAllocate,  // DeviceNet.Release(it) after "already allocated"
-    kSetCosPath,             // Connection 4's produced path, where the profile names one
+    kSetCosPath,             // its produced path, where the profile names one
     kCosInhibit,             // its production inhibit time (change of state, when configured)
     kCosSize,                // its produced size, checked
-    kAckTimer,               // the Acknowledge Handler's timer and retry limit (acknowledged)
+    kAckTimer,  // the Acknowledge Handler's timer and retry limit (acknowledged, not bit-strobe)
     kRetryLimit,
     kCosEpr,  // its EPR: the connection starts producing
     kOnline,  // not a request: the poll connection starts
@@ -232,6 +239,8 @@ class Node final : private ExplicitClient::Listener {
   // The change-of-state steps in order, those that do not apply skipped.
   Step cos_step_after(Step step) const;
   std::uint8_t cos_choice() const;
+  // The EPR asked for the input connection (a bit-strobe one takes the node's).
+  Duration input_epr_asked() const;
   // Its allocation bits without acknowledgment suppression (for Release).
   std::uint8_t cos_connection_bits() const;
   // A connection lost while the others live (the change-of-state
@@ -292,6 +301,7 @@ class Node final : private ExplicitClient::Listener {
   void poll_on_change(TimePoint now);
   void accept_poll_response(Bytes data, TimePoint now);
   void bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now);
+  void on_input_message(bool strobe_response, Bytes payload, TimePoint now);
   void take_cos_message(Bytes data, TimePoint now);
   // One frame of an I/O message of `size` bytes: whole in it when it fits
   // one frame, else a fragment for `reassembler` (reset it after a complete
@@ -388,8 +398,9 @@ class Node final : private ExplicitClient::Listener {
   bool applied_idle_ = true;
   IoReassembler io_reassembler_{kMaxIoSize};
 
-  // Change-of-state or cyclic connection: what the start-up learnt, then the
-  // consumer of its messages (from its Set of EPR on).
+  // The input connection (change of state, cyclic or bit-strobe): what the
+  // start-up learnt, then the consumer of its messages (from its Set of EPR
+  // on; a bit-strobe connection's with acknowledgment suppressed).
   bool cos_allocated_ = false;
   bool cos_requested_ = false;
   bool cos_release_tried_ = false;  // its Allocate retried once after a Release

@@ -173,7 +173,7 @@ void Node::resend_step(TimePoint now) {
 
 void Node::get(Step step, const cip::AttributeRef& target, TimePoint now) {
   RequestMessage r;
-  r.service = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
+  r.service = cip::code(cip::Service::kGetAttributeSingle);
   r.class_id = target.class_id;
   r.instance_id = target.instance_id;
   r.attribute = target.attribute;
@@ -195,17 +195,25 @@ std::uint8_t Node::cos_connection_bits() const {
 }
 
 std::uint8_t Node::cos_choice() const {
-  const auto& cos = config_.profile.cos;
-  if (!cos) return 0;
-  return static_cast<std::uint8_t>(
-      (cos->cyclic ? allocation::kCyclic : allocation::kChangeOfState) |
-      (cos->acknowledged ? 0 : allocation::kAckSuppression));
+  const auto& in = config_.profile.input_connection;
+  if (!in) return 0;
+  switch (in->kind) {
+    case InputKind::kBitStrobe:
+      return allocation::kBitStrobe;
+    case InputKind::kCyclic:
+      return static_cast<std::uint8_t>(allocation::kCyclic |
+                                       (in->acknowledged ? 0 : allocation::kAckSuppression));
+    case InputKind::kChangeOfState:
+      break;
+  }
+  return static_cast<std::uint8_t>(allocation::kChangeOfState |
+                                   (in->acknowledged ? 0 : allocation::kAckSuppression));
 }
 
 void Node::release(Step step, std::uint8_t choice, TimePoint now) {
   const std::array<std::uint8_t, 1> data{choice};
   RequestMessage r;
-  r.service = static_cast<std::uint8_t>(cip::Service::kReleaseMasterSlave);
+  r.service = cip::code(cip::Service::kReleaseMasterSlave);
   r.class_id = kDeviceNetObject.class_id;
   r.instance_id = 1;
   r.data = Bytes(data);
@@ -237,9 +245,10 @@ void Node::attempt_allocate(TimePoint now) {
   consumed_path_in_force_.clear();
   cos_path_refusal_.clear();
   cos_asked_ = CosSettings{};
-  if (const auto& cos = config_.profile.cos) {
-    cos_asked_.expected_packet_rate = cos->expected_packet_rate;
-    cos_asked_.ack_suppressed = !cos->acknowledged;
+  if (const auto& in = config_.profile.input_connection) {
+    cos_asked_.expected_packet_rate = input_epr_asked();
+    // Nothing acknowledges a bit-strobe response.
+    cos_asked_.ack_suppressed = !in->acknowledged || in->strobed();
   }
   ++counters_.allocate_attempts;
   run(Step::kAllocateExplicit, now);
@@ -262,7 +271,7 @@ void Node::run(Step step, TimePoint now) {
       const std::uint8_t choice = step == Step::kAllocateCos ? cos_choice() : r.choice;
       const std::array<std::uint8_t, 2> data{choice, port_.master_mac.value()};
       RequestMessage m;
-      m.service = static_cast<std::uint8_t>(cip::Service::kAllocateMasterSlave);
+      m.service = cip::code(cip::Service::kAllocateMasterSlave);
       m.class_id = kDeviceNetObject.class_id;
       m.instance_id = 1;
       m.data = Bytes(data);
@@ -302,21 +311,21 @@ void Node::run(Step step, TimePoint now) {
           timeout = std::min(client_.response_timeout(), 2 * config_.expected_packet_rate);
           break;
         case Step::kSetCosPath:
-          value.assign(Bytes(config_.profile.cos->produced_path));
+          value.assign(Bytes(config_.profile.input_connection->produced_path));
           break;
         case Step::kCosInhibit:
-          value.assign(Bytes(uint_le(to_ms(*config_.profile.cos->inhibit))));
+          value.assign(Bytes(uint_le(to_ms(*config_.profile.input_connection->inhibit))));
           break;
         case Step::kCosEpr:
           // Right after the poll connection's start, bounded as its Set was.
-          value.assign(Bytes(uint_le(to_ms(config_.profile.cos->expected_packet_rate))));
+          value.assign(Bytes(uint_le(to_ms(input_epr_asked()))));
           timeout = std::min(client_.response_timeout(), 2 * poll_epr_);
           break;
         default:
           break;
       }
       RequestMessage m;
-      m.service = static_cast<std::uint8_t>(cip::Service::kSetAttributeSingle);
+      m.service = cip::code(cip::Service::kSetAttributeSingle);
       m.class_id = target.class_id;
       m.instance_id = target.instance_id;
       m.attribute = target.attribute;
@@ -338,6 +347,19 @@ void Node::advance(Step next, TimePoint now) {
 
 cip::AttributeRef Node::target_of(Step step) const {
   const StepRow& r = row(step);
+  // The rows name Connection 4; a bit-strobe connection is instance 3.
+  if (config_.profile.input_connection && config_.profile.input_connection->strobed()) {
+    switch (step) {
+      case Step::kSetCosPath:
+        return conn::kStrobeProducedPath;
+      case Step::kCosSize:
+        return conn::kStrobeProducedSize;
+      case Step::kCosEpr:
+        return conn::kStrobeExpectedPacketRate;
+      default:
+        break;
+    }
+  }
   // The two profile targets share class, instance and attribute 0: their
   // names tell them apart.
   if (r.target.name == kProfileSetting.name) {
@@ -397,7 +419,8 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
           r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode &&
           !last_request_data_.empty() && last_request_data_.view()[0] != allocation::kExplicit &&
           (last_request_data_.view()[0] & allocation::kExplicit) != 0) {
-        constexpr std::uint8_t kCos = allocation::kChangeOfState | allocation::kCyclic;
+        constexpr std::uint8_t kCos =
+            allocation::kChangeOfState | allocation::kCyclic | allocation::kBitStrobe;
         const std::uint8_t asked = last_request_data_.view()[0];
         release(
             step,
@@ -923,7 +946,7 @@ Node::Step Node::check_sizes(TimePoint now) {
     log_.info("{}; the paths in force give the sizes the configuration needs: going on",
               path_refusal_);
   }
-  return config_.profile.cos ? Step::kAllocateCos : Step::kExplicitEpr;
+  return config_.profile.input_connection ? Step::kAllocateCos : Step::kExplicitEpr;
 }
 
 Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
@@ -948,30 +971,37 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
         "poll period of {} ms: a lost connection is noticed only after {} ms",
         to_ms(epr), to_ms(asked), to_ms(config_.poll_period), 4 * to_ms(epr));
   }
-  return config_.profile.cos ? Step::kCosEpr : Step::kOnline;
+  return config_.profile.input_connection ? Step::kCosEpr : Step::kOnline;
 }
 
-// --- change of state or cyclic ---------------------------------------------------
+// --- the input connection: change of state, cyclic or bit-strobe -------------------
 
-// The change-of-state connection is set up once the poll connection's sizes
-// are verified, and started (its EPR) right after the poll connection's:
+Duration Node::input_epr_asked() const {
+  const auto& in = config_.profile.input_connection;
+  if (!in) return Duration::zero();
+  return in->strobed() ? config_.expected_packet_rate : in->expected_packet_rate;
+}
+
+// The input connection is set up once the poll connection's sizes are
+// verified, and started (its EPR) right after the poll connection's:
 // nothing runs between the poll connection's start and its first poll but
-// that one Set.
+// that one Set. A bit-strobe connection has no inhibit time and no
+// Acknowledge Handler.
 Node::Step Node::cos_step_after(Step step) const {
   if (step == Step::kCosEpr) return Step::kOnline;
   static constexpr Step kOrder[] = {Step::kAllocateCos, Step::kSetCosPath, Step::kCosInhibit,
                                     Step::kCosSize,     Step::kAckTimer,   Step::kRetryLimit,
                                     Step::kExplicitEpr};
-  const CosConnection& cos = *config_.profile.cos;
+  const InputConnection& cos = *config_.profile.input_connection;
   const auto applies = [&](Step s) {
     switch (s) {
       case Step::kSetCosPath:
         return !cos.produced_path.empty();
       case Step::kCosInhibit:
-        return !cos.cyclic && cos.inhibit.has_value();
+        return cos.kind == InputKind::kChangeOfState && cos.inhibit.has_value();
       case Step::kAckTimer:
       case Step::kRetryLimit:
-        return cos.acknowledged;
+        return cos.acknowledged && !cos.strobed();
       default:
         return true;
     }
@@ -988,7 +1018,7 @@ Node::Step Node::after_allocate_cos(const ExplicitResult& r, TimePoint now) {
     cos_allocated_ = true;
     return cos_step_after(Step::kAllocateCos);
   }
-  const char* kind = config_.profile.cos->cyclic ? "cyclic" : "change-of-state";
+  const std::string_view kind = to_string(config_.profile.input_connection->kind);
   return io_allocate_refused(
       r, now, fmt::format("Allocate of the {} connection (choice 0x{:02X})", kind, cos_choice()),
       fmt::format("; the node's connection = \"{}\" needs it", kind), cos_release_tried_,
@@ -1001,7 +1031,7 @@ Node::Step Node::after_allocate_cos(const ExplicitResult& r, TimePoint now) {
 Node::Step Node::after_cos_step(const ExplicitResult& r, TimePoint now) {
   const Step step = last_step_;
   const cip::AttributeRef target = target_of(step);
-  const CosConnection& cos = *config_.profile.cos;
+  const InputConnection& cos = *config_.profile.input_connection;
   switch (step) {
     case Step::kSetCosPath:
       if (!r.ok()) {
@@ -1048,7 +1078,7 @@ Node::Step Node::after_cos_step(const ExplicitResult& r, TimePoint now) {
     }
     case Step::kCosEpr: {
       // As the poll's: the value the device returned is the one it uses.
-      const Duration epr = returned_epr(r, cos.expected_packet_rate);
+      const Duration epr = returned_epr(r, input_epr_asked());
       cos_asked_.expected_packet_rate = epr;
       if (cos_) cos_->set_expected_packet_rate(epr);
       break;
@@ -1164,16 +1194,21 @@ void Node::go_online(TimePoint now) {
   }
   if (cos_) {
     const CosSettings& c = cos_->settings();
+    const InputKind kind = config_.profile.input_connection->kind;
     reason += fmt::format(
         "; inputs {} (EPR {} ms, {})",
-        config_.profile.cos->cyclic ? "cyclic" : "on change of state",
+        kind == InputKind::kCyclic          ? "cyclic"
+        : kind == InputKind::kChangeOfState ? "on change of state"
+                                            : "bit-strobed",
         to_ms(c.expected_packet_rate),
-        c.ack_suppressed ? std::string("acknowledgment suppressed")
-                         : fmt::format("acknowledged: the device retries after {} ms, {} time(s){}",
-                                       to_ms(c.ack_timer), unsigned{c.retry_limit},
-                                       ack_handler_unread_ ? " (defaults: its Acknowledge "
-                                                             "Handler not read)"
-                                                           : ""));
+        kind == InputKind::kBitStrobe ? std::string("strobed with the port's other nodes")
+        : c.ack_suppressed
+            ? std::string("acknowledgment suppressed")
+            : fmt::format("acknowledged: the device retries after {} ms, {} time(s){}",
+                          to_ms(c.ack_timer), unsigned{c.retry_limit},
+                          ack_handler_unread_ ? " (defaults: its Acknowledge "
+                                                "Handler not read)"
+                                              : ""));
   }
   if (!identity_state_supported_) reason += "; Identity.State not supported: state unknown";
   set_state(NodeState::kOnline, std::move(reason), now);

@@ -191,21 +191,33 @@ void Node::bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint 
   }
 }
 
-// --- change of state or cyclic --------------------------------------------------
+// --- the input connection: change of state, cyclic or bit-strobe -------------
 
-void Node::on_cos_message(Bytes payload, TimePoint now) {
-  // From the Set of its EPR on (a first message may come before the answer).
-  if (!cos_ || (state_ != NodeState::kOnline && step_ != Step::kCosEpr)) {
-    bad_cos_message(NodeError::Kind::kCosUnexpected, static_cast<std::uint32_t>(payload.size()),
-                    now);
+void Node::on_cos_message(Bytes payload, TimePoint now) { on_input_message(false, payload, now); }
+
+void Node::on_strobe_response(Bytes payload, TimePoint now) {
+  on_input_message(true, payload, now);
+}
+
+void Node::on_input_message(bool strobe_response, Bytes payload, TimePoint now) {
+  const auto& in = config_.profile.input_connection;
+  // From the Set of its EPR on (a first message may come before the answer),
+  // on the message its kind produces.
+  if (!cos_ || in->strobed() != strobe_response ||
+      (state_ != NodeState::kOnline && step_ != Step::kCosEpr)) {
+    bad_cos_message(
+        strobe_response ? NodeError::Kind::kStrobeUnexpected : NodeError::Kind::kCosUnexpected,
+        static_cast<std::uint32_t>(payload.size()), now);
     return;
   }
-  const IoFrame f = io_frame(cos_reassembler_, payload, config_.profile.cos->produced_size);
+  const IoFrame f = io_frame(cos_reassembler_, payload, in->produced_size);
   if (f.outcome == IoFrame::kComplete) {
     take_cos_message(f.message, now);
   } else if (f.outcome != IoFrame::kIncomplete) {
-    bad_cos_message(f.outcome == IoFrame::kWrongSize ? NodeError::Kind::kCosLength
-                                                     : NodeError::Kind::kCosMalformed,
+    // A bit-strobe response is one frame: never out of order.
+    bad_cos_message(f.outcome != IoFrame::kWrongSize ? NodeError::Kind::kCosMalformed
+                    : strobe_response                ? NodeError::Kind::kStrobeLength
+                                                     : NodeError::Kind::kCosLength,
                     f.got, now);
   }
   if (f.outcome == IoFrame::kComplete || f.outcome == IoFrame::kWrongSize) cos_reassembler_.reset();
@@ -231,20 +243,24 @@ void Node::bad_cos_message(NodeError::Kind kind, std::uint32_t got, TimePoint no
   // watchdog ends the connection.
   // A straggler of a connection just released, or a message for another
   // master's connection of a node this one polls, is no news.
-  if (kind == NodeError::Kind::kCosUnexpected &&
-      (!config_.profile.cos || (!cos_ && state_ != NodeState::kOnline))) {
+  const bool unexpected =
+      kind == NodeError::Kind::kCosUnexpected || kind == NodeError::Kind::kStrobeUnexpected;
+  if (unexpected &&
+      (!config_.profile.input_connection || (!cos_ && state_ != NodeState::kOnline))) {
     ++counters_.cos_errors;
     return;
   }
   ++counters_.cos_errors;
-  const std::size_t expected = config_.profile.cos ? config_.profile.cos->produced_size : 0;
+  const auto& in = config_.profile.input_connection;
+  const std::size_t expected = in ? in->produced_size : 0;
   record(kind, now, got, static_cast<std::uint32_t>(expected));
   error_log_limit_.warn(log_, now, "{}", last_error_.describe());
   if (state_ != NodeState::kOnline) return;
   if (++cos_consecutive_errors_ >= port_.max_consecutive_errors) {
-    lose_and_release(fmt::format("{} bad change-of-state messages in a row: {}",
-                                 cos_consecutive_errors_, last_error_.describe()),
-                     now);
+    lose_and_release(
+        fmt::format("{} bad {} messages in a row: {}", cos_consecutive_errors_,
+                    to_string(config_.profile.input_connection->kind), last_error_.describe()),
+        now);
   }
 }
 

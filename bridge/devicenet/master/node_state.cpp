@@ -64,6 +64,12 @@ std::string NodeError::describe() const {
       return "fragmented change-of-state message out of order";
     case Kind::kHeartbeatMissed:
       return "connection lost: no change-of-state message for 4 x EPR";
+    case Kind::kStrobeLength:
+      return fmt::format("bit-strobe response of {} bytes, expected {}", got, expected);
+    case Kind::kStrobeUnexpected:
+      return "bit-strobe response with no bit-strobe connection";
+    case Kind::kStrobeMissed:
+      return "connection lost: no bit-strobe response for 4 x EPR";
   }
   return "?";
 }

@@ -50,6 +50,9 @@ struct NodeError {
     kCosUnexpected,      // change-of-state/cyclic message with no such connection
     kCosMalformed,       // fragmented change-of-state/cyclic message out of order
     kHeartbeatMissed,    // no change-of-state/cyclic message for 4 x EPR
+    kStrobeLength,       // bit-strobe response of the wrong size (got/expected)
+    kStrobeUnexpected,   // bit-strobe response with no bit-strobe connection
+    kStrobeMissed,       // no bit-strobe response for 4 x EPR
   };
   Kind kind = Kind::kNone;
   TimePoint at{};
@@ -73,7 +76,9 @@ struct NodeCounters {
   std::uint64_t idle_empty_responses = 0;  // idle polls answered with no data (valid)
   std::uint64_t explicit_retries = 0;      // life-cycle requests sent again after no answer
   std::uint64_t settings_written = 0;      // attributes the start-up had to change
-  // Change-of-state or cyclic connection (instance 4), where the node has one.
+  // The input connection, where the node has one: change of state or cyclic
+  // (instance 4), or bit-strobe (instance 3: its responses; no acks, no
+  // retries).
   std::uint64_t cos_messages = 0;       // messages taken, the device's retries included
   std::uint64_t cos_acks = 0;           // acknowledgments sent
   std::uint64_t cos_retries = 0;        // the device's retries seen (an acknowledgment it missed)

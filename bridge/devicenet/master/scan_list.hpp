@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bridge/common/bytes.hpp"
@@ -85,25 +86,43 @@ struct SizeSource {
   friend bool operator==(const SizeSource&, const SizeSource&) = default;
 };
 
-// A change-of-state or cyclic connection (Connection instance 4) beside the
-// poll connection: the device produces its inputs on it, on a change (no
-// sooner than the inhibit time after the last) and at least once per EPR as
-// a heartbeat, or every EPR (cyclic); the master acknowledges each message
-// unless acknowledgment is suppressed. The outputs, and the device's answer
-// to them, stay on the poll connection (which then keeps the connections
-// alive at the node's poll period). Nothing for 4 x EPR is the node's loss.
-struct CosConnection {
-  bool cyclic = false;       // allocation choice 0x20 rather than 0x10
-  bool acknowledged = true;  // false: allocated with 0x40, nothing acknowledged or retried
-  Duration expected_packet_rate = milliseconds(1000);  // heartbeat or cycle, as asked
+// The connection beside the poll connection on which the device produces
+// its inputs:
+// - change of state or cyclic (Connection instance 4): on a change (no
+//   sooner than the inhibit time after the last) and at least once per EPR
+//   as a heartbeat, or every EPR (cyclic); the master acknowledges each
+//   message unless acknowledgment is suppressed;
+// - bit-strobe (Connection instance 3): the device answers each of the
+//   master's bit-strobe commands (Group 2 message 0, one per port, 64 bits,
+//   one per MAC) on Group 1 message 14, in one frame. The master strobes at
+//   the shortest poll period of its strobed nodes, and sends every node's
+//   bit as 0: a device that takes its bit as an output is not supported.
+//   Its EPR is the node's (NodeConfig::expected_packet_rate).
+// The outputs, and the device's answer to them, stay on the poll connection
+// (which keeps the connections alive at the node's poll period). Nothing for
+// 4 x EPR is the node's loss.
+enum class InputKind : std::uint8_t { kChangeOfState, kCyclic, kBitStrobe };
+std::string_view to_string(InputKind kind) noexcept;  // "change-of-state", "cyclic", "bit-strobe"
+
+struct InputConnection {
+  InputKind kind = InputKind::kChangeOfState;
+  // Change of state and cyclic: false allocates with 0x40, nothing
+  // acknowledged or retried. A bit-strobe response is never acknowledged.
+  bool acknowledged = true;
+  // Change of state and cyclic: the heartbeat or cycle, as asked.
+  Duration expected_packet_rate = milliseconds(1000);
   // Production inhibit time (attribute 17, change of state only); none: the
   // device's own is left.
   std::optional<Duration> inhibit;
   std::vector<std::uint8_t> produced_path;  // attribute 14; empty: the device's default
   std::size_t produced_size = 0;            // message bytes expected
 
-  friend bool operator==(const CosConnection&, const CosConnection&) = default;
+  bool strobed() const noexcept { return kind == InputKind::kBitStrobe; }
+  friend bool operator==(const InputConnection&, const InputConnection&) = default;
 };
+
+// A bit-strobe response is one frame.
+inline constexpr std::size_t kMaxStrobeResponse = 8;
 
 // Device-specific knowledge the node life cycle needs, as data: built by a
 // profile (profiles/cdn127/node_profile.hpp).
@@ -118,7 +137,8 @@ struct NodeProfile {
   std::string format_description;           // e.g. "request 4 B [DOUT PAD AOUT] ..."
   bool has_size_fallback = false;
   SizeSource size_fallback;
-  std::optional<CosConnection> cos;  // inputs also on change of state or cyclic
+  std::optional<InputConnection>
+      input_connection;  // inputs also on change of state, cyclic or bit-strobe
 
   friend bool operator==(const NodeProfile&, const NodeProfile&) = default;
 };

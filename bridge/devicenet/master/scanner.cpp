@@ -41,14 +41,15 @@ void validate_node(const ScannerConfig& c, const NodeConfig& n) {
     throw std::invalid_argument(
         fmt::format("node {}: poll messages over {} bytes", mac, Node::kMaxIoSize));
   }
-  if (const auto& cos = n.profile.cos) {
-    if (cos->expected_packet_rate <= Duration::zero()) {
-      throw std::invalid_argument(
-          fmt::format("node {}: change-of-state expected packet rate must be positive", mac));
+  if (const auto& in = n.profile.input_connection) {
+    if (!in->strobed() && in->expected_packet_rate <= Duration::zero()) {
+      throw std::invalid_argument(fmt::format("node {}: {} expected packet rate must be positive",
+                                              mac, to_string(in->kind)));
     }
-    if (cos->produced_size > Node::kMaxIoSize) {
+    const std::size_t most = in->strobed() ? kMaxStrobeResponse : Node::kMaxIoSize;
+    if (in->produced_size > most) {
       throw std::invalid_argument(
-          fmt::format("node {}: change-of-state messages over {} bytes", mac, Node::kMaxIoSize));
+          fmt::format("node {}: {} messages over {} bytes", mac, to_string(in->kind), most));
     }
   }
 }
@@ -64,6 +65,18 @@ void Scanner::check(const ScannerConfig& c) {
     }
     seen[n.mac.value()] = true;
   }
+}
+
+std::string_view to_string(InputKind kind) noexcept {
+  switch (kind) {
+    case InputKind::kChangeOfState:
+      return "change-of-state";
+    case InputKind::kCyclic:
+      return "cyclic";
+    case InputKind::kBitStrobe:
+      return "bit-strobe";
+  }
+  return "?";
 }
 
 std::string_view to_string(PortState state) noexcept {
@@ -153,6 +166,7 @@ Status Scanner::add_node(NodeConfig node, TimePoint now) {
     n.set_poll_phase(now);
     n.start(now, now);
   }
+  if (state_ == PortState::kRunning) schedule_strobes(now);
   // Otherwise the node starts when the port scans (begin_scanning) or when
   // the one leaving is released (reap).
   return {};
@@ -251,6 +265,7 @@ void Scanner::begin_scanning(TimePoint now) {
     node.set_poll_phase(now + period * i / count);
     node.start(now, now + milliseconds(2) * i);
   }
+  schedule_strobes(now);
   for (auto& n : leaving_) n->release_after_loss(now);
 }
 
@@ -368,27 +383,32 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
 
   if (state_ == PortState::kCheckingMac) return;
 
-  if (id->group == MessageGroup::k1 &&
-      id->message_id == static_cast<std::uint8_t>(Group1Message::kSlavePollResponse)) {
-    if (Node* n = route(id->mac)) {
-      n->on_poll_response(payload, rx_time);
-    } else {
-      ++counters_.unknown_nodes;
-      answering_other_master_.set(id->mac.value());  // polled: another master holds it
-      heard_unconfigured(id->mac, "answering another master's poll", rx_time);
+  if (id->group == MessageGroup::k1) {
+    // A slave's I/O message: its node's, or from a MAC another master holds.
+    struct IoMessage {
+      Group1Message message;
+      void (Node::*take)(Bytes, TimePoint);
+      const char* heard_as;
+    };
+    static constexpr IoMessage kIoMessages[] = {
+        {Group1Message::kSlavePollResponse, &Node::on_poll_response,
+         "answering another master's poll"},
+        {Group1Message::kSlaveCosCyclic, &Node::on_cos_message,
+         "producing for another master (change of state)"},
+        {Group1Message::kSlaveBitStrobeResponse, &Node::on_strobe_response,
+         "answering another master's bit-strobe"},
+    };
+    for (const IoMessage& m : kIoMessages) {
+      if (id->message_id != static_cast<std::uint8_t>(m.message)) continue;
+      if (Node* n = route(id->mac)) {
+        (n->*m.take)(payload, rx_time);
+      } else {
+        ++counters_.unknown_nodes;
+        answering_other_master_.set(id->mac.value());
+        heard_unconfigured(id->mac, m.heard_as, rx_time);
+      }
+      return;
     }
-    return;
-  }
-  if (id->group == MessageGroup::k1 &&
-      id->message_id == static_cast<std::uint8_t>(Group1Message::kSlaveCosCyclic)) {
-    if (Node* n = route(id->mac)) {
-      n->on_cos_message(payload, rx_time);
-    } else {
-      ++counters_.unknown_nodes;
-      answering_other_master_.set(id->mac.value());  // producing: another master holds it
-      heard_unconfigured(id->mac, "producing for another master (change of state)", rx_time);
-    }
-    return;
   }
   if (id->group == MessageGroup::k2 &&
       id->message_id == static_cast<std::uint8_t>(Group2Message::kSlaveExplicitResponse)) {
@@ -468,6 +488,7 @@ void Scanner::on_timer(TimePoint now) {
       if (n->next_poll() <= now + window) n->poll_ahead(now);
     }
   }
+  if (now >= next_strobe_) strobe(now);
   finish_stopping(now);
 }
 
@@ -477,7 +498,42 @@ TimePoint Scanner::next_deadline() const {
   TimePoint t = probe_ ? probe_->deadline() : kNever;
   for (const auto& n : nodes_) t = std::min(t, n->deadline());
   for (const auto& n : leaving_) t = std::min(t, n->deadline());
-  return t;
+  return std::min(t, next_strobe_);
+}
+
+Duration Scanner::strobe_period() const {
+  Duration period = Duration::zero();
+  for (const auto& n : nodes_) {
+    const auto& in = n->config().profile.input_connection;
+    if (!in || !in->strobed()) continue;
+    if (period == Duration::zero() || n->config().poll_period < period) {
+      period = n->config().poll_period;
+    }
+  }
+  return period;
+}
+
+void Scanner::strobe(TimePoint now) {
+  const Duration period = state_ == PortState::kRunning ? strobe_period() : Duration::zero();
+  if (period == Duration::zero()) {
+    next_strobe_ = kNever;
+    return;
+  }
+  next_strobe_ = now + period;
+  // One command for every strobed node, each one's bit 0 (no strobe
+  // outputs); none while no node has its bit-strobe connection.
+  if (std::none_of(nodes_.begin(), nodes_.end(), [](const auto& n) { return n->strobed(); })) {
+    return;
+  }
+  can::CanFrame frame;
+  frame.id = group2_id(config_.master_mac, Group2Message::kMasterBitStrobeCommand);
+  frame.len = kBitStrobeCommandSize;
+  sink_.send(frame, now);
+  ++counters_.bit_strobes;
+}
+
+void Scanner::schedule_strobes(TimePoint now) {
+  if (next_strobe_ == kNever && strobe_period() > Duration::zero()) next_strobe_ = now;
 }
 
 Status Scanner::scan_bus(TimePoint now) {

@@ -33,6 +33,7 @@ struct PortCounters {
   std::uint64_t invalid_identifiers = 0;  // outside the DeviceNet groups
   std::uint64_t foreign_frames = 0;       // valid, but not for this master
   std::uint64_t unknown_nodes = 0;        // from a MAC not in the scan list
+  std::uint64_t bit_strobes = 0;          // bit-strobe commands sent
 };
 
 class Scanner {
@@ -136,6 +137,15 @@ class Scanner {
   void drop_leaving(std::string_view reason, TimePoint now);
   // A frame from `mac`, which is not in the scan list and not the master's.
   void heard_unconfigured(MacId mac, std::string_view how, TimePoint at);
+  // The port's bit-strobe command (Group 2 message 0, 8 bytes, one bit per
+  // MAC): every strobe_period() while a node has its bit-strobe connection
+  // (Node::strobed()); the period is the shortest poll period of the scan
+  // list's bit-strobe nodes (zero: none). schedule_strobes() starts the
+  // timer when the scan list has one.
+  static constexpr std::uint8_t kBitStrobeCommandSize = 8;
+  Duration strobe_period() const;
+  void strobe(TimePoint now);
+  void schedule_strobes(TimePoint now);
   // Ends the bus scan under way, if any, and reports it; `why` (not empty)
   // when it ends early.
   void end_bus_scan(std::string_view why, TimePoint now);
@@ -159,6 +169,7 @@ class Scanner {
   std::unique_ptr<BusProbe> probe_;
   TimePoint probe_started_{};
   RateLimitedLog foreign_log_limit_;
+  TimePoint next_strobe_ = kNever;
 };
 
 }  // namespace dnbridge::devicenet

@@ -109,8 +109,7 @@ Result<RequestMessage> decode_request(Bytes message, BodyFormat format) noexcept
 
 Result<std::size_t> encode_success_response(std::uint8_t service, Bytes data,
                                             MutableBytes out) noexcept {
-  if ((service & cip::kResponseFlag) != 0 ||
-      service == static_cast<std::uint8_t>(cip::Service::kErrorResponse)) {
+  if ((service & cip::kResponseFlag) != 0 || service == cip::code(cip::Service::kErrorResponse)) {
     return Errc::kOutOfRange;
   }
   ByteWriter w(out);
@@ -124,8 +123,7 @@ Result<std::size_t> encode_error_response(cip::GeneralStatus status, std::uint8_
                                           MutableBytes out) noexcept {
   if (status == cip::GeneralStatus::kSuccess) return Errc::kOutOfRange;
   ByteWriter w(out);
-  w.u8(static_cast<std::uint8_t>(static_cast<std::uint8_t>(cip::Service::kErrorResponse) |
-                                 cip::kResponseFlag));
+  w.u8(static_cast<std::uint8_t>(cip::code(cip::Service::kErrorResponse) | cip::kResponseFlag));
   w.u8(static_cast<std::uint8_t>(status));
   w.u8(additional);
   if (!w.ok()) return Errc::kBufferTooSmall;
@@ -161,7 +159,7 @@ Result<can::CanFrame> make_allocate_frame(MacId slave, MacId master, std::uint8_
   if (!valid_choice(choice)) return Errc::kOutOfRange;
   const std::uint8_t payload[] = {
       encode_header({.frag = false, .xid = false, .mac = master}),
-      static_cast<std::uint8_t>(cip::Service::kAllocateMasterSlave),
+      cip::code(cip::Service::kAllocateMasterSlave),
       kDeviceNetClass,
       0x01,  // instance 1
       choice,
@@ -175,7 +173,7 @@ Result<can::CanFrame> make_release_frame(MacId slave, MacId master, std::uint8_t
   if (!valid_choice(choice)) return Errc::kOutOfRange;
   const std::uint8_t payload[] = {
       encode_header({.frag = false, .xid = false, .mac = master}),
-      static_cast<std::uint8_t>(cip::Service::kReleaseMasterSlave),
+      cip::code(cip::Service::kReleaseMasterSlave),
       kDeviceNetClass,
       0x01,  // instance 1
       choice,

@@ -79,9 +79,7 @@ struct ResponseMessage {
   std::uint8_t additional_status = cip::kNoAdditionalCode;
   Bytes data;  // service data of a success response; points into the input
 
-  bool is_error() const noexcept {
-    return service == static_cast<std::uint8_t>(cip::Service::kErrorResponse);
-  }
+  bool is_error() const noexcept { return service == cip::code(cip::Service::kErrorResponse); }
 };
 
 // `service` without the R/R bit; kOutOfRange if it has it or is 0x14 (that

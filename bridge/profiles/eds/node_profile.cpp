@@ -183,7 +183,14 @@ Result<IoEntries> io_entries(const EdsFile& file, ConnectionKind connection, std
   IoEntries e;
   e.input = (*c)->input != 0 ? file.io.input((*c)->input) : nullptr;
   const ConnectionInfo* out = *c;
-  if (connection == ConnectionKind::kChangeOfState || connection == ConnectionKind::kCyclic) {
+  if (connection != ConnectionKind::kPoll) {
+    if (connection == ConnectionKind::kStrobe && (*c)->output != 0) {
+      return explain(why, Errc::kUnsupported,
+                     fmt::format("the EDS's bit-strobe connection consumes Output{}: dnbridge's "
+                                 "master sends every strobe bit as 0, and takes outputs on the "
+                                 "poll connection only",
+                                 (*c)->output));
+    }
     auto poll = offered(ConnectionKind::kPoll);
     if (!poll) return poll.error();
     out = *poll;
@@ -192,8 +199,25 @@ Result<IoEntries> io_entries(const EdsFile& file, ConnectionKind connection, std
   return e;
 }
 
-bool is_cos(ConnectionKind k) {
-  return k == ConnectionKind::kChangeOfState || k == ConnectionKind::kCyclic;
+NodeIo layouts_of(const EdsFile& file, const IoEntries& e) {
+  NodeIo io;
+  if (e.input) io.produced = layout_of(file, *e.input);
+  if (e.output) io.consumed = layout_of(file, *e.output);
+  return io;
+}
+
+std::optional<devicenet::InputKind> input_kind(ConnectionKind k) {
+  switch (k) {
+    case ConnectionKind::kChangeOfState:
+      return devicenet::InputKind::kChangeOfState;
+    case ConnectionKind::kCyclic:
+      return devicenet::InputKind::kCyclic;
+    case ConnectionKind::kStrobe:
+      return devicenet::InputKind::kBitStrobe;
+    case ConnectionKind::kPoll:
+      break;
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -201,29 +225,29 @@ bool is_cos(ConnectionKind k) {
 Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::string* why) {
   auto e = io_entries(file, connection, why);
   if (!e) return e.error();
-  NodeIo io;
-  if (e->input) io.produced = layout_of(file, *e->input);
-  if (e->output) io.consumed = layout_of(file, *e->output);
-  return io;
+  return layouts_of(file, *e);
 }
 
 Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> shared,
                                                  const EdsNode& node, std::string* why) {
   const EdsFile& file = *shared;
-  auto io = node_io(file, node.connection, why);
-  if (!io) return io.error();
-  if (node.connection == ConnectionKind::kStrobe) {
+  auto entries = io_entries(file, node.connection, why);
+  if (!entries) return entries.error();
+  const IoEntries& e = *entries;
+  const NodeIo io = layouts_of(file, e);
+  if (node.connection == ConnectionKind::kStrobe &&
+      io.produced.size > devicenet::kMaxStrobeResponse) {
     return explain(why, Errc::kUnsupported,
-                   fmt::format("connection \"{}\": dnbridge's master does not open bit-strobe "
-                               "connections",
-                               to_string(node.connection)));
+                   fmt::format("the EDS's bit-strobe input is {} bytes: a bit-strobe response "
+                               "carries at most {}",
+                               io.produced.size, devicenet::kMaxStrobeResponse));
   }
-  if (io->consumed.size > 0 && node.safe_state.empty()) {
+  if (io.consumed.size > 0 && node.safe_state.empty()) {
     return explain(
         why, Errc::kMalformed,
         fmt::format("the node has outputs ({}) and no safe state: give the parameters that set "
                     "their fault and idle actions (safe_state)",
-                    describe_data(io->consumed, "output")));
+                    describe_data(io.consumed, "output")));
   }
 
   devicenet::NodeProfile p;
@@ -246,28 +270,29 @@ Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> 
   if (auto s = add(node.parameters, "parameters"); !s) return s.error();
   if (auto s = add(node.safe_state, "safe_state"); !s) return s.error();
 
-  const IoEntries e = *io_entries(file, node.connection, why);
-  // On change of state or cyclic the poll response carries the same data as
-  // the connection's messages.
+  // On change of state, cyclic or bit-strobe the poll response carries the
+  // same data as the input connection's messages.
   if (e.input) p.produced_path = cip::encoded(e.input->path);
   if (e.output) p.consumed_path = cip::encoded(e.output->path);
   for (const IoData* d : {e.input, e.output}) {
     if (auto check = member_list_check(shared, d)) p.checks.push_back(std::move(*check));
   }
-  p.produced_size = io->produced.size;
-  p.consumed_size = io->consumed.size;
-  if (is_cos(node.connection)) {
-    devicenet::CosConnection cos;
-    cos.cyclic = node.connection == ConnectionKind::kCyclic;
-    cos.acknowledged = node.acknowledged;
-    cos.expected_packet_rate = node.heartbeat;
-    if (!cos.cyclic) cos.inhibit = node.inhibit;
-    cos.produced_path = p.produced_path;
-    cos.produced_size = io->produced.size;
-    p.cos = std::move(cos);
+  p.produced_size = io.produced.size;
+  p.consumed_size = io.consumed.size;
+  if (const auto kind = input_kind(node.connection)) {
+    devicenet::InputConnection in;
+    in.kind = *kind;
+    if (*kind != devicenet::InputKind::kBitStrobe) {
+      in.acknowledged = node.acknowledged;
+      in.expected_packet_rate = node.heartbeat;
+    }
+    if (*kind == devicenet::InputKind::kChangeOfState) in.inhibit = node.inhibit;
+    in.produced_path = p.produced_path;
+    in.produced_size = io.produced.size;
+    p.input_connection = std::move(in);
   }
-  p.format_description = fmt::format("{}, {}", describe_data(io->produced, "input"),
-                                     describe_data(io->consumed, "output"));
+  p.format_description = fmt::format("{}, {}", describe_data(io.produced, "input"),
+                                     describe_data(io.consumed, "output"));
   return p;
 }
 

@@ -77,8 +77,9 @@ Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
 
 // The scan-list profile of `node`. Fails (kUnsupported, kMalformed,
 // kOutOfRange), `why` naming the parameter and what is wrong, for: a
-// connection the EDS does not offer or the master does not open (bit-strobe),
-// an unknown parameter (with the nearest name), one given twice, one
+// connection the EDS does not offer, a bit-strobe connection that consumes
+// an output or produces more than one frame (the master sends no strobe
+// outputs), an unknown parameter (with the nearest name), one given twice, one
 // read only, one without a link path or of a string type, a value outside
 // its type or the EDS's limits, and outputs without a safe state.
 //

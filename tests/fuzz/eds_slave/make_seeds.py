@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the session seeds of the eds_slave fuzz target: what a master at
-MAC 0 sends the example I/O block at MAC 1, frame by frame, in the record
+MAC 0 sends the example I/O block (or valve manifold) at MAC 1, frame by frame, in the record
 format of support/session_records.hpp. The files are committed (corpus/);
 run this again after changing a session here. The seeds named cdn127_* are
 the cdn127_slave target's (a master bringing up a node at MAC 1), copied.
@@ -21,6 +21,8 @@ POLL = 0x400 | MAC << 3 | 5         # Group 2 message 5, poll command
 UNCONNECTED = 0x400 | MAC << 3 | 6  # Group 2 message 6, Allocate / Release
 DUP_MAC = 0x400 | MAC << 3 | 7      # Group 2 message 7
 COS_ACK = 0x400 | MAC << 3 | 2      # Group 2 message 2
+STROBE = 0x400 | 0 << 3 | 0         # Group 2 message 0 of the master at MAC 0
+OTHER_STROBE = 0x400 | 9 << 3 | 0   # ... of another master
 OFFLINE_OWNERSHIP = 0x7EF
 
 
@@ -138,6 +140,18 @@ s = online().allocate(0x13).epr(2, 100).epr(4, 100)
 s.frame(POLL, [0x0F, 0x00], 10).frame(COS_ACK, [], 5).wait(11000)
 s.record(STOP, 1).wait(1000).wait(1000).wait(10).allocate(0x03)
 SESSIONS["master_gone_power_cycle"] = s
+
+# Bit-strobe (the valve manifold's; refused by the I/O block): its produced
+# path, EPR, commands of its master and of another, a status change, the
+# watchdog, a Connection Reset, Release.
+s = online().allocate(0x05).set_conn(3, 14, assembly_path(102)).set_conn(3, 16, [])
+s.epr(3, 100)
+for _ in range(3):
+    s.frame(STROBE, [0x02, 0, 0, 0, 0, 0, 0, 0], 50)
+s.frame(OTHER_STROBE, [0xFF] * 8, 10).inputs(0x01, 0x00).frame(STROBE, [], 10)
+s.wait(500).frame(STROBE, [0] * 8, 10).request([0x05, 0x05, 0x03])
+s.frame(STROBE, [0] * 8, 10).release(0x04).frame(STROBE, [0] * 8, 10).release(0x01)
+SESSIONS["bit_strobe_commands_timeout_reset"] = s
 
 # A duplicate MAC during the check: Communication Fault; offline ownership
 # taken (vendor 65001 = 0xFDE9, serial 0xDB000101).

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "bridge/devicenet/wire/identifier.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 #include "tests/fuzz/support/session_records.hpp"
 
@@ -32,6 +33,13 @@ class CheckingSink final : public can::FrameSink {
     FUZZ_CHECK(frame.len <= can::kMaxDataLength);
     FUZZ_CHECK(now >= last_);
     last_ = now;
+    // The bit-strobe command: the master's, 8 bytes, every bit 0.
+    if (frame.id == devicenet::group2_id(devicenet::MacId::from(0).value(),
+                                         devicenet::Group2Message::kMasterBitStrobeCommand)) {
+      FUZZ_CHECK(frame.len == 8);
+      FUZZ_CHECK(
+          std::all_of(frame.data.begin(), frame.data.end(), [](std::uint8_t b) { return b == 0; }));
+    }
   }
 
  private:

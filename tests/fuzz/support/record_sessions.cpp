@@ -1,19 +1,24 @@
 // Writes seed inputs for the scanner and cdn127_slave fuzz targets: the
-// master (with the scanner target's scan list) and simulated CDN127s wired
-// back to back with no bus delay, run on a fake clock. What the master
+// master (with the scanner target's scan list) and simulated CDN127s, with
+// the example valve manifold bit-strobed at MAC 3, wired back to back with
+// no bus delay, run on a fake clock. What the master
 // receives, and when its timers run, is written as the scanner's input; what
 // the CDN127 at MAC 1 receives, and its timers, as the slave's.
 //
 // Usage: fuzz_record_sessions <scanner corpus dir> <cdn127_slave corpus dir>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "adapters/sim/cdn127/cdn127_slave.hpp"
+#include "adapters/sim/generic/eds_slave.hpp"
 #include "bridge/devicenet/master/scanner.hpp"
+#include "bridge/profiles/eds/eds_file.hpp"
 #include "tests/fuzz/support/session_records.hpp"
 
 namespace {
@@ -58,7 +63,20 @@ struct Scenario {
   // After the explicit request, node 2 taken out of the scan list, then put
   // back with another poll period (a reload).
   bool toggle_node = false;
+  bool valves = true;  // the valve manifold at MAC 3
 };
+
+eds::EdsFile valve_manifold() {
+  std::ifstream in(std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-valve-manifold.eds");
+  std::stringstream text;
+  text << in.rdbuf();
+  auto parsed = eds::parse(text.str());
+  if (!parsed.file) {
+    std::fprintf(stderr, "the valve manifold's EDS does not read\n");
+    std::exit(1);
+  }
+  return std::move(*parsed.file);
+}
 
 void write(const std::string& path, const std::vector<std::uint8_t>& bytes) {
   std::ofstream f(path, std::ios::binary);
@@ -71,7 +89,7 @@ void run(const Scenario& s, const std::string& scanner_dir, const std::string& s
   devicenet::ScannerObserver observer;
   devicenet::Scanner scanner(fuzz::fuzz_scanner_config(), master_sink, observer, Logger());
   std::vector<std::unique_ptr<QueueSink>> slave_sinks;
-  std::vector<std::unique_ptr<sim::Cdn127Slave>> slaves;
+  std::vector<std::unique_ptr<sim::Group2Slave>> slaves;
   for (std::size_t i = 0; i < s.devices.size(); ++i) {
     if (!s.devices[i]) continue;
     slave_sinks.push_back(std::make_unique<QueueSink>(queue));
@@ -80,7 +98,14 @@ void run(const Scenario& s, const std::string& scanner_dir, const std::string& s
     slaves.push_back(std::make_unique<sim::Cdn127Slave>(*slave_sinks.back(), o));
   }
   // The slave target's device is the one at MAC 1, when present.
-  sim::Cdn127Slave* recorded = s.devices[0] ? slaves.front().get() : nullptr;
+  sim::Group2Slave* recorded = s.devices[0] ? slaves.front().get() : nullptr;
+  if (s.valves) {
+    slave_sinks.push_back(std::make_unique<QueueSink>(queue));
+    sim::EdsSlaveOptions o;
+    o.mac = fuzz::kFuzzStrobedMac;
+    o.serial_number = 0xDB000103;
+    slaves.push_back(std::make_unique<sim::EdsSlave>(*slave_sinks.back(), valve_manifold(), o));
+  }
 
   Stream master_in, slave_in;
   TimePoint now = fuzz::kSessionStart;
@@ -178,11 +203,13 @@ void run(const Scenario& s, const std::string& scanner_dir, const std::string& s
   }
   write(scanner_dir + "/session_" + s.name, master_in.bytes());
   if (recorded) write(slave_dir + "/session_" + s.name, slave_in.bytes());
-  std::printf("%s: scanner %zu B, slave %zu B, node 1 %s\n", s.name.c_str(),
-              master_in.bytes().size(), slave_in.bytes().size(),
-              std::string(devicenet::to_string(
-                              scanner.node(devicenet::MacId::from(1).value())->state()))
-                  .c_str());
+  const auto state = [&](unsigned mac) {
+    const devicenet::Node* n = scanner.node(devicenet::MacId::from(mac).value());
+    return std::string(n ? devicenet::to_string(n->state()) : "not listed");
+  };
+  std::printf("%s: scanner %zu B, slave %zu B, node 1 %s, node 3 %s\n", s.name.c_str(),
+              master_in.bytes().size(), slave_in.bytes().size(), state(1).c_str(),
+              state(fuzz::kFuzzStrobedMac).c_str());
 }
 
 }  // namespace

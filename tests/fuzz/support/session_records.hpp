@@ -90,7 +90,8 @@ inline void append_record(std::vector<std::uint8_t>& out, Op op, Duration step, 
 
 // The scanner target's scan list: master MAC 0, a CDN127 with its factory
 // configuration at MAC 1 and one set to the CDN118 preset at MAC 2, with the
-// integration tests' timings.
+// integration tests' timings; and the example valve manifold (deploy/eds) at
+// MAC 3, bit-strobed.
 inline rack::PumpConfig fuzz_pump(unsigned mac, profiles::cdn127::ConfigurationPreset preset) {
   rack::PumpConfig p;
   p.node.mac = devicenet::MacId::from(mac).value();
@@ -106,12 +107,38 @@ inline std::vector<rack::PumpConfig> fuzz_pumps() {
           fuzz_pump(2, profiles::cdn127::ConfigurationPreset::kCdn118)};
 }
 
+// The valve manifold's profile as the EDS profile builds it (without its
+// settings and member list checks): identity, the status byte (Assembly
+// 102) produced on the poll and bit-strobe connections, the coils (Assembly
+// 151) consumed.
+inline constexpr unsigned kFuzzStrobedMac = 3;
+inline devicenet::NodeConfig fuzz_strobed_node() {
+  devicenet::NodeConfig n;
+  n.mac = devicenet::MacId::from(kFuzzStrobedMac).value();
+  n.name = "valves";
+  n.poll_period = milliseconds(100);
+  n.expected_packet_rate = milliseconds(500);
+  n.profile.identity = {65001, 27, 2};
+  n.profile.produced_path = {0x20, 0x04, 0x24, 0x66, 0x30, 0x03};
+  n.profile.consumed_path = {0x20, 0x04, 0x24, 0x97, 0x30, 0x03};
+  n.profile.produced_size = 1;
+  n.profile.consumed_size = 2;
+  devicenet::InputConnection strobe;
+  strobe.kind = devicenet::InputKind::kBitStrobe;
+  strobe.produced_path = n.profile.produced_path;
+  strobe.produced_size = 1;
+  n.profile.input_connection = strobe;
+  return n;
+}
+
 inline devicenet::ScannerConfig fuzz_scanner_config() {
   devicenet::ScannerConfig port;
   port.master_mac = devicenet::MacId::from(0).value();
   port.vendor_id = 59;
   port.serial_number = 0xDB000001;
-  return rack::PumpRack::scanner_config(port, fuzz_pumps());
+  devicenet::ScannerConfig c = rack::PumpRack::scanner_config(port, fuzz_pumps());
+  c.nodes.push_back(fuzz_strobed_node());
+  return c;
 }
 
 // The slave target's device: a CDN127 at MAC 1 as it leaves the factory.

@@ -171,7 +171,7 @@ TEST(SuccessResponse, EncodeRefusesResponseBitAndErrorService) {
 
 TEST(Request, GetAttributeSingleInEachBodyFormat) {
   RequestMessage get;
-  get.service = static_cast<std::uint8_t>(cip::Service::kGetAttributeSingle);
+  get.service = cip::code(cip::Service::kGetAttributeSingle);
   get.class_id = 0x05;     // Connection object
   get.instance_id = 0x02;  // poll connection
   get.attribute = 0x09;    // expected packet rate
@@ -253,7 +253,7 @@ TEST(Request, DecodeRefusesResponse) {
 TEST(ExpectedPacketRate, SetRequestAndResponseGolden) {
   const ByteVec data = {0x0A, 0x0E};  // 3594 ms, UINT LE
   RequestMessage set;
-  set.service = static_cast<std::uint8_t>(cip::Service::kSetAttributeSingle);
+  set.service = cip::code(cip::Service::kSetAttributeSingle);
   set.class_id = 0x05;
   set.instance_id = 0x02;
   set.attribute = 0x09;

@@ -100,12 +100,12 @@ TEST(Scanner, AChangeOfStateConnectionWithoutARateOrTooLargeIsRefused) {
   DiscardSink sink;
   StateTimes observer;
   ScannerConfig config = three_nodes();
-  config.nodes[1].profile.cos = CosConnection{};
+  config.nodes[1].profile.input_connection = InputConnection{};
   EXPECT_NO_THROW(Scanner(config, sink, observer, Logger()));
-  config.nodes[1].profile.cos->expected_packet_rate = Duration::zero();
+  config.nodes[1].profile.input_connection->expected_packet_rate = Duration::zero();
   EXPECT_THROW(Scanner(config, sink, observer, Logger()), std::invalid_argument);
-  config.nodes[1].profile.cos->expected_packet_rate = milliseconds(100);
-  config.nodes[1].profile.cos->produced_size = Node::kMaxIoSize + 1;
+  config.nodes[1].profile.input_connection->expected_packet_rate = milliseconds(100);
+  config.nodes[1].profile.input_connection->produced_size = Node::kMaxIoSize + 1;
   EXPECT_THROW(Scanner(config, sink, observer, Logger()), std::invalid_argument);
 }
 

@@ -156,7 +156,7 @@ INSTANTIATE_TEST_SUITE_P(
                 Errc::kMalformed,
                 "safe_state: Param8 \"Output idle action\" is given twice"}));
 
-TEST(EdsNodeProfile, AConnectionTheEdsDoesNotOfferOrTheMasterDoesNotOpenIsRefused) {
+TEST(EdsNodeProfile, AConnectionTheEdsDoesNotOfferIsRefused) {
   const EdsFile f = test::example_eds(test::kIoBlockEds);
   EdsNode n = polled();
   std::string why;
@@ -164,18 +164,55 @@ TEST(EdsNodeProfile, AConnectionTheEdsDoesNotOfferOrTheMasterDoesNotOpenIsRefuse
   EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kUnsupported));
   EXPECT_EQ(why,
             "the EDS offers no bit-strobe connection (it offers: poll, change of state, cyclic)");
-  // The valve manifold offers bit-strobe, which the master does not open;
-  // and no change of state.
+  // The valve manifold offers bit-strobe, and no change of state.
   const EdsFile manifold = test::example_eds(test::kValveManifoldEds);
-  EdsNode m;
-  m.connection = ConnectionKind::kStrobe;
-  EXPECT_EQ(profile_of(manifold, m, &why).error(), make_error_code(Errc::kUnsupported));
-  EXPECT_EQ(why,
-            "connection \"bit-strobe\": dnbridge's master does not open bit-strobe "
-            "connections");
+  EdsNode m = polled();
   m.connection = ConnectionKind::kChangeOfState;
   EXPECT_EQ(profile_of(manifold, m, &why).error(), make_error_code(Errc::kUnsupported));
   EXPECT_EQ(why, "the EDS offers no change of state connection (it offers: poll, bit-strobe)");
+}
+
+TEST(EdsNodeProfile, ABitStrobedNodeAnswersWithItsStrobeInputOnBothConnections) {
+  const EdsFile manifold = test::example_eds(test::kValveManifoldEds);
+  EdsNode m = polled();
+  m.connection = ConnectionKind::kStrobe;
+  std::string why;
+  auto p = profile_of(manifold, m, &why);
+  ASSERT_TRUE(p.ok()) << why;
+  ASSERT_TRUE(p->input_connection.has_value());
+  EXPECT_EQ(p->input_connection->kind, devicenet::InputKind::kBitStrobe);
+  // Input2 (Assembly 102, the status byte) on Connection 3 and on the poll
+  // connection; Output1 (Assembly 151, the coils) polled.
+  const std::vector<std::uint8_t> assembly102{0x20, 0x04, 0x24, 0x66, 0x30, 0x03};
+  EXPECT_EQ(p->input_connection->produced_path, assembly102);
+  EXPECT_EQ(p->produced_path, assembly102);
+  EXPECT_EQ(p->input_connection->produced_size, 1u);
+  EXPECT_EQ(p->produced_size, 1u);
+  EXPECT_EQ(p->consumed_size, 2u);
+  EXPECT_FALSE(p->input_connection->inhibit.has_value());
+}
+
+TEST(EdsNodeProfile, ABitStrobeThatConsumesAnOutputOrAnswersInMoreThanOneFrameIsRefused) {
+  const std::string device =
+      "[Device]\nVendCode = 1; ProdType = 0; ProdCode = 2; MajRev = 1; MinRev = 1;\n";
+  auto consumes = parse(device +
+                        "[IO_Info]\nPollInfo = 1, 1, 1;\nStrobeInfo = 2, 1, 1;\n"
+                        "Input1 = 1, 0, 3, \"in\", 6, \"20 04 24 64 30 03\", \"\";\n"
+                        "Output1 = 1, 0, 3, \"out\", 6, \"20 04 24 96 30 03\", \"\";\n");
+  ASSERT_TRUE(consumes.file.has_value());
+  EdsNode n;
+  n.connection = ConnectionKind::kStrobe;
+  std::string why;
+  EXPECT_EQ(profile_of(*consumes.file, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why,
+            "the EDS's bit-strobe connection consumes Output1: dnbridge's master sends every "
+            "strobe bit as 0, and takes outputs on the poll connection only");
+  auto large = parse(device +
+                     "[IO_Info]\nPollInfo = 1, 1, 0;\nStrobeInfo = 2, 1, 0;\n"
+                     "Input1 = 9, 0, 3, \"in\", 6, \"20 04 24 64 30 03\", \"\";\n");
+  ASSERT_TRUE(large.file.has_value());
+  EXPECT_EQ(profile_of(*large.file, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why, "the EDS's bit-strobe input is 9 bytes: a bit-strobe response carries at most 8");
 }
 
 TEST(EdsNodeProfile, ChangeOfStateNeedsThePollConnectionBesideItForTheOutputs) {
@@ -203,23 +240,23 @@ TEST(EdsNodeProfile, AChangeOfStateNodeProducesTheInputsOnInstance4AndIsPolledFo
   std::string why;
   auto p = profile_of(f, n, &why);
   ASSERT_TRUE(p.ok()) << why;
-  ASSERT_TRUE(p->cos.has_value());
-  EXPECT_FALSE(p->cos->cyclic);
-  EXPECT_FALSE(p->cos->acknowledged);
-  EXPECT_EQ(p->cos->expected_packet_rate, milliseconds(250));
-  EXPECT_EQ(p->cos->inhibit, milliseconds(15));
+  ASSERT_TRUE(p->input_connection.has_value());
+  EXPECT_FALSE(p->input_connection->kind == devicenet::InputKind::kCyclic);
+  EXPECT_FALSE(p->input_connection->acknowledged);
+  EXPECT_EQ(p->input_connection->expected_packet_rate, milliseconds(250));
+  EXPECT_EQ(p->input_connection->inhibit, milliseconds(15));
   // Input1 (Assembly 100) on both connections; Output1 (Assembly 150) polled.
   const std::vector<std::uint8_t> assembly100{0x20, 0x04, 0x24, 0x64, 0x30, 0x03};
-  EXPECT_EQ(p->cos->produced_path, assembly100);
+  EXPECT_EQ(p->input_connection->produced_path, assembly100);
   EXPECT_EQ(p->produced_path, assembly100);
-  EXPECT_EQ(p->cos->produced_size, 4u);
+  EXPECT_EQ(p->input_connection->produced_size, 4u);
   EXPECT_EQ(p->consumed_size, 2u);
 
   n.connection = ConnectionKind::kCyclic;
   p = profile_of(f, n, &why);
   ASSERT_TRUE(p.ok()) << why;
-  EXPECT_TRUE(p->cos->cyclic);
-  EXPECT_FALSE(p->cos->inhibit.has_value());  // a cyclic connection has none
+  EXPECT_TRUE(p->input_connection->kind == devicenet::InputKind::kCyclic);
+  EXPECT_FALSE(p->input_connection->inhibit.has_value());  // a cyclic connection has none
 }
 
 TEST(EdsNodeProfile, AParameterWithoutALinkPathOrOfAStringTypeIsNotSet) {
