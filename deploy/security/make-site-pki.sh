@@ -50,7 +50,7 @@ Makes (or extends) the DDS Security PKI of a dnbridge site in DIR.
 
 Without =RACK a bridge or supervisor is granted every rack's partition
 ("dnbridge/*") and the default partition, where versions before partitions
-exchange commands; with it, the partitions "dnbridge/RACK" of those racks
+exchange commands (DeviceCommand, newer, in "dnbridge/*" only); with it, the partitions "dnbridge/RACK" of those racks
 only. Given again, a name keeps its racks unless new ones are given.
 
 Names and racks: letters, digits, '.', '_' and '-'. Everything else is denied: a
@@ -321,8 +321,9 @@ EOF
 topics() { for t in "$@"; do echo "            <topic>dnbridge/$t</topic>"; done; }
 # The state topics are in the default partition; commands, requests and
 # replies in their rack's, "dnbridge/RACK" (every rack's: "dnbridge/*"),
-# and in the default partition too, where bridges and supervisors of
-# versions before partitions have them (an upgrade goes rack by rack).
+# and, for every rack, in the default partition too, where bridges and
+# supervisors of versions before partitions have them (an upgrade goes rack
+# by rack); DeviceCommand, newer than partitions, in the racks' only.
 state_topics() { topics PumpState DeviceState NodeStatus PortStatus; }
 publish_of() {
   case $1 in
@@ -349,25 +350,35 @@ subscribe_in_racks_of() {
       ;;
   esac
 }
-# rule KIND TOPICS [RACKS]: a <publish> or <subscribe> rule; with RACKS
-# ("*" or RACK,...), in those racks' partitions, and for "*" in the default
-# partition too. Without, in the default partition.
-rule() {
+# emit KIND TOPICS [PARTITION...]: a <publish> or <subscribe> rule of TOPICS
+# (none: nothing), in those partitions (none: the default partition).
+emit() {
   [ -n "$2" ] || return 0
   printf '        <%s>\n          <topics>\n%s\n          </topics>\n' "$1" "$2"
-  if [ -n "${3:-}" ]; then
+  if (($# > 2)); then
+    local p
     echo "          <partitions>"
-    if [ "$3" = "*" ]; then
-      echo "            <partition></partition>"
-      echo "            <partition>dnbridge/*</partition>"
-    else
-      local r
-      IFS=, read -r -a rule_racks <<<"$3"
-      for r in "${rule_racks[@]}"; do echo "            <partition>dnbridge/$r</partition>"; done
-    fi
+    for p in "${@:3}"; do echo "            <partition>$p</partition>"; done
     echo "          </partitions>"
   fi
   printf '        </%s>\n' "$1"
+}
+# rule KIND TOPICS [RACKS]: with RACKS ("*" or RACK,...), in those racks'
+# partitions; for "*" in the default partition too, but for the topics
+# that came after partitions (DeviceCommand): no version has them there.
+# Without RACKS, in the default partition.
+rule() {
+  if [ -z "${3:-}" ]; then
+    emit "$1" "$2"
+  elif [ "$3" = "*" ]; then
+    emit "$1" "$(grep -v '>dnbridge/DeviceCommand<' <<<"$2" || true)" "" "dnbridge/*"
+    emit "$1" "$(grep '>dnbridge/DeviceCommand<' <<<"$2" || true)" "dnbridge/*"
+  else
+    local r partitions=()
+    IFS=, read -r -a rule_racks <<<"$3"
+    for r in "${rule_racks[@]}"; do partitions+=("dnbridge/$r"); done
+    emit "$1" "$2" "${partitions[@]}"
+  fi
 }
 # openssl prints "notBefore=Nov 22 10:00:00 2026 GMT"; a grant wants ISO 8601.
 iso_date() { date -u -d "${1#*=}" +%Y-%m-%dT%H:%M:%SZ; }

@@ -122,6 +122,14 @@ run --supervisor 'scada-2=*' || fail "scada-2=*: $(cat "$work/out")"
 grep -q "^supervisor scada-2$" "$pki/roster" || fail "scada-2=* kept racks: $(cat "$pki/roster")"
 grep_grant=$(grant_of supervisor-scada-2)
 grep -q "<partition>dnbridge/\*</partition>" <<<"$grep_grant" || fail "scada-2=* has not every rack"
+# The default partition for the topics of versions before partitions, not
+# for DeviceCommand (newer): the rule that names it has every rack's only.
+grep -q "<partition></partition>" <<<"$grep_grant" || fail "scada-2=* lacks the default partition"
+device_rule=$(awk '/<publish>/ { r = "" } { r = r $0 "\n" } /<\/publish>/ && r ~ /DeviceCommand/ { printf "%s", r }' <<<"$grep_grant")
+[ -n "$device_rule" ] || fail "scada-2=* may not publish DeviceCommand"
+if grep -q "<partition></partition>\|PumpCommand" <<<"$device_rule"; then
+  fail "DeviceCommand is granted in the default partition: $device_rule"
+fi
 verify_all
 
 echo "== a host renewed"
