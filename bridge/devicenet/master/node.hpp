@@ -342,6 +342,9 @@ class Node final : private ExplicitClient::Listener {
   std::size_t check_index_ = 0;      // the check in hand
   bool poll_release_tried_ = false;  // the poll Allocate retried once after a Release
   std::uint8_t stale_choice_ = 0;    // I/O connections left from before, to release
+  // A Release refused whole (0x0B): the connections still to release one
+  // at a time (the one in hand included); 0 otherwise.
+  std::uint8_t releases_left_ = 0;
   InlineBytes<16> setting_found_;    // what the device had before the Set
   unsigned step_timeouts_ = 0;       // consecutive timeouts of the current life-cycle step
   Step last_step_ = Step::kNone;

@@ -211,6 +211,7 @@ std::uint8_t Node::cos_choice() const {
 }
 
 void Node::release(Step step, std::uint8_t choice, TimePoint now) {
+  releases_left_ = 0;
   const std::array<std::uint8_t, 1> data{choice};
   RequestMessage r;
   r.service = cip::code(cip::Service::kReleaseMasterSlave);
@@ -413,20 +414,24 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
     case Step::kReleaseFault:
     case Step::kReleaseShutdown:
       // Released with a connection the device did not have: refused whole
-      // (0x0B). Without the change-of-state connection, then without the
-      // poll connection: the explicit connection alone.
-      if (r.error == Errc::kDeviceError &&
-          r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode &&
-          !last_request_data_.empty() && last_request_data_.view()[0] != allocation::kExplicit &&
-          (last_request_data_.view()[0] & allocation::kExplicit) != 0) {
-        constexpr std::uint8_t kCos =
-            allocation::kChangeOfState | allocation::kCyclic | allocation::kBitStrobe;
+      // (0x0B). Then one connection at a time, whatever each answer: the
+      // I/O connections first, the explicit connection last.
+      if (!last_request_data_.empty()) {
         const std::uint8_t asked = last_request_data_.view()[0];
-        release(
-            step,
-            (asked & kCos) != 0 ? static_cast<std::uint8_t>(asked & ~kCos) : allocation::kExplicit,
-            now);
-        return;
+        std::uint8_t left = static_cast<std::uint8_t>(releases_left_ & ~asked);
+        if (releases_left_ == 0 && r.error == Errc::kDeviceError &&
+            r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode &&
+            (asked & (asked - 1)) != 0) {
+          left = asked;
+        }
+        if (left != 0) {
+          // Its lowest bit but the explicit connection's, while there is one.
+          const std::uint8_t io = left & static_cast<std::uint8_t>(~allocation::kExplicit);
+          const auto next = static_cast<std::uint8_t>(io != 0 ? io & -io : left);
+          release(step, next, now);
+          releases_left_ = left;
+          return;
+        }
       }
       connected_ = poll_allocated_ = poll_requested_ = cos_allocated_ = cos_requested_ = false;
       cos_.reset();

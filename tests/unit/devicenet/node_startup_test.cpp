@@ -279,6 +279,21 @@ TEST_F(NodeStartup, EveryRequestAndAnswerOnTheWire) {
   EXPECT_EQ(node().counters().errors, 0u);
   EXPECT_EQ(sent(), "(nothing sent)");
   EXPECT_EQ(node().counters().allocate_attempts, 1u);
+
+  // 13. Shutdown: an idle poll, then Release of both connections. A device
+  // that no longer has one of them refuses the Release whole (0x0B): each
+  // connection is then released alone, the poll connection first.
+  scanner_->stop(now_);
+  EXPECT_EQ(sent(), "465:");
+  answer("3CC:");
+  EXPECT_EQ(sent(), "466: 40 4C 03 01 03");  // [4C Release][03][01][03 explicit + poll]
+  answer("463: 40 94 0B 02");                // already in the requested state
+  EXPECT_EQ(sent(), "466: 00 4C 03 01 02");  // the poll connection alone
+  answer("463: 00 94 0B 02");                // which it had not
+  EXPECT_EQ(sent(), "466: 40 4C 03 01 01");  // the explicit connection alone
+  answer("463: 40 CC");
+  EXPECT_EQ(sent(), "(nothing sent)");
+  EXPECT_EQ(states_.last, NodeState::kStopped) << states_.last_reason;
 }
 
 }  // namespace
