@@ -398,11 +398,13 @@ Record counters_record(const dnbridge_NodeCounters& c) {
   counter("commands accepted", "commands_accepted", c.commands_accepted);
   counter("commands refused", "commands_refused", c.commands_refused);
   if (c.cos_messages != 0 || c.heartbeats_missed != 0) {
-    counter("cos messages", "cos_messages", c.cos_messages);
-    counter("cos acks", "cos_acks", c.cos_acks);
-    counter("cos retries", "cos_retries", c.cos_retries);
-    counter("cos errors", "cos_errors", c.cos_errors);
-    counter("heartbeats missed", "heartbeats_missed", c.heartbeats_missed);
+    // The input connection: change of state, cyclic or bit-strobe (the
+    // reason says which); acks and retries are change of state's and cyclic's.
+    counter("input messages", "cos_messages", c.cos_messages);
+    counter("input acks", "cos_acks", c.cos_acks);
+    counter("input retries", "cos_retries", c.cos_retries);
+    counter("input errors", "cos_errors", c.cos_errors);
+    counter("inputs lost (4 x EPR)", "heartbeats_missed", c.heartbeats_missed);
   }
   return r;
 }

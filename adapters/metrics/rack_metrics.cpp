@@ -187,15 +187,17 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
         f.counter("dnbridge_node_reconnects_total", "Returns from online to allocation", labels,
                   static_cast<double>(c.reconnects));
         f.counter("dnbridge_node_cos_messages_total",
-                  "Change-of-state or cyclic messages taken (the device's retries included)",
+                  "Messages of the input connection taken: change of state or cyclic (the "
+                  "device's retries included), or bit-strobe responses",
                   labels, static_cast<double>(c.cos_messages));
         f.counter("dnbridge_node_cos_retries_total",
                   "Change-of-state or cyclic messages the device sent again (an acknowledgment "
                   "it missed)",
                   labels, static_cast<double>(c.cos_retries));
         f.counter("dnbridge_node_heartbeats_missed_total",
-                  "Change-of-state or cyclic connections lost: 4 x EPR without a message", labels,
-                  static_cast<double>(c.heartbeats_missed));
+                  "Input connections (change of state, cyclic, bit-strobe) lost: 4 x EPR "
+                  "without a message",
+                  labels, static_cast<double>(c.heartbeats_missed));
         f.counter("dnbridge_node_explicit_requests_total",
                   "Explicit requests sent to the node (the bridge's own and remote ones)", labels,
                   static_cast<double>(node.explicit_counters.requests));

@@ -703,6 +703,9 @@ TEST_F(EdsSlaveByFrames, TheBitStrobeConnectionAnswersItsMastersCommands) {
   EXPECT_EQ(get(kInstance3, 5), (Reply{0x8E, 0x00, 0x04}));  // 0x400 + (0 << 3)
   EXPECT_EQ(get(kInstance3, 14), (Reply{0x8E, 0x20, 0x04, 0x24, 0x66, 0x30, 0x03}));
   EXPECT_EQ(set(kInstance3, 16, assembly_path(102)), (Reply{0x94, 0x0E, 0xFF}));
+  // Input1 (Assembly 101) is the poll connection's only ([IO_Info] mask 1).
+  EXPECT_EQ(set(kInstance3, 14, assembly_path(101)), (Reply{0x94, 0x09, 0xFF}));
+  EXPECT_EQ(set(kInstance3, 14, assembly_path(102)), (Reply{0x90}));
 
   const auto strobe = [&](unsigned master) {
     return io(devicenet::group2_id(mac(master), devicenet::Group2Message::kMasterBitStrobeCommand),

@@ -110,9 +110,13 @@ TEST_F(StrobeRackTest, TheNodeIsStrobedEveryPeriodAndAnswersWithItsStatus) {
   EXPECT_EQ(rack_->scanner().counters().bit_strobes, counters().cos_messages);
 
   // The manifold's status (Assembly 102: supply ok, coil short circuit, as
-  // its Discrete Input Points have them) changes: the next strobe tells it.
+  // its Discrete Input Points have them) changes: the next strobe tells it,
+  // while its poll responses are lost on the bus.
   ASSERT_TRUE(view().has_inputs);
   EXPECT_EQ(view().inputs, ByteVec{0x00});
+  const auto no_polls = world().bus().faults().add(
+      sim::FaultRule::drop(devicenet::group1_id(Group1Message::kSlavePollResponse, mac(kValves))));
+  const std::uint64_t poll_responses = counters().responses;
   ASSERT_TRUE(device().objects().set_assembly_data(102, Bytes(ByteVec{0x01})));
   const std::uint64_t responses = counters().cos_messages;
   world().run_for(milliseconds(110));
@@ -121,11 +125,15 @@ TEST_F(StrobeRackTest, TheNodeIsStrobedEveryPeriodAndAnswersWithItsStatus) {
   ASSERT_TRUE(device().objects().set_assembly_data(102, Bytes(ByteVec{0x03})));
   world().run_for(milliseconds(110));
   EXPECT_EQ(view().inputs, ByteVec{0x03});
+  EXPECT_EQ(counters().responses, poll_responses);
+  world().bus().faults().remove(no_polls);
+  EXPECT_EQ(node().state(), devicenet::NodeState::kOnline) << node().reason();
 
   // The coils stay on the poll connection.
   ASSERT_TRUE(
       rack_->devices().command(mac(kValves), ByteVec{0x42, 0x01}, "supervisor", now()).ok());
-  world().run_for(milliseconds(50));
+  // (by the next poll slot: the poll outstanding lost its response).
+  world().run_for(milliseconds(150));
   EXPECT_EQ(*device().objects().param_number(4), 0x0142);
 }
 
@@ -142,6 +150,79 @@ TEST_F(StrobeRackTest, OneCommandServesEveryStrobedNodeAtTheShortestPollPeriod) 
   // Both answer each one.
   EXPECT_EQ(counters(kValves).cos_messages - a, strobes_.size());
   EXPECT_EQ(counters(kValves2).cos_messages - b, strobes_.size());
+}
+
+TEST_F(StrobeRackTest, ANodeAddedWithAShorterPeriodIsStrobedAtItsPeriodAtOnce) {
+  // Strobed every 10 s, then a node polled every 20 ms comes in (a reload).
+  auto slow = strobed_manifold(kValves, milliseconds(10000));
+  slow.node.expected_packet_rate = milliseconds(10000);
+  start({slow});
+  ASSERT_TRUE(run_until_online()) << node().reason();
+  world().run_for(milliseconds(300));
+  auto fast = strobed_manifold(kValves2, milliseconds(20));
+  fast.node.expected_packet_rate = milliseconds(80);
+  const auto eds = std::make_shared<const eds::EdsFile>(example_eds(kValveManifoldEds));
+  rack_->add_eds_device(*eds, sim::default_eds_slave_options(mac(kValves2)), now());
+  rack_->port().reconfigure(rack_->scanner().config(), rack::PortNodes{{}, {slow, fast}}, now());
+  ASSERT_TRUE(world().run_until(
+      [&] { return node(kValves2).state() == devicenet::NodeState::kOnline; }, seconds(5)))
+      << node(kValves2).reason();
+  strobes_.clear();
+  world().run_for(milliseconds(1000));
+  // Every 20 ms from then on; never lost (4 x 80 ms without a response).
+  EXPECT_GE(strobes_.size(), 49u);
+  EXPECT_LE(strobes_.size(), 51u);
+  EXPECT_EQ(counters(kValves2).heartbeats_missed, 0u);
+  EXPECT_EQ(counters(kValves2).reconnects, 0u);
+  EXPECT_EQ(node(kValves2).state(), devicenet::NodeState::kOnline);
+}
+
+TEST_F(StrobeRackTest, ANodeThatStillAnswersTheStrobesAfterItsReleaseWasLostIsReleased) {
+  start({strobed_manifold(kValves), strobed_manifold(kValves2)});
+  ASSERT_TRUE(run_until_online()) << node().reason() << " / " << node(kValves2).reason();
+  // Taken out of the scan list; its idle poll and Release are lost. The
+  // strobes for the other node keep its bit-strobe connection alive.
+  const std::uint32_t unconnected =
+      devicenet::group2_id(mac(kValves2), Group2Message::kUnconnectedExplicitRequest);
+  const auto lost = world().bus().faults().add(sim::FaultRule::drop(unconnected));
+  rack_->port().reconfigure(rack_->scanner().config(),
+                            rack::PortNodes{{}, {strobed_manifold(kValves)}}, now());
+  ASSERT_TRUE(world().run_until([&] { return rack_->scanner().nodes_leaving() == 0; }, seconds(5)));
+  world().bus().faults().remove(lost);
+  ASSERT_EQ(device(kValves2).strobe_state(), sim::ConnectionState::kEstablished);
+  // Its next response: the master releases its bit-strobe connection.
+  world().run_for(milliseconds(300));
+  EXPECT_EQ(device(kValves2).strobe_state(), sim::ConnectionState::kNonExistent);
+  const auto answered = device(kValves2).strobe_counters().responses;
+  world().run_for(milliseconds(500));
+  EXPECT_EQ(device(kValves2).strobe_counters().responses, answered);
+  // It is no other master's: a bus scan asks it.
+  EXPECT_TRUE(rack_->scanner().unconfigured_heard(now()).test(kValves2));
+  EXPECT_EQ(node().state(), devicenet::NodeState::kOnline);
+}
+
+TEST_F(StrobeRackTest, ABitStrobeConnectionLeftFromBeforeIsReleasedAtAllocation) {
+  start();
+  ASSERT_TRUE(run_until_online()) << node().reason();
+  // The master loses the bus and checks its MAC again: the device keeps
+  // its connections, which the master allocates afresh.
+  std::vector<std::uint8_t> releases;
+  const std::uint32_t unconnected =
+      devicenet::group2_id(mac(kValves), Group2Message::kUnconnectedExplicitRequest);
+  world().bus().set_tap([&](const sim::WireFrame& w) {
+    if (w.frame.id == unconnected && w.frame.len == 5 && w.frame.data[1] == 0x4C) {
+      releases.push_back(w.frame.data[4]);
+    }
+  });
+  rack_->scanner().recheck_mac("bus-off recovered", now());
+  ASSERT_TRUE(world().run_until(
+      [&] { return rack_->scanner().state() != devicenet::PortState::kRunning; }, seconds(1)));
+  ASSERT_TRUE(run_until_online()) << node().reason();
+  // The explicit connection, which the device still has, released when its
+  // Allocate is refused; then its I/O connections still allocated from
+  // before (poll and bit-strobe), together, before the configuration.
+  EXPECT_EQ(releases, (std::vector<std::uint8_t>{0x01, 0x06}));
+  EXPECT_EQ(device().strobe_state(), sim::ConnectionState::kEstablished);
 }
 
 TEST_F(StrobeRackTest, FourEprsWithoutAResponseLoseTheNodeAndItComesBackWhenHeardAgain) {

@@ -218,8 +218,9 @@ Reply reset_connection(ConnectionSet& set, std::uint16_t instance, Bytes data,
 
 Reply reset_connection_class(ConnectionSet& set, Bytes data, TimePoint now) noexcept {
   if (!data.empty()) return reply_error(GeneralStatus::kTooMuchData);
-  for (const std::uint16_t i : {connection_instance::kExplicit, connection_instance::kPoll,
-                                connection_instance::kChangeOfState}) {
+  for (const std::uint16_t i :
+       {connection_instance::kExplicit, connection_instance::kPoll, connection_instance::kBitStrobe,
+        connection_instance::kChangeOfState}) {
     if (set.exists(i)) (void)set.reset(i, now);
   }
   return kReplyOk;

@@ -304,9 +304,11 @@ PollResult EdsSlave::poll(Bytes command, TimePoint now) noexcept {
 
 std::uint16_t EdsSlave::connection_size(std::uint16_t instance, bool produced) const noexcept {
   if (instance == connection_instance::kExplicit) return kExplicitMessageSize;
-  if (instance == connection_instance::kBitStrobe && !produced) return kStrobeCommandSize;
   const Connection* c = connections_.connection(instance);
   if (c == nullptr) return 0;
+  if (instance == connection_instance::kBitStrobe && !produced) {
+    return c->state == ConnectionState::kNonExistent ? 0 : kStrobeCommandSize;
+  }
   const std::uint16_t assembly = produced ? c->produced_assembly : c->consumed_assembly;
   if (assembly == 0) return 0;
   return static_cast<std::uint16_t>(objects_.assembly_data(assembly).size());
@@ -323,8 +325,31 @@ bool EdsSlave::assembly_allowed(std::uint16_t instance, bool produced,
         instance == connection_instance::kBitStrobe || !is_output_assembly(assembly)) {
       return false;
     }
+  } else if (!input_carried_by(assembly, instance)) {
+    return false;
   }
   return fits_one_frame(objects_.assembly_data(assembly).size());
+}
+
+bool EdsSlave::input_carried_by(std::uint16_t assembly, std::uint16_t instance) const noexcept {
+  // An [IO_Info] input names the connections that may carry it; an
+  // assembly no input names (an output's echo) is not checked.
+  const eds::EdsFile& file = objects_.file();
+  for (const eds::IoData& in : file.io.inputs) {
+    if (io_assembly(file, &in) != assembly || in.carried_by.bits == 0) continue;
+    switch (instance) {
+      case connection_instance::kPoll:
+        return in.carried_by.has(eds::ConnectionKind::kPoll);
+      case connection_instance::kBitStrobe:
+        return in.carried_by.has(eds::ConnectionKind::kStrobe);
+      case connection_instance::kChangeOfState:
+        return in.carried_by.has(eds::ConnectionKind::kChangeOfState) ||
+               in.carried_by.has(eds::ConnectionKind::kCyclic);
+      default:
+        return false;
+    }
+  }
+  return true;
 }
 
 bool EdsSlave::is_output_assembly(std::uint16_t assembly) const noexcept {

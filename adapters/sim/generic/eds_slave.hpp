@@ -19,8 +19,10 @@
 // and output; attributes 7/8 are the sizes they pack to. A consumed path
 // names an assembly [IO_Info] lists as an output (an OutputN), never an
 // input: a poll command must not overwrite the inputs' (read only)
-// parameters. A poll command
-// shorter than the consumed size is the idle condition (bridge/PROTOCOL.md
+// parameters. A produced path (of any I/O connection) that names an
+// [IO_Info] input must name one whose mask lets that connection carry it
+// (0x09 otherwise), as a device that produces each input only where its EDS
+// says. A poll command shorter than the consumed size is the idle condition (bridge/PROTOCOL.md
 // §7): the idle action; Release of an established poll connection is idle
 // too; its watchdog expiring, or a duplicate MAC, the fault action. At
 // power-up the outputs are zero. The actions are EdsSlaveOptions', unless
@@ -197,6 +199,10 @@ class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoA
   void apply_output_action(bool fault, std::uint16_t outputs) noexcept;
   // An assembly [IO_Info] lists as an output.
   bool is_output_assembly(std::uint16_t assembly) const noexcept;
+  // Whether the connection `instance` may produce `assembly`: as the mask of
+  // the [IO_Info] input that names it says (any, for an assembly no input
+  // names).
+  bool input_carried_by(std::uint16_t assembly, std::uint16_t instance) const noexcept;
   // The convention's parameters, when the EDS has all four (ParamN's N).
   struct SafeStateParams {
     unsigned fault_action = 0, fault_value = 0, idle_action = 0, idle_value = 0;

@@ -135,7 +135,7 @@ class Node final : private ExplicitClient::Listener {
     kAllocateExplicit,  // DeviceNet.Allocate(explicit)
     kReleaseStale,      // DeviceNet.Release(explicit) after "already allocated"
     kAllocationInfo,    // what the device has allocated besides
-    kReleaseStalePoll,  // DeviceNet.Release(poll, change of state) left from before
+    kReleaseStalePoll,  // DeviceNet.Release(its I/O connections) left from before
     kVendor,
     kProductType,
     kProductCode,

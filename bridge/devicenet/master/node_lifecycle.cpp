@@ -539,7 +539,9 @@ Node::Step Node::after_allocate_explicit(const ExplicitResult& r, TimePoint now)
 Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint) {
   // I/O connections left from before (this master's, restarted) are
   // released: they are made afresh once the configuration is in place.
-  constexpr std::uint8_t kIo = allocation::kPoll | allocation::kChangeOfState | allocation::kCyclic;
+  constexpr std::uint8_t kIo = allocation::kPoll | allocation::kBitStrobe |
+                               allocation::kMulticastPoll | allocation::kChangeOfState |
+                               allocation::kCyclic;
   if (r.ok() && !r.data.empty() && (r.data[0] & kIo) != 0) {
     stale_choice_ = static_cast<std::uint8_t>(r.data[0] & kIo);
     log_.info("I/O connections are still allocated from before (0x{:02X}): releasing them",

@@ -103,6 +103,7 @@ Scanner::Scanner(ScannerConfig config, can::FrameSink& sink, ScannerObserver& ob
       mac_check_(config_.master_mac, mac_check_config(config_)) {
   check(config_);
   unconfigured_last_heard_.fill(kNever);
+  stray_strobe_release_.fill(kNever);
   nodes_.reserve(config_.nodes.size());
   for (const auto& n : config_.nodes) make_node(n);
 }
@@ -192,6 +193,7 @@ Status Scanner::remove_node(MacId mac, TimePoint now) {
   node->retire("taking it out of the scan list", now);
   leaving_.push_back(std::move(node));
   reap(now);
+  schedule_strobes(now);
   return {};
 }
 
@@ -246,6 +248,7 @@ void Scanner::set_state(PortState next, std::string reason, TimePoint now) {
 void Scanner::start(TimePoint now) {
   if (state_ != PortState::kStopped) return;
   unconfigured_last_heard_.fill(kNever);
+  stray_strobe_release_.fill(kNever);
   answering_other_master_.reset();
   set_state(PortState::kCheckingMac,
             fmt::format("checking that no other node has MAC {}", config_.master_mac.value()), now);
@@ -388,20 +391,22 @@ void Scanner::dispatch(const can::CanFrame& frame, TimePoint rx_time) {
     struct IoMessage {
       Group1Message message;
       void (Node::*take)(Bytes, TimePoint);
-      const char* heard_as;
+      const char* heard_as;  // null: see stray_strobe_response()
     };
     static constexpr IoMessage kIoMessages[] = {
         {Group1Message::kSlavePollResponse, &Node::on_poll_response,
          "answering another master's poll"},
         {Group1Message::kSlaveCosCyclic, &Node::on_cos_message,
          "producing for another master (change of state)"},
-        {Group1Message::kSlaveBitStrobeResponse, &Node::on_strobe_response,
-         "answering another master's bit-strobe"},
+        {Group1Message::kSlaveBitStrobeResponse, &Node::on_strobe_response, nullptr},
     };
     for (const IoMessage& m : kIoMessages) {
       if (id->message_id != static_cast<std::uint8_t>(m.message)) continue;
       if (Node* n = route(id->mac)) {
         (n->*m.take)(payload, rx_time);
+      } else if (m.heard_as == nullptr) {
+        ++counters_.unknown_nodes;
+        stray_strobe_response(id->mac, rx_time);
       } else {
         ++counters_.unknown_nodes;
         answering_other_master_.set(id->mac.value());
@@ -519,7 +524,11 @@ void Scanner::strobe(TimePoint now) {
     next_strobe_ = kNever;
     return;
   }
-  next_strobe_ = now + period;
+  // Slots one period apart, as polls are: a late wake-up does not delay the
+  // next one (a wake-up a period or more late starts them again from now).
+  strobe_slot_ = next_strobe_;
+  next_strobe_ = strobe_slot_ + period;
+  if (next_strobe_ <= now) next_strobe_ = now + period;
   // One command for every strobed node, each one's bit 0 (no strobe
   // outputs); none while no node has its bit-strobe connection.
   if (std::none_of(nodes_.begin(), nodes_.end(), [](const auto& n) { return n->strobed(); })) {
@@ -533,7 +542,31 @@ void Scanner::strobe(TimePoint now) {
 }
 
 void Scanner::schedule_strobes(TimePoint now) {
-  if (next_strobe_ == kNever && strobe_period() > Duration::zero()) next_strobe_ = now;
+  const Duration period = strobe_period();
+  if (period == Duration::zero()) {
+    next_strobe_ = kNever;
+  } else {
+    // One period (the scan list's, now) after the last slot, at once if none.
+    next_strobe_ = strobe_slot_ == kNever ? now : strobe_slot_ + period;
+  }
+}
+
+void Scanner::stray_strobe_response(MacId mac, TimePoint at) {
+  // A node the scan list does not have answers this port's bit-strobe
+  // commands (a Group 1 message 14 names no master, but a slave answers only
+  // its owner's): a bit-strobe connection this master left allocated (its
+  // Release lost, or the node taken out of the configuration while the
+  // master was away), kept alive by the strobes of the others. Released,
+  // at most once per kStrayStrobeReleaseInterval while it goes on.
+  heard_unconfigured(mac, "answering this port's bit-strobe commands", at);
+  TimePoint& sent = stray_strobe_release_[mac.value()];
+  if (sent != kNever && at - sent < kStrayStrobeReleaseInterval) return;
+  sent = at;
+  if (auto frame = make_release_frame(mac, config_.master_mac, allocation::kBitStrobe)) {
+    log_.info("MAC {} answers this port's bit-strobe commands: its bit-strobe connection released",
+              mac.value());
+    sink_.send(*frame, at);
+  }
 }
 
 Status Scanner::scan_bus(TimePoint now) {

@@ -140,12 +140,15 @@ class Scanner {
   // The port's bit-strobe command (Group 2 message 0, 8 bytes, one bit per
   // MAC): every strobe_period() while a node has its bit-strobe connection
   // (Node::strobed()); the period is the shortest poll period of the scan
-  // list's bit-strobe nodes (zero: none). schedule_strobes() starts the
-  // timer when the scan list has one.
+  // list's bit-strobe nodes (zero: none). schedule_strobes() sets the next
+  // slot when the port starts scanning and when the scan list changes.
   static constexpr std::uint8_t kBitStrobeCommandSize = 8;
   Duration strobe_period() const;
   void strobe(TimePoint now);
   void schedule_strobes(TimePoint now);
+  // A bit-strobe response from a MAC the scan list does not have.
+  static constexpr Duration kStrayStrobeReleaseInterval = seconds(10);
+  void stray_strobe_response(MacId mac, TimePoint at);
   // Ends the bus scan under way, if any, and reports it; `why` (not empty)
   // when it ends early.
   void end_bus_scan(std::string_view why, TimePoint now);
@@ -170,6 +173,8 @@ class Scanner {
   TimePoint probe_started_{};
   RateLimitedLog foreign_log_limit_;
   TimePoint next_strobe_ = kNever;
+  TimePoint strobe_slot_ = kNever;                               // the last slot served
+  std::array<TimePoint, MacId::kMax + 1> stray_strobe_release_;  // kNever: none sent
 };
 
 }  // namespace dnbridge::devicenet

@@ -194,6 +194,15 @@ Result<IoEntries> io_entries(const EdsFile& file, ConnectionKind connection, std
     auto poll = offered(ConnectionKind::kPoll);
     if (!poll) return poll.error();
     out = *poll;
+    // The poll connection answers with the same input (one input per node).
+    if (e.input && e.input->carried_by.bits != 0 &&
+        !e.input->carried_by.has(ConnectionKind::kPoll)) {
+      return explain(why, Errc::kUnsupported,
+                     fmt::format("Input{} (\"{}\") is carried by {} only (EDS line {}): a "
+                                 "node on {} is polled for the same input beside it",
+                                 e.input->number, e.input->name, to_string(e.input->carried_by),
+                                 e.input->line, to_string(connection)));
+    }
   }
   e.output = out->output != 0 ? file.io.output(out->output) : nullptr;
   return e;

@@ -213,6 +213,17 @@ TEST(EdsNodeProfile, ABitStrobeThatConsumesAnOutputOrAnswersInMoreThanOneFrameIs
   ASSERT_TRUE(large.file.has_value());
   EXPECT_EQ(profile_of(*large.file, n, &why).error(), make_error_code(Errc::kUnsupported));
   EXPECT_EQ(why, "the EDS's bit-strobe input is 9 bytes: a bit-strobe response carries at most 8");
+  // An input the poll connection may not carry: the node is polled for the
+  // same input beside its bit-strobe connection.
+  auto strobe_only = parse(device +
+                           "[IO_Info]\nPollInfo = 1, 1, 0;\nStrobeInfo = 2, 2, 0;\n"
+                           "Input1 = 1, 0, 1, \"in\", 6, \"20 04 24 64 30 03\", \"\";\n"
+                           "Input2 = 1, 0, 2, \"status\", 6, \"20 04 24 65 30 03\", \"\";\n");
+  ASSERT_TRUE(strobe_only.file.has_value());
+  EXPECT_EQ(profile_of(*strobe_only.file, n, &why).error(), make_error_code(Errc::kUnsupported));
+  EXPECT_EQ(why,
+            "Input2 (\"status\") is carried by bit-strobe only (EDS line 7): a node on "
+            "bit-strobe is polled for the same input beside it");
 }
 
 TEST(EdsNodeProfile, ChangeOfStateNeedsThePollConnectionBesideItForTheOutputs) {
