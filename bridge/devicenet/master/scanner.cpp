@@ -539,6 +539,7 @@ void Scanner::strobe(TimePoint now) {
   frame.len = kBitStrobeCommandSize;
   sink_.send(frame, now);
   ++counters_.bit_strobes;
+  last_strobe_sent_ = now;
 }
 
 void Scanner::schedule_strobes(TimePoint now) {
@@ -552,12 +553,21 @@ void Scanner::schedule_strobes(TimePoint now) {
 }
 
 void Scanner::stray_strobe_response(MacId mac, TimePoint at) {
-  // A node the scan list does not have answers this port's bit-strobe
-  // commands (a Group 1 message 14 names no master, but a slave answers only
-  // its owner's): a bit-strobe connection this master left allocated (its
-  // Release lost, or the node taken out of the configuration while the
-  // master was away), kept alive by the strobes of the others. Released,
-  // at most once per kStrayStrobeReleaseInterval while it goes on.
+  // A Group 1 message 14 names no master, and a slave answers only its
+  // owner's strobes. While this port strobes (its last command within a
+  // period), a node the scan list does not have that answers is taken for a
+  // bit-strobe connection this master left allocated (its Release lost, or
+  // the node taken out of the configuration while the master was away),
+  // kept alive by the strobes of the others: released, at most once per
+  // kStrayStrobeReleaseInterval while it goes on (a device another master
+  // owns refuses that Release). Otherwise it answers another master.
+  const Duration period = strobe_period();
+  if (last_strobe_sent_ == kNever || period == Duration::zero() ||
+      at - last_strobe_sent_ > period) {
+    answering_other_master_.set(mac.value());
+    heard_unconfigured(mac, "answering another master's bit-strobe", at);
+    return;
+  }
   heard_unconfigured(mac, "answering this port's bit-strobe commands", at);
   TimePoint& sent = stray_strobe_release_[mac.value()];
   if (sent != kNever && at - sent < kStrayStrobeReleaseInterval) return;

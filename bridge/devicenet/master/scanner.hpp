@@ -174,6 +174,7 @@ class Scanner {
   RateLimitedLog foreign_log_limit_;
   TimePoint next_strobe_ = kNever;
   TimePoint strobe_slot_ = kNever;                               // the last slot served
+  TimePoint last_strobe_sent_ = kNever;                          // the last command sent
   std::array<TimePoint, MacId::kMax + 1> stray_strobe_release_;  // kNever: none sent
 };
 

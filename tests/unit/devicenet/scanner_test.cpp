@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
@@ -41,6 +42,17 @@ ScannerConfig three_nodes() {
   return c;
 }
 
+// Starts `scanner` at `now` and runs the duplicate MAC check of the
+// master's MAC (two windows, nobody answers); the time it ends.
+TimePoint start_scanning(Scanner& scanner, TimePoint now) {
+  scanner.start(now);
+  for (int i = 0; i < 2; ++i) {
+    now = scanner.next_deadline();
+    scanner.on_timer(now);
+  }
+  return now;
+}
+
 // Regression (found by the scanner fuzz target): when scanning began, each
 // node reported "waiting for the first Allocate" stamped with its staggered
 // first attempt (now + 2 ms * index), a time still to come, so the events the
@@ -49,13 +61,7 @@ TEST(Scanner, NodeStartIsReportedWhenItHappensNotAtTheStaggeredFirstAttempt) {
   DiscardSink sink;
   StateTimes observer;
   Scanner scanner(three_nodes(), sink, observer, Logger());
-  TimePoint now = TimePoint{} + seconds(100);
-  scanner.start(now);
-  // The duplicate MAC check of the master's MAC: two windows, nobody answers.
-  for (int i = 0; i < 2; ++i) {
-    now = scanner.next_deadline();
-    scanner.on_timer(now);
-  }
+  const TimePoint now = start_scanning(scanner, TimePoint{} + seconds(100));
   ASSERT_EQ(scanner.state(), PortState::kRunning);
   ASSERT_EQ(observer.events.size(), 3u);
   for (const auto& e : observer.events) {
@@ -167,6 +173,33 @@ TEST(Scanner, NodesHeardAtUnconfiguredMacsAreListedUntilNotHeardForTenMinutes) {
   scanner.on_frame(powering_up(17), later);
   EXPECT_EQ(observer.macs, (std::vector<unsigned>{17, 40, 17}));
   EXPECT_EQ(scanner.unconfigured_heard(later).count(), 2u);
+}
+
+// A bit-strobe response (Group 1 message 14) from a MAC the scan list does
+// not have, while this port strobes nobody, answers another master: no
+// Release is sent to it, and a bus scan does not ask it.
+TEST(Scanner, ABitStrobeResponseWhileThePortStrobesNobodyIsAnotherMastersNode) {
+  class Recording final : public can::FrameSink {
+   public:
+    void send(const can::CanFrame& frame, TimePoint) override { ids.push_back(frame.id); }
+    std::vector<std::uint32_t> ids;
+  } sink;
+  StateTimes observer;
+  Scanner scanner(three_nodes(), sink, observer, Logger());
+  TimePoint now = start_scanning(scanner, TimePoint{} + seconds(100));
+  ASSERT_EQ(scanner.state(), PortState::kRunning);
+  scanner.on_frame(can::CanFrame::make(0x380 | 40, Bytes{}).value(), now);
+  EXPECT_TRUE(scanner.unconfigured_heard(now).test(40));
+  ASSERT_TRUE(scanner.scan_bus(now).ok());
+  for (int i = 0; i < 100000 && scanner.scanning_bus(); ++i) {
+    now = scanner.next_deadline();
+    scanner.on_timer(now);
+  }
+  ASSERT_FALSE(scanner.scanning_bus());
+  const std::uint32_t to_40 = 0x406 | (40 << 3);  // Group 2 message 6 to MAC 40
+  const std::uint32_t to_41 = 0x406 | (41 << 3);
+  EXPECT_EQ(std::count(sink.ids.begin(), sink.ids.end(), to_40), 0);
+  EXPECT_GT(std::count(sink.ids.begin(), sink.ids.end(), to_41), 0);  // others are asked
 }
 
 }  // namespace
