@@ -14,10 +14,14 @@
 //       with the bridge's QoS, in the pattern of (1)'s poll responses, taken
 //       by the subscriber process as in (1); the bridge's own addition to (1)
 //       is measured against it.
+//   (0d) one thread of this process waking another on the same CPU, nothing
+//       else running: the one hand-over each of (1) and (2) makes.
 //   (1) poll response received by the master -> PumpState taken by a
 //       subscriber in another process: wall clock at take - source timestamp
 //       (the bridge stamps each sample with the CAN receive time of the poll
-//       response it comes from).
+//       response it comes from). Split sample by sample (matched by node and
+//       analog value): the response's way to the port's thread (the CAN
+//       controller waking it), and from there to the take.
 //   (2) PumpCommand written in another process -> the poll frame carrying the
 //       new outputs, written by the master to its CAN interface, and its start
 //       of frame on the simulated bus (after any frame already on the wire
@@ -26,6 +30,8 @@
 //       poll schedule at every phase. (1) and (2) are measured with polls
 //       every 10 ms and every 100 ms (the shipped default). Commands that
 //       meet a poll in flight: from its response to the new poll written.
+//       The others split: until the port's thread woke for the command, and
+//       from there to the frame written.
 //   (3) CPU time of the bridge per second of wall time, 4 ports x 63 nodes
 //       polled every 10 ms, the simulated devices' threads left out; (3b)
 //       the same with a PumpState per poll; (3c) Cyclone alone writing (3b)'s
@@ -56,6 +62,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -215,7 +222,14 @@ int run_client(const ClientOptions& o) {
   std::atomic<std::size_t> ready_count{0};
   std::atomic<bool> measuring{false};
   std::atomic<std::uint64_t> taken{0};
-  std::vector<std::int64_t> latencies;  // reader thread until joined
+  // Each new poll response's sample: its latency, key and analog input
+  // (with which the benchmark finds the response it came from).
+  struct StateLatency {
+    std::int64_t ns;
+    std::size_t key;
+    int analog;
+  };
+  std::vector<StateLatency> latencies;  // reader thread until joined
   latencies.reserve(200000);
 
   std::thread taker([&] {
@@ -252,7 +266,7 @@ int run_client(const ClientOptions& o) {
         taken.fetch_add(1, std::memory_order_relaxed);
         // A new analog value: the sample of a new poll response.
         if (state_latency && is_ready && fresh) {
-          latencies.push_back((now - s.info().source_timestamp()).count());
+          latencies.push_back({(now - s.info().source_timestamp()).count(), *key, analog});
         }
       }
     }
@@ -339,9 +353,9 @@ int run_client(const ClientOptions& o) {
   // "taken" first: the benchmark ends a CPU window on it, before it reads
   // the rest.
   std::string out;
-  out.reserve(latencies.size() * 12 + written.size() * 32 + 256);
+  out.reserve(latencies.size() * 24 + written.size() * 32 + 256);
   out += fmt::format("taken {} {}\n", taken.load(), elapsed);
-  for (auto l : latencies) out += fmt::format("state {}\n", l);
+  for (const auto& l : latencies) out += fmt::format("state {} {} {}\n", l.ns, l.key, l.analog);
   if (commanding) {
     for (const auto& w : written) out += fmt::format("cmd {} {} {}\n", w.mac, w.value, w.at);
   }
@@ -360,7 +374,9 @@ struct PortWire {
   std::uint32_t bitrate = 0;
   bool ramp = false;            // a new analog input value before every poll
   bool record_outputs = false;  // the first poll frame of each new output value
+  std::size_t index = 0;        // the port's place in the setup (the subscriber's keys)
   profiles::cdn127::PollRequestLayout request_layout;
+  profiles::cdn127::PollResponseLayout response_layout;
   std::array<std::uint16_t, 64> ramp_value{};
   std::array<int, 64> last_output{};
   std::atomic<std::uint64_t> polls{0};
@@ -381,10 +397,23 @@ struct PortWire {
     // poll at a time).
     bool after_response;
     std::int64_t response_rx;  // then: that response's receive time, steady clock
+    // When the port's thread last woke (came back from waiting) before it
+    // wrote the frame, steady clock.
+    std::int64_t woke;
+  };
+  // A poll response (of a new analog input value) and when the port's
+  // thread had it: its receive time to that is the wake-up of the thread
+  // by the CAN controller (here, the simulated bus's thread).
+  struct HandedResponse {
+    std::size_t key;  // port index * 64 + MAC, as the subscriber's
+    unsigned value;   // its analog input
+    std::int64_t rx;
+    std::int64_t handed;
   };
   std::mutex mutex;
   std::vector<OutputFrame> output_frames;
   std::vector<WrittenFrame> written_frames;
+  std::vector<HandedResponse> handed_responses;
   std::array<int, 64> last_written{};
 
   // The MAC and analog output of a poll request carrying outputs.
@@ -412,7 +441,7 @@ struct PortWire {
     std::lock_guard lock(mutex);
     const bool after_response = static_cast<int>(out->first) == answering_mac;
     written_frames.push_back(
-        {out->first, out->second, at, after_response, after_response ? answering_rx : 0});
+        {out->first, out->second, at, after_response, after_response ? answering_rx : 0, woke});
   }
 
   // On the port's thread: the MAC whose poll response the master is being
@@ -429,6 +458,22 @@ struct PortWire {
     answering_rx = rx_time.time_since_epoch().count();
   }
   void on_received() { answering_mac = -1; }
+
+  // On the port's thread: when it came back from waiting, the first time
+  // it ran after (a frame handed to it, or the wait's return).
+  std::int64_t woke = 0;
+  void on_waiting() { woke = 0; }
+  void on_running() {
+    if (woke == 0) woke = steady_ns();
+  }
+  void on_response(const can::CanFrame& frame, std::int64_t rx) {
+    const auto handed = steady_ns();
+    const auto inputs = profiles::cdn127::decode_poll_response(response_layout, 0, frame.payload());
+    if (!inputs || !inputs->analog_inputs_raw[0]) return;
+    std::lock_guard lock(mutex);
+    handed_responses.push_back({index * 64 + static_cast<unsigned>(answering_mac),
+                                *inputs->analog_inputs_raw[0], rx, handed});
+  }
 
   void on_wire(const sim::WireFrame& wf) {
     const auto id = devicenet::decode_identifier(wf.frame.id);
@@ -473,8 +518,10 @@ class WrittenFramesBackend final : public port::CanBackend {
   can::FrameSink& sink() override { return sink_; }
   TimePoint now() const override { return inner_->now(); }
   void wait(TimePoint deadline, port::FrameReceiver& receiver) override {
+    wire_.on_waiting();
     Receiver noting{receiver, wire_};
     inner_->wait(deadline, noting);
+    wire_.on_running();
   }
   void wake() override { inner_->wake(); }
   port::BusCounters counters() const override { return inner_->counters(); }
@@ -498,7 +545,9 @@ class WrittenFramesBackend final : public port::CanBackend {
    public:
     Receiver(port::FrameReceiver& inner, PortWire& wire) : inner_(inner), wire_(wire) {}
     void on_frame(const can::CanFrame& frame, TimePoint rx_time) override {
+      wire_.on_running();
       wire_.on_receiving(frame, rx_time);
+      if (wire_.answering_mac >= 0) wire_.on_response(frame, rx_time.time_since_epoch().count());
       inner_.on_frame(frame, rx_time);
       wire_.on_received();
     }
@@ -547,13 +596,12 @@ class Bridge {
       }
       c.ports.push_back(std::move(p));
     }
-    const auto layout =
+    const auto format =
         profiles::cdn127::poll_format(
             profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127))
-            .value()
-            .request;
+            .value();
     auto factory = [this, &s, &log,
-                    layout](const daemon::PortConfig& p) -> std::unique_ptr<port::CanBackend> {
+                    format](const daemon::PortConfig& p) -> std::unique_ptr<port::CanBackend> {
       std::vector<MacId> macs;
       for (const auto& n : p.nodes) macs.push_back(n.pump.node.mac);
       auto backend = std::make_unique<sim::ThreadedSimBackend>(p.bitrate, macs, &log);
@@ -562,9 +610,13 @@ class Bridge {
       wire->bitrate = p.bitrate;
       wire->ramp = s.ramp;
       wire->record_outputs = s.record_outputs;
-      wire->request_layout = layout;
+      wire->index = static_cast<std::size_t>(std::find(s.ports.begin(), s.ports.end(), p.name) -
+                                             s.ports.begin());
+      wire->request_layout = format.request;
+      wire->response_layout = format.response;
       wire->last_output.fill(-1);
       wire->last_written.fill(-1);
+      wire->handed_responses.reserve(1 << 18);
       PortWire* w = wire.get();
       auto* b = backend.get();
       backend->post(
@@ -628,6 +680,9 @@ class Bridge {
   std::vector<PortWire::WrittenFrame> written_frames() {
     return gather(&PortWire::written_frames);
   }
+  std::vector<PortWire::HandedResponse> handed_responses() {
+    return gather(&PortWire::handed_responses);
+  }
 
  private:
   // One record of every port's wire, in port order.
@@ -686,6 +741,13 @@ std::vector<std::string> client_args(const std::string& mode, int domain,
 // calls `on_ready`, its "taken" line (end of its window) `on_end`.
 struct ClientOutput {
   std::vector<double> state_us;
+  // The same, with the sample's key and analog input.
+  struct State {
+    double us;
+    std::size_t key;
+    unsigned value;
+  };
+  std::vector<State> states;
   struct Cmd {
     unsigned mac, value;
     std::int64_t at;
@@ -705,7 +767,14 @@ ClientOutput read_client(Child child, double seconds, OnReady on_ready, OnEnd on
     if (*line == "ready") {
       on_ready();
     } else if (line->rfind("state ", 0) == 0) {
-      out.state_us.push_back(std::stod(line->substr(6)) / 1e3);
+      long long ns = 0;
+      std::size_t key = 0;
+      int value = -1;
+      if (std::sscanf(line->c_str(), "state %lld %zu %d", &ns, &key, &value) == 3) {
+        out.state_us.push_back(static_cast<double>(ns) / 1e3);
+        if (value >= 0)
+          out.states.push_back({out.state_us.back(), key, static_cast<unsigned>(value)});
+      }
     } else if (line->rfind("cmd ", 0) == 0) {
       ClientOutput::Cmd c{};
       long long at = 0;
@@ -935,6 +1004,51 @@ DirectStateResult direct_state(int domain, Placement cpus, double window_seconds
   return r;
 }
 
+// (0d): one thread waking another of the same process, on the CPU it runs
+// on, with nothing else to do: the one hand-over each of the bridge's paths
+// makes (a received frame to the port's thread, a command from Cyclone's
+// thread to it), as the simulated bus makes it: a time stamped, a queue
+// under a mutex, a condition variable. One every 250 us, `seconds` long.
+std::vector<double> thread_handover(double seconds) {
+  std::mutex mutex;
+  std::condition_variable woken;
+  std::vector<std::int64_t> queue;
+  bool stop = false;
+  std::vector<double> latencies;
+  latencies.reserve(static_cast<std::size_t>(seconds * 4000) + 16);
+  std::thread waiter([&] {
+    std::vector<std::int64_t> taken;
+    std::unique_lock lock(mutex);
+    for (;;) {
+      woken.wait(lock, [&] { return stop || !queue.empty(); });
+      if (stop) return;
+      taken.swap(queue);
+      lock.unlock();
+      const auto now = steady_ns();
+      for (auto at : taken) latencies.push_back(static_cast<double>(now - at) / 1e3);
+      taken.clear();
+      lock.lock();
+    }
+  });
+  const auto start = monotonic_ns();
+  const auto end = start + static_cast<std::int64_t>(seconds * 1e9);
+  for (auto next = start; next < end; next += 250'000) {
+    sleep_until_monotonic(next);
+    {
+      std::lock_guard lock(mutex);
+      queue.push_back(steady_ns());
+    }
+    woken.notify_one();
+  }
+  {
+    std::lock_guard lock(mutex);
+    stop = true;
+  }
+  woken.notify_one();
+  waiter.join();
+  return latencies;
+}
+
 int run_bench(const Options& o) {
   const int domain = o.domain >= 0 ? o.domain : 200 + static_cast<int>(getpid() % 30);
   const std::string tag = fmt::format("dnbridge-bench-{}", getpid());
@@ -997,6 +1111,16 @@ int run_bench(const Options& o) {
         us(cyc.half_rtt_max), window_p99_lo, window_p99_hi);
     return Reference{cyc.half_rtt_p50, cyc.half_rtt_p99};
   };
+
+  if (o.latency_seconds > 0 && o.direct_seconds > 0) {
+    const Summary h = summarize(thread_handover(std::min(o.direct_seconds, 5.0)));
+    fmt::print(
+        "(0d) a thread woken by another of this process on the same CPU, nothing else running\n"
+        "     (a condition variable, one every 250 us): the hand-over each of the bridge's paths\n"
+        "     makes once\n"
+        "     samples {}  p50 {}  p99 {}  max {}\n\n",
+        h.count, us(h.p50), us(h.p99), us(h.max));
+  }
 
   // (0b), the listener's: what the bridge's command path adds is measured
   // against it.
@@ -1098,8 +1222,36 @@ int run_bench(const Options& o) {
     if (direct_state_summary) {
       const double added = state.p99 - direct_state_summary->p99;
       fmt::print(
-          "    the bridge's own addition: p99 {} - (0c)'s p99 {} = {}   target <= 10 us: {}\n",
-          us(state.p99), us(direct_state_summary->p99), us(added), verdict(added <= 10.0));
+          "    the bridge's own addition: p99 {} - (0c)'s p99 {} = {}   target <= 10 us: {}\n"
+          "                               p50 {} - (0c)'s p50 {} = {}\n",
+          us(state.p99), us(direct_state_summary->p99), us(added), verdict(added <= 10.0),
+          us(state.p50), us(direct_state_summary->p50), us(state.p50 - direct_state_summary->p50));
+    }
+    // (1) in two, sample by sample: the response's way to the port's thread
+    // (the CAN controller waking it: here the simulated bus's thread, for a
+    // SocketCAN socket the kernel), and from there to the take (the bridge's
+    // own work, then Cyclone's, as in (0c), whose writer is already after_wake).
+    std::map<std::pair<std::size_t, unsigned>, std::int64_t> wake_ns;
+    for (const auto& h : bridge.handed_responses()) wake_ns[{h.key, h.value}] = h.handed - h.rx;
+    std::vector<double> wake_us, after_wake_us;
+    for (const auto& st : out.states) {
+      const auto it = wake_ns.find({st.key, st.value});
+      if (it == wake_ns.end()) continue;
+      wake_us.push_back(static_cast<double>(it->second) / 1e3);
+      after_wake_us.push_back(st.us - wake_us.back());
+    }
+    const Summary wake = summarize(wake_us);
+    const Summary after_wake = summarize(after_wake_us);
+    fmt::print(
+        "    in two ({} samples matched to their responses):\n"
+        "      the response handed to the port's thread (its wake-up):  p50 {}  p99 {}  max {}\n"
+        "      the port's thread having it -> PumpState taken:          p50 {}  p99 {}  max {}\n",
+        after_wake.count, us(wake.p50), us(wake.p99), us(wake.max), us(after_wake.p50),
+        us(after_wake.p99), us(after_wake.max));
+    if (direct_state_summary) {
+      fmt::print("    the bridge's own addition after the wake-up, against (0c): p50 {}  p99 {}\n",
+                 us(after_wake.p50 - direct_state_summary->p50),
+                 us(after_wake.p99 - direct_state_summary->p99));
     }
 
     std::map<std::pair<unsigned, unsigned>, PortWire::OutputFrame> frames;
@@ -1111,6 +1263,8 @@ int run_bench(const Options& o) {
     // Commands that met a poll in flight: from that poll's response received
     // to the next poll frame written, and that frame's time on the wire.
     std::vector<double> after_response_us;
+    std::vector<double> to_woken, woken_to_write;
+    std::size_t found_running = 0;
     double frame_us = 0;
     std::size_t waited = 0;
     for (const auto& c : out.commands) {
@@ -1126,6 +1280,14 @@ int run_bench(const Options& o) {
                                     1e3);
       } else {
         to_write_free.push_back(write_us);
+        // In two: until the port's thread woke for it, and its own work
+        // from there (unless the thread was running when it was written).
+        if (wr->second.woke >= c.at) {
+          to_woken.push_back(static_cast<double>(wr->second.woke - c.at) / 1e3);
+          woken_to_write.push_back(static_cast<double>(wr->second.at - wr->second.woke) / 1e3);
+        } else {
+          ++found_running;
+        }
       }
       to_start.push_back(static_cast<double>(it->second.start - c.at) / 1e3);
       to_end.push_back(static_cast<double>(it->second.end - c.at) / 1e3);
@@ -1179,6 +1341,26 @@ int run_bench(const Options& o) {
           "    the bridge's own addition, no poll in flight: p99 {} - (0b) listener's p99 {} = {}"
           "   target <= 10 us: {}\n",
           us(cmd_write_free.p99), us(direct_listener->p99), us(added), verdict(added <= 10.0));
+      fmt::print(
+          "                                                 p50 {} - (0b) listener's p50 {} = {}\n",
+          us(cmd_write_free.p50), us(direct_listener->p50),
+          us(cmd_write_free.p50 - direct_listener->p50));
+    }
+    {
+      const Summary woken = summarize(to_woken);
+      const Summary work = summarize(woken_to_write);
+      fmt::print(
+          "    no poll in flight, in two ({} commands; {} more found the port's thread running):\n"
+          "      command written -> the port's thread woken for it:  p50 {}  p99 {}  max {}\n"
+          "      the port's thread woken -> the frame written:       p50 {}  p99 {}  max {}\n",
+          woken.count, found_running, us(woken.p50), us(woken.p99), us(woken.max), us(work.p50),
+          us(work.p99), us(work.max));
+      if (direct_listener) {
+        fmt::print(
+            "      the first against (0b) listener (Cyclone's delivery): p50 {}  p99 {} (the "
+            "hand-over\n      from the listener to the port's thread)\n",
+            us(woken.p50 - direct_listener->p50), us(woken.p99 - direct_listener->p99));
+      }
     }
     fmt::print(
         "    ratio to Cyclone one-way, start of frame:   p50 {:.2f}  p99 {:.2f}   target p99 "
