@@ -1230,23 +1230,29 @@ int run_bench(const Options& o) {
     // (1) in two, sample by sample: the response's way to the port's thread
     // (the CAN controller waking it: here the simulated bus's thread, for a
     // SocketCAN socket the kernel), and from there to the take (the bridge's
-    // own work, then Cyclone's, as in (0c), whose writer is already after_wake).
+    // own work, then Cyclone's, as in (0c), whose writer is awake when it stamps).
+    // (A value a node's input took twice, its ramp having wrapped, matches
+    // no sample.)
+    constexpr std::int64_t kTwice = -1;
     std::map<std::pair<std::size_t, unsigned>, std::int64_t> wake_ns;
-    for (const auto& h : bridge.handed_responses()) wake_ns[{h.key, h.value}] = h.handed - h.rx;
+    for (const auto& h : bridge.handed_responses()) {
+      const auto [it, added] = wake_ns.try_emplace({h.key, h.value}, h.handed - h.rx);
+      if (!added) it->second = kTwice;
+    }
     std::vector<double> wake_us, after_wake_us;
     for (const auto& st : out.states) {
       const auto it = wake_ns.find({st.key, st.value});
-      if (it == wake_ns.end()) continue;
+      if (it == wake_ns.end() || it->second == kTwice) continue;
       wake_us.push_back(static_cast<double>(it->second) / 1e3);
       after_wake_us.push_back(st.us - wake_us.back());
     }
     const Summary wake = summarize(wake_us);
     const Summary after_wake = summarize(after_wake_us);
     fmt::print(
-        "    in two ({} samples matched to their responses):\n"
+        "    in two ({} of the {} samples matched to their responses):\n"
         "      the response handed to the port's thread (its wake-up):  p50 {}  p99 {}  max {}\n"
         "      the port's thread having it -> PumpState taken:          p50 {}  p99 {}  max {}\n",
-        after_wake.count, us(wake.p50), us(wake.p99), us(wake.max), us(after_wake.p50),
+        after_wake.count, state.count, us(wake.p50), us(wake.p99), us(wake.max), us(after_wake.p50),
         us(after_wake.p99), us(after_wake.max));
     if (direct_state_summary) {
       fmt::print("    the bridge's own addition after the wake-up, against (0c): p50 {}  p99 {}\n",
