@@ -1115,11 +1115,12 @@ int run_bench(const Options& o) {
   if (o.latency_seconds > 0 && o.direct_seconds > 0) {
     const Summary h = summarize(thread_handover(std::min(o.direct_seconds, 5.0)));
     fmt::print(
-        "(0d) a thread woken by another of this process on the same CPU, nothing else running\n"
+        "(0d) a thread woken by another of this process {}, nothing else running\n"
         "     (a condition variable, one every 250 us): the hand-over each of the bridge's paths\n"
         "     makes once\n"
         "     samples {}  p50 {}  p99 {}  max {}\n\n",
-        h.count, us(h.p50), us(h.p99), us(h.max));
+        cpus.tested >= 0 ? "on the same CPU" : "(both where the kernel puts them)", h.count,
+        us(h.p50), us(h.p99), us(h.max));
   }
 
   // (0b), the listener's: what the bridge's command path adds is measured
