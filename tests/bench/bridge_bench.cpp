@@ -368,7 +368,8 @@ int run_client(const ClientOptions& o) {
 // ---------------------------------------------------------------------------
 // The bridge side
 
-// What the bus tap of one port sees, on that port's world thread.
+// What the bus tap of one port sees, on that port's world thread, and what
+// its master writes and is handed, on the port's thread.
 struct PortWire {
   sim::ThreadedSimBackend* backend = nullptr;
   std::uint32_t bitrate = 0;
@@ -397,23 +398,26 @@ struct PortWire {
     // poll at a time).
     bool after_response;
     std::int64_t response_rx;  // then: that response's receive time, steady clock
-    // When the port's thread last woke (came back from waiting) before it
-    // wrote the frame, steady clock.
+    // The port's thread's last wait before it wrote the frame: when it
+    // began, and when the thread ran again after it, steady clock.
+    std::int64_t waited_since;
     std::int64_t woke;
   };
-  // A poll response (of a new analog input value) and when the port's
-  // thread had it: its receive time to that is the wake-up of the thread
-  // by the CAN controller (here, the simulated bus's thread).
+  // A poll response and when the port's thread had it. `slept`: the thread
+  // was waiting when the response was received and this was the first
+  // frame it was handed: the receive time to `handed` is then its wake-up
+  // by the CAN controller (here, the simulated bus's thread) alone.
   struct HandedResponse {
+    can::CanFrame frame;
     std::size_t key;  // port index * 64 + MAC, as the subscriber's
-    unsigned value;   // its analog input
     std::int64_t rx;
     std::int64_t handed;
+    bool slept;
   };
   std::mutex mutex;
   std::vector<OutputFrame> output_frames;
   std::vector<WrittenFrame> written_frames;
-  std::vector<HandedResponse> handed_responses;
+  std::vector<HandedResponse> handed_responses;  // the port's thread; read once it stopped
   std::array<int, 64> last_written{};
 
   // The MAC and analog output of a poll request carrying outputs.
@@ -440,8 +444,8 @@ struct PortWire {
     last_written[out->first] = static_cast<int>(out->second);
     std::lock_guard lock(mutex);
     const bool after_response = static_cast<int>(out->first) == answering_mac;
-    written_frames.push_back(
-        {out->first, out->second, at, after_response, after_response ? answering_rx : 0, woke});
+    written_frames.push_back({out->first, out->second, at, after_response,
+                              after_response ? answering_rx : 0, waiting_since, woke});
   }
 
   // On the port's thread: the MAC whose poll response the master is being
@@ -459,20 +463,31 @@ struct PortWire {
   }
   void on_received() { answering_mac = -1; }
 
-  // On the port's thread: when it came back from waiting, the first time
-  // it ran after (a frame handed to it, or the wait's return).
+  // On the port's thread: when it began its last wait, and when it ran
+  // again after it (a frame handed to it, or the wait's return). Kept short:
+  // it runs inside the paths measured.
+  std::int64_t waiting_since = 0;
   std::int64_t woke = 0;
-  void on_waiting() { woke = 0; }
-  void on_running() {
-    if (woke == 0) woke = steady_ns();
+  void on_waiting() {
+    woke = 0;
+    waiting_since = steady_ns();
   }
-  void on_response(const can::CanFrame& frame, std::int64_t rx) {
-    const auto handed = steady_ns();
+  // True the first time after a wait.
+  bool on_running() {
+    if (woke != 0) return false;
+    woke = steady_ns();
+    return true;
+  }
+  void on_response(const can::CanFrame& frame, std::int64_t rx, bool first) {
+    const auto handed = first ? woke : steady_ns();
+    handed_responses.push_back({frame, index * 64 + static_cast<unsigned>(answering_mac), rx,
+                                handed, first && waiting_since <= rx});
+  }
+  // The analog input of a poll response; none if it carries none.
+  std::optional<unsigned> analog_input(const can::CanFrame& frame) const {
     const auto inputs = profiles::cdn127::decode_poll_response(response_layout, 0, frame.payload());
-    if (!inputs || !inputs->analog_inputs_raw[0]) return;
-    std::lock_guard lock(mutex);
-    handed_responses.push_back({index * 64 + static_cast<unsigned>(answering_mac),
-                                *inputs->analog_inputs_raw[0], rx, handed});
+    if (!inputs || !inputs->analog_inputs_raw[0]) return std::nullopt;
+    return *inputs->analog_inputs_raw[0];
   }
 
   void on_wire(const sim::WireFrame& wf) {
@@ -521,7 +536,7 @@ class WrittenFramesBackend final : public port::CanBackend {
     wire_.on_waiting();
     Receiver noting{receiver, wire_};
     inner_->wait(deadline, noting);
-    wire_.on_running();
+    (void)wire_.on_running();
   }
   void wake() override { inner_->wake(); }
   port::BusCounters counters() const override { return inner_->counters(); }
@@ -545,9 +560,11 @@ class WrittenFramesBackend final : public port::CanBackend {
    public:
     Receiver(port::FrameReceiver& inner, PortWire& wire) : inner_(inner), wire_(wire) {}
     void on_frame(const can::CanFrame& frame, TimePoint rx_time) override {
-      wire_.on_running();
+      const bool first = wire_.on_running();
       wire_.on_receiving(frame, rx_time);
-      if (wire_.answering_mac >= 0) wire_.on_response(frame, rx_time.time_since_epoch().count());
+      if (wire_.answering_mac >= 0) {
+        wire_.on_response(frame, rx_time.time_since_epoch().count(), first);
+      }
       inner_.on_frame(frame, rx_time);
       wire_.on_received();
     }
@@ -680,8 +697,26 @@ class Bridge {
   std::vector<PortWire::WrittenFrame> written_frames() {
     return gather(&PortWire::written_frames);
   }
-  std::vector<PortWire::HandedResponse> handed_responses() {
-    return gather(&PortWire::handed_responses);
+  // Every poll response handed to a port's thread: its key and analog
+  // value, from its receive time to the thread having it (ns), and whether
+  // that was the thread's wake-up for it (PortWire::HandedResponse::slept).
+  // Once the bridge has stopped.
+  struct Handed {
+    std::size_t key;
+    unsigned value;
+    std::int64_t ns;
+    bool slept;
+  };
+  std::vector<Handed> handed_responses() {
+    std::vector<Handed> all;
+    for (const auto& w : wires_) {
+      for (const auto& h : w->handed_responses) {
+        if (const auto value = w->analog_input(h.frame)) {
+          all.push_back({h.key, *value, h.handed - h.rx, h.slept});
+        }
+      }
+    }
+    return all;
   }
 
  private:
@@ -1009,6 +1044,8 @@ DirectStateResult direct_state(int domain, Placement cpus, double window_seconds
 // makes (a received frame to the port's thread, a command from Cyclone's
 // thread to it), as the simulated bus makes it: a time stamped, a queue
 // under a mutex, a condition variable. One every 250 us, `seconds` long.
+// The best case: the waking thread sleeps right after, so the woken one has
+// the CPU at once; in the bridge the waking thread goes on with its work.
 std::vector<double> thread_handover(double seconds) {
   std::mutex mutex;
   std::condition_variable woken;
@@ -1116,8 +1153,8 @@ int run_bench(const Options& o) {
     const Summary h = summarize(thread_handover(std::min(o.direct_seconds, 5.0)));
     fmt::print(
         "(0d) a thread woken by another of this process {}, nothing else running\n"
-        "     (a condition variable, one every 250 us): the hand-over each of the bridge's paths\n"
-        "     makes once\n"
+        "     (a condition variable, one every 250 us; the waking thread then sleeps): the\n"
+        "     hand-over each of the bridge's paths makes once, at its best\n"
         "     samples {}  p50 {}  p99 {}  max {}\n\n",
         cpus.tested >= 0 ? "on the same CPU" : "(both where the kernel puts them)", h.count,
         us(h.p50), us(h.p99), us(h.max));
@@ -1232,25 +1269,27 @@ int run_bench(const Options& o) {
     // (the CAN controller waking it: here the simulated bus's thread, for a
     // SocketCAN socket the kernel), and from there to the take (the bridge's
     // own work, then Cyclone's, as in (0c), whose writer is awake when it stamps).
-    // (A value a node's input took twice, its ramp having wrapped, matches
-    // no sample.)
-    constexpr std::int64_t kTwice = -1;
+    // Only responses that found the port's thread waiting, and were the
+    // first frame it was handed: for the others the time to the thread
+    // includes its own work. (A value a node's input took twice, its ramp
+    // having wrapped, matches no sample.)
+    constexpr std::int64_t kNotMatched = -1;
     std::map<std::pair<std::size_t, unsigned>, std::int64_t> wake_ns;
     for (const auto& h : bridge.handed_responses()) {
-      const auto [it, added] = wake_ns.try_emplace({h.key, h.value}, h.handed - h.rx);
-      if (!added) it->second = kTwice;
+      const auto [it, added] = wake_ns.try_emplace({h.key, h.value}, h.slept ? h.ns : kNotMatched);
+      if (!added) it->second = kNotMatched;
     }
     std::vector<double> wake_us, after_wake_us;
     for (const auto& st : out.states) {
       const auto it = wake_ns.find({st.key, st.value});
-      if (it == wake_ns.end() || it->second == kTwice) continue;
+      if (it == wake_ns.end() || it->second == kNotMatched) continue;
       wake_us.push_back(static_cast<double>(it->second) / 1e3);
       after_wake_us.push_back(st.us - wake_us.back());
     }
     const Summary wake = summarize(wake_us);
     const Summary after_wake = summarize(after_wake_us);
     fmt::print(
-        "    in two ({} of the {} samples matched to their responses):\n"
+        "    in two ({} of the {} samples: those whose response woke the port's thread):\n"
         "      the response handed to the port's thread (its wake-up):  p50 {}  p99 {}  max {}\n"
         "      the port's thread having it -> PumpState taken:          p50 {}  p99 {}  max {}\n",
         after_wake.count, state.count, us(wake.p50), us(wake.p99), us(wake.max), us(after_wake.p50),
@@ -1271,7 +1310,7 @@ int run_bench(const Options& o) {
     // to the next poll frame written, and that frame's time on the wire.
     std::vector<double> after_response_us;
     std::vector<double> to_woken, woken_to_write;
-    std::size_t found_running = 0;
+    std::size_t not_split = 0;
     double frame_us = 0;
     std::size_t waited = 0;
     for (const auto& c : out.commands) {
@@ -1288,12 +1327,14 @@ int run_bench(const Options& o) {
       } else {
         to_write_free.push_back(write_us);
         // In two: until the port's thread woke for it, and its own work
-        // from there (unless the thread was running when it was written).
-        if (wr->second.woke >= c.at) {
+        // from there. Only when the thread was waiting when the command was
+        // written and woke after: it may still have woken for something
+        // else (a poll due, a response) before the command reached it.
+        if (wr->second.waited_since <= c.at && wr->second.woke >= c.at) {
           to_woken.push_back(static_cast<double>(wr->second.woke - c.at) / 1e3);
           woken_to_write.push_back(static_cast<double>(wr->second.at - wr->second.woke) / 1e3);
         } else {
-          ++found_running;
+          ++not_split;
         }
       }
       to_start.push_back(static_cast<double>(it->second.start - c.at) / 1e3);
@@ -1357,15 +1398,17 @@ int run_bench(const Options& o) {
       const Summary woken = summarize(to_woken);
       const Summary work = summarize(woken_to_write);
       fmt::print(
-          "    no poll in flight, in two ({} commands; {} more found the port's thread running):\n"
+          "    no poll in flight, in two ({} commands written while the port's thread waited; {} "
+          "others):\n"
           "      command written -> the port's thread woken for it:  p50 {}  p99 {}  max {}\n"
           "      the port's thread woken -> the frame written:       p50 {}  p99 {}  max {}\n",
-          woken.count, found_running, us(woken.p50), us(woken.p99), us(woken.max), us(work.p50),
+          woken.count, not_split, us(woken.p50), us(woken.p99), us(woken.max), us(work.p50),
           us(work.p99), us(work.max));
       if (direct_listener) {
         fmt::print(
             "      the first against (0b) listener (Cyclone's delivery): p50 {}  p99 {} (the "
-            "hand-over\n      from the listener to the port's thread)\n",
+            "bridge's\n      listener taking the command to the port's inbox, and the "
+            "hand-over to the port's thread)\n",
             us(woken.p50 - direct_listener->p50), us(woken.p99 - direct_listener->p99));
       }
     }
