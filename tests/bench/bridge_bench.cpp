@@ -31,7 +31,9 @@
 //       every 10 ms and every 100 ms (the shipped default). Commands that
 //       meet a poll in flight: from its response to the new poll written.
 //       The others split: until the port's thread woke for the command, and
-//       from there to the frame written.
+//       from there to the frame written; the first again at the wake-up the
+//       bridge's listener asks for (the end of its work on Cyclone's
+//       thread), which leaves the hand-over to the port's thread alone.
 //   (3) CPU time of the bridge per second of wall time, 4 ports x 63 nodes
 //       polled every 10 ms, the simulated devices' threads left out; (3b)
 //       the same with a PumpState per poll; (3c) Cyclone alone writing (3b)'s
@@ -402,6 +404,10 @@ struct PortWire {
     // began, and when the thread ran again after it, steady clock.
     std::int64_t waited_since;
     std::int64_t woke;
+    // The last wake() of the port's loop before the thread ran again (an
+    // item posted to its inbox, here by the bridge's command listener on
+    // Cyclone's thread), steady clock; 0 if none during that wait.
+    std::int64_t woken_by;
   };
   // A poll response and when the port's thread had it. `slept`: the thread
   // was waiting when the response was received and this was the first
@@ -445,7 +451,7 @@ struct PortWire {
     std::lock_guard lock(mutex);
     const bool after_response = static_cast<int>(out->first) == answering_mac;
     written_frames.push_back({out->first, out->second, at, after_response,
-                              after_response ? answering_rx : 0, waiting_since, woke});
+                              after_response ? answering_rx : 0, waiting_since, woke, woken_by});
   }
 
   // On the port's thread: the MAC whose poll response the master is being
@@ -468,14 +474,20 @@ struct PortWire {
   // it runs inside the paths measured.
   std::int64_t waiting_since = 0;
   std::int64_t woke = 0;
+  std::int64_t woken_by = 0;
+  // Written by whichever thread wakes the port's loop.
+  std::atomic<std::int64_t> last_wake{0};
   void on_waiting() {
     woke = 0;
     waiting_since = steady_ns();
   }
+  void on_wake() { last_wake.store(steady_ns(), std::memory_order_relaxed); }
   // True the first time after a wait.
   bool on_running() {
     if (woke != 0) return false;
     woke = steady_ns();
+    const auto wake = last_wake.load(std::memory_order_relaxed);
+    woken_by = wake >= waiting_since ? wake : 0;
     return true;
   }
   void on_response(const can::CanFrame& frame, std::int64_t rx, bool first) {
@@ -538,7 +550,10 @@ class WrittenFramesBackend final : public port::CanBackend {
     inner_->wait(deadline, noting);
     (void)wire_.on_running();
   }
-  void wake() override { inner_->wake(); }
+  void wake() override {
+    wire_.on_wake();
+    inner_->wake();
+  }
   port::BusCounters counters() const override { return inner_->counters(); }
   std::string interface_name() const override { return inner_->interface_name(); }
   std::uint32_t bitrate() const override { return inner_->bitrate(); }
@@ -1310,6 +1325,10 @@ int run_bench(const Options& o) {
     // to the next poll frame written, and that frame's time on the wire.
     std::vector<double> after_response_us;
     std::vector<double> to_woken, woken_to_write;
+    // Of those, the ones whose thread a wake() after the command woke: until
+    // that wake() (Cyclone's delivery, the bridge's listener), and from it
+    // to the thread running (the hand-over alone).
+    std::vector<double> to_wake_call, wake_to_woken;
     std::size_t not_split = 0;
     double frame_us = 0;
     std::size_t waited = 0;
@@ -1333,6 +1352,11 @@ int run_bench(const Options& o) {
         if (wr->second.waited_since <= c.at && wr->second.woke >= c.at) {
           to_woken.push_back(static_cast<double>(wr->second.woke - c.at) / 1e3);
           woken_to_write.push_back(static_cast<double>(wr->second.at - wr->second.woke) / 1e3);
+          if (wr->second.woken_by >= c.at) {
+            to_wake_call.push_back(static_cast<double>(wr->second.woken_by - c.at) / 1e3);
+            wake_to_woken.push_back(static_cast<double>(wr->second.woke - wr->second.woken_by) /
+                                    1e3);
+          }
         } else {
           ++not_split;
         }
@@ -1410,6 +1434,21 @@ int run_bench(const Options& o) {
             "bridge's\n      listener taking the command to the port's inbox, and the "
             "hand-over to the port's thread)\n",
             us(woken.p50 - direct_listener->p50), us(woken.p99 - direct_listener->p99));
+      }
+      const Summary to_call = summarize(to_wake_call);
+      const Summary handing = summarize(wake_to_woken);
+      fmt::print(
+          "      the first in two ({} of them: the thread woken by a wake() after the command):\n"
+          "        command written -> the listener wakes the port's loop: p50 {}  p99 {}  max {}\n"
+          "        that wake -> the port's thread running (the hand-over): p50 {}  p99 {}  max "
+          "{}\n",
+          to_call.count, us(to_call.p50), us(to_call.p99), us(to_call.max), us(handing.p50),
+          us(handing.p99), us(handing.max));
+      if (direct_listener) {
+        fmt::print(
+            "        the listener's part against (0b) listener: p50 {}  p99 {} (the bridge's "
+            "listener\n        taking the command to the port's inbox)\n",
+            us(to_call.p50 - direct_listener->p50), us(to_call.p99 - direct_listener->p99));
       }
     }
     fmt::print(
