@@ -48,12 +48,20 @@ constexpr std::string_view to_string(BusState s) noexcept {
   return "?";
 }
 
+// Nothing goes out or comes in: bus-off, or the interface down.
+constexpr bool bus_lost(BusState s) noexcept {
+  return s == BusState::kBusOff || s == BusState::kDown;
+}
+
 struct BusCounters {
   BusState state = BusState::kUnknown;
   std::uint16_t tx_errors = 0;  // transmit error counter
   std::uint16_t rx_errors = 0;  // receive error counter
   std::uint64_t frames = 0;     // frames seen on the bus, both ways
   std::uint64_t bits = 0;       // their length on the wire, stuffing included
+  // Times the bus was lost (bus_lost) since the backend was made: a loss
+  // and its recovery between two looks at `state` still show here.
+  std::uint64_t losses = 0;
 };
 
 class CanBackend {

@@ -9,12 +9,6 @@
 
 namespace dnbridge::port {
 
-namespace {
-
-bool bus_lost(BusState b) { return b == BusState::kDown || b == BusState::kBusOff; }
-
-}  // namespace
-
 using devicenet::MacId;
 
 PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
@@ -234,8 +228,7 @@ void PortLoop::handle_scan_call(ScanCall call, TimePoint now) {
                        config_.port));
     return;
   }
-  if (!scanner().scanning_bus() &&
-      (bus_seen_ == BusState::kBusOff || bus_seen_ == BusState::kDown)) {
+  if (!scanner().scanning_bus() && bus_lost(bus_seen_)) {
     // Every MAC would be silent: a scan would say nothing is there.
     refuse(rack::TransactionStatus::kPortOffline,
            fmt::format("port {}: the bus is {}: no bus scan", config_.port, to_string(bus_seen_)));
@@ -374,13 +367,22 @@ void PortLoop::run() {
       log_.info("stopping: idling and releasing every node");
       scanner().stop(now);
     }
-    const BusState bus = backend_->counters().state;
+    const BusCounters counters = backend_->counters();
+    const BusState bus = counters.state;
     // A bus that comes back (bus-off recovered, the interface up again):
-    // the master checks its own MAC again before it scans.
-    if (bus != bus_seen_) {
-      if (bus_lost(bus_seen_) && !bus_lost(bus) && master_was_started && !stopping) {
-        scanner().recheck_mac(
-            bus_seen_ == BusState::kDown ? "the interface is up again" : "bus-off recovered", now);
+    // the master checks its own MAC again before it scans, and every node
+    // comes back idle. A loss that began and ended while the loop was not
+    // looking (both within one wait) counts as much as one it saw.
+    const bool unseen_loss =
+        counters.losses != bus_losses_seen_ && !bus_lost(bus_seen_) && !bus_lost(bus);
+    bus_losses_seen_ = counters.losses;
+    if (bus != bus_seen_ || unseen_loss) {
+      if ((unseen_loss || (bus_lost(bus_seen_) && !bus_lost(bus))) && master_was_started &&
+          !stopping) {
+        scanner().recheck_mac(unseen_loss                    ? "the bus was lost and is back"
+                              : bus_seen_ == BusState::kDown ? "the interface is up again"
+                                                             : "bus-off recovered",
+                              now);
       }
       bus_seen_ = bus;
     }

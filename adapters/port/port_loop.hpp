@@ -232,6 +232,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   BusCounters last_counters_{};
   BusState bus_state_ = BusState::kUnknown;  // as last published
   BusState bus_seen_ = BusState::kUnknown;   // as last seen by the loop
+  std::uint64_t bus_losses_seen_ = 0;        // BusCounters::losses, likewise
   TimePoint metrics_time_{};
   struct Metrics {
     double frames_per_second = 0;

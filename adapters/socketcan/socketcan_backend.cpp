@@ -168,7 +168,7 @@ void SocketCanBackend::try_open(TimePoint now) {
   problem_.clear();
   // A real controller reports its state and counters over netlink; a
   // virtual one (vcan) has none, and stays "unknown".
-  bus_.state = state_from_netlink().value_or(BusState::kUnknown);
+  set_bus_state(state_from_netlink().value_or(BusState::kUnknown));
   can_berr_counter berr{};
   if (!io_->has_controller(options_.interface)) {
     // Nothing more to ask a virtual interface.
@@ -200,12 +200,17 @@ void SocketCanBackend::go_down(const std::string& why, TimePoint now) {
     socket_.close();
   }
   drop_queue("the interface went down");
-  bus_.state = BusState::kDown;
+  set_bus_state(BusState::kDown);
   problem_ = fmt::format("interface {}: {}", options_.interface, why);
   log_.error("{}; checked again every {} ms", problem_,
              std::chrono::duration_cast<milliseconds>(options_.reopen_period).count());
   reopen_at_ = now + options_.reopen_period;
   restart_at_ = kNever;
+}
+
+void SocketCanBackend::set_bus_state(BusState state) {
+  if (port::bus_lost(state) && !port::bus_lost(bus_.state)) ++bus_.losses;
+  bus_.state = state;
 }
 
 // --- the wait --------------------------------------------------------------
@@ -341,7 +346,7 @@ void SocketCanBackend::on_error_frame(const Received& r, TimePoint now) {
   if (report.tx_errors) bus_.tx_errors = *report.tx_errors;
   if (report.rx_errors) bus_.rx_errors = *report.rx_errors;
   const BusState before = bus_.state;
-  if (report.state) bus_.state = *report.state;
+  if (report.state) set_bus_state(*report.state);
 
   if (bus_.state != before) {
     const LogLevel level = bus_.state == BusState::kErrorActive ? LogLevel::kInfo

@@ -121,6 +121,12 @@ class UnpluggedBackend final : public CanBackend, private can::FrameSink {
     plugged_ = false;
     bus_->wake();
   }
+  // The bus lost and back between two looks of the port's loop at its
+  // state: only the count of losses tells.
+  void lose_unseen() {
+    losses_.fetch_add(1);
+    bus_->wake();
+  }
   std::uint64_t dropped() const { return dropped_; }
 
   can::FrameSink& sink() override { return *this; }
@@ -140,6 +146,7 @@ class UnpluggedBackend final : public CanBackend, private can::FrameSink {
   BusCounters counters() const override {
     BusCounters c = bus_->counters();
     if (!plugged_) c.state = BusState::kDown;
+    c.losses = losses_.load();
     return c;
   }
   std::string interface_name() const override { return "can7"; }
@@ -158,6 +165,7 @@ class UnpluggedBackend final : public CanBackend, private can::FrameSink {
   std::unique_ptr<sim::SimBackend> bus_;
   std::atomic<bool> plugged_{false};
   std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::uint64_t> losses_{0};
 };
 
 PortLoopConfig config_for(const std::vector<unsigned>& macs) {
@@ -605,6 +613,32 @@ TEST(PortLoop, AnInterfaceBackUpMakesTheMasterCheckItsMacAgain) {
                      "the interface is up again: checking again that no other node has MAC 0") !=
            publisher.port_reasons.end();
   }));
+  ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps[1].online; }));
+  loop.stop();
+  loop.join();
+}
+
+// A bus-off and its recovery both within one wait of the port's loop (the
+// backend counts it): the master checks its MAC again as for a loss it saw,
+// and the node is made afresh.
+TEST(PortLoop, ABusLostAndBackWhileTheLoopWaitedIsStillALoss) {
+  RecordingPublisher publisher;
+  auto backend = std::make_unique<UnpluggedBackend>(
+      std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(1)}));
+  UnpluggedBackend* interface = backend.get();
+  interface->plug_in();
+  PortLoop loop(config_for({1}), std::move(backend), publisher, null_log_sink());
+  loop.start();
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(1) && publisher.pumps[1].online; }));
+
+  interface->lose_unseen();
+  ASSERT_TRUE(publisher.wait_for([&] {
+    return std::find(publisher.port_reasons.begin(), publisher.port_reasons.end(),
+                     "the bus was lost and is back: checking again that no other node has MAC "
+                     "0") != publisher.port_reasons.end();
+  }));
+  ASSERT_TRUE(publisher.wait_for([&] { return !publisher.pumps[1].online; }));
   ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps[1].online; }));
   loop.stop();
   loop.join();

@@ -427,6 +427,31 @@ TEST_F(BackendFault, AControllerFoundBusOffAtOpenIsRestartedByPolicy) {
   EXPECT_EQ(io.restarts, std::vector<TimePoint>{kStart + milliseconds(500)});
 }
 
+// A bus-off and its recovery read in one wait: the state is the last one,
+// and the loss is counted, so that the port's loop, which looks at the state
+// only between waits, still learns of it.
+TEST_F(BackendFault, ABusOffAndItsRecoveryInOneWaitAreCountedAsALoss) {
+  SocketCanBackend b(options(BusOffRecovery::kInterface), Logger(), io);
+  EXPECT_EQ(b.counters().losses, 0u);
+  io.inject(CAN_ERR_FLAG | CAN_ERR_CRTL, crtl(CAN_ERR_CRTL_TX_PASSIVE, 128, 0));
+  poll(b);
+  EXPECT_EQ(b.counters().state, BusState::kErrorPassive);
+  EXPECT_EQ(b.counters().losses, 0u) << "error-passive still carries frames";
+
+  io.inject(CAN_ERR_FLAG | CAN_ERR_BUSOFF);
+  io.inject(CAN_ERR_FLAG | CAN_ERR_RESTARTED);
+  poll(b);
+  EXPECT_EQ(b.counters().state, BusState::kErrorActive);
+  EXPECT_EQ(b.counters().losses, 1u);
+
+  // A second bus-off report while off is the same loss.
+  io.inject(CAN_ERR_FLAG | CAN_ERR_BUSOFF);
+  io.inject(CAN_ERR_FLAG | CAN_ERR_BUSOFF);
+  poll(b);
+  EXPECT_EQ(b.counters().state, BusState::kBusOff);
+  EXPECT_EQ(b.counters().losses, 2u);
+}
+
 // --- (4) the interface goes down or away ---------------------------------------
 
 TEST_F(BackendFault, EnetdownOnWriteReportsTheBusDownAndReopensOnItsTimer) {
@@ -439,6 +464,7 @@ TEST_F(BackendFault, EnetdownOnWriteReportsTheBusDownAndReopensOnItsTimer) {
   wait_until(b, kStart + milliseconds(1));  // the retry meets ENETDOWN
   EXPECT_FALSE(b.is_up());
   EXPECT_EQ(b.counters().state, BusState::kDown);
+  EXPECT_EQ(b.counters().losses, 1u);
   EXPECT_EQ(b.problem(), "interface can0: " + errno_code(ENETDOWN).message());
   EXPECT_EQ(b.transmit_queued(), 0u);
   EXPECT_EQ(b.stats().transmit_dropped, 2u);
