@@ -34,10 +34,11 @@ constexpr sim::ClassAttribute kIdentityState{profiles::cdn127::class_id::kIdenti
 
 // The keys of a CDN127's readings (read_settings), refused by name on a
 // device that runs its EDS file.
-constexpr std::array<std::string_view, 10> kReadingKeys{"configuration_locked_while_poll_allocated",
+constexpr std::array<std::string_view, 11> kReadingKeys{"configuration_locked_while_poll_allocated",
                                                         "poll_paths_fixed",
                                                         "idle_poll_answered_empty",
                                                         "no_ack_of_last_request_fragment",
+                                                        "release_keeps_outputs",
                                                         "identity_state_supported",
                                                         "unsafe_factory_output_actions",
                                                         "explicit_response_delay_ms",
@@ -60,6 +61,7 @@ DeviceSettings read_settings(TableReader& t) {
   flag("poll_paths_fixed", s.poll_paths_fixed);
   flag("idle_poll_answered_empty", s.idle_poll_answered_empty);
   flag("no_ack_of_last_request_fragment", s.no_ack_of_last_request_fragment);
+  flag("release_keeps_outputs", s.release_keeps_outputs);
   flag("identity_state_supported", s.identity_state_supported);
   flag("unsafe_factory_output_actions", s.unsafe_factory_output_actions);
   ms("explicit_response_delay_ms", 0, kMaxDelayMs, s.explicit_response_delay);
@@ -186,6 +188,7 @@ void DeviceSettings::apply_to(sim::SlaveOptions& o) const {
   if (no_ack_of_last_request_fragment) {
     o.no_ack_of_last_request_fragment = *no_ack_of_last_request_fragment;
   }
+  if (release_keeps_outputs) o.release_keeps_outputs = *release_keeps_outputs;
   if (explicit_response_delay) o.explicit_response_delay = *explicit_response_delay;
   if (poll_response_delay) o.poll_response_delay = *poll_response_delay;
   if (serial_number_udint) o.serial_number_udint = *serial_number_udint;
@@ -262,6 +265,7 @@ std::string describe_readings(const sim::SlaveOptions& o) {
   if (o.poll_paths_fixed) parts.emplace_back("poll paths fixed");
   if (o.idle_poll_answered_empty) parts.emplace_back("idle poll answered empty");
   if (o.no_ack_of_last_request_fragment) parts.emplace_back("no ack of last request fragment");
+  if (o.release_keeps_outputs) parts.emplace_back("outputs kept on release");
   auto ms_of = [](Duration d) { return std::chrono::duration_cast<milliseconds>(d).count(); };
   if (o.explicit_response_delay > Duration::zero()) {
     parts.push_back(fmt::format("explicit responses {} ms late", ms_of(o.explicit_response_delay)));

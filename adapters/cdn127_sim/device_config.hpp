@@ -27,6 +27,7 @@
 //   poll_paths_fixed = true|false
 //   idle_poll_answered_empty = true|false
 //   no_ack_of_last_request_fragment = true|false
+//   release_keeps_outputs = true|false
 //   explicit_response_delay_ms = 0..60000
 //   poll_response_delay_ms = 0..60000
 //   serial_number_bytes = 2|4
@@ -63,6 +64,7 @@ struct DeviceSettings {
   std::optional<bool> poll_paths_fixed;
   std::optional<bool> idle_poll_answered_empty;
   std::optional<bool> no_ack_of_last_request_fragment;
+  std::optional<bool> release_keeps_outputs;
   std::optional<Duration> explicit_response_delay;
   std::optional<Duration> poll_response_delay;
   std::optional<bool> serial_number_udint;       // serial_number_bytes = 4

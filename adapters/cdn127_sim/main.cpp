@@ -62,6 +62,7 @@ int main(int argc, char** argv) {
       "  poll_paths_fixed = true          # Connection 2 attributes 14/16 Get only (0x0E)\n"
       "  idle_poll_answered_empty = true  # idle poll answered with 0 bytes\n"
       "  no_ack_of_last_request_fragment = true  # the response answers the last fragment\n"
+      "  release_keeps_outputs = true     # a Release of the poll connection keeps outputs\n"
       "  explicit_response_delay_ms = 300 # explicit and Allocate/Release answers this late\n"
       "  poll_response_delay_ms = 3       # poll responses this late\n"
       "  serial_number_bytes = 2          # Identity serial: 2 (UINT) or 4 (UDINT)\n"

@@ -149,6 +149,61 @@ TEST(BadInput, CorruptedPollResponsesAreCountedNotTaken) {
   EXPECT_EQ(rack.pumps().pump(mac(6))->inputs.analog_inputs_raw[0], 1234);
 }
 
+// Ten bad poll responses in a row while the pump runs: the node is lost, and
+// its outputs go idle with one poll before the connections are released. The
+// device is not left with the outputs last commanded until its own watchdog,
+// nor released with them (what a device does on a Release, the manual does
+// not say).
+TEST(BadInput, BadPollResponsesLoseTheNodeWithItsOutputsIdledFirst) {
+  sim::SimRack rack(rack_config({6}));
+  rack.start();
+  ASSERT_TRUE(rack.world().run_until([&] { return rack.all_online(); }, seconds(20)));
+  profiles::cdn127::PumpOutputs on;
+  on.pump_on = true;
+  on.analog_out_raw = 777;
+  ASSERT_TRUE(rack.pumps().command(mac(6), on, rack.now()).ok());
+  rack.world().run_for(milliseconds(300));
+  ASSERT_EQ(rack.device(mac(6)).device().outputs(), on);
+
+  // The master's frames to node 6 from here on.
+  std::vector<can::CanFrame> to_node;
+  rack.world().bus().set_tap([&](const sim::WireFrame& w) {
+    const auto id = devicenet::decode_identifier(w.frame.id);
+    if (id && id->group == devicenet::MessageGroup::k2 && id->mac == mac(6)) {
+      to_node.push_back(w.frame);
+    }
+  });
+  // The next ten poll responses each lose a byte.
+  auto rule = sim::FaultRule::corrupt(0x3C0 + 6, sim::Corruption::kTruncate, 1);
+  rule.count = 10;
+  rack.world().bus().faults().add(rule);
+  const auto& node = *rack.scanner().node(mac(6));
+  ASSERT_TRUE(
+      rack.world().run_until([&] { return node.state() != NodeState::kOnline; }, seconds(5)));
+  rack.world().run_for(milliseconds(5));
+  EXPECT_NE(node.reason().find("10 bad poll responses in a row"), std::string::npos)
+      << node.reason();
+  EXPECT_FALSE(rack.device(mac(6)).device().outputs().pump_on)
+      << "the outputs are idle at once, not after the device's watchdog";
+
+  // On the wire: the last poll before the first Release is the idle one.
+  const auto message = [](const can::CanFrame& f) {
+    return devicenet::decode_identifier(f.id)->message_id;
+  };
+  const auto release = std::find_if(to_node.begin(), to_node.end(), [&](const can::CanFrame& f) {
+    return message(f) ==
+               static_cast<std::uint8_t>(devicenet::Group2Message::kUnconnectedExplicitRequest) &&
+           f.len >= 2 && f.data[1] == 0x4C;
+  });
+  ASSERT_NE(release, to_node.end());
+  const auto last_poll = std::find_if(
+      std::make_reverse_iterator(release), to_node.rend(), [&](const can::CanFrame& f) {
+        return message(f) == static_cast<std::uint8_t>(devicenet::Group2Message::kMasterIoPoll);
+      });
+  ASSERT_NE(last_poll, to_node.rend());
+  EXPECT_EQ(last_poll->len, 0u) << "an idle poll";
+}
+
 // An analog input off the 0..4095 scale (a failed converter, 4096 and
 // 0xFFFF): that channel is marked and counted; the discrete inputs and the
 // other channel of the same responses keep coming, so an alarm that comes

@@ -469,6 +469,45 @@ TEST_P(BusLoss, ThePumpComesBackIdleAndStaysOffUntilANewCommand) {
   expect_idle_until_a_new_command();
 }
 
+// A bus lost for less than the device's own timeout less the MAC check: the
+// poll connection outlives it, still carrying every output on. The master
+// finds it at the next start-up and releases it; a device that keeps its
+// outputs on a Release (the strict reading: the manual names no action)
+// must have been polled idle first, or it would run the pump on until the
+// new connection idles it, and for good if the start-up then stopped at a
+// fault.
+TEST_F(SafeStateRack, AConnectionLeftFromBeforeTheLossIsPolledIdleBeforeItsRelease) {
+  build([](sim::SimRackConfig& c) { c.pumps[0].node.expected_packet_rate = seconds(2); },
+        [](sim::SlaveOptions& o) { o.release_keeps_outputs = true; });
+  ASSERT_TRUE(run_until_state(NodeState::kOnline, seconds(10))) << view().reason;
+  command_all_on();
+
+  silence_master();
+  world().run_for(milliseconds(300));
+  unsilence_master();
+  bool released = false;
+  world().bus().set_tap([&](const sim::WireFrame& f) {
+    count(f);
+    const auto& d = f.frame.data;
+    // [hdr][4C Release][03 DeviceNet][01][choice]: the poll connection's.
+    released =
+        released ||
+        (f.frame.id == devicenet::group2_id(
+                           mac(kMac), devicenet::Group2Message::kUnconnectedExplicitRequest) &&
+         f.frame.len == 5 && d[1] == 0x4C && (d[4] & 0x02) != 0);
+  });
+  rack_->scanner().recheck_mac("bus-off recovered", now());
+  note_loss();
+  ASSERT_TRUE(world().run_until([&] { return released; }, seconds(10)));
+  world().run_for(milliseconds(2));
+  EXPECT_NE(view().state, NodeState::kOnline) << "still starting up";
+  EXPECT_FALSE(outputs().pump_on) << "the stale connection was released with the pump on";
+  EXPECT_FALSE(outputs().n2_ballast_on);
+
+  ASSERT_TRUE(run_until_state(NodeState::kOnline, seconds(20))) << view().reason;
+  expect_idle_until_a_new_command();
+}
+
 INSTANTIATE_TEST_SUITE_P(Outages, BusLoss,
                          ::testing::Values(
                              // Shorter than the device's 4 x EPR: its connection outlives the

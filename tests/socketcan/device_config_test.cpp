@@ -42,6 +42,7 @@ configuration_locked_while_poll_allocated = true
 poll_paths_fixed = true
 idle_poll_answered_empty = true
 no_ack_of_last_request_fragment = true
+release_keeps_outputs = true
 explicit_response_delay_ms = 300
 poll_response_delay_ms = 3
 serial_number_bytes = 4
@@ -61,6 +62,7 @@ unsafe_factory_output_actions = true
   EXPECT_TRUE(o.poll_paths_fixed);
   EXPECT_TRUE(o.idle_poll_answered_empty);
   EXPECT_TRUE(o.no_ack_of_last_request_fragment);
+  EXPECT_TRUE(o.release_keeps_outputs);
   EXPECT_EQ(o.explicit_response_delay, milliseconds(300));
   EXPECT_EQ(o.poll_response_delay, milliseconds(3));
   EXPECT_TRUE(o.serial_number_udint);
@@ -69,7 +71,8 @@ unsafe_factory_output_actions = true
   EXPECT_EQ(o.factory_output_actions, sim::kUnsafeFactoryOutputActions);
   EXPECT_EQ(describe_readings(o),
             "configuration locked while poll allocated, poll paths fixed, idle poll answered "
-            "empty, no ack of last request fragment, explicit responses 300 ms late, poll "
+            "empty, no ack of last request fragment, outputs kept on release, explicit responses "
+            "300 ms late, poll "
             "responses 3 ms late, 4-byte serial number, no Identity State, EPR in steps of 100 "
             "ms, unsafe factory output actions (every output holds on fault and idle)");
 }

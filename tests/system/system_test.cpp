@@ -285,7 +285,8 @@ TEST_F(SystemTest, RackOnlineStateAndCommandsOnTheWire) {
 // cdn127-sim devices with every reading of the manual that field devices
 // took (--reading field: configuration locked while a poll connection
 // exists, fixed poll paths, idle polls answered empty, no ack of a
-// request's last fragment, explicit answers 300 ms and poll answers 3 ms
+// request's last fragment, outputs kept on a Release, explicit answers
+// 300 ms and poll answers 3 ms
 // late, a 2-byte serial number, no Identity State, expected packet rates in
 // steps of 100 ms): every node online with one allocation of each
 // connection, a command applied, the whole traffic clean under tshark.

@@ -56,6 +56,7 @@ void apply_field_reading(SlaveOptions& o) {
   o.poll_paths_fixed = true;
   o.idle_poll_answered_empty = true;
   o.no_ack_of_last_request_fragment = true;
+  o.release_keeps_outputs = true;
   o.explicit_response_delay = milliseconds(300);
   o.poll_response_delay = milliseconds(3);
   o.serial_number_udint = false;
@@ -146,10 +147,12 @@ bool Cdn127Device::assembly_allowed(std::uint16_t instance, bool produced,
 void Cdn127Device::on_io_established(std::uint16_t, TimePoint) noexcept { poll_running_ = false; }
 
 // A master that releases the poll connection has stopped the exchange on
-// purpose: the outputs take their idle values (the manual names no action for
-// this case; idle rather than fault is this simulator's reading).
+// purpose: the outputs take their idle values, or, as the strict reading
+// has it, stay as they are (the manual names no action for this case).
 void Cdn127Device::on_io_released(std::uint16_t, const Connection& before, TimePoint now) noexcept {
-  if (before.state == ConnectionState::kEstablished) apply_idle_actions(now);
+  if (before.state == ConnectionState::kEstablished && !options_.release_keeps_outputs) {
+    apply_idle_actions(now);
+  }
   poll_running_ = false;
 }
 

@@ -151,6 +151,10 @@ struct SlaveOptions {
   // (bridge/PROTOCOL.md §5: the receiver acks every fragment, the last
   // included).
   bool no_ack_of_last_request_fragment = false;
+  // A Release of an established poll connection leaves the outputs as they
+  // are (the manual names no action for it; a master must idle them first).
+  // Off: the outputs take their idle values, as on an idle poll.
+  bool release_keeps_outputs = false;
   // A slow device: every explicit response (success or error, on the
   // explicit connection or the unconnected port: Allocate/Release answers
   // included) goes out this long after its request arrived, and every poll
@@ -164,7 +168,8 @@ struct SlaveOptions {
 
 // Every reading above at once, the strictest device a master may meet:
 // configuration locked while the poll connection exists, fixed poll paths,
-// idle polls answered empty, no ack of a request's last fragment, explicit
+// idle polls answered empty, no ack of a request's last fragment, outputs
+// kept on a Release of the poll connection, explicit
 // responses 300 ms and poll responses 3 ms late, the 2-byte (UINT) serial
 // number, no Identity State attribute (0x01/8), expected packet rates in
 // steps of 100 ms. What `cdn127-sim --reading field` runs.

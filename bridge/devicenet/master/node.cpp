@@ -101,6 +101,11 @@ Duration Node::next_backoff() {
 }
 
 void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
+  if (state_ == NodeState::kOnline) {
+    ++counters_.reconnects;
+    // Outputs to the device's idle state before the connections go.
+    idle_poll_before_release(now);
+  }
   next_poll_ = kNever;
   deferred_poll_ = kNever;
   poll_deadline_ = kNever;

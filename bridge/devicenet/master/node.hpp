@@ -244,12 +244,14 @@ class Node final : private ExplicitClient::Listener {
   // Its allocation bits without acknowledgment suppression (for Release).
   std::uint8_t cos_connection_bits() const;
   // A connection lost while the others live (the change-of-state
-  // watchdog): the outputs idle with one poll, every connection released,
-  // then absent as after any loss.
+  // watchdog, bad poll responses): the outputs idle with one poll, every
+  // connection released, then absent as after any loss.
   void lose_and_release(std::string reason, TimePoint now);
   // One idle poll now, whatever the outputs in force, before the
-  // connections go (its answer comes once the node has left online).
-  void idle_poll_before_leaving(TimePoint now);
+  // connections go: the device applies its idle action, not whatever it
+  // does on a Release (the manual names nothing). Its answer, and that to a
+  // poll outstanding, come once the node has left online, and are not taken.
+  void idle_poll_before_release(TimePoint now);
   void on_keepalive_result(const ExplicitResult& r, TimePoint now);
   // The Identity Status and State read last: a major fault takes the node to
   // kDeviceFault (false); a minor one is warned of when it appears.
@@ -286,6 +288,8 @@ class Node final : private ExplicitClient::Listener {
   // Timers stopped, connections and requests dropped, nothing sent.
   void forget_connections(Errc why, TimePoint now);
   void release_for_shutdown(TimePoint now);
+  // Into a fault state, re-checked after fault_recheck; an online node's
+  // outputs idle with one poll first, then what it holds is released.
   void enter_fault(NodeState fault, std::string reason, TimePoint now);
   void set_state(NodeState next, std::string reason, TimePoint now);
   void record(NodeError::Kind kind, TimePoint now, std::uint32_t got = 0,

@@ -536,7 +536,7 @@ Node::Step Node::after_allocate_explicit(const ExplicitResult& r, TimePoint now)
   return Step::kNone;
 }
 
-Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint) {
+Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint now) {
   // I/O connections left from before (this master's, restarted) are
   // released: they are made afresh once the configuration is in place.
   constexpr std::uint8_t kIo = allocation::kPoll | allocation::kBitStrobe |
@@ -546,6 +546,10 @@ Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint) {
     stale_choice_ = static_cast<std::uint8_t>(r.data[0] & kIo);
     log_.info("I/O connections are still allocated from before (0x{:02X}): releasing them",
               stale_choice_);
+    // A poll connection left from before (a restart within the device's
+    // own timeout, a bus lost and back, a loss by bad responses) may still
+    // carry the outputs last commanded: idle first, as on any release.
+    if ((stale_choice_ & allocation::kPoll) != 0) idle_poll_before_release(now);
     return Step::kReleaseStalePoll;
   }
   return Step::kVendor;
@@ -1146,9 +1150,9 @@ bool Node::check_health(TimePoint now) {
   return false;
 }
 
-void Node::idle_poll_before_leaving(TimePoint now) {
-  // The answers to it, and to a poll outstanding, arrive once the node has
-  // left online.
+void Node::idle_poll_before_release(TimePoint now) {
+  // Frames written to the port leave in the order written: the Release
+  // that follows reaches the device after this poll.
   stray_poll_responses_ = poll_outstanding_ ? 2 : 1;
   const bool idle = idle_;
   idle_ = true;
@@ -1157,11 +1161,6 @@ void Node::idle_poll_before_leaving(TimePoint now) {
 }
 
 void Node::device_fault(std::string reason, TimePoint now) {
-  if (state_ == NodeState::kOnline) {
-    ++counters_.reconnects;
-    // Outputs to the device's idle state before the connections go.
-    idle_poll_before_leaving(now);
-  }
   enter_fault(NodeState::kDeviceFault, std::move(reason), now);
 }
 
@@ -1169,7 +1168,7 @@ void Node::lose_and_release(std::string reason, TimePoint now) {
   // The poll connection lives: the outputs go to the device's idle state at
   // once rather than after its own watchdog, and what the device holds is
   // released (the node is allocated afresh after the back-off).
-  if (state_ == NodeState::kOnline) idle_poll_before_leaving(now);
+  if (state_ == NodeState::kOnline) idle_poll_before_release(now);
   const std::uint8_t held = held_connections();
   lose(std::move(reason), now);
   if (held != 0) release(Step::kReleaseFault, held, now);

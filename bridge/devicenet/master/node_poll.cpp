@@ -185,9 +185,11 @@ void Node::bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint 
   poll_outstanding_ = false;
   poll_deadline_ = kNever;
   if (++consecutive_errors_ >= port_.max_consecutive_errors) {
-    lose(fmt::format("{} bad poll responses in a row: {}", consecutive_errors_,
-                     last_error_.describe()),
-         now);
+    // The poll connection lives (the device answers): idle and released now,
+    // not left to the device's watchdog with the outputs last commanded.
+    lose_and_release(fmt::format("{} bad poll responses in a row: {}", consecutive_errors_,
+                                 last_error_.describe()),
+                     now);
   }
 }
 

@@ -296,5 +296,33 @@ TEST_F(NodeStartup, EveryRequestAndAnswerOnTheWire) {
   EXPECT_EQ(states_.last, NodeState::kStopped) << states_.last_reason;
 }
 
+// A poll connection still allocated from before (this master restarted, or
+// lost the bus, within the device's own timeout) may still carry the outputs
+// last commanded: it is polled idle before it is released, and the answer to
+// that poll is not taken for an error.
+TEST_F(NodeStartup, APollConnectionLeftFromBeforeIsPolledIdleBeforeItsRelease) {
+  scanner_->start(now_);
+  EXPECT_EQ(sent(), "407: 00 00 00 00 00 00 00");
+  now_ = scanner_->next_deadline();
+  run_timers();
+  EXPECT_EQ(sent(), "407: 00 00 00 00 00 00 00");
+  now_ = scanner_->next_deadline();
+  run_timers();
+  ASSERT_EQ(scanner_->state(), PortState::kRunning);
+
+  EXPECT_EQ(sent(), "466: 40 4B 03 01 01 00");
+  answer("463: 40 CB 00");
+  EXPECT_EQ(sent(), "464: 00 0E 03 01 05");
+  answer("463: 00 8E 03 00");                // [03 choice: explicit + poll][00 master]
+  EXPECT_EQ(sent(), "465:");                 // idle
+  EXPECT_EQ(sent(), "466: 40 4C 03 01 02");  // then [4C Release][02 poll]
+  answer("3CC: 00 1F 00 00 00 00");          // the device's answer to the idle poll
+  answer("463: 40 CC");
+  EXPECT_EQ(sent(), "464: 00 0E 01 01 01");  // on to the identity
+  EXPECT_EQ(node().counters().errors, 0u);
+  EXPECT_EQ(node().counters().idle_polls, 1u);
+  EXPECT_EQ(states_.last, NodeState::kIdentifying) << states_.last_reason;
+}
+
 }  // namespace
 }  // namespace dnbridge::devicenet
