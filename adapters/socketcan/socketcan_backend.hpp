@@ -129,7 +129,8 @@ class SocketCanBackend final : public port::CanBackend {
 
   void try_open(TimePoint now);
   void go_down(const std::string& why, TimePoint now);
-  // Every change of bus_.state goes here: it counts the losses.
+  // Every change of bus_.state after construction goes here: it counts the
+  // losses.
   void set_bus_state(port::BusState state);
   void receive(port::FrameReceiver& receiver, bool& delivered, TimePoint now);
   void on_error_frame(const Received& r, TimePoint now);

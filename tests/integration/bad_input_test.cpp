@@ -155,7 +155,14 @@ TEST(BadInput, CorruptedPollResponsesAreCountedNotTaken) {
 // nor released with them (what a device does on a Release, the manual does
 // not say).
 TEST(BadInput, BadPollResponsesLoseTheNodeWithItsOutputsIdledFirst) {
-  sim::SimRack rack(rack_config({6}));
+  auto config = rack_config({6});
+  config.create_devices = false;
+  sim::SimRack rack(std::move(config));
+  // A device that keeps its outputs on a Release: only the idle poll turns
+  // the pump off.
+  sim::SlaveOptions options = sim::default_slave_options(mac(6));
+  options.release_keeps_outputs = true;
+  rack.add_device(std::move(options), std::nullopt);
   rack.start();
   ASSERT_TRUE(rack.world().run_until([&] { return rack.all_online(); }, seconds(20)));
   profiles::cdn127::PumpOutputs on;

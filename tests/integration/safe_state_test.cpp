@@ -508,6 +508,30 @@ TEST_F(SafeStateRack, AConnectionLeftFromBeforeTheLossIsPolledIdleBeforeItsRelea
   expect_idle_until_a_new_command();
 }
 
+// A node taken out of the configuration while the master is off the bus: its
+// idle poll on leaving is lost with the bus, and its device, whose timeout
+// outlasts the loss, still runs the pump. Once the master is back it is
+// released, and polled idle first.
+TEST_F(SafeStateRack, ANodeTakenOutDuringABusLossIsPolledIdleBeforeItsRelease) {
+  build([](sim::SimRackConfig& c) { c.pumps[0].node.expected_packet_rate = seconds(2); },
+        [](sim::SlaveOptions& o) { o.release_keeps_outputs = true; });
+  ASSERT_TRUE(run_until_state(NodeState::kOnline, seconds(10))) << view().reason;
+  command_all_on();
+
+  silence_master();
+  (void)rack_->port().reconfigure(rack_->scanner().config(), std::vector<rack::PumpConfig>{},
+                                  now());
+  ASSERT_EQ(rack_->scanner().nodes_leaving(), 1u);
+  world().run_for(milliseconds(300));
+  unsilence_master();
+  rack_->scanner().recheck_mac("bus-off recovered", now());
+  ASSERT_TRUE(
+      world().run_until([&] { return rack_->scanner().nodes_leaving() == 0; }, seconds(10)));
+  world().run_for(milliseconds(2));
+  EXPECT_FALSE(outputs().pump_on) << "released with the pump on";
+  EXPECT_FALSE(outputs().n2_ballast_on);
+}
+
 INSTANTIATE_TEST_SUITE_P(Outages, BusLoss,
                          ::testing::Values(
                              // Shorter than the device's 4 x EPR: its connection outlives the

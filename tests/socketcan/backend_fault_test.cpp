@@ -444,7 +444,8 @@ TEST_F(BackendFault, ABusOffAndItsRecoveryInOneWaitAreCountedAsALoss) {
   EXPECT_EQ(b.counters().state, BusState::kErrorActive);
   EXPECT_EQ(b.counters().losses, 1u);
 
-  // A second bus-off report while off is the same loss.
+  // Another bus-off is another loss; a second report of it while the bus is
+  // off is not.
   io.inject(CAN_ERR_FLAG | CAN_ERR_BUSOFF);
   io.inject(CAN_ERR_FLAG | CAN_ERR_BUSOFF);
   poll(b);

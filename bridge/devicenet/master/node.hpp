@@ -250,7 +250,7 @@ class Node final : private ExplicitClient::Listener {
   // One idle poll now, whatever the outputs in force, before the
   // connections go: the device applies its idle action, not whatever it
   // does on a Release (the manual names nothing). Its answer, and that to a
-  // poll outstanding, come once the node has left online, and are not taken.
+  // poll outstanding, are strays: the node is not online when they come.
   void idle_poll_before_release(TimePoint now);
   void on_keepalive_result(const ExplicitResult& r, TimePoint now);
   // The Identity Status and State read last: a major fault takes the node to
@@ -374,7 +374,7 @@ class Node final : private ExplicitClient::Listener {
   bool identity_state_supported_ = true;
   bool keepalive_reads_status_ = false;  // which the last keep-alive read
   std::string minor_faults_;             // as last warned of
-  unsigned stray_poll_responses_ = 0;    // answers to expect after a device fault's idle poll
+  unsigned stray_poll_responses_ = 0;    // answers to expect to an idle poll before a Release
   bool epr_warned_ = false;
 
   NodeIdentity identity_;

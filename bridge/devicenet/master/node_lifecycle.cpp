@@ -225,6 +225,9 @@ void Node::release_after_loss(TimePoint now) {
   if (state_ == NodeState::kStopped) return;
   shutting_down_ = true;
   reports_data_ = false;
+  // Its idle poll on retiring may have been lost with the bus, and the device
+  // may have kept the connection through a short loss: idle first.
+  idle_poll_before_release(now);
   release(
       Step::kReleaseShutdown,
       static_cast<std::uint8_t>(allocation::kExplicit | allocation::kPoll | cos_connection_bits()),
@@ -279,13 +282,17 @@ void Node::run(Step step, TimePoint now) {
       issue(step, m, true, now);
       return;
     }
-    case Verb::kRelease:
-      release(step,
-              step == Step::kReleaseStalePoll        ? stale_choice_
-              : step == Step::kReleaseCosForAllocate ? cos_connection_bits()
-                                                     : r.choice,
-              now);
+    case Verb::kRelease: {
+      const std::uint8_t choice = step == Step::kReleaseStalePoll        ? stale_choice_
+                                  : step == Step::kReleaseCosForAllocate ? cos_connection_bits()
+                                                                         : r.choice;
+      // A poll connection released during the start-up may be one left from
+      // before (a restart, or a bus lost and back, within the device's own
+      // timeout), still carrying the outputs last commanded: idle first.
+      if ((choice & allocation::kPoll) != 0) idle_poll_before_release(now);
+      release(step, choice, now);
       return;
+    }
     case Verb::kGet:
       get(step, target_of(step), now);
       return;
@@ -536,7 +543,7 @@ Node::Step Node::after_allocate_explicit(const ExplicitResult& r, TimePoint now)
   return Step::kNone;
 }
 
-Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint now) {
+Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint) {
   // I/O connections left from before (this master's, restarted) are
   // released: they are made afresh once the configuration is in place.
   constexpr std::uint8_t kIo = allocation::kPoll | allocation::kBitStrobe |
@@ -546,10 +553,6 @@ Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint now) {
     stale_choice_ = static_cast<std::uint8_t>(r.data[0] & kIo);
     log_.info("I/O connections are still allocated from before (0x{:02X}): releasing them",
               stale_choice_);
-    // A poll connection left from before (a restart within the device's
-    // own timeout, a bus lost and back, a loss by bad responses) may still
-    // carry the outputs last commanded: idle first, as on any release.
-    if ((stale_choice_ & allocation::kPoll) != 0) idle_poll_before_release(now);
     return Step::kReleaseStalePoll;
   }
   return Step::kVendor;
@@ -1158,6 +1161,9 @@ void Node::idle_poll_before_release(TimePoint now) {
   idle_ = true;
   send_poll(now);
   idle_ = idle;
+  // Its answer is a stray, counted above: no poll of the node's own waits.
+  poll_outstanding_ = false;
+  poll_deadline_ = kNever;
 }
 
 void Node::device_fault(std::string reason, TimePoint now) {
