@@ -211,6 +211,23 @@ TEST(BadInput, BadPollResponsesLoseTheNodeWithItsOutputsIdledFirst) {
   EXPECT_EQ(last_poll->len, 0u) << "an idle poll";
 }
 
+// The answer to a stopping node's idle poll comes bad: the node is released
+// and stops all the same, not held until its port gives up waiting.
+TEST(BadInput, ABadAnswerToTheIdlePollOfAShutdownStillEndsInARelease) {
+  sim::SimRack rack(rack_config({6}));
+  rack.start();
+  ASSERT_TRUE(rack.world().run_until([&] { return rack.all_online(); }, seconds(20)));
+  // Every poll response from here on loses a byte.
+  rack.world().bus().faults().add(
+      sim::FaultRule::corrupt(0x3C0 + 6, sim::Corruption::kTruncate, 1));
+  const auto& node = *rack.scanner().node(mac(6));
+  const auto errors = node.counters().errors;
+  rack.scanner().stop(rack.now());
+  ASSERT_TRUE(rack.world().run_until([&] { return rack.scanner().stopped(); }, seconds(2)));
+  EXPECT_EQ(node.state(), NodeState::kStopped) << node.reason();
+  EXPECT_GT(node.counters().errors, errors) << "the answer was a bad one";
+}
+
 // An analog input off the 0..4095 scale (a failed converter, 4096 and
 // 0xFFFF): that channel is marked and counted; the discrete inputs and the
 // other channel of the same responses keep coming, so an alarm that comes

@@ -287,6 +287,9 @@ class Node final : private ExplicitClient::Listener {
   void lose(std::string reason, TimePoint now);
   // Timers stopped, connections and requests dropped, nothing sent.
   void forget_connections(Errc why, TimePoint now);
+  // The answer to a shutting-down node's poll came: its idle poll next, or,
+  // that answered, the Release.
+  void continue_shutdown(TimePoint now);
   void release_for_shutdown(TimePoint now);
   // Into a fault state, re-checked after fault_recheck; an online node's
   // outputs idle with one poll first, then what it holds is released.

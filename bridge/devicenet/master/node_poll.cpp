@@ -146,6 +146,14 @@ void Node::on_poll_response(Bytes payload, TimePoint now) {
   if (f.outcome == IoFrame::kComplete || f.outcome == IoFrame::kWrongSize) io_reassembler_.reset();
 }
 
+void Node::continue_shutdown(TimePoint now) {
+  if (outputs_dirty_) {
+    send_poll(now);  // the idle poll, after the one that was outstanding
+  } else {
+    release_for_shutdown(now);
+  }
+}
+
 void Node::accept_poll_response(Bytes data, TimePoint now) {
   if (!poll_outstanding_) {
     // Late: the poll timed out, but the data is the device's and current.
@@ -167,11 +175,7 @@ void Node::accept_poll_response(Bytes data, TimePoint now) {
   }
   if (reports_data_) observer_.on_poll_response(config_.mac, data, now);
   if (shutting_down_) {
-    if (outputs_dirty_) {
-      send_poll(now);  // the idle poll, after the one that was outstanding
-    } else {
-      release_for_shutdown(now);
-    }
+    continue_shutdown(now);
     return;
   }
   if (outputs_dirty_ && config_.immediate_poll_on_change) poll_on_change(now);
@@ -184,6 +188,11 @@ void Node::bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint 
   if (state_ != NodeState::kOnline) return;
   poll_outstanding_ = false;
   poll_deadline_ = kNever;
+  if (shutting_down_) {
+    // Answered, if badly: the shutdown goes on as after a good answer.
+    continue_shutdown(now);
+    return;
+  }
   if (++consecutive_errors_ >= port_.max_consecutive_errors) {
     // The poll connection lives (the device answers): idle and released now,
     // not left to the device's watchdog with the outputs last commanded.
