@@ -100,6 +100,10 @@ std::optional<unsigned> number_after(std::string_view keyword, std::string_view 
 
 }  // namespace
 
+bool EdsFile::param_left_out(unsigned number) const noexcept {
+  return std::find(params_left_out.begin(), params_left_out.end(), number) != params_left_out.end();
+}
+
 std::optional<unsigned> param_number(std::string_view name) noexcept {
   return number_after(name, "Param");
 }
@@ -179,6 +183,11 @@ class Reader {
     }
     cross_check(file);
     if (out_.errors > 0) return std::nullopt;
+    // In a file read without an error, an entry found wrong was left out
+    // with a warning.
+    for (const std::string& key : failed_) {
+      if (auto n = number_after(key, "Param")) file.params_left_out.push_back(*n);
+    }
     return file;
   }
 

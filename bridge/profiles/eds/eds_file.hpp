@@ -162,9 +162,13 @@ struct EdsFile {
   Device device;
   IoInfo io;
   std::vector<Param> params;
+  // The N of each ParamN entry left out (a warning says why, at its line):
+  // an assembly member may still name it; its bits are then not read.
+  std::vector<unsigned> params_left_out;
   std::vector<Assembly> assemblies;
 
   const Param* param(unsigned number) const noexcept;
+  bool param_left_out(unsigned number) const noexcept;
   // The parameter `name` names: "ParamN", or a name (any case) no other
   // parameter has. nullptr when none does, or several (params_named()).
   const Param* param(std::string_view name) const noexcept;

@@ -320,6 +320,10 @@ TEST(EdsFile, AParameterOfATypeNotReadIsLeftOutWithAWarning) {
                     "[Assembly]\nAssem1 = \"a\", , 32, 0, , , 32, Param1;\n"));
   ASSERT_TRUE(parsed.file.has_value()) << all(parsed);
   EXPECT_TRUE(parsed.file->params.empty());
+  // The assembly still names it; the file says it was left out.
+  EXPECT_EQ(parsed.file->params_left_out, std::vector<unsigned>{1});
+  EXPECT_TRUE(parsed.file->param_left_out(1));
+  EXPECT_FALSE(parsed.file->param_left_out(2));
   ASSERT_EQ(parsed.problems.size(), 1u) << all(parsed);
   EXPECT_EQ(parsed.problems[0].severity, Problem::Severity::kWarning);
   EXPECT_EQ(parsed.problems[0].line, 4u);
