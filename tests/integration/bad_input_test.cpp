@@ -228,6 +228,47 @@ TEST(BadInput, ABadAnswerToTheIdlePollOfAShutdownStillEndsInARelease) {
   EXPECT_GT(node.counters().errors, errors) << "the answer was a bad one";
 }
 
+// Stopped while a poll is outstanding, and neither it nor the idle poll
+// after it is answered: the idle poll still goes before the Release, so a
+// device that keeps its outputs on a Release does not keep the pump on.
+TEST(BadInput, AStopWhoseOutstandingPollGoesUnansweredStillPollsIdleFirst) {
+  auto config = rack_config({6});
+  config.create_devices = false;
+  sim::SimRack rack(std::move(config));
+  sim::SlaveOptions options = sim::default_slave_options(mac(6));
+  options.release_keeps_outputs = true;
+  rack.add_device(std::move(options), std::nullopt);
+  rack.start();
+  ASSERT_TRUE(rack.world().run_until([&] { return rack.all_online(); }, seconds(20)));
+  profiles::cdn127::PumpOutputs on;
+  on.pump_on = true;
+  ASSERT_TRUE(rack.pumps().command(mac(6), on, rack.now()).ok());
+  rack.world().run_for(milliseconds(300));
+  ASSERT_TRUE(rack.device(mac(6)).device().outputs().pump_on);
+
+  // From here on no poll is answered; stop right after a poll went out.
+  rack.world().bus().faults().add(sim::FaultRule::drop(0x3C0 + 6));
+  const std::uint32_t poll = devicenet::group2_id(mac(6), devicenet::Group2Message::kMasterIoPoll);
+  std::vector<can::CanFrame> to_node;
+  bool polled = false;
+  rack.world().bus().set_tap([&](const sim::WireFrame& w) {
+    polled = polled || w.frame.id == poll;
+    if ((w.frame.id & 0x7F8) == (poll & 0x7F8) && polled) to_node.push_back(w.frame);
+  });
+  ASSERT_TRUE(rack.world().run_until([&] { return polled; }, seconds(1)));
+  to_node.clear();
+  rack.scanner().stop(rack.now());
+  ASSERT_TRUE(rack.world().run_until([&] { return rack.scanner().stopped(); }, seconds(2)));
+  EXPECT_FALSE(rack.device(mac(6)).device().outputs().pump_on) << "released with the pump on";
+  // On the wire after the stop: the idle poll, then the Release.
+  ASSERT_GE(to_node.size(), 2u);
+  EXPECT_EQ(to_node[0].id, poll);
+  EXPECT_EQ(to_node[0].len, 0u);
+  EXPECT_EQ(to_node[1].id,
+            devicenet::group2_id(mac(6), devicenet::Group2Message::kUnconnectedExplicitRequest));
+  EXPECT_EQ(to_node[1].data[1], 0x4C);
+}
+
 // An analog input off the 0..4095 scale (a failed converter, 4096 and
 // 0xFFFF): that channel is marked and counted; the discrete inputs and the
 // other channel of the same responses keep coming, so an alarm that comes

@@ -230,8 +230,10 @@ void Node::on_timer(TimePoint now) {
     poll_deadline_ = kNever;
     ++counters_.timeouts;
     record(NodeError::Kind::kPollTimeout, now);
-    // The idle poll of a shutdown went unanswered: release all the same.
-    if (shutting_down_) release_for_shutdown(now);
+    // A stopping node's poll went unanswered: its idle poll next, if the
+    // one outstanding was not it; the Release once the idle poll is answered
+    // or goes unanswered.
+    if (shutting_down_) continue_shutdown(now);
   }
   if (shutting_down_) return;
   // The device drops the connection after 4 x EPR without a poll; the master

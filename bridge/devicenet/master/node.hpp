@@ -287,8 +287,8 @@ class Node final : private ExplicitClient::Listener {
   void lose(std::string reason, TimePoint now);
   // Timers stopped, connections and requests dropped, nothing sent.
   void forget_connections(Errc why, TimePoint now);
-  // The answer to a shutting-down node's poll came: its idle poll next, or,
-  // that answered, the Release.
+  // A shutting-down node's poll was answered (well or badly) or timed out:
+  // its idle poll next, or, that one done, the Release.
   void continue_shutdown(TimePoint now);
   void release_for_shutdown(TimePoint now);
   // Into a fault state, re-checked after fault_recheck; an online node's
