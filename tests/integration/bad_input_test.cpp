@@ -3,6 +3,7 @@
 // order are counted, logged at a limited rate, and polling goes on.
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 
 #include "bridge/devicenet/wire/identifier.hpp"
@@ -149,17 +150,13 @@ TEST(BadInput, CorruptedPollResponsesAreCountedNotTaken) {
   EXPECT_EQ(rack.pumps().pump(mac(6))->inputs.analog_inputs_raw[0], 1234);
 }
 
-// Ten bad poll responses in a row while the pump runs: the node is lost, and
-// its outputs go idle with one poll before the connections are released. The
-// device is not left with the outputs last commanded until its own watchdog,
-// nor released with them (what a device does on a Release, the manual does
-// not say).
-TEST(BadInput, BadPollResponsesLoseTheNodeWithItsOutputsIdledFirst) {
+// Node 6 online on a device that keeps its outputs on a Release (only an
+// idle poll turns its pump off), commanded on with the analog output at 777.
+void start_running_pump_that_keeps_outputs_on_release(std::unique_ptr<sim::SimRack>& out) {
   auto config = rack_config({6});
   config.create_devices = false;
-  sim::SimRack rack(std::move(config));
-  // A device that keeps its outputs on a Release: only the idle poll turns
-  // the pump off.
+  out = std::make_unique<sim::SimRack>(std::move(config));
+  sim::SimRack& rack = *out;
   sim::SlaveOptions options = sim::default_slave_options(mac(6));
   options.release_keeps_outputs = true;
   rack.add_device(std::move(options), std::nullopt);
@@ -171,6 +168,17 @@ TEST(BadInput, BadPollResponsesLoseTheNodeWithItsOutputsIdledFirst) {
   ASSERT_TRUE(rack.pumps().command(mac(6), on, rack.now()).ok());
   rack.world().run_for(milliseconds(300));
   ASSERT_EQ(rack.device(mac(6)).device().outputs(), on);
+}
+
+// Ten bad poll responses in a row while the pump runs: the node is lost, and
+// its outputs go idle with one poll before the connections are released. The
+// device is not left with the outputs last commanded until its own watchdog,
+// nor released with them (what a device does on a Release, the manual does
+// not say).
+TEST(BadInput, BadPollResponsesLoseTheNodeWithItsOutputsIdledFirst) {
+  std::unique_ptr<sim::SimRack> running;
+  ASSERT_NO_FATAL_FAILURE(start_running_pump_that_keeps_outputs_on_release(running));
+  sim::SimRack& rack = *running;
 
   // The master's frames to node 6 from here on.
   std::vector<can::CanFrame> to_node;
@@ -232,19 +240,9 @@ TEST(BadInput, ABadAnswerToTheIdlePollOfAShutdownStillEndsInARelease) {
 // after it is answered: the idle poll still goes before the Release, so a
 // device that keeps its outputs on a Release does not keep the pump on.
 TEST(BadInput, AStopWhoseOutstandingPollGoesUnansweredStillPollsIdleFirst) {
-  auto config = rack_config({6});
-  config.create_devices = false;
-  sim::SimRack rack(std::move(config));
-  sim::SlaveOptions options = sim::default_slave_options(mac(6));
-  options.release_keeps_outputs = true;
-  rack.add_device(std::move(options), std::nullopt);
-  rack.start();
-  ASSERT_TRUE(rack.world().run_until([&] { return rack.all_online(); }, seconds(20)));
-  profiles::cdn127::PumpOutputs on;
-  on.pump_on = true;
-  ASSERT_TRUE(rack.pumps().command(mac(6), on, rack.now()).ok());
-  rack.world().run_for(milliseconds(300));
-  ASSERT_TRUE(rack.device(mac(6)).device().outputs().pump_on);
+  std::unique_ptr<sim::SimRack> running;
+  ASSERT_NO_FATAL_FAILURE(start_running_pump_that_keeps_outputs_on_release(running));
+  sim::SimRack& rack = *running;
 
   // From here on no poll is answered; stop right after a poll went out.
   rack.world().bus().faults().add(sim::FaultRule::drop(0x3C0 + 6));
