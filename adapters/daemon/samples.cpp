@@ -91,9 +91,9 @@ void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string
 
 namespace {
 
-void fill_safe_state(dnbridge_SafeState& out, const rack::PumpView& v) {
-  out.known = v.safe_state.has_value();
-  out.source = v.safe_state_source == cdn127::SafeStateSource::kDevice
+void fill_safe_state(dnbridge_NodeStatus& out, const rack::PumpView& v) {
+  out.safe_state_known = v.safe_state.has_value();
+  out.safe_state_source = v.safe_state_source == cdn127::SafeStateSource::kDevice
                    ? dnbridge_SAFE_STATE_DEVICE
                    : dnbridge_SAFE_STATE_CONFIGURED;
   const auto unknown = dnbridge_SAFE_ACTION_UNKNOWN;
@@ -106,7 +106,8 @@ void fill_safe_state(dnbridge_SafeState& out, const rack::PumpView& v) {
   out.analog_output_fault_raw = s ? s->analog_fault.raw : 0;
   out.analog_output_on_idle = s ? to_idl(s->analog_idle) : unknown;
   out.analog_output_idle_raw = s ? s->analog_idle.raw : 0;
-  set_string(out.text, s ? std::string_view(v.safe_state_text) : std::string_view{"not read yet"});
+  set_string(out.safe_state_text,
+             s ? std::string_view(v.safe_state_text) : std::string_view{"not read yet"});
 }
 
 }  // namespace
@@ -201,7 +202,7 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
         fmt::format("analog input {}: {} counts, above {}", i + 1, *raw, cdn127::kAnalogMaxRaw);
   }
   set_string(out.invalid_inputs, invalid);
-  fill_safe_state(out.safe_state, v);
+  fill_safe_state(out, v);
   set_string(out.idle_reason, v.idle_reason());
   out.counters.responses_with_invalid_inputs = v.responses_with_invalid_inputs;
 }
@@ -212,14 +213,13 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   // Its safe state is the EDS parameters the configuration gives: no
   // CDN127 action to name, the values read back in words.
   const auto unknown = dnbridge_SAFE_ACTION_UNKNOWN;
-  auto& safe = out.safe_state;
-  safe.known = !v.safe_state_text.empty();
-  safe.source = dnbridge_SAFE_STATE_CONFIGURED;
-  safe.pump_on_fault = safe.pump_on_idle = safe.n2_ballast_on_fault = safe.n2_ballast_on_idle =
-      safe.analog_output_on_fault = safe.analog_output_on_idle = unknown;
-  safe.analog_output_fault_raw = safe.analog_output_idle_raw = 0;
-  set_string(safe.text,
-             safe.known ? std::string_view(v.safe_state_text) : std::string_view{"not read yet"});
+  out.safe_state_known = !v.safe_state_text.empty();
+  out.safe_state_source = dnbridge_SAFE_STATE_CONFIGURED;
+  out.pump_on_fault = out.pump_on_idle = out.n2_ballast_on_fault = out.n2_ballast_on_idle =
+      out.analog_output_on_fault = out.analog_output_on_idle = unknown;
+  out.analog_output_fault_raw = out.analog_output_idle_raw = 0;
+  set_string(out.safe_state_text, out.safe_state_known ? std::string_view(v.safe_state_text)
+                                                       : std::string_view{"not read yet"});
   set_string(out.idle_reason, v.idle_reason());
 }
 

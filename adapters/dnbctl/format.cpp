@@ -357,10 +357,10 @@ void pump_json(JsonWriter& out, const dnbridge_PumpState& s) { pump_record(s).wr
 
 namespace {
 
-Record safe_state_record(const dnbridge_SafeState& s) {
+Record safe_state_record(const dnbridge_NodeStatus& s) {
   Record r;
-  r.json("known", static_cast<bool>(s.known))
-      .json("source", s.source == dnbridge_SAFE_STATE_DEVICE ? "device" : "configured")
+  r.json("known", static_cast<bool>(s.safe_state_known))
+      .json("source", s.safe_state_source == dnbridge_SAFE_STATE_DEVICE ? "device" : "configured")
       .json("pump_on_fault", dds::name_of(s.pump_on_fault))
       .json("pump_on_idle", dds::name_of(s.pump_on_idle))
       .json("n2_ballast_on_fault", dds::name_of(s.n2_ballast_on_fault))
@@ -369,7 +369,7 @@ Record safe_state_record(const dnbridge_SafeState& s) {
       .json("analog_output_fault_raw", s.analog_output_fault_raw)
       .json("analog_output_on_idle", dds::name_of(s.analog_output_on_idle))
       .json("analog_output_idle_raw", s.analog_output_idle_raw)
-      .json("text", view(s.text));
+      .json("text", view(s.safe_state_text));
   return r;
 }
 
@@ -536,11 +536,11 @@ Record node_record(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
   }
   if (device) add_device_data(r, *device);
   r.add("safe state",
-        fmt::format("{} ({})", view(n.safe_state.text),
-                    n.safe_state.source == dnbridge_SAFE_STATE_DEVICE
+        fmt::format("{} ({})", view(n.safe_state_text),
+                    n.safe_state_source == dnbridge_SAFE_STATE_DEVICE
                         ? "the device's own, kept"
                         : "from the configuration, read back"),
-        "safe_state", Json::object(safe_state_record(n.safe_state)))
+        "safe_state", Json::object(safe_state_record(n)))
       .add("device faults", none_if_empty(view(n.device_faults)), "device_faults",
            view(n.device_faults))
       .json("idle_reason", view(n.idle_reason))

@@ -132,10 +132,10 @@ TEST_F(DeviceTest, DeviceStateCarriesTheDataAndTheEdsFields) {
   EXPECT_EQ(device_param(9), 0x40);
   ASSERT_TRUE(nodes_.until([&] {
     const auto* n = nodes_.latest(pump_mac(kDevice));
-    return n && n->safe_state.known;
+    return n && n->safe_state_known;
   }));
   const auto* n = nodes_.latest(pump_mac(kDevice));
-  EXPECT_EQ(dds::view(n->safe_state.text),
+  EXPECT_EQ(dds::view(n->safe_state_text),
             "Param6 Output fault action = 0; Param7 Output fault value = 0; Param8 Output idle "
             "action = 0; Param9 Output idle value = 64");
   EXPECT_EQ(n->vendor_id, 65001);

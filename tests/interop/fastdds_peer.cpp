@@ -221,7 +221,7 @@ class Peer {
       std::ostringstream o;
       o << "state=" << static_cast<int>(node.state()) << " product=" << node.product_name()
         << " vendor=" << node.vendor_id() << " polls=" << (node.counters().polls() > 0 ? 1 : 0)
-        << " safe=" << node.safe_state().text();
+        << " safe=" << node.safe_state_text();
       auto& line = nodes_[Key{node.rack(), node.port(), node.mac()}];
       if (o.str() != line) {
         line = o.str();
