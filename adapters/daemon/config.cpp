@@ -255,6 +255,14 @@ constexpr std::int64_t kMaxPollBatchMs = 1000;
 constexpr std::int64_t kMaxResponseTimeoutMs =
     60'000;  // cut to a quarter of each node's poll period
 constexpr double kAnalogFullScaleVolts = 10.0;
+// A command refresh shorter than a DDS write's round trip under load would
+// idle a healthy commander's pumps; longer than ten minutes is no bound.
+constexpr std::int64_t kMinCommandRefreshMs = 50;
+constexpr std::int64_t kMaxCommandRefreshMs = 600'000;
+// A lease shorter than this would have a commander lose its pumps on any
+// hiccup of its host; longer than ten minutes is no bound.
+constexpr std::int64_t kMinCommanderLeaseMs = 100;
+constexpr std::int64_t kMaxCommanderLeaseMs = 600'000;
 
 // The keys of the outputs' safe state, and where each goes.
 struct SafeStateKey {
@@ -382,6 +390,20 @@ void read_resume(const Layers& layers, NodeSettings& s, Problems& r) {
 
 // Reads every setting a node and [defaults] share into `s`, which holds the
 // built-in values to start with.
+// command_refresh_ms: 0 (off), or how often a commander must write a
+// node's command for it to stay in force.
+std::optional<Duration> read_command_refresh(const toml::node& n, Problems& r) {
+  auto v = read_ms(n, "command_refresh_ms", 0, kMaxCommandRefreshMs, r);
+  if (v && *v > Duration::zero() && *v < milliseconds(kMinCommandRefreshMs)) {
+    r.error(n.source(),
+            fmt::format("command_refresh_ms = {} is too short: use 0 (off) or {}..{} ms",
+                        std::chrono::duration_cast<milliseconds>(*v).count(), kMinCommandRefreshMs,
+                        kMaxCommandRefreshMs));
+    return std::nullopt;
+  }
+  return v;
+}
+
 void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
   if (Found f = layers.find("profile"); f.value) {
     if (auto v = read_string(*f.value, "profile", r)) {
@@ -511,6 +533,9 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
                 fmt::format("no_commander = \"{}\" is not a policy: use \"idle\" or \"hold\"", *v));
       }
     }
+  }
+  if (Found f = layers.find("command_refresh_ms"); f.value) {
+    if (auto v = read_command_refresh(*f.value, r)) s.pump.command_refresh = *v;
   }
   if (cdn127) read_safe_state(layers, s, r);
   read_resume(layers, s, r);
@@ -863,6 +888,10 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
             "allocate_retry_max_ms is shorter than allocate_retry_min_ms");
   }
 
+  if (const toml::node* n = t.get("command_refresh_ms")) {
+    port.command_refresh = read_command_refresh(*n, r);
+  }
+
   read_port_nodes(t, table, port, defaults, ctx, r);
   if (const toml::node* n = t.get("simulated_unconfigured")) {
     read_simulated_unconfigured(*n, port, r);
@@ -941,6 +970,10 @@ void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
       ok = false;
     }
     read_node_settings(Layers{&nt, defaults}, s, r);
+    // The port's command refresh before [defaults]', after the node's own.
+    if (port.command_refresh && !nt.get("command_refresh_ms")) {
+      s.pump.command_refresh = *port.command_refresh;
+    }
     if (s.is_eds()) {
       read_eds_node(nt, ctx, s, r);
     } else {
@@ -1059,6 +1092,12 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadCo
   }
   if (const toml::node* n = root.get("master_mac")) {
     if (auto v = read_mac(*n, "master_mac", r)) config.master_mac = *v;
+  }
+  if (const toml::node* n = root.get("max_commander_lease_ms")) {
+    if (auto v = read_ms(*n, "max_commander_lease_ms", kMinCommanderLeaseMs, kMaxCommanderLeaseMs,
+                         r)) {
+      config.max_commander_lease = *v;
+    }
   }
   if (const toml::node* n = root.get("log_level")) {
     if (auto v = read_string(*n, "log_level", r)) {
@@ -1195,6 +1234,7 @@ rack::DeviceConfig NodeSettings::device() const {
   d.node = pump.node;
   d.no_commander = pump.no_commander;
   d.resume = pump.resume;
+  d.command_refresh = pump.command_refresh;
   d.eds = eds;
   d.eds_path = eds_path;
   d.eds_digest = eds_digest;

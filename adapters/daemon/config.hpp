@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "adapters/dds/topics.hpp"
 #include "adapters/security/settings.hpp"
 #include "adapters/socketcan/socketcan_backend.hpp"
 #include "bridge/common/log.hpp"
@@ -82,6 +83,9 @@ struct PortConfig {
   // (host_identity.hpp), so that bridges on one bus differ.
   std::optional<std::uint32_t> master_serial_number;
   std::vector<NodeSettings> nodes;
+  // The port's command_refresh_ms, for its nodes that give none of their
+  // own (else [defaults]'s, else off).
+  std::optional<Duration> command_refresh;
   // interface = "simulated" only: simulated CDN127s on the bus at MACs the
   // configuration does not have (simulated_unconfigured = [17]), as a
   // device with its MAC switch set wrong would be.
@@ -98,6 +102,11 @@ struct DaemonConfig {
   // port ([explicit_policy]); by default, nothing that takes a node's
   // connections, outputs or configuration from the bridge.
   rack::ExplicitPolicy explicit_policy;
+  // The longest liveliness lease a command writer may offer
+  // (max_commander_lease_ms): the longest a commander that froze, or whose
+  // host stalled or was cut off, holds the outputs it commands. A writer
+  // offering a longer lease, or an infinite one, does not command.
+  Duration max_commander_lease = dds::kDefaultMaxCommanderLease;
   // DDS Security of the bridge's participant ([security]); none: Cyclone's
   // XML configuration decides (CYCLONEDDS_URI), by default no security.
   std::optional<security::Settings> security;

@@ -103,7 +103,17 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends, Reloa
     by_name[p.name] = ports_.back().get();
   }
   input_.emplace(participant_, publisher_, config_.rack, std::move(by_name),
-                 Logger(log, "dds input"), [this](ReloadCall call) { request_reload(call); });
+                 Logger(log, "dds input"), [this](ReloadCall call) { request_reload(call); },
+                 config_.max_commander_lease);
+  publisher_.set_max_commander_lease(config_.max_commander_lease);
+  EndpointWatch::Settings watch;
+  watch.rack = config_.rack;
+  watch.max_commander_lease = config_.max_commander_lease;
+  watch.nodes_with_refresh = [this](std::uint32_t ms) { return nodes_with_refresh(ms); };
+  watch.counted = [this](std::uint32_t refused, std::uint32_t unmatched) {
+    publisher_.set_endpoint_counts(refused, unmatched);
+  };
+  endpoints_.emplace(participant_, std::move(watch), Logger(log, "dds endpoints"));
   if (metrics_) {
     metrics_server_.emplace(*config_.metrics_listen, metrics_);
     const auto listening = metrics_server_->ports();
@@ -161,11 +171,28 @@ void Daemon::start() {
   reload_thread_ = std::thread([this] { run_reloads(); });
   port::name_thread(reload_thread_, "reload");
   input_->start();
+  endpoints_->start();
+}
+
+std::string Daemon::nodes_with_refresh(std::uint32_t ms) const {
+  std::string out;
+  for (const auto& p : ports_) {
+    std::string macs;
+    for (unsigned m = 0; m <= devicenet::MacId::kMax; ++m) {
+      const auto mac = *devicenet::MacId::from(m);
+      if (p->has_node(mac) && p->command_refresh_ms(mac) == ms) {
+        macs += fmt::format("{}{}", macs.empty() ? "" : ", ", m);
+      }
+    }
+    if (!macs.empty()) out += fmt::format("{}port {}: {}", out.empty() ? "" : "; ", p->name(), macs);
+  }
+  return out;
 }
 
 void Daemon::stop() {
   if (!running_) return;
   running_ = false;
+  endpoints_->stop();
   input_->stop();
   {
     std::lock_guard lock(reloads_mutex_);

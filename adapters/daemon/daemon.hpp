@@ -14,6 +14,7 @@
 
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/dds_input.hpp"
+#include "adapters/daemon/endpoint_watch.hpp"
 #include "adapters/daemon/dds_publisher.hpp"
 #include "adapters/daemon/reload.hpp"
 #include "adapters/dds/participant.hpp"
@@ -112,6 +113,9 @@ class Daemon {
   std::optional<port::PublisherTee> tee_;
   std::vector<std::unique_ptr<port::PortLoop>> ports_;
   std::optional<DdsInput> input_;
+  std::optional<EndpointWatch> endpoints_;
+  // The nodes of every port with a command refresh of `ms`, in words.
+  std::string nodes_with_refresh(std::uint32_t ms) const;
   // Last: no scrape reads the publisher or the input once they are gone.
   std::optional<metrics::MetricsServer> metrics_server_;
   bool running_ = false;

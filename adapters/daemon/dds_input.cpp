@@ -129,16 +129,17 @@ void DrainFirstLogSink::write_structured(LogLevel level, std::string_view compon
 
 DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
                    std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log,
-                   std::function<void(ReloadCall)> reload)
+                   std::function<void(ReloadCall)> reload, Duration max_commander_lease)
     : rack_(std::move(rack)),
       publisher_(publisher),
       ports_(std::move(ports)),
       log_(std::move(log)),
       partition_{dds::rack_partition(rack_)},
       commands_held_(participant),
+      participant_(participant),
+      command_topic_(publisher.command_topic()),
+      max_commander_lease_(max_commander_lease),
       command_listener_([this] { on_commands_available(); }),
-      commands_(participant, publisher.command_topic(), dds::command_reader_qos(partition_),
-                command_listener_.get()),
       requests_(participant, publisher.request_topic(), dds::request_reader_qos(partition_)),
       reload_(std::move(reload)),
       command_buffer_(kBatch),
@@ -151,10 +152,12 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       command_log_(log_.to(command_sink_)),
       own_sink_(log_.sink(), [this] { drain_command_log(); }) {
   log_ = log_.to(own_sink_);
-  device_commands_ = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)", [&] {
-    return DeviceCommandsIn(participant, dds::command_reader_qos(partition_),
-                            command_listener_.get());
-  });
+  device_command_topic_ = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)",
+                                       [&] { return dds::Topic<dnbridge_DeviceCommand>(participant); });
+  {
+    std::lock_guard lock(command_take_mutex_);
+    ensure_command_classes();
+  }
   // Readers of the services that DDS Security grants (the publisher has
   // their topics), each as far as it grants it.
   if (const auto* topic = publisher.scan_request_topic()) {
@@ -173,8 +176,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   // is set, and taking resets only DATA_AVAILABLE: with the default mask
   // (every status) a matched writer's SUBSCRIPTION_MATCHED, never read here,
   // would keep the waitset triggered and this thread spinning.
-  std::vector<const dds::Entity*> readers{&commands_, &requests_};
-  if (device_commands_) readers.push_back(&device_commands_->reader);
+  std::vector<const dds::Entity*> readers{&requests_};
   if (scan_requests_) readers.push_back(&*scan_requests_);
   if (reload_requests_) readers.push_back(&*reload_requests_);
   for (const dds::Entity* reader : readers) {
@@ -203,8 +205,13 @@ void DdsInput::start() {
 void DdsInput::stop() {
   accepting_ = false;
   // No listener call after this: none is handing a command to a port.
-  (void)dds::DataListener::detach(commands_);
-  if (device_commands_) (void)dds::DataListener::detach(device_commands_->reader);
+  {
+    std::lock_guard lock(command_take_mutex_);
+    for (const auto& c : command_classes_) {
+      (void)dds::DataListener::detach(c->pumps);
+      if (c->devices) (void)dds::DataListener::detach(*c->devices);
+    }
+  }
   if (!thread_.joinable()) return;
   (void)stop_.trigger();
   thread_.join();
@@ -264,6 +271,54 @@ void DdsInput::run() {
       deliver_commands();
     }
     requests_left = requests && take_requests();
+    if (refresh_generations() != classes_for_generation_) {
+      {
+        std::lock_guard lock(command_take_mutex_);
+        ensure_command_classes();
+      }
+      commands_pending_ = true;  // any that came while the new readers were made
+      deliver_commands();
+    }
+  }
+}
+
+std::uint64_t DdsInput::refresh_generations() const {
+  std::uint64_t sum = 0;
+  for (const auto& [name, loop] : ports_) sum += loop->refresh_generation();
+  return sum;
+}
+
+void DdsInput::ensure_command_classes() {
+  classes_for_generation_ = refresh_generations();
+  std::vector<std::uint32_t> wanted{0};
+  for (const auto& [name, loop] : ports_) {
+    for (unsigned m = 0; m <= devicenet::MacId::kMax; ++m) {
+      const std::uint32_t ms = loop->command_refresh_ms(*devicenet::MacId::from(m));
+      if (ms != 0 && std::find(wanted.begin(), wanted.end(), ms) == wanted.end()) {
+        wanted.push_back(ms);
+      }
+    }
+  }
+  for (const std::uint32_t ms : wanted) {
+    if (std::any_of(command_classes_.begin(), command_classes_.end(),
+                    [&](const auto& c) { return c->refresh_ms == ms; })) {
+      continue;
+    }
+    const auto deadline = ms == 0 ? std::nullopt : std::optional<Duration>(milliseconds(ms));
+    const dds::Qos qos = dds::command_reader_qos(partition_, max_commander_lease_, deadline);
+    auto made = std::make_unique<CommandClass>(CommandClass{
+        ms, dds::Reader<dnbridge_PumpCommand>(participant_, command_topic_, qos,
+                                              command_listener_.get()),
+        std::nullopt});
+    if (device_command_topic_) {
+      made->devices.emplace(participant_, *device_command_topic_, qos, command_listener_.get());
+    }
+    if (ms != 0) {
+      log_.info("commands of the nodes with command_refresh_ms = {} are taken from writers "
+                "offering a deadline of at most {} ms",
+                ms, ms);
+    }
+    command_classes_.push_back(std::move(made));
   }
 }
 
@@ -297,25 +352,33 @@ void DdsInput::deliver_commands() {
 }
 
 void DdsInput::take_commands() {
-  take_batches(
-      [this] { return commands_.take(command_buffer_); }, command_buffer_.capacity(), 0,
-      command_log_, "pump commands",
-      [this](std::size_t i) { on_command(command_buffer_.data(i), command_buffer_.info(i)); });
-  if (!device_commands_) return;
-  take_batches([this] { return device_commands_->reader.take(device_command_buffer_); },
-               device_command_buffer_.capacity(), 0, command_log_, "device commands",
-               [this](std::size_t i) {
-                 on_device_command(device_command_buffer_.data(i), device_command_buffer_.info(i));
-               });
+  for (const auto& cls : command_classes_) {
+    const CommandClass& from = *cls;
+    take_batches([&] { return from.pumps.take(command_buffer_); }, command_buffer_.capacity(), 0,
+                 command_log_, "pump commands", [&](std::size_t i) {
+                   on_command(command_buffer_.data(i), command_buffer_.info(i), from);
+                 });
+    if (!from.devices) continue;
+    take_batches([&] { return from.devices->take(device_command_buffer_); },
+                 device_command_buffer_.capacity(), 0, command_log_, "device commands",
+                 [&](std::size_t i) {
+                   on_device_command(device_command_buffer_.data(i),
+                                     device_command_buffer_.info(i), from);
+                 });
+  }
 }
 
 template <class Command>
-port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info, bool device) {
+port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info, bool device,
+                                   const CommandClass& from) {
   port::PortLoop* loop = port_of(dds::view(c.port));
   const auto mac = devicenet::MacId::from(c.mac);
   const bool node = loop && mac && loop->has_node(*mac);
   const bool pump = node && loop->has_pump(*mac);
-  if (node && pump != device) return loop;
+  // Every class's readers have every instance: a node's commands are its
+  // own class's, and a refusal is said once, by the class without refresh.
+  if (node && pump != device) return loop->command_refresh_ms(*mac) == from.refresh_ms ? loop : nullptr;
+  if (from.refresh_ms != 0) return nullptr;
   command_warn_limit_.warn(
       command_log_, port::steady_now(), "{} command{} for port \"{}\" MAC {} refused: {}",
       device ? "device" : "pump",
@@ -327,20 +390,13 @@ port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info
   return nullptr;
 }
 
-void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info) {
+void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info,
+                          const CommandClass& from) {
   if (dds::view(c.rack) != rack_) return;  // another bridge's pump
+  port::PortLoop* loop = loop_for(c, info, false, from);
+  if (!loop) return;
   if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
-  port::PortLoop* loop = port_of(dds::view(c.port));
   const auto mac = devicenet::MacId::from(c.mac);
-  if (!loop || !mac || !loop->has_pump(*mac)) {
-    command_warn_limit_.warn(
-        command_log_, port::steady_now(), "pump command{} for port \"{}\" MAC {} refused: {}",
-        info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "", dds::view(c.port),
-        c.mac,
-        loop && mac && loop->has_node(*mac) ? "the node is not a pump (its profile is \"eds\")"
-                                            : "not in this rack's configuration");
-    return;
-  }
   // No live commander left for this pump (all writers gone, or disposed):
   // idle. A command taken after its writer left carries that state itself,
   // with no sample of its own to tell it; it is not applied: a commander
@@ -354,11 +410,12 @@ void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& 
   loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
 }
 
-void DdsInput::on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info) {
+void DdsInput::on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info,
+                                 const CommandClass& from) {
   if (dds::view(c.rack) != rack_) return;  // another bridge's device
-  if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
-  port::PortLoop* loop = loop_for(c, info, true);
+  port::PortLoop* loop = loop_for(c, info, true, from);
   if (!loop) return;
+  if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
   const auto mac = devicenet::MacId::from(c.mac);
   // As for a pump (on_command): no live commander left, idle.
   if (info.instance_state() != dds::InstanceState::kAlive) {

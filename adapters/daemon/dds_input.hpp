@@ -4,6 +4,9 @@
 // loop through the loop's inbox; nothing here touches master state.
 // Commands are taken by a listener, on the Cyclone thread that delivers
 // them, and handed over at once (take, push, wake: nothing that waits);
+// one pair of command readers per command refresh the rack's nodes have
+// (their requested deadline: dds::command_reader_qos), each taking only its
+// own nodes' commands, all with the rack's lease bound;
 // under a flood, at most once per hold-off, the rest by the input's own
 // thread at its end. Requests are taken on that thread, from a waitset.
 // Requests for other racks are left to their bridges.
@@ -86,9 +89,11 @@ class DdsInput {
  public:
   // `reload`: called (on the input's thread) with each reload request for
   // this rack; it must return at once (Daemon::request_reload queues it).
+  // `max_commander_lease`: the rack's max_commander_lease_ms.
   DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
            std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log,
-           std::function<void(ReloadCall)> reload = {});
+           std::function<void(ReloadCall)> reload = {},
+           Duration max_commander_lease = dds::kDefaultMaxCommanderLease);
   ~DdsInput();
   DdsInput(const DdsInput&) = delete;
   DdsInput& operator=(const DdsInput&) = delete;
@@ -121,13 +126,23 @@ class DdsInput {
   void take_scan_requests();
   void on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample);
   void take_reload_requests();
-  void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info);
-  void on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info);
+  // The command readers of the nodes with one command refresh (0: none).
+  struct CommandClass;
+  void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info,
+                  const CommandClass& from);
+  void on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info,
+                         const CommandClass& from);
   // The port loop a command sample is for, when the MAC is a node of that
-  // loop of the kind the topic commands (`device`: DeviceCommand); else the
-  // refusal is logged (rate-limited) and null.
+  // loop of the kind the topic commands (`device`: DeviceCommand) and of the
+  // reader's command refresh; else null, and a refusal (a node not in the
+  // rack, or of the other kind) is logged (rate-limited).
   template <class Command>
-  port::PortLoop* loop_for(const Command& c, const dds::SampleInfo& info, bool device);
+  port::PortLoop* loop_for(const Command& c, const dds::SampleInfo& info, bool device,
+                           const CommandClass& from);
+  // A class of command readers for every command refresh the ports' nodes
+  // have now (none is deleted before stop). Under command_take_mutex_.
+  void ensure_command_classes();
+  std::uint64_t refresh_generations() const;
   void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
   template <class Command>
   void note_clock_skew(const Command& c, const dds::SampleInfo& info);
@@ -148,18 +163,22 @@ class DdsInput {
   std::atomic<bool> held_signalled_{false};  // the input thread takes them at the hold-off's end
   std::atomic<TimePoint::rep> next_command_take_{0};  // steady clock ticks
   dds::GuardCondition commands_held_;
-  dds::DataListener command_listener_;  // before the reader: it outlives it
-  dds::Reader<dnbridge_PumpCommand> commands_;
-  // DeviceCommand: its topic and reader (with the same listener); none when
-  // DDS Security does not grant the topic (unless_denied).
-  struct DeviceCommandsIn {
-    DeviceCommandsIn(const dds::Participant& participant, const dds::Qos& qos,
-                     const dds_listener_t* listener)
-        : topic(participant), reader(participant, topic, qos, listener) {}
-    dds::Topic<dnbridge_DeviceCommand> topic;
-    dds::Reader<dnbridge_DeviceCommand> reader;
+  const dds::Participant& participant_;
+  const dds::Topic<dnbridge_PumpCommand>& command_topic_;
+  Duration max_commander_lease_;
+  dds::DataListener command_listener_;  // before the readers: it outlives them
+  // DeviceCommand's topic; none when DDS Security does not grant it
+  // (unless_denied).
+  std::optional<dds::Topic<dnbridge_DeviceCommand>> device_command_topic_;
+  struct CommandClass {
+    std::uint32_t refresh_ms;  // 0: the nodes without a command refresh
+    dds::Reader<dnbridge_PumpCommand> pumps;
+    std::optional<dds::Reader<dnbridge_DeviceCommand>> devices;
   };
-  std::optional<DeviceCommandsIn> device_commands_;
+  // Guarded by command_take_mutex_; classes are added, never removed, while
+  // the input runs (a listener call may be on any of them).
+  std::vector<std::unique_ptr<CommandClass>> command_classes_;
+  std::uint64_t classes_for_generation_ = ~0ull;  // the ports' refresh generations then
   dds::Reader<dnbridge_ExplicitRequest> requests_;
   // Absent when DDS Security does not grant the service (unless_denied).
   std::optional<dds::Reader<dnbridge_BusScanRequest>> scan_requests_;

@@ -117,6 +117,9 @@ void DdsPublisher::port_status(const port::PortStatusView& status, TimePoint sou
   dds::Owned<dnbridge_PortStatus> sample;
   fill_port_status(*sample, rack_, status);
   sample->replies_undelivered = replies_undelivered(status.port);
+  sample->max_commander_lease_ms = max_commander_lease_ms_.load(std::memory_order_relaxed);
+  sample->commanders_refused = commanders_refused_.load(std::memory_order_relaxed);
+  sample->endpoints_unmatched = endpoints_unmatched_.load(std::memory_order_relaxed);
   check_state(port_writer_.write(*sample, clock_.to_wall(source_time)), "PortStatus");
 }
 

@@ -111,6 +111,15 @@ class DdsPublisher final : public port::PortPublisher {
   std::uint64_t state_write_failures() const {
     return state_write_failures_.load(std::memory_order_relaxed);
   }
+  // The rack's figures that every PortStatus carries (any thread).
+  void set_max_commander_lease(Duration lease) {
+    max_commander_lease_ms_ = static_cast<std::uint32_t>(
+        std::chrono::duration_cast<milliseconds>(lease).count());
+  }
+  void set_endpoint_counts(std::uint32_t commanders_refused, std::uint32_t endpoints_unmatched) {
+    commanders_refused_ = commanders_refused;
+    endpoints_unmatched_ = endpoints_unmatched;
+  }
   // Replies handed over at most this many at a time; more are undelivered.
   static constexpr std::size_t kReplyBacklog = 1024;
 
@@ -138,6 +147,9 @@ class DdsPublisher final : public port::PortPublisher {
 
   std::string rack_;
   Logger log_;
+  std::atomic<std::uint32_t> max_commander_lease_ms_{0};
+  std::atomic<std::uint32_t> commanders_refused_{0};
+  std::atomic<std::uint32_t> endpoints_unmatched_{0};
   // The rack's partition, where its replies go (dds::rack_partition).
   std::vector<std::string> partition_;
   WallClock clock_;

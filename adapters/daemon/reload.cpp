@@ -104,6 +104,8 @@ ReloadPlan plan_reload(const DaemonConfig& in_force, const DaemonConfig& next,
       out.push_back("security: its files differ from those in force");
     }
   }
+  differ("max_commander_lease_ms", std::to_string(to_ms(in_force.max_commander_lease)),
+         std::to_string(to_ms(next.max_commander_lease)));
   differ("metrics listen", in_force.metrics_listen.value_or("off"),
          next.metrics_listen.value_or("off"));
   for (const auto& p : next.ports) {

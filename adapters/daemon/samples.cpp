@@ -123,6 +123,8 @@ void fill_node_common(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   set_string(out.name, v.name);
   out.state = to_idl(node.state);
   set_string(out.reason, node.reason);
+  out.command_refresh_ms =
+      static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(v.command_refresh).count());
 
   const auto& id = node.identity;
   out.vendor_id = id.vendor_id;

@@ -37,6 +37,12 @@ Result<std::vector<DiscoveredParticipant>> DiscoveredParticipants::take() const 
         d.user_data.assign(static_cast<const char*>(data), size);
         dds_free(data);
       }
+      dds_liveliness_kind_t kind{};
+      dds_duration_t lease = DDS_INFINITY;
+      if (infos[i].valid_data && p->qos != nullptr && dds_qget_liveliness(p->qos, &kind, &lease) &&
+          lease != DDS_INFINITY) {
+        d.lease = std::chrono::nanoseconds(lease);
+      }
       out.push_back(std::move(d));
     }
     if (n > 0) (void)dds_return_loan(handle(), samples, n);

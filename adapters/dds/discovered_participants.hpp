@@ -14,6 +14,7 @@
 
 #include "adapters/dds/entity.hpp"
 #include "adapters/dds/participant.hpp"
+#include "bridge/common/time.hpp"
 
 namespace dnbridge::dds {
 
@@ -25,6 +26,9 @@ struct DiscoveredParticipant {
   std::string name;   // empty when it gave none (or the sample only tells it left)
   std::string user_data;  // its USER_DATA as text (host_user_data), when it gave some
   bool alive = true;  // false: it left the domain (or was lost)
+  // Its lease (how long it stays known without a sign of life); none:
+  // infinite, or not told.
+  std::optional<Duration> lease;
 };
 
 class DiscoveredParticipants : public Entity {

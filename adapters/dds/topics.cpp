@@ -73,16 +73,19 @@ std::vector<std::string> rack_partitions(std::span<const std::string> racks) {
 
 std::vector<std::string> rack_partitions(std::string_view rack) { return {rack_partition(rack)}; }
 
-Qos command_writer_qos(std::span<const std::string> partitions, int32_t strength, Duration lease) {
+Qos command_writer_qos(std::span<const std::string> partitions, int32_t strength, Duration lease,
+                       std::optional<Duration> deadline) {
   Qos qos = command_common();
   qos.partitions(partitions);
   qos.ownership_strength(strength)
       .liveliness(Liveliness::kAutomatic, lease)
       .autodispose_unregistered_instances(false);
+  if (deadline) qos.deadline(*deadline);
   return qos;
 }
 
-Qos command_reader_qos(std::span<const std::string> partitions) {
+Qos command_reader_qos(std::span<const std::string> partitions, Duration max_lease,
+                       std::optional<Duration> deadline) {
   Qos qos = command_common();
   qos.partitions(partitions);
   // Commands in the order they arrive, whatever their source timestamps:
@@ -90,9 +93,11 @@ Qos command_reader_qos(std::span<const std::string> partitions) {
   // later sample dropped, its own unregistration included, and hold its
   // pumps long after it left. (Any writer's order is compatible with this.)
   qos.destination_order_by_source_timestamp(false);
-  // An infinite requested lease accepts every writer's lease; the writer's
-  // own lease still decides when the reader sees it lose liveliness.
-  qos.liveliness(Liveliness::kAutomatic, kInfinite);
+  // A writer matches when its lease is at most the one requested (any
+  // liveliness kind: automatic is the weakest asked for); its own lease
+  // still decides when the reader sees it lose liveliness.
+  qos.liveliness(Liveliness::kAutomatic, max_lease);
+  qos.deadline(deadline.value_or(kInfinite));
   return qos;
 }
 

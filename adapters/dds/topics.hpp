@@ -123,8 +123,24 @@ Qos state_reader_qos(std::optional<Duration> deadline = std::nullopt);
 // Autodispose is off: a departing stronger writer must only unregister, so
 // that the instance stays alive while a weaker writer still commands it.
 // `partitions`: rack_partitions(...) of the racks written to or read.
-Qos command_writer_qos(std::span<const std::string> partitions, int32_t strength, Duration lease);
-Qos command_reader_qos(std::span<const std::string> partitions);
+//
+// `deadline`, when given: the writer promises to write each instance at
+// least that often. A bridge whose nodes have a command refresh
+// (command_refresh_ms) takes their commands only from writers offering a
+// deadline of at most that.
+Qos command_writer_qos(std::span<const std::string> partitions, int32_t strength, Duration lease,
+                       std::optional<Duration> deadline = std::nullopt);
+// The bridge's: it requests a lease of at most `max_lease`, so that a writer
+// offering a longer one (or an infinite one) does not match, and, for the
+// nodes with a command refresh, a deadline of `deadline` (none: any writer's).
+// A deadline missed lets the next live writer of the instance take it over,
+// whatever its strength, until the stronger one writes again.
+// kDefaultMaxCommanderLease is the bridge's max_commander_lease_ms when its
+// configuration gives none.
+inline constexpr Duration kDefaultMaxCommanderLease = seconds(10);
+Qos command_reader_qos(std::span<const std::string> partitions,
+                       Duration max_lease = kDefaultMaxCommanderLease,
+                       std::optional<Duration> deadline = std::nullopt);
 
 // --- ExplicitRequest / ExplicitReply -------------------------------------------
 // Reliable. A transaction is one instance; keep-last 4 per instance leaves

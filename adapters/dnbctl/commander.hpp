@@ -4,6 +4,7 @@
 // the strongest commands it. When this writer goes (dnbctl exits), the pump passes to the next
 // strongest commander or, with none left, to the bridge's no-commander policy (idle, or hold the
 // last outputs).
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -27,16 +28,27 @@ struct Outputs {
 // (killed, frozen), before it takes a command as gone.
 inline constexpr Duration kCommandLease = seconds(2);
 
+// How often a command is written again while it is held: every second, and
+// four times per command refresh when the node has one, so that a write
+// lost or late on the network still leaves it in force.
+inline Duration rewrite_period(Duration refresh) {
+  return refresh > Duration::zero() ? std::min<Duration>(seconds(1), refresh / 4) : seconds(1);
+}
+
 // A writer of command topic T for the nodes of `rack` (in its partition:
-// only its bridge gets them).
+// only its bridge gets them). `refresh`: the node's command refresh
+// (NodeStatus.command_refresh_ms), offered as the writer's deadline; the
+// command must then be written again at least that often (rewrite_period).
 template <class T>
 class CommandWriter {
  public:
-  CommandWriter(Client& client, std::int32_t strength, const std::string& rack)
+  CommandWriter(Client& client, std::int32_t strength, const std::string& rack,
+                Duration refresh = Duration::zero())
       : topic_(client.participant()),
         writer_(client.participant(), topic_,
-                dds::command_writer_qos(std::vector{dds::rack_partition(rack)}, strength,
-                                        kCommandLease)) {}
+                dds::command_writer_qos(
+                    std::vector{dds::rack_partition(rack)}, strength, kCommandLease,
+                    refresh > Duration::zero() ? std::optional(refresh) : std::nullopt)) {}
 
   // Until a command reader (a bridge) matched; false at the deadline.
   // Commands are volatile: one written before a bridge matched is lost.

@@ -108,6 +108,18 @@ std::string nodes_text(const dnbridge_PortStatus& p) {
   return s;
 }
 
+// "lease at most 10000 ms", with the commanders and endpoints the bridge
+// does not match: "lease at most 10000 ms; 1 commander refused, 2 endpoints
+// unmatched (the bridge's log says who)".
+std::string commanders_text(const dnbridge_PortStatus& p) {
+  std::string s = fmt::format("lease at most {} ms", p.max_commander_lease_ms);
+  if (p.commanders_refused == 0 && p.endpoints_unmatched == 0) return s;
+  s += fmt::format("; {} commander{} refused, {} endpoint{} unmatched (the bridge's log says who)",
+                   p.commanders_refused, p.commanders_refused == 1 ? "" : "s",
+                   p.endpoints_unmatched, p.endpoints_unmatched == 1 ? "" : "s");
+  return s;
+}
+
 Json unconfigured_json(const dnbridge_PortStatus& p) {
   std::vector<Json> macs;
   for (const auto mac : view(p.unconfigured_macs)) macs.emplace_back(static_cast<unsigned>(mac));
@@ -142,7 +154,11 @@ Record port_record(const dnbridge_PortStatus& p) {
       .json("explicit_retained", p.explicit_retained)
       .json("explicit_refused_for_limits", p.explicit_refused_for_limits)
       .json("replies_undelivered", p.replies_undelivered)
-      .json("loop_longest_pass_ms", Decimal{p.loop_longest_pass_ms, 2});
+      .json("loop_longest_pass_ms", Decimal{p.loop_longest_pass_ms, 2})
+      .add("commanders", commanders_text(p),
+           {{"max_commander_lease_ms", p.max_commander_lease_ms},
+            {"commanders_refused", p.commanders_refused},
+            {"endpoints_unmatched", p.endpoints_unmatched}});
   return r;
 }
 
@@ -526,6 +542,12 @@ Record node_record(const dnbridge_NodeStatus& n, const dnbridge_PumpState* pump,
           {{"last_error", view(n.last_error)},
            {"last_error_general_status", n.last_error_general_status},
            {"last_error_additional_status", n.last_error_additional_status}})
+      .add("command refresh",
+           n.command_refresh_ms == 0
+               ? std::string("off")
+               : fmt::format("{} ms: a command not written again for this long is not in force",
+                             n.command_refresh_ms),
+           "command_refresh_ms", n.command_refresh_ms)
       .add("last refused command", none_if_empty(view(n.last_command_refused)),
            "last_command_refused", view(n.last_command_refused))
       .add("invalid inputs", none_if_empty(view(n.invalid_inputs)), "invalid_inputs",

@@ -25,15 +25,15 @@ namespace dnbridge::dnbctl {
 namespace {
 
 // While waiting for the echo, and while holding, the command is written
-// again this often: a bridge whose command reader matched late still gets
-// it, and --hold-for keeps it current.
-constexpr auto kRewritePeriod = std::chrono::seconds(1);
+// again every rewrite_period (commander.hpp): a bridge whose command reader
+// matched late still gets it, and --hold-for keeps it current.
 
 constexpr const char* kLifetimeNote =
     "A command stays in force only while a commander is live: when dnbctl exits its command "
     "writer goes away and the bridge puts the pump's outputs idle (the device's own idle state), "
     "unless the node's no-commander policy is \"hold\", or passes the pump to the next strongest "
-    "live commander. --hold-for SECONDS keeps commanding (written again every second) until the "
+    "live commander. --hold-for SECONDS keeps commanding (written again every second, or four "
+    "times per command refresh when the node has one: NodeStatus command_refresh_ms) until the "
     "time is up or Ctrl-C. The outputs not named keep the values the device applies now (all off "
     "and 0 when the outputs are idle).";
 
@@ -65,11 +65,14 @@ void outputs_json(JsonWriter& out, const Outputs& o) {
       .end_object();
 }
 
-// Writes a command at once, then again every kRewritePeriod.
+// Writes a command at once, then again every `period`.
 class Rewriter {
  public:
-  Rewriter(std::string name, std::function<Status()> write)
-      : name_(std::move(name)), write_(std::move(write)) {}
+  Rewriter(std::string name, Duration period, std::function<Status()> write)
+      : name_(std::move(name)),
+        period_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(period)),
+        write_(std::move(write)) {}
+  std::chrono::steady_clock::time_point next_due() const { return next_; }
   void when_due() {
     const auto now = std::chrono::steady_clock::now();
     if (now < next_) return;
@@ -77,11 +80,12 @@ class Rewriter {
       throw CommandError(Exit::kFailed, fmt::format("{}: writing the command failed: {}", name_,
                                                     s.error().message()));
     }
-    next_ = now + kRewritePeriod;
+    next_ = now + period_;
   }
 
  private:
   std::string name_;
+  std::chrono::steady_clock::duration period_;
   std::function<Status()> write_;
   std::chrono::steady_clock::time_point next_ = std::chrono::steady_clock::now();
 };
@@ -158,16 +162,26 @@ void hold_or_note(Client& client, const GlobalOptions& o, double hold_for_second
     const Deadline hold_end = std::chrono::steady_clock::now() +
                               std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                   std::chrono::duration<double>(hold_for_seconds));
-    client.wait_until(hold_end, [&] {
+    for (;;) {
       rewriter.when_due();
-      return false;
-    });
+      if (std::chrono::steady_clock::now() >= hold_end || interrupted()) break;
+      (void)client.wait_until(std::min(hold_end, rewriter.next_due()), [] { return false; });
+    }
   } else if (!o.json) {
     std::fputs(
         "dnbctl: note: the command ends when dnbctl exits, unless the bridge's policy for "
         "the node is \"hold\" (see --hold-for)\n",
         stderr);
   }
+}
+
+// The node's command refresh, as its bridge publishes it (NodeStatus,
+// transient-local: at once); zero when off, or without a NodeStatus by
+// `deadline`.
+Duration command_refresh_of(Client& client, const NodeKey& key, Deadline deadline) {
+  client.wait_until(deadline, [&] { return client.node(key) != nullptr; });
+  const auto* n = client.node(key);
+  return n ? milliseconds(n->data->command_refresh_ms) : Duration::zero();
 }
 
 // Which kind of node a command is for: each has its own state and command
@@ -291,16 +305,18 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
     case Output::kBallast: wanted.n2_ballast_on = *on; break;
     case Output::kAnalog: wanted.analog_output_raw = analog->raw; break;
   }
-  Commander commander(client, args.strength, key.rack);
+  const Duration refresh = command_refresh_of(client, key, deadline_after(o.timeout()));
+  Commander commander(client, args.strength, key.rack, refresh);
   const Deadline deadline = deadline_after(o.timeout());
   wait_for_bridge(client, commander, key, deadline,
                   "commands (a bridge of a version before partitions reads them elsewhere)",
                   o.timeout_seconds);
 
-  // Written, then again every kRewritePeriod, until the echo shows it applied
+  // Written, then again every rewrite period, until the echo shows it applied
   // or the bridge refused it.
   const std::uint64_t samples_before = client.pump(key)->samples;
-  Rewriter rewriter(name, [&] { return commander.write(key, wanted, issuer); });
+  Rewriter rewriter(name, rewrite_period(refresh),
+                    [&] { return commander.write(key, wanted, issuer); });
   const std::string failure = command_until_applied(
       client, key, deadline, rewriter,
       [&] {
@@ -440,11 +456,13 @@ Exit run_device_outputs(const GlobalOptions& o, const DeviceOutputArgs& args) {
   Client client = make_client(o);
   const NodeKey key = node_of_kind(client, o, *ref, NodeKind::kDevice);
   const std::string name = node_name(key.rack, key.port, key.mac);
-  DeviceCommander commander(client, args.strength, key.rack);
+  const Duration refresh = command_refresh_of(client, key, deadline_after(o.timeout()));
+  DeviceCommander commander(client, args.strength, key.rack, refresh);
   const Deadline deadline = deadline_after(o.timeout());
   wait_for_bridge(client, commander, key, deadline, "device commands", o.timeout_seconds);
   const std::uint64_t samples_before = client.device(key)->samples;
-  Rewriter rewriter(name, [&] { return commander.write(key, wanted, issuer); });
+  Rewriter rewriter(name, rewrite_period(refresh),
+                    [&] { return commander.write(key, wanted, issuer); });
   const std::string failure = command_until_applied(
       client, key, deadline, rewriter,
       [&] {

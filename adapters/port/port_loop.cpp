@@ -41,6 +41,31 @@ void PortLoop::note_scan_list() {
   for (const auto& d : config_.devices) devices |= std::uint64_t{1} << d.node.mac.value();
   pump_list_.store(pumps, std::memory_order_relaxed);
   scan_list_.store(pumps | devices, std::memory_order_relaxed);
+  std::array<std::uint32_t, MacId::kMax + 1> refresh{};
+  const auto ms_of = [](Duration d) {
+    return static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(d).count());
+  };
+  for (const auto& p : config_.pumps) refresh[p.node.mac.value()] = ms_of(p.command_refresh);
+  for (const auto& d : config_.devices) refresh[d.node.mac.value()] = ms_of(d.command_refresh);
+  for (std::size_t i = 0; i < refresh.size(); ++i) {
+    refresh_ms_[i].store(refresh[i], std::memory_order_relaxed);
+  }
+  refresh_generation_.fetch_add(1, std::memory_order_release);
+}
+
+void PortLoop::expire_silent_commanders(TimePoint now) {
+  const auto say = [&](const auto& silenced, const auto& view_of) {
+    for (const auto& s : silenced) {
+      const auto* v = view_of(s.mac);
+      log_.warn("node {}: commander {} silent for {} ms (command_refresh_ms): {}", s.mac.value(),
+                s.issuer,
+                v ? std::chrono::duration_cast<milliseconds>(v->command_refresh).count() : 0,
+                v && v->outputs_requested ? "outputs held (no_commander = \"hold\")"
+                                          : "no live commander left");
+    }
+  };
+  say(rack().expire_silent_commanders(now), [&](MacId m) { return rack().pump(m); });
+  say(devices().expire_silent_commanders(now), [&](MacId m) { return devices().device(m); });
 }
 
 PortLoop::~PortLoop() {
@@ -361,7 +386,11 @@ void PortLoop::run() {
     const bool master_was_started = master_started_;
     if (!stopping) start_master_when_up(now);
     while (scanner().next_deadline() <= now) scanner().on_timer(now);
-    if (!drain_inbox(now) && !stopping) {
+    const bool keep_running = drain_inbox(now);
+    // After the inbox: a command that came while the loop waited renews its
+    // node's refresh before the refresh is looked at.
+    expire_silent_commanders(now);
+    if (!keep_running && !stopping) {
       stopping = true;
       stop_deadline = now + config_.shutdown_timeout;
       log_.info("stopping: idling and releasing every node");
@@ -396,7 +425,8 @@ void PortLoop::run() {
     if (stopping && !calls_waiting_ && (scanner().stopped() || now >= stop_deadline)) break;
 
     TimePoint wake = std::min({scanner().next_deadline(), stop_deadline,
-                               port_status_time_ + config_.status_period, gateway_->next_expiry()});
+                               port_status_time_ + config_.status_period, gateway_->next_expiry(),
+                               rack().next_refresh_deadline(), devices().next_refresh_deadline()});
     for (const auto& p : published_) {
       wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
     }

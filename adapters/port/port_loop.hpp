@@ -4,6 +4,7 @@
 // gateway and the CAN backend; nothing else touches them. Other threads
 // (the DDS input) talk to it through its inbox, which wakes it. State is
 // published from here.
+#include <array>
 #include <atomic>
 #include <bit>
 #include <bitset>
@@ -116,6 +117,14 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   }
   bool has_pump(devicenet::MacId mac) const {
     return (pump_list_.load(std::memory_order_relaxed) >> mac.value()) & 1u;
+  }
+  // The node's command_refresh_ms, 0 when off or not a node (any thread).
+  std::uint32_t command_refresh_ms(devicenet::MacId mac) const {
+    return refresh_ms_[mac.value()].load(std::memory_order_relaxed);
+  }
+  // Changes whenever a node's command refresh may have changed (any thread).
+  std::uint64_t refresh_generation() const {
+    return refresh_generation_.load(std::memory_order_acquire);
   }
 
   // For a service manager, from any thread. The port has finished its
@@ -248,6 +257,10 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
 
   std::atomic<std::uint64_t> scan_list_{0};  // bit per MAC; set on the port's thread
   std::atomic<std::uint64_t> pump_list_{0};  // the same, of the pumps
+  std::array<std::atomic<std::uint32_t>, devicenet::MacId::kMax + 1> refresh_ms_{};
+  std::atomic<std::uint64_t> refresh_generation_{0};
+  // Commands not written again within their node's command refresh: idle.
+  void expire_silent_commanders(TimePoint now);
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
   std::deque<rack::ExplicitCall> calls_;

@@ -22,6 +22,9 @@ struct DeviceConfig {
   devicenet::NodeConfig node;  // its profile is made from the EDS (scanner_config)
   NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
   ResumePolicy resume = ResumePolicy::kFreshCommand;
+  // Zero: off. Otherwise a command must be written again at least this
+  // often to stay in force (NodeRack::expire_silent_commanders).
+  Duration command_refresh{};
   std::shared_ptr<const eds::EdsFile> eds;
   std::string eds_path;          // as configured, for people
   std::uint64_t eds_digest = 0;  // of the file's text: a changed file is a changed device
@@ -43,9 +46,7 @@ struct DeviceView : NodeView {
   // Outputs requested by the layer above (not yet necessarily applied), by
   // `commanded_by`.
   std::optional<std::vector<std::uint8_t>> outputs_requested;
-  std::string_view idle_reason() const {
-    return outputs_requested ? std::string_view{} : to_string(idle_cause);
-  }
+  std::string idle_reason() const { return idle_text(outputs_requested.has_value()); }
 
   // The safe state the device had when the node last came online: each
   // safe_state parameter as read back after the download, in words

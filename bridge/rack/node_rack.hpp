@@ -9,7 +9,8 @@
 // NodeRack<Profile> is that logic once; a profile says what its data is:
 //
 //   struct Profile {
-//     using Config = ...;   // .node (devicenet::NodeConfig), .no_commander, .resume
+//     using Config = ...;   // .node (devicenet::NodeConfig), .no_commander, .resume,
+//                           // .command_refresh
 //     using View = ...;     // derives from NodeView; .outputs_requested (std::optional<Outputs>)
 //     using Outputs = ...;  // a command's outputs, as the layer above gives them
 //     struct Slot;          // what the profile keeps per node (its data layout)
@@ -56,6 +57,7 @@ enum class IdleCause : std::uint8_t {
   kNoCommander,   // the last commander went away
   kAfterLoss,     // back after a loss: a new command is needed (ResumePolicy::kFreshCommand)
   kReconfigured,  // configured again after a reload: a new command is needed
+  kCommanderSilent,  // the command was not written again within the node's command refresh
 };
 std::string_view to_string(IdleCause cause) noexcept;
 
@@ -82,6 +84,11 @@ struct NodeView {
   std::string commanded_by;
   // Why the outputs are idle, when no command is in force.
   IdleCause idle_cause = IdleCause::kNoCommandYet;
+  // Zero: off. Otherwise a command not written again for this long is no
+  // longer in force (IdleCause::kCommanderSilent).
+  Duration command_refresh{};
+  // "idle: ..." when no command is in force; empty otherwise.
+  std::string idle_text(bool command_in_force) const;
   // The device's minor faults (Identity.Status), in words; empty when none.
   std::string minor_faults;
 
@@ -116,19 +123,37 @@ class NodeRack : public devicenet::ScannerObserver {
   // device applies its own configured idle actions) or, if configured so,
   // keeps its last outputs.
   Status release_command(devicenet::MacId mac, TimePoint now) {
-    View* v = find(mac);
-    if (!v || !scanner_) return Errc::kOutOfRange;
-    Entry& e = entry(mac);
-    if (e.no_commander == NoCommanderPolicy::kHoldLastOutputs) {
-      e.held_without_commander = v->outputs_requested.has_value();
-      return {};
+    return release(mac, IdleCause::kNoCommander, now);
+  }
+
+  // The command refresh: a command in force that was not written again for
+  // its node's command_refresh counts as having no live commander
+  // (release_command, with IdleCause::kCommanderSilent). Returns the nodes
+  // released so, with the issuer that fell silent.
+  struct Silenced {
+    devicenet::MacId mac;
+    std::string issuer;
+  };
+  std::vector<Silenced> expire_silent_commanders(TimePoint now) {
+    std::vector<Silenced> out;
+    for (std::size_t i = 0; i < views_.size(); ++i) {
+      const Entry& e = entries_[i];
+      if (!refresh_due(views_[i], e) || now < e.last_command + views_[i].command_refresh) continue;
+      Silenced s{views_[i].mac, views_[i].commanded_by};
+      (void)release(s.mac, IdleCause::kCommanderSilent, now);
+      out.push_back(std::move(s));
     }
-    e.held_without_commander = false;
-    if (v->outputs_requested) v->idle_cause = IdleCause::kNoCommander;
-    v->outputs_requested.reset();
-    v->commanded_by.clear();
-    ++v->changes;
-    return scanner_->set_idle(mac, true, now);
+    return out;
+  }
+  // When expire_silent_commanders has next something to do; kNever if not.
+  TimePoint next_refresh_deadline() const {
+    TimePoint next = kNever;
+    for (std::size_t i = 0; i < views_.size(); ++i) {
+      if (refresh_due(views_[i], entries_[i])) {
+        next = std::min(next, entries_[i].last_command + views_[i].command_refresh);
+      }
+    }
+    return next;
   }
 
   // Live changes, made together with the master's scan list
@@ -141,6 +166,7 @@ class NodeRack : public devicenet::ScannerObserver {
     entries_.push_back(entry_of(c));
     index_[c.node.mac.value()] = static_cast<int>(views_.size());
     views_.push_back(Profile::view_of(c, entries_.back().slot));
+    views_.back().command_refresh = c.command_refresh;
   }
   void remove(devicenet::MacId mac) {
     const int i = index_[mac.value()];
@@ -170,19 +196,23 @@ class NodeRack : public devicenet::ScannerObserver {
     fresh.reason = "configuration changed: released, to be configured again";
     fresh.state_since = v.state_since;
     fresh.idle_cause = IdleCause::kReconfigured;
+    fresh.command_refresh = c.command_refresh;
     fresh.changes = v.changes + 1;
     fresh.status_changes = v.status_changes + 1;
     v = std::move(fresh);
   }
   // Only what the bridge itself does with the node changed (its name, its
-  // no-commander and resume policies): view and command are kept, but for
-  // outputs held for a commander that has gone when the new policy is idle.
+  // no-commander and resume policies, its command refresh): view and command
+  // are kept, but for outputs held for a commander that has gone when the
+  // new policy is idle. A new command refresh counts from now.
   void update(const Config& c, TimePoint now) {
     View* v = find(c.node.mac);
     if (!v) return;
     Entry& e = entry(c.node.mac);
     e.no_commander = c.no_commander;
     e.resume = c.resume;
+    if (v->command_refresh != c.command_refresh) e.last_command = std::max(e.last_command, now);
+    v->command_refresh = c.command_refresh;
     v->name = c.node.name;
     ++v->changes;
     ++v->status_changes;
@@ -314,6 +344,7 @@ class NodeRack : public devicenet::ScannerObserver {
     v.outputs_requested = outputs;
     v.commanded_by = std::string(issuer);
     entry(v.mac).held_without_commander = false;
+    entry(v.mac).last_command = now;
     ++v.commands_accepted;
     ++v.changes;
     return {};
@@ -326,9 +357,34 @@ class NodeRack : public devicenet::ScannerObserver {
     ResumePolicy resume = ResumePolicy::kFreshCommand;
     // The last commander went away while the policy held its outputs.
     bool held_without_commander = false;
+    TimePoint last_command{};  // when the command in force was last taken
   };
   static Entry entry_of(const Config& c) {
-    return Entry{Profile::slot_of(c), c.no_commander, c.resume, false};
+    return Entry{Profile::slot_of(c), c.no_commander, c.resume, false, {}};
+  }
+
+  // A command is in force that the node's command refresh may expire.
+  static bool refresh_due(const View& v, const Entry& e) {
+    return v.command_refresh > Duration::zero() && v.outputs_requested.has_value() &&
+           !e.held_without_commander;
+  }
+
+  // No live commander left (`cause`): idle, or the outputs held if the
+  // node's policy says so.
+  Status release(devicenet::MacId mac, IdleCause cause, TimePoint now) {
+    View* v = find(mac);
+    if (!v || !scanner_) return Errc::kOutOfRange;
+    Entry& e = entry(mac);
+    if (e.no_commander == NoCommanderPolicy::kHoldLastOutputs) {
+      e.held_without_commander = v->outputs_requested.has_value();
+      return {};
+    }
+    e.held_without_commander = false;
+    if (v->outputs_requested) v->idle_cause = cause;
+    v->outputs_requested.reset();
+    v->commanded_by.clear();
+    ++v->changes;
+    return scanner_->set_idle(mac, true, now);
   }
   Entry& entry(devicenet::MacId mac) {
     return entries_[static_cast<std::size_t>(index_[mac.value()])];

@@ -24,6 +24,9 @@ struct PumpConfig {
   devicenet::NodeConfig node;
   NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
   ResumePolicy resume = ResumePolicy::kFreshCommand;
+  // Zero: off. Otherwise a command must be written again at least this
+  // often to stay in force (NodeRack::expire_silent_commanders).
+  Duration command_refresh{};
   profiles::cdn127::SafeStateConfig safe_state;
   profiles::cdn127::IoConfiguration io;
   // The identity the device must show; the CDN127's (vendor 59, product type
@@ -41,9 +44,7 @@ struct PumpView : NodeView {
   // `commanded_by`.
   std::optional<profiles::cdn127::PumpOutputs> outputs_requested;
   // "idle: ..." when no command is in force; empty otherwise.
-  std::string_view idle_reason() const {
-    return outputs_requested ? std::string_view{} : to_string(idle_cause);
-  }
+  std::string idle_reason() const { return idle_text(outputs_requested.has_value()); }
 
   // The outputs' fault and idle actions the device had when the node last
   // came online (read back after the download, or the device's own kept),

@@ -28,7 +28,8 @@ bool same_device_settings(const DeviceConfig& a, const DeviceConfig& b) {
 
 template <class Config>
 bool same_handling(const Config& a, const Config& b) {
-  return a.node.name == b.node.name && a.no_commander == b.no_commander && a.resume == b.resume;
+  return a.node.name == b.node.name && a.no_commander == b.no_commander && a.resume == b.resume &&
+         a.command_refresh == b.command_refresh;
 }
 
 template <class Config>
