@@ -54,14 +54,28 @@
 //       back and prints "deleted"; on "write N" writes writer N's command
 //       again and prints "written"; the writers left live until the end of
 //       stdin.
+//   commander MAC STRENGTH LEASE_MS DEADLINE_MS ISSUER
+//       a commander with the documented command writer QoS and that strength,
+//       liveliness lease (0: infinite) and deadline (0: none). Prints
+//       "matched" once a bridge's command reader matched it, or "refused P"
+//       when one refused it with an incompatible QoS (P: the policy's ID).
+//       On "write" it writes PumpCommand MAC on (n2 ballast on, analog
+//       4000) and prints "written"; on "refresh MS" writes it every MS
+//       milliseconds from a thread of its own ("refreshing"), until
+//       "silent" ("silent": its DDS stack stays alive, nothing more is
+//       written); at the end of stdin it deletes its writer and exits.
 //   state-reader
 //       a PumpState reader with the documented state QoS, never taken from;
 //       prints "receiving" once it holds a sample; stays until the end of
 //       stdin. Stopped (SIGSTOP), it is a reader that acknowledges nothing.
 #include <unistd.h>
 
+#include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
+#include <mutex>
+#include <thread>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
@@ -149,6 +163,86 @@ int ahead(dds_domainid_t domain, unsigned mac, std::int32_t strength, Duration l
   while (next_line(line) && line != "exit") {
   }
   writer.reset();  // unregisters its instance, stamped with this (wrong) clock's now
+  return 0;
+}
+
+int commander(dds_domainid_t domain, unsigned mac, std::int32_t strength, Duration lease,
+              Duration deadline, const std::string& issuer) {
+  dds::Participant participant(domain, dds::Participant::ClientName{issuer});
+  dds::Topic<dnbridge_PumpCommand> topic(participant);
+  dds::Writer<dnbridge_PumpCommand> writer(
+      participant, topic,
+      dds::command_writer_qos(e2e::sim_rack_partitions(), strength,
+                              lease == Duration::zero() ? dds::kInfinite : lease,
+                              deadline == Duration::zero() ? std::nullopt
+                                                           : std::optional<Duration>(deadline)));
+  if (!writer.set_status_mask(DDS_PUBLICATION_MATCHED_STATUS |
+                              DDS_OFFERED_INCOMPATIBLE_QOS_STATUS)) {
+    fail("status mask of the PumpCommand writer");
+  }
+  {
+    dds::WaitSet waitset(participant);
+    waitset.attach(writer, 1);
+    const auto until = std::chrono::steady_clock::now() + kMatchTimeout;
+    for (;;) {
+      dds_offered_incompatible_qos_status_t refused{};
+      if (dds_get_offered_incompatible_qos_status(writer.handle(), &refused) == DDS_RETCODE_OK &&
+          refused.total_count > 0) {
+        say("refused " + std::to_string(refused.last_policy_id));
+        break;
+      }
+      if (writer.matched_subscriptions().value_or(0) > 0) {
+        say("matched");
+        break;
+      }
+      const auto left = until - std::chrono::steady_clock::now();
+      if (left <= Duration::zero()) fail("neither matched nor refused");
+      (void)waitset.wait(std::chrono::duration_cast<Duration>(left));
+    }
+  }
+  const auto command = pump_command(mac, true, true, 4000, issuer);
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool refreshing = false;
+  bool done = false;
+  Duration period{};
+  std::thread refresher([&] {
+    std::unique_lock lock(mutex);
+    for (;;) {
+      changed.wait(lock, [&] { return refreshing || done; });
+      if (done) return;
+      if (!writer.write(*command)) fail("writing the command");
+      changed.wait_for(lock, period, [&] { return !refreshing || done; });
+    }
+  });
+  std::string line;
+  while (next_line(line)) {
+    if (line == "write") {
+      if (!writer.write(*command)) fail("writing the command");
+      say("written");
+    } else if (line.rfind("refresh ", 0) == 0) {
+      {
+        std::lock_guard lock(mutex);
+        period = milliseconds(std::stol(line.substr(8)));
+        refreshing = true;
+      }
+      changed.notify_all();
+      say("refreshing");
+    } else if (line == "silent") {
+      {
+        std::lock_guard lock(mutex);
+        refreshing = false;
+      }
+      changed.notify_all();
+      say("silent");
+    }
+  }
+  {
+    std::lock_guard lock(mutex);
+    done = true;
+  }
+  changed.notify_all();
+  refresher.join();
   return 0;
 }
 
@@ -349,7 +443,9 @@ int usage() {
                "       dnbridge_careless_client DOMAIN stall-replies REQUESTER REPEATS GETS\n"
                "       dnbridge_careless_client DOMAIN flood ISSUER STRENGTH COUNT\n"
                "       dnbridge_careless_client DOMAIN three-writers STRENGTH LEASE_MS READERS\n"
-               "       dnbridge_careless_client DOMAIN state-reader\n";
+               "       dnbridge_careless_client DOMAIN state-reader\n"
+               "       dnbridge_careless_client DOMAIN commander MAC STRENGTH LEASE_MS DEADLINE_MS "
+               "ISSUER\n";
   return 2;
 }
 
@@ -378,6 +474,10 @@ int run(const std::vector<std::string>& args) {
                          static_cast<std::uint32_t>(number(4)));
   }
   if (mode == "state-reader" && args.size() == 2) return state_reader(domain);
+  if (mode == "commander" && args.size() == 7) {
+    return commander(domain, static_cast<unsigned>(number(2)), static_cast<std::int32_t>(number(3)),
+                     milliseconds(number(4)), milliseconds(number(5)), args[6]);
+  }
   return usage();
 }
 
