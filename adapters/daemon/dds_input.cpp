@@ -152,8 +152,9 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       command_log_(log_.to(command_sink_)),
       own_sink_(log_.sink(), [this] { drain_command_log(); }) {
   log_ = log_.to(own_sink_);
-  device_command_topic_ = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)",
-                                       [&] { return dds::Topic<dnbridge_DeviceCommand>(participant); });
+  device_command_topic_ =
+      unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)",
+                    [&] { return dds::Topic<dnbridge_DeviceCommand>(participant); });
   {
     std::lock_guard lock(command_take_mutex_);
     ensure_command_classes();
@@ -377,7 +378,9 @@ port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info
   const bool pump = node && loop->has_pump(*mac);
   // Every class's readers have every instance: a node's commands are its
   // own class's, and a refusal is said once, by the class without refresh.
-  if (node && pump != device) return loop->command_refresh_ms(*mac) == from.refresh_ms ? loop : nullptr;
+  if (node && pump != device) {
+    return loop->command_refresh_ms(*mac) == from.refresh_ms ? loop : nullptr;
+  }
   if (from.refresh_ms != 0) return nullptr;
   command_warn_limit_.warn(
       command_log_, port::steady_now(), "{} command{} for port \"{}\" MAC {} refused: {}",

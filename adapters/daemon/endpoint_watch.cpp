@@ -40,6 +40,9 @@ EndpointWatch::EndpointWatch(const dds::Participant& participant, Settings setti
   if (dds_get_guid(participant.handle(), &g) == DDS_RETCODE_OK) {
     std::memcpy(self_.data(), g.v, self_.size());
   }
+  // The bridge's own topics exist by now: what is discovered is compared
+  // with their types from the first sample on.
+  learn_types(dds::local_endpoints(participant));
   waitset_.attach(participants_reader_, kParticipants);
   waitset_.attach(endpoints_reader_.publications(), kPublications);
   waitset_.attach(endpoints_reader_.subscriptions(), kSubscriptions);
@@ -172,8 +175,7 @@ std::string EndpointWatch::why_unmatched(const Remote& r,
       e.type_name);
 }
 
-void EndpointWatch::look(TimePoint now) {
-  const std::vector<dds::LocalEndpoint> locals = dds::local_endpoints(participant_);
+void EndpointWatch::learn_types(const std::vector<dds::LocalEndpoint>& locals) {
   for (const auto& l : locals) {
     if (types_.count(l.topic) != 0) continue;
     const dds_entity_t topic = dds_get_topic(l.handle);
@@ -184,6 +186,11 @@ void EndpointWatch::look(TimePoint now) {
       (void)borrowed.release();
     }
   }
+}
+
+void EndpointWatch::look(TimePoint now) {
+  const std::vector<dds::LocalEndpoint> locals = dds::local_endpoints(participant_);
+  learn_types(locals);
   std::uint32_t refused = 0;
   std::uint32_t unmatched = 0;
   for (auto& [guid, r] : remotes_) {
@@ -212,8 +219,8 @@ void EndpointWatch::look(TimePoint now) {
     ++(commander ? refused : unmatched);
     if (why == r.reported) continue;
     log_.with("DDS_GUID", dds::to_string(guid))
-        .warn("{}: {}: {}", who(e), commander ? "refused as a commander" : "does not match the bridge",
-              why);
+        .warn("{}: {}: {}", who(e),
+              commander ? "refused as a commander" : "does not match the bridge", why);
     r.reported = std::move(why);
   }
   const bool refused_changed = refused != commanders_refused_.exchange(refused);

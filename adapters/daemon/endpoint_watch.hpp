@@ -65,6 +65,8 @@ class EndpointWatch {
                             bool& commander) const;
   std::string who(const dds::DiscoveredEndpoint& e) const;
   const dds::TypeInfo* type_of(std::string_view topic);
+  // The type information of the topics of `locals` not known yet.
+  void learn_types(const std::vector<dds::LocalEndpoint>& locals);
 
   const dds::Participant& participant_;
   Settings settings_;

@@ -1,7 +1,9 @@
 #include "adapters/dds/discovered_endpoints.hpp"
 
-// ddsi_typelib.h needs the QoS types of ddsi_xqos.h first.
+// ddsi_typelib.h (ddsi_typeinfo_equal) needs the QoS types of ddsi_xqos.h,
+// which comes first.
 #include <dds/ddsi/ddsi_xqos.h>
+// After it.
 #include <dds/ddsi/ddsi_typelib.h>
 #include <fmt/format.h>
 #include <fnmatch.h>
@@ -101,8 +103,9 @@ TypeInfo::~TypeInfo() {
 
 std::optional<bool> TypeInfo::same_as(const dds_builtintopic_endpoint_t& endpoint) const {
   const dds_typeinfo_t* theirs = nullptr;
-  if (info_ == nullptr || dds_builtintopic_get_endpoint_type_info(
-                              const_cast<dds_builtintopic_endpoint_t*>(&endpoint), &theirs) < 0 ||
+  if (info_ == nullptr ||
+      dds_builtintopic_get_endpoint_type_info(const_cast<dds_builtintopic_endpoint_t*>(&endpoint),
+                                              &theirs) < 0 ||
       theirs == nullptr) {
     return std::nullopt;
   }
@@ -183,7 +186,8 @@ bool partitions_meet(const std::vector<std::string>& a, const std::vector<std::s
   const auto& pa = a.empty() ? kDefault : a;
   const auto& pb = b.empty() ? kDefault : b;
   return std::any_of(pa.begin(), pa.end(), [&](const std::string& x) {
-    return std::any_of(pb.begin(), pb.end(), [&](const std::string& y) { return names_meet(x, y); });
+    return std::any_of(pb.begin(), pb.end(),
+                       [&](const std::string& y) { return names_meet(x, y); });
   });
 }
 

@@ -7,8 +7,12 @@
  * a reader of state that is reliable and transient-local with keep-last 1
  * gets the current state at once; a command writer must be reliable,
  * volatile, keep-last 1 with exclusive ownership (its strength decides who
- * commands a pump) and keeps the pump commanded only while it lives. It is
- * published in the rack's partition, "dnbridge/" followed by the rack name:
+ * commands a pump) and keeps the pump commanded only while it lives; its
+ * liveliness lease (2 s here) is how long a frozen supervisor keeps the
+ * pump, and the bridge refuses one over its max_commander_lease_ms (10 s
+ * unless configured). When the node has a command refresh (NodeStatus
+ * command_refresh_ms), the writer offers it as its deadline and writes at
+ * a quarter of it. It is published in the rack's partition, "dnbridge/" followed by the rack name:
  * the bridge of that rack reads commands there, and no other bridge gets
  * them. State is in the default partition: one reader for every rack. */
 #include <dds/dds.h>
@@ -27,7 +31,8 @@ static dds_qos_t* state_reader_qos(void) {
   return q;
 }
 
-static dds_qos_t* command_writer_qos(const char* rack, int32_t strength) {
+/* `refresh_ms`: the node's command refresh, 0 when it has none. */
+static dds_qos_t* command_writer_qos(const char* rack, int32_t strength, uint32_t refresh_ms) {
   dds_qos_t* q = dds_create_qos();
   static char partition[256];
   if (snprintf(partition, sizeof partition, "dnbridge/%s", rack) >= (int)sizeof partition) {
@@ -44,7 +49,44 @@ static dds_qos_t* command_writer_qos(const char* rack, int32_t strength) {
   dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_SECS(2));
   dds_qset_destination_order(q, DDS_DESTINATIONORDER_BY_SOURCE_TIMESTAMP);
   dds_qset_writer_data_lifecycle(q, false);
+  if (refresh_ms > 0) dds_qset_deadline(q, DDS_MSECS(refresh_ms));
   return q;
+}
+
+/* The node's command refresh as its NodeStatus says (transient-local: here
+ * once matched), waiting at most `ms`; 0 when it has none or no NodeStatus
+ * came. */
+static uint32_t command_refresh_ms(dds_entity_t participant, const char* rack, const char* port,
+                                   uint8_t mac, int ms) {
+  dds_entity_t topic =
+      dds_create_topic(participant, &dnbridge_NodeStatus_desc, "dnbridge/NodeStatus", NULL, NULL);
+  dds_qos_t* rq = state_reader_qos();
+  dds_entity_t reader = dds_create_reader(participant, topic, rq, NULL);
+  dds_delete_qos(rq);
+  dds_entity_t waitset = dds_create_waitset(participant);
+  dds_entity_t readable = dds_create_readcondition(reader, DDS_ANY_STATE);
+  dds_waitset_attach(waitset, readable, 0);
+  const dds_time_t deadline = dds_time() + DDS_MSECS(ms);
+  uint32_t refresh = 0;
+  int found = 0;
+  while (!found && dds_time() < deadline) {
+    dds_waitset_wait_until(waitset, NULL, 0, deadline);
+    void* samples[16] = {NULL};
+    dds_sample_info_t infos[16];
+    int n = dds_take(reader, samples, infos, 16, 16);
+    for (int i = 0; i < n; i++) {
+      const dnbridge_NodeStatus* s = samples[i];
+      if (infos[i].valid_data && strcmp(s->rack, rack) == 0 && strcmp(s->port, port) == 0 &&
+          s->mac == mac) {
+        refresh = s->command_refresh_ms;
+        found = 1;
+      }
+    }
+    if (n > 0) dds_return_loan(reader, samples, n);
+  }
+  dds_delete(waitset);
+  dds_delete(reader);
+  return refresh;
 }
 
 typedef enum { ANY, ONLINE, COMMANDED, IDLE } Wanted;
@@ -101,7 +143,11 @@ int main(int argc, char** argv) {
   dds_qos_t* rq = state_reader_qos();
   dds_entity_t reader = dds_create_reader(participant, state_topic, rq, NULL);
   dds_delete_qos(rq);
-  dds_qos_t* wq = command_writer_qos(rack, 10);
+  const uint32_t refresh = command_refresh_ms(participant, rack, port, mac, 10000);
+  /* Twice a second, or four times per command refresh. */
+  const int period_ms = refresh > 0 && refresh / 4 < 500 ? (int)(refresh / 4) : 500;
+  if (refresh > 0) printf("the node's command refresh: %u ms\n", refresh);
+  dds_qos_t* wq = command_writer_qos(rack, 10, refresh);
   dds_entity_t writer = dds_create_writer(participant, command_topic, wq, NULL);
   dds_delete_qos(wq);
 
@@ -125,12 +171,13 @@ int main(int argc, char** argv) {
   command.issuer = "supervisor example";
   printf("commanding the pump on for %d s:\n", seconds);
   int applied = 0;
-  for (int i = 0; i < seconds * 2; i++) {
-    /* Re-written twice a second: a commander that writes periodically takes
-     * over at once when a stronger one goes away, and its first write cannot
-     * be lost to a bridge that has not matched it yet. */
+  for (int i = 0; i < seconds * 1000 / period_ms; i++) {
+    /* Written again periodically: a commander that writes periodically takes
+     * over at once when a stronger one goes away, its first write cannot be
+     * lost to a bridge that has not matched it yet, and a node's command
+     * refresh stays met. */
     dds_write(writer, &command);
-    applied |= wait_state(waitset, reader, rack, port, mac, COMMANDED, 500);
+    applied |= wait_state(waitset, reader, rack, port, mac, COMMANDED, period_ms);
   }
   if (!applied) {
     fprintf(stderr, "the command was not applied\n");

@@ -118,13 +118,17 @@ TEST(Format, PortJsonCarriesTheExplicitCountsAndTheLoopsBusyTime) {
   p->explicit_refused_for_limits = 12;
   p->replies_undelivered = 1;
   p->loop_longest_pass_ms = 0.44f;
+  p->max_commander_lease_ms = 10000;
+  p->commanders_refused = 2;
+  p->endpoints_unmatched = 1;
   JsonWriter out(false);
   out.begin_object();
   port_json_members(out, *p);
   out.end_object();
   EXPECT_NE(out.str().find(R"("explicit_outstanding":3,"explicit_retained":256,)"
                            R"("explicit_refused_for_limits":12,"replies_undelivered":1,)"
-                           R"("loop_longest_pass_ms":0.44})"),
+                           R"("loop_longest_pass_ms":0.44,"max_commander_lease_ms":10000,)"
+                           R"("commanders_refused":2,"endpoints_unmatched":1})"),
             std::string::npos)
       << out.str();
 }

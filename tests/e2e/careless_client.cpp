@@ -63,7 +63,8 @@
 //       4000) and prints "written"; on "refresh MS" writes it every MS
 //       milliseconds from a thread of its own ("refreshing"), until
 //       "silent" ("silent": its DDS stack stays alive, nothing more is
-//       written); at the end of stdin it deletes its writer and exits.
+//       written); on "unregister" it unregisters the instance and prints
+//       "unregistered"; at the end of stdin it deletes its writer and exits.
 //   state-reader
 //       a PumpState reader with the documented state QoS, never taken from;
 //       prints "receiving" once it holds a sample; stays until the end of
@@ -228,6 +229,9 @@ int commander(dds_domainid_t domain, unsigned mac, std::int32_t strength, Durati
       }
       changed.notify_all();
       say("refreshing");
+    } else if (line == "unregister") {
+      if (!writer.unregister_instance(*command)) fail("unregistering the command's instance");
+      say("unregistered");
     } else if (line == "silent") {
       {
         std::lock_guard lock(mutex);

@@ -74,13 +74,17 @@ TEST_F(CommanderBoundTest, ACommanderOfferingAnInfiniteLeaseIsRefusedAndThePumpS
   ASSERT_TRUE(c.send_line("write"));
   ASSERT_EQ(c.read_line(milliseconds(5000)), "written");
   // The bridge says who it refused, and PortStatus counts it.
-  ASSERT_TRUE(ports_.until([&] {
-    const auto* p = port_status();
-    return p && p->commanders_refused == 1;
-  }, seconds(10))) << "PortStatus does not count the refused commander";
+  ASSERT_TRUE(ports_.until(
+      [&] {
+        const auto* p = port_status();
+        return p && p->commanders_refused == 1;
+      },
+      seconds(10)))
+      << "PortStatus does not count the refused commander";
   EXPECT_EQ(port_status()->max_commander_lease_ms, 10000u);
-  EXPECT_TRUE(log_.contains(LogLevel::kWarn, "refused as a commander: offers a liveliness lease "
-                                             "of infinite"));
+  EXPECT_TRUE(log_.contains(LogLevel::kWarn,
+                            "refused as a commander: offers a liveliness lease "
+                            "of infinite"));
   EXPECT_TRUE(log_.contains(LogLevel::kWarn, "\"infinite lease\""))
       << "the refusal does not name the commander's participant";
   // Nothing it writes commands the pump: two publish periods show it idle.
@@ -122,6 +126,42 @@ TEST_F(CommanderBoundTest, AStoppedCommanderProcessLosesItsPumpWithinItsLeaseAnd
   EXPECT_FALSE(device_pump_on());
 }
 
+TEST_F(CommanderBoundTest, AKilledCommanderProcessLosesItsPumpWithinItsLeaseAndOnePoll) {
+  ASSERT_NO_FATAL_FAILURE(start_online());
+  auto& c = commander("to be killed", 10, kLease, Duration::zero());
+  ASSERT_EQ(c.read_line(milliseconds(15000)), "matched");
+  ASSERT_TRUE(c.send_line("write"));
+  ASSERT_EQ(c.read_line(milliseconds(5000)), "written");
+  ASSERT_TRUE(pumps_.until([&] { return echoes("to be killed"); }));
+  // No unregistration, no goodbye: only the lease tells.
+  const auto killed = SteadyClock::now();
+  ASSERT_TRUE(c.signal(SIGKILL));
+  const bool idled = pumps_.until([&] { return idle("idle: no live commander"); },
+                                  kLease + kPoll + kMargin, milliseconds(20));
+  const double took = ms_since(killed);
+  ASSERT_TRUE(idled) << "the pump stayed commanded by a killed commander";
+  report("commander process killed (SIGKILL, 2 s lease) -> pump idle", took);
+  EXPECT_FALSE(device_pump_on());
+}
+
+TEST_F(CommanderBoundTest, ACommanderThatUnregistersItsInstanceLosesThePumpAtOnce) {
+  ASSERT_NO_FATAL_FAILURE(start_online());
+  auto& c = commander("unregistering", 10, kLease, Duration::zero());
+  ASSERT_EQ(c.read_line(milliseconds(15000)), "matched");
+  ASSERT_TRUE(c.send_line("write"));
+  ASSERT_EQ(c.read_line(milliseconds(5000)), "written");
+  ASSERT_TRUE(pumps_.until([&] { return echoes("unregistering"); }));
+  const auto unregistered = SteadyClock::now();
+  ASSERT_TRUE(c.send_line("unregister"));
+  ASSERT_EQ(c.read_line(milliseconds(5000)), "unregistered");
+  ASSERT_TRUE(pumps_.until([&] { return idle("idle: no live commander"); }, kPoll + kMargin,
+                           milliseconds(20)))
+      << "the pump stayed commanded after its commander unregistered the instance";
+  report("commander unregistered its instance (writer live) -> pump idle",
+         ms_since(unregistered));
+  EXPECT_FALSE(device_pump_on());
+}
+
 TEST_F(CommanderBoundTest, ASilentCommanderLosesItsPumpWithinTheRefreshAndOnePoll) {
   ASSERT_NO_FATAL_FAILURE(start_online(refresh_config()));
   // A commander offering no deadline cannot command a node with a refresh.
@@ -144,12 +184,15 @@ TEST_F(CommanderBoundTest, ASilentCommanderLosesItsPumpWithinTheRefreshAndOnePol
     const auto* n = nodes_.latest(pump_mac(kMac));
     return n && n->command_refresh_ms == 500;
   }));
-  ASSERT_TRUE(ports_.until([&] {
-    const auto* p = port_status();
-    return p && p->commanders_refused == 1;
-  }, seconds(10)));
-  EXPECT_TRUE(log_.contains(LogLevel::kWarn, "offers no deadline; it does not command the nodes "
-                                             "with command_refresh_ms = 500 (port A: 3)"));
+  ASSERT_TRUE(ports_.until(
+      [&] {
+        const auto* p = port_status();
+        return p && p->commanders_refused == 1;
+      },
+      seconds(10)));
+  EXPECT_TRUE(log_.contains(LogLevel::kWarn,
+                            "offers no deadline; it does not command the nodes "
+                            "with command_refresh_ms = 500 (port A: 3)"));
 
   // Its DDS stack alive, its liveliness asserted: only its writes stop.
   ASSERT_TRUE(c.send_line("silent"));

@@ -32,6 +32,10 @@
 #include <string>
 #include <vector>
 
+#include "adapters/dds/participant.hpp"
+#include "adapters/dds/reader.hpp"
+#include "adapters/dds/topics.hpp"
+#include "adapters/dds/waitset.hpp"
 #include "e2e/child_process.hpp"
 #include "support/simulated_rack.hpp"
 
@@ -322,9 +326,30 @@ TEST_F(Cyclone11InteropTest, AReaderOfTheFormerNodeStatusIsNotMatched) {
   const fs::path former =
       python_types(DNBRIDGE_SOURCE_DIR "/tests/interop/former_node_status.idl", "former");
   ASSERT_FALSE(HasFailure());
+  // The bridge's side is not silent: PortStatus counts the reader, read here
+  // with the bridge's own types and QoS.
+  const std::string uri = cyclonedds_uri();
+  ASSERT_EQ(setenv("CYCLONEDDS_URI", uri.substr(uri.find('=') + 1).c_str(), 1), 0);
+  dds::Participant participant(kDomain, dds::Participant::ClientName{"cyclone11 interop test"});
+  dds::Topic<dnbridge_PortStatus> topic(participant);
+  dds::Reader<dnbridge_PortStatus> ports(participant, topic, dds::state_reader_qos());
+  ASSERT_TRUE(ports.set_status_mask(DDS_DATA_AVAILABLE_STATUS));
+  dds::WaitSet arrivals(participant);
+  arrivals.attach(ports, 1);
   Program reader(
       {kPython.string(), "-u", kSupervisor.string(), "former-node-status", std::to_string(kDomain)},
       {"PYTHONPATH=" + former.string()}, "cyclone11 former NodeStatus| ");
+  std::uint32_t unmatched = 0;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (unmatched == 0 && std::chrono::steady_clock::now() < until) {
+    auto taken = ports.take(16);
+    ASSERT_TRUE(taken.ok());
+    for (const auto& s : *taken) {
+      if (s.valid_data()) unmatched = std::max(unmatched, s.data().endpoints_unmatched);
+    }
+    if (unmatched == 0) (void)arrivals.wait(std::chrono::seconds(1));
+  }
+  EXPECT_GE(unmatched, 1u) << "the bridge's PortStatus does not count the reader it does not match";
   EXPECT_EQ(reader.finish(kSupervisorBound), 0) << reader.output();
 }
 

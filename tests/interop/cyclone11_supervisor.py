@@ -61,8 +61,9 @@ OTHERS_BOUND_S = 30.0
 # matched can reach the bridge before it has discovered the writer.
 REWRITE_PERIOD_S = 1.0
 # The former NodeStatus type: after the bridge's writer and its type are
-# known here, the time a reader has to (wrongly) match it.
-UNMATCHED_QUIET_S = 3.0
+# known here, the time a reader has to (wrongly) match it, and for the
+# bridge to report it (it counts a reader unmatched 3 s after discovery).
+UNMATCHED_QUIET_S = 8.0
 
 GET_ATTRIBUTE_SINGLE = 0x0E
 IDENTITY_CLASS = 1
