@@ -388,8 +388,6 @@ void read_resume(const Layers& layers, NodeSettings& s, Problems& r) {
   }
 }
 
-// Reads every setting a node and [defaults] share into `s`, which holds the
-// built-in values to start with.
 // command_refresh_ms: 0 (off), or how often a commander must write a
 // node's command for it to stay in force.
 std::optional<Duration> read_command_refresh(const toml::node& n, Problems& r) {
@@ -404,6 +402,8 @@ std::optional<Duration> read_command_refresh(const toml::node& n, Problems& r) {
   return v;
 }
 
+// Reads every setting a node and [defaults] share into `s`, which holds the
+// built-in values to start with.
 void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
   if (Found f = layers.find("profile"); f.value) {
     if (auto v = read_string(*f.value, "profile", r)) {
@@ -973,6 +973,13 @@ void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
     // The port's command refresh before [defaults]', after the node's own.
     if (port.command_refresh && !nt.get("command_refresh_ms")) {
       s.pump.command_refresh = *port.command_refresh;
+    }
+    if (s.pump.command_refresh > Duration::zero() &&
+        s.pump.no_commander == NoCommanderPolicy::kHoldLastOutputs && name_node) {
+      r.warning(name_node->source(),
+                fmt::format("node \"{}\" has a command refresh and no_commander = \"hold\": "
+                            "the outputs of a commander that falls silent stay as it left them",
+                            s.pump.node.name));
     }
     if (s.is_eds()) {
       read_eds_node(nt, ctx, s, r);

@@ -328,6 +328,18 @@ ReloadReport Daemon::reload() {
     r.message = fmt::format("{}: {} problem(s): nothing changed", r.file, r.problems.size());
     return r;
   }
+  // The command readers of every command refresh the file gives exist
+  // before a port applies it: a node's commands never go unread meanwhile.
+  std::vector<std::uint32_t> refreshes;
+  for (const auto& c : loops) {
+    const auto add = [&](Duration d) {
+      refreshes.push_back(
+          static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(d).count()));
+    };
+    for (const auto& p : c.pumps) add(p.command_refresh);
+    for (const auto& d : c.devices) add(d.command_refresh);
+  }
+  if (input_) input_->prepare_command_refreshes(refreshes);
   std::vector<std::pair<std::string, std::future<port::PortChange>>> pending;
   for (auto& c : loops) {
     port::PortLoop* loop = port(c.port);

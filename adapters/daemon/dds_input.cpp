@@ -158,6 +158,9 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   {
     std::lock_guard lock(command_take_mutex_);
     ensure_command_classes();
+    if (command_classes_.empty() || command_classes_.front()->refresh_ms != 0) {
+      throw std::runtime_error("creating the reader of the pumps' commands failed (logged)");
+    }
   }
   // Readers of the services that DDS Security grants (the publisher has
   // their topics), each as far as it grants it.
@@ -208,6 +211,7 @@ void DdsInput::stop() {
   // No listener call after this: none is handing a command to a port.
   {
     std::lock_guard lock(command_take_mutex_);
+    classes_closed_ = true;
     for (const auto& c : command_classes_) {
       (void)dds::DataListener::detach(c->pumps);
       if (c->devices) (void)dds::DataListener::detach(*c->devices);
@@ -291,35 +295,54 @@ std::uint64_t DdsInput::refresh_generations() const {
 
 void DdsInput::ensure_command_classes() {
   classes_for_generation_ = refresh_generations();
-  std::vector<std::uint32_t> wanted{0};
+  ensure_command_class(0);
   for (const auto& [name, loop] : ports_) {
     for (unsigned m = 0; m <= devicenet::MacId::kMax; ++m) {
       const std::uint32_t ms = loop->command_refresh_ms(*devicenet::MacId::from(m));
-      if (ms != 0 && std::find(wanted.begin(), wanted.end(), ms) == wanted.end()) {
-        wanted.push_back(ms);
-      }
+      if (ms != 0) ensure_command_class(ms);
     }
   }
-  for (const std::uint32_t ms : wanted) {
-    if (std::any_of(command_classes_.begin(), command_classes_.end(),
-                    [&](const auto& c) { return c->refresh_ms == ms; })) {
-      continue;
-    }
-    const auto deadline = ms == 0 ? std::nullopt : std::optional<Duration>(milliseconds(ms));
-    const dds::Qos qos = dds::command_reader_qos(partition_, max_commander_lease_, deadline);
-    auto made = std::make_unique<CommandClass>(CommandClass{
-        ms, dds::Reader<dnbridge_PumpCommand>(participant_, command_topic_, qos,
-                                              command_listener_.get()),
-        std::nullopt});
+}
+
+void DdsInput::prepare_command_refreshes(const std::vector<std::uint32_t>& refreshes) {
+  {
+    std::lock_guard lock(command_take_mutex_);
+    for (const std::uint32_t ms : refreshes) ensure_command_class(ms);
+  }
+  commands_pending_ = true;  // any that came while the new readers were made
+  deliver_commands();
+}
+
+void DdsInput::ensure_command_class(std::uint32_t ms) {
+  if (classes_closed_) return;
+  if (std::any_of(command_classes_.begin(), command_classes_.end(),
+                  [&](const auto& c) { return c->refresh_ms == ms; })) {
+    return;
+  }
+  const auto deadline = ms == 0 ? std::nullopt : std::optional<Duration>(milliseconds(ms));
+  const dds::Qos qos = dds::command_reader_qos(partition_, max_commander_lease_, deadline);
+  try {
+    auto made = std::make_unique<CommandClass>(
+        CommandClass{ms,
+                     dds::Reader<dnbridge_PumpCommand>(participant_, command_topic_, qos,
+                                                       command_listener_.get()),
+                     std::nullopt});
     if (device_command_topic_) {
-      made->devices.emplace(participant_, *device_command_topic_, qos, command_listener_.get());
+      made->devices = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)", [&] {
+        return dds::Reader<dnbridge_DeviceCommand>(participant_, *device_command_topic_, qos,
+                                                   command_listener_.get());
+      });
     }
     if (ms != 0) {
-      log_.info("commands of the nodes with command_refresh_ms = {} are taken from writers "
-                "offering a deadline of at most {} ms",
-                ms, ms);
+      log_.info(
+          "commands of the nodes with command_refresh_ms = {} are taken from writers offering a "
+          "deadline of at most {} ms",
+          ms, ms);
     }
     command_classes_.push_back(std::move(made));
+  } catch (const std::exception& e) {
+    // Their commands are not taken: a command in force lapses at its refresh.
+    log_.error("no command reader for the nodes with command_refresh_ms = {}: {}", ms, e.what());
   }
 }
 

@@ -4,11 +4,12 @@
 // loop through the loop's inbox; nothing here touches master state.
 // Commands are taken by a listener, on the Cyclone thread that delivers
 // them, and handed over at once (take, push, wake: nothing that waits);
-// one pair of command readers per command refresh the rack's nodes have
-// (their requested deadline: dds::command_reader_qos), each taking only its
-// own nodes' commands, all with the rack's lease bound;
 // under a flood, at most once per hold-off, the rest by the input's own
-// thread at its end. Requests are taken on that thread, from a waitset.
+// thread at its end. There is one pair of command readers per command
+// refresh the rack's nodes have (their requested deadline:
+// dds::command_reader_qos), each taking only its own nodes' commands, all
+// with the rack's lease bound. Requests are taken on the input's own thread,
+// from a waitset.
 // Requests for other racks are left to their bridges.
 #include <atomic>
 #include <functional>
@@ -102,6 +103,11 @@ class DdsInput {
   // Returns when the thread has ended and no command is being handed over.
   void stop();
 
+  // Makes the command readers of these command refreshes (ms; 0: none)
+  // that do not exist yet, at once: called before a reload gives a node a
+  // new refresh (any thread).
+  void prepare_command_refreshes(const std::vector<std::uint32_t>& refreshes);
+
   // Samples with data for this rack taken so far (any thread).
   std::uint64_t commands_taken() const noexcept { return commands_taken_.load(); }
   // Times commands came within the hold-off after a take (a flood) and were
@@ -142,6 +148,11 @@ class DdsInput {
   // A class of command readers for every command refresh the ports' nodes
   // have now (none is deleted before stop). Under command_take_mutex_.
   void ensure_command_classes();
+  // The class of `refresh_ms`, made if missing; a failure is logged (the
+  // nodes of that refresh then take no command: their commands lapse).
+  // Under command_take_mutex_.
+  void ensure_command_class(std::uint32_t refresh_ms);
+  bool classes_closed_ = false;  // stop(): no class is made after it (under the mutex)
   std::uint64_t refresh_generations() const;
   void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
   template <class Command>

@@ -134,8 +134,9 @@ std::string EndpointWatch::why_unmatched(const Remote& r,
   const auto& e = r.endpoint;
   commander = false;
   if (e.writer && is_command_topic(e.topic)) {
+    // A command reader missing it: it does not command that reader's nodes.
+    commander = true;
     if (!e.lease || *e.lease > settings_.max_commander_lease) {
-      commander = true;
       return fmt::format(
           "offers a liveliness lease of {}; rack {} takes commands only from writers offering at "
           "most {} ms (max_commander_lease_ms): it commands nothing here. Set the command "
@@ -152,7 +153,6 @@ std::string EndpointWatch::why_unmatched(const Remote& r,
                                       nodes.empty() ? "" : fmt::format(" ({})", nodes)));
     }
     if (!refreshes.empty()) {
-      commander = true;
       std::string list;
       for (const auto& x : refreshes) list += (list.empty() ? "" : "; ") + x;
       return fmt::format(
@@ -165,8 +165,9 @@ std::string EndpointWatch::why_unmatched(const Remote& r,
   }
   if (e.same_type == false) {
     return fmt::format(
-        "its type \"{}\" differs from the bridge's (XTypes type information): built from "
-        "another version of dnbridge.idl? (the data-model guide's compatibility policy)",
+        "its type \"{}\" differs from the bridge's in its XTypes type information (built from "
+        "another version of dnbridge.idl? the data-model guide's \"Types and generators\"), or "
+        "its QoS is incompatible",
         e.type_name);
   }
   return fmt::format(
@@ -178,14 +179,16 @@ std::string EndpointWatch::why_unmatched(const Remote& r,
 void EndpointWatch::learn_types(const std::vector<dds::LocalEndpoint>& locals) {
   for (const auto& l : locals) {
     if (types_.count(l.topic) != 0) continue;
-    const dds_entity_t topic = dds_get_topic(l.handle);
-    if (topic > 0) {
-      // A borrowed handle: the entity that owns the topic deletes it.
-      dds::Entity borrowed(topic);
-      types_.emplace(l.topic, std::make_unique<dds::TypeInfo>(borrowed));
-      (void)borrowed.release();
+    if (const dds_entity_t topic = dds_get_topic(l.handle); topic > 0) {
+      types_.emplace(l.topic, std::make_unique<dds::TypeInfo>(topic));
     }
   }
+}
+
+bool EndpointWatch::serves_nodes(const dds::LocalEndpoint& l) const {
+  if (l.writer || !is_command_topic(l.topic) || !l.deadline) return true;
+  const auto ms = static_cast<std::uint32_t>(ms_of(*l.deadline));
+  return !settings_.nodes_with_refresh || !settings_.nodes_with_refresh(ms).empty();
 }
 
 void EndpointWatch::look(TimePoint now) {
@@ -200,6 +203,7 @@ void EndpointWatch::look(TimePoint now) {
     for (const auto& l : locals) {
       if (l.topic != e.topic || l.writer == e.writer) continue;
       if (!dds::partitions_meet(l.partitions, e.partitions)) continue;
+      if (!serves_nodes(l)) continue;  // a command reader of a refresh no node has now
       relevant.push_back(&l);
       if (std::find(l.matched.begin(), l.matched.end(), guid) == l.matched.end()) {
         missing.push_back(&l);
@@ -216,11 +220,18 @@ void EndpointWatch::look(TimePoint now) {
     if (now - r.first_seen < settings_.grace) continue;
     bool commander = false;
     std::string why = why_unmatched(r, missing, commander);
-    ++(commander ? refused : unmatched);
+    // A command writer matched by some of the command readers commands their
+    // nodes: said once, not counted as refused.
+    const bool partly = commander && missing.size() < relevant.size();
+    if (!partly) ++(commander ? refused : unmatched);
     if (why == r.reported) continue;
-    log_.with("DDS_GUID", dds::to_string(guid))
-        .warn("{}: {}: {}", who(e),
-              commander ? "refused as a commander" : "does not match the bridge", why);
+    const Logger log = log_.with("DDS_GUID", dds::to_string(guid));
+    if (partly) {
+      log.info("{}: {}", who(e), why);
+    } else {
+      log.warn("{}: {}: {}", who(e),
+               commander ? "refused as a commander" : "does not match the bridge", why);
+    }
     r.reported = std::move(why);
   }
   const bool refused_changed = refused != commanders_refused_.exchange(refused);

@@ -64,6 +64,9 @@ class EndpointWatch {
   std::string why_unmatched(const Remote& r, const std::vector<const dds::LocalEndpoint*>& by,
                             bool& commander) const;
   std::string who(const dds::DiscoveredEndpoint& e) const;
+  // Whether `l` is one of the bridge's endpoints that counts: not a command
+  // reader of a refresh that no node has now (after a reload).
+  bool serves_nodes(const dds::LocalEndpoint& l) const;
   const dds::TypeInfo* type_of(std::string_view topic);
   // The type information of the topics of `locals` not known yet.
   void learn_types(const std::vector<dds::LocalEndpoint>& locals);

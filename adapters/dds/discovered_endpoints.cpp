@@ -93,8 +93,8 @@ std::string to_string(const Guid& guid) {
   return s;
 }
 
-TypeInfo::TypeInfo(const Entity& topic) {
-  if (dds_get_typeinfo(topic.handle(), &info_) < 0) info_ = nullptr;
+TypeInfo::TypeInfo(dds_entity_t topic) {
+  if (dds_get_typeinfo(topic, &info_) < 0) info_ = nullptr;
 }
 
 TypeInfo::~TypeInfo() {

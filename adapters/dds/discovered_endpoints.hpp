@@ -41,7 +41,8 @@ struct DiscoveredEndpoint {
 // A local topic's type information, to compare discovered endpoints with.
 class TypeInfo {
  public:
-  explicit TypeInfo(const Entity& topic);
+  // Of `topic`, a topic entity (not owned).
+  explicit TypeInfo(dds_entity_t topic);
   ~TypeInfo();
   TypeInfo(const TypeInfo&) = delete;
   TypeInfo& operator=(const TypeInfo&) = delete;

@@ -133,8 +133,11 @@ Qos command_writer_qos(std::span<const std::string> partitions, int32_t strength
 // The bridge's: it requests a lease of at most `max_lease`, so that a writer
 // offering a longer one (or an infinite one) does not match, and, for the
 // nodes with a command refresh, a deadline of `deadline` (none: any writer's).
-// A deadline missed lets the next live writer of the instance take it over,
-// whatever its strength, until the stronger one writes again.
+// The deadline makes a writer that does not promise the refresh refuse to
+// match; it does not hand a silent owner's instance to a weaker writer: Cyclone
+// DDS renews an instance's deadline on the samples exclusive ownership
+// rejects too, so a weaker writer that keeps writing keeps the silent
+// owner's deadline met (the bridge's own refresh idles the node).
 // kDefaultMaxCommanderLease is the bridge's max_commander_lease_ms when its
 // configuration gives none.
 inline constexpr Duration kDefaultMaxCommanderLease = seconds(10);

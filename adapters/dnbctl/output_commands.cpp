@@ -24,9 +24,6 @@
 namespace dnbridge::dnbctl {
 namespace {
 
-// While waiting for the echo, and while holding, the command is written
-// again every rewrite_period (commander.hpp): a bridge whose command reader
-// matched late still gets it, and --hold-for keeps it current.
 
 constexpr const char* kLifetimeNote =
     "A command stays in force only while a commander is live: when dnbctl exits its command "
@@ -65,7 +62,10 @@ void outputs_json(JsonWriter& out, const Outputs& o) {
       .end_object();
 }
 
-// Writes a command at once, then again every `period`.
+// Writes a command at once, then again every `period` (rewrite_period,
+// commander.hpp), while waiting for the echo and while holding: a bridge
+// whose command reader matched late still gets it, and --hold-for keeps it
+// current.
 class Rewriter {
  public:
   Rewriter(std::string name, Duration period, std::function<Status()> write)

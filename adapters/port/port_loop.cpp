@@ -57,9 +57,9 @@ void PortLoop::expire_silent_commanders(TimePoint now) {
   const auto say = [&](const auto& silenced, const auto& view_of) {
     for (const auto& s : silenced) {
       const auto* v = view_of(s.mac);
-      log_.warn("node {}: commander {} silent for {} ms (command_refresh_ms): {}", s.mac.value(),
-                s.issuer,
-                v ? std::chrono::duration_cast<milliseconds>(v->command_refresh).count() : 0,
+      silent_log_.warn(log_, now, "node {}: commander {} silent for {} ms (command_refresh_ms): {}",
+                s.mac.value(), s.issuer,
+                std::chrono::duration_cast<milliseconds>(s.silent_for).count(),
                 v && v->outputs_requested ? "outputs held (no_commander = \"hold\")"
                                           : "no live commander left");
     }

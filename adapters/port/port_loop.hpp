@@ -261,6 +261,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   std::atomic<std::uint64_t> refresh_generation_{0};
   // Commands not written again within their node's command refresh: idle.
   void expire_silent_commanders(TimePoint now);
+  RateLimitedLog silent_log_;  // a commander writing just slower than its refresh
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
   std::deque<rack::ExplicitCall> calls_;

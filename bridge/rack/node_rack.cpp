@@ -24,7 +24,7 @@ std::string NodeView::idle_text(bool command_in_force) const {
   if (command_in_force) return {};
   if (idle_cause == IdleCause::kCommanderSilent) {
     return fmt::format("idle: commander silent for {} ms",
-                       std::chrono::duration_cast<milliseconds>(command_refresh).count());
+                       std::chrono::duration_cast<milliseconds>(silent_for).count());
   }
   return std::string(to_string(idle_cause));
 }

@@ -87,6 +87,9 @@ struct NodeView {
   // Zero: off. Otherwise a command not written again for this long is no
   // longer in force (IdleCause::kCommanderSilent).
   Duration command_refresh{};
+  // IdleCause::kCommanderSilent: how long the commander had been silent
+  // when its command lapsed (its refresh).
+  Duration silent_for{};
   // "idle: ..." when no command is in force; empty otherwise.
   std::string idle_text(bool command_in_force) const;
   // The device's minor faults (Identity.Status), in words; empty when none.
@@ -126,20 +129,24 @@ class NodeRack : public devicenet::ScannerObserver {
     return release(mac, IdleCause::kNoCommander, now);
   }
 
-  // The command refresh: a command in force that was not written again for
-  // its node's command_refresh counts as having no live commander
-  // (release_command, with IdleCause::kCommanderSilent). Returns the nodes
-  // released so, with the issuer that fell silent.
+  // The command refresh: a command in force on an online node that was not
+  // written again by its lapse time (the node's command_refresh after it
+  // was taken) counts as having no live commander (release_command, with
+  // IdleCause::kCommanderSilent). Returns the nodes released so, with the
+  // issuer that fell silent and how long it had been.
   struct Silenced {
     devicenet::MacId mac;
     std::string issuer;
+    Duration silent_for{};
   };
   std::vector<Silenced> expire_silent_commanders(TimePoint now) {
     std::vector<Silenced> out;
     for (std::size_t i = 0; i < views_.size(); ++i) {
       const Entry& e = entries_[i];
-      if (!refresh_due(views_[i], e) || now < e.last_command + views_[i].command_refresh) continue;
-      Silenced s{views_[i].mac, views_[i].commanded_by};
+      if (!lapse_due(views_[i], e) || now < e.lapse_at) continue;
+      // Silent for at least its refresh (the loop may see it a little late).
+      Silenced s{views_[i].mac, views_[i].commanded_by, e.lapse_at - e.last_command};
+      views_[i].silent_for = s.silent_for;
       (void)release(s.mac, IdleCause::kCommanderSilent, now);
       out.push_back(std::move(s));
     }
@@ -149,9 +156,7 @@ class NodeRack : public devicenet::ScannerObserver {
   TimePoint next_refresh_deadline() const {
     TimePoint next = kNever;
     for (std::size_t i = 0; i < views_.size(); ++i) {
-      if (refresh_due(views_[i], entries_[i])) {
-        next = std::min(next, entries_[i].last_command + views_[i].command_refresh);
-      }
+      if (lapse_due(views_[i], entries_[i])) next = std::min(next, entries_[i].lapse_at);
     }
     return next;
   }
@@ -204,14 +209,24 @@ class NodeRack : public devicenet::ScannerObserver {
   // Only what the bridge itself does with the node changed (its name, its
   // no-commander and resume policies, its command refresh): view and command
   // are kept, but for outputs held for a commander that has gone when the
-  // new policy is idle. A new command refresh counts from now.
+  // new policy is idle. A command in force under a refresh that changes must
+  // still be written again in time: by its lapse time under the refresh it
+  // was taken with (when the new one is off), or within the new refresh
+  // from now, whichever is later.
   void update(const Config& c, TimePoint now) {
     View* v = find(c.node.mac);
     if (!v) return;
     Entry& e = entry(c.node.mac);
     e.no_commander = c.no_commander;
     e.resume = c.resume;
-    if (v->command_refresh != c.command_refresh) e.last_command = std::max(e.last_command, now);
+    if (v->command_refresh != c.command_refresh && v->outputs_requested) {
+      const bool was_on = v->command_refresh > Duration::zero();
+      if (c.command_refresh > Duration::zero()) {
+        e.lapse_at = std::max(was_on ? e.lapse_at : TimePoint{}, now + c.command_refresh);
+      } else if (!was_on) {
+        e.lapse_at = kNever;
+      }
+    }
     v->command_refresh = c.command_refresh;
     v->name = c.node.name;
     ++v->changes;
@@ -249,6 +264,9 @@ class NodeRack : public devicenet::ScannerObserver {
       if (const devicenet::Node* node = scanner_->node(mac)) {
         Profile::on_online(*v, entry(mac).slot, *node);
       }
+    }
+    if (to == NodeState::kOnline && v->outputs_requested && v->command_refresh > Duration::zero()) {
+      entry(mac).lapse_at = at + v->command_refresh;
     }
     v->state = to;
     v->reason = reason;
@@ -343,8 +361,10 @@ class NodeRack : public devicenet::ScannerObserver {
     }
     v.outputs_requested = outputs;
     v.commanded_by = std::string(issuer);
-    entry(v.mac).held_without_commander = false;
-    entry(v.mac).last_command = now;
+    Entry& e = entry(v.mac);
+    e.held_without_commander = false;
+    e.last_command = now;
+    e.lapse_at = v.command_refresh > Duration::zero() ? now + v.command_refresh : kNever;
     ++v.commands_accepted;
     ++v.changes;
     return {};
@@ -358,15 +378,18 @@ class NodeRack : public devicenet::ScannerObserver {
     // The last commander went away while the policy held its outputs.
     bool held_without_commander = false;
     TimePoint last_command{};  // when the command in force was last taken
+    TimePoint lapse_at = kNever;  // when it lapses unless written again
   };
   static Entry entry_of(const Config& c) {
-    return Entry{Profile::slot_of(c), c.no_commander, c.resume, false, {}};
+    return Entry{Profile::slot_of(c), c.no_commander, c.resume, false, {}, kNever};
   }
 
-  // A command is in force that the node's command refresh may expire.
-  static bool refresh_due(const View& v, const Entry& e) {
-    return v.command_refresh > Duration::zero() && v.outputs_requested.has_value() &&
-           !e.held_without_commander;
+  // A command is in force on an online node, and may lapse. (Offline, a
+  // command is neither renewed nor applied; one kept by resume =
+  // "last-command" gets a refresh from the node's return.)
+  static bool lapse_due(const View& v, const Entry& e) {
+    return v.online && v.outputs_requested.has_value() && !e.held_without_commander &&
+           e.lapse_at != kNever;
   }
 
   // No live commander left (`cause`): idle, or the outputs held if the

@@ -116,6 +116,46 @@ TEST_F(CommandRefresh, ANodeWithoutRefreshKeepsItsCommandForAnyTime) {
   EXPECT_TRUE(rack().device(mac(2)).device().outputs().pump_on);
 }
 
+// A reload that changes a node's refresh while a command is in force: the
+// command must still be written again in time, through the readers of the
+// new refresh, and a commander that does so keeps its pump.
+TEST_F(CommandRefresh, ARefreshTurnedOffByAReloadStillLapsesACommandNotWrittenAgain) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  ASSERT_TRUE(command().ok());
+  const TimePoint lapse = rack().now() + kRefresh;
+  rack().world().run_for(milliseconds(100));
+  auto off = rack_config({1, 2}).pumps[0];
+  off.command_refresh = Duration::zero();
+  pumps().update(off, rack().now());
+  EXPECT_EQ(pumps().next_refresh_deadline(), lapse);
+  const auto silenced = run_for(kRefresh);
+  ASSERT_EQ(silenced.size(), 1u) << "a command the commander never wrote again stayed in force";
+  EXPECT_FALSE(device_on());
+  // Written again, it holds without a refresh.
+  ASSERT_TRUE(command().ok());
+  EXPECT_EQ(pumps().next_refresh_deadline(), kNever);
+  EXPECT_TRUE(run_for(seconds(10)).empty());
+  EXPECT_TRUE(device_on());
+}
+
+TEST_F(CommandRefresh, ARefreshTurnedOnByAReloadCountsFromTheReload) {
+  auto config = rack_config({1});
+  rack_ = std::make_unique<sim::SimRack>(config);
+  rack_->start();
+  ASSERT_TRUE(rack().world().run_until([&] { return rack().all_online(); }, seconds(20)));
+  ASSERT_TRUE(command().ok());
+  rack().world().run_for(seconds(5));
+  auto on = config.pumps[0];
+  on.command_refresh = kRefresh;
+  pumps().update(on, rack().now());
+  EXPECT_EQ(pumps().next_refresh_deadline(), rack().now() + kRefresh);
+  ASSERT_TRUE(run_for(kRefresh - milliseconds(10)).empty());
+  ASSERT_TRUE(command().ok());  // in time
+  EXPECT_TRUE(run_for(kRefresh - milliseconds(10)).empty());
+  EXPECT_TRUE(device_on());
+  EXPECT_EQ(run_for(milliseconds(20)).size(), 1u);
+}
+
 TEST_F(CommandRefresh, UnderTheHoldPolicyASilentCommandersOutputsAreHeld) {
   ASSERT_NO_FATAL_FAILURE(start(rack::NoCommanderPolicy::kHoldLastOutputs));
   ASSERT_TRUE(command().ok());
