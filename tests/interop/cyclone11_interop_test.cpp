@@ -92,15 +92,7 @@ const std::vector<std::string> kTopics = {"PumpState",       "PumpCommand",   "D
 // exists.
 std::string rack_config() {
   std::string text = support::simulated_rack_config(kDomain, kRack, "info");
-  text +=
-      "  [[port.node]]\n  mac = 20\n  name = \"io-1\"\n  profile = \"eds\"\n"
-      "  eds = \"" DNBRIDGE_SOURCE_DIR
-      "/deploy/eds/dnbridge-example-io-block.eds\"\n"
-      "  connection = \"change-of-state\"\n"
-      "  safe_state = [ { name = \"Output fault action\", value = 0 },\n"
-      "                 { name = \"Output fault value\", value = 0 },\n"
-      "                 { name = \"Output idle action\", value = 0 },\n"
-      "                 { name = \"Output idle value\", value = 0 } ]\n";
+  text += support::example_io_block_node(DNBRIDGE_SOURCE_DIR);
   return text;
 }
 

@@ -33,4 +33,21 @@ inline std::string simulated_rack_config(std::int64_t domain, std::string_view r
   return text;
 }
 
+// A [[port.node]] of the last [[port]]: the example I/O block of
+// deploy/eds at MAC 20 ("io-1"), on change of state, its safe state every
+// output off; `source_dir` is the source tree's.
+inline std::string example_io_block_node(std::string_view source_dir) {
+  std::string text =
+      "  [[port.node]]\n  mac = 20\n  name = \"io-1\"\n  profile = \"eds\"\n  eds = \"";
+  text += source_dir;
+  text +=
+      "/deploy/eds/dnbridge-example-io-block.eds\"\n"
+      "  connection = \"change-of-state\"\n"
+      "  safe_state = [ { name = \"Output fault action\", value = 0 },\n"
+      "                 { name = \"Output fault value\", value = 0 },\n"
+      "                 { name = \"Output idle action\", value = 0 },\n"
+      "                 { name = \"Output idle value\", value = 0 } ]\n";
+  return text;
+}
+
 }  // namespace dnbridge::support
