@@ -20,6 +20,7 @@ enum Token : dds::WaitSet::Token {
   kScanRequests = 4,
   kReloadRequests = 5,
   kLogWaiting = 6,
+  kSilenced = 7,
 };
 
 // A command stamped further ahead of this host's clock is reported.
@@ -29,6 +30,13 @@ constexpr Duration kClockSkewReported = seconds(1);
 // each pump's newest command is applied once per hold-off, at most 1 ms late;
 // one that comes alone is taken at once, on Cyclone's thread.
 constexpr Duration kCommandHoldoff = milliseconds(1);
+
+// The filter of a node's own command readers (DdsInput::node_readers_).
+template <class Command, class Key>
+bool commands_node(const Command& c, const void* key) {
+  const auto& k = *static_cast<const Key*>(key);
+  return c.mac == k.mac && dds::view(c.port) == k.port && dds::view(c.rack) == k.rack;
+}
 
 // Samples taken at a time.
 constexpr std::size_t kBatch = 32;
@@ -148,6 +156,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       stop_(participant),
       waitset_(participant),
       log_waiting_(participant),
+      silenced_(participant),
       command_sink_(log_.sink(), [this] { (void)log_waiting_.trigger(); }),
       command_log_(log_.to(command_sink_)),
       own_sink_(log_.sink(), [this] { drain_command_log(); }) {
@@ -194,6 +203,14 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
   if (reload_requests_) waitset_.attach(*reload_requests_, kReloadRequests);
   waitset_.attach(stop_, kStop);
   waitset_.attach(log_waiting_, kLogWaiting);
+  waitset_.attach(silenced_, kSilenced);
+  for (const auto& [name, loop] : ports_) {
+    auto& seen = silences_seen_[name];
+    for (unsigned m = 0; m <= devicenet::MacId::kMax; ++m) {
+      seen[m] = loop->silences(*devicenet::MacId::from(m));
+    }
+    loop->watch_silences([this] { (void)silenced_.trigger(); });
+  }
 }
 
 DdsInput::~DdsInput() { stop(); }
@@ -208,14 +225,17 @@ void DdsInput::start() {
 
 void DdsInput::stop() {
   accepting_ = false;
+  for (const auto& [name, loop] : ports_) loop->watch_silences({});
   // No listener call after this: none is handing a command to a port.
   {
     std::lock_guard lock(command_take_mutex_);
     classes_closed_ = true;
-    for (const auto& c : command_classes_) {
-      (void)dds::DataListener::detach(c->pumps);
-      if (c->devices) (void)dds::DataListener::detach(*c->devices);
-    }
+    const auto detach = [](const CommandClass& c) {
+      if (c.pumps) (void)dds::DataListener::detach(*c.pumps);
+      if (c.devices) (void)dds::DataListener::detach(*c.devices);
+    };
+    for (const auto& c : command_classes_) detach(*c);
+    for (const auto& [key, c] : node_readers_) detach(*c);
   }
   if (!thread_.joinable()) return;
   (void)stop_.trigger();
@@ -268,6 +288,15 @@ void DdsInput::run() {
         (void)log_waiting_.take_triggered();
         drain_command_log();
       }
+      if (token == kSilenced) {
+        (void)silenced_.take_triggered();
+        {
+          std::lock_guard lock(command_take_mutex_);
+          make_readers_of_silenced_nodes();
+        }
+        commands_pending_ = true;  // any that came while the new readers were made
+        deliver_commands();
+      }
     }
     if (commands_held && port::steady_now() >= TimePoint{Duration(next_command_take_.load())}) {
       commands_held = false;
@@ -295,6 +324,7 @@ std::uint64_t DdsInput::refresh_generations() const {
 
 void DdsInput::ensure_command_classes() {
   classes_for_generation_ = refresh_generations();
+  drop_stale_node_readers();
   ensure_command_class(0);
   for (const auto& [name, loop] : ports_) {
     for (unsigned m = 0; m <= devicenet::MacId::kMax; ++m) {
@@ -322,11 +352,9 @@ void DdsInput::ensure_command_class(std::uint32_t ms) {
   const auto deadline = ms == 0 ? std::nullopt : std::optional<Duration>(milliseconds(ms));
   const dds::Qos qos = dds::command_reader_qos(partition_, max_commander_lease_, deadline);
   try {
-    auto made = std::make_unique<CommandClass>(
-        CommandClass{ms,
-                     dds::Reader<dnbridge_PumpCommand>(participant_, command_topic_, qos,
-                                                       command_listener_.get()),
-                     std::nullopt});
+    auto made = std::make_unique<CommandClass>();
+    made->refresh_ms = ms;
+    made->pumps.emplace(participant_, command_topic_, qos, command_listener_.get());
     if (device_command_topic_) {
       made->devices = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)", [&] {
         return dds::Reader<dnbridge_DeviceCommand>(participant_, *device_command_topic_, qos,
@@ -343,6 +371,69 @@ void DdsInput::ensure_command_class(std::uint32_t ms) {
   } catch (const std::exception& e) {
     // Their commands are not taken: a command in force lapses at its refresh.
     log_.error("no command reader for the nodes with command_refresh_ms = {}: {}", ms, e.what());
+  }
+}
+
+void DdsInput::make_readers_of_silenced_nodes() {
+  for (const auto& [name, loop] : ports_) {
+    auto& seen = silences_seen_[name];
+    for (unsigned m = 0; m <= devicenet::MacId::kMax; ++m) {
+      const auto mac = *devicenet::MacId::from(m);
+      const std::uint32_t silences = loop->silences(mac);
+      if (silences == seen[m]) continue;
+      seen[m] = silences;
+      const std::uint32_t refresh = loop->command_refresh_ms(mac);
+      if (!loop->has_node(mac) || refresh == 0) continue;  // a reload came since
+      make_node_readers(name, mac, !loop->has_pump(mac), refresh);
+    }
+  }
+}
+
+void DdsInput::make_node_readers(const std::string& port, devicenet::MacId mac, bool device,
+                                 std::uint32_t refresh_ms) {
+  if (classes_closed_) return;
+  auto key = std::make_unique<NodeKey>(NodeKey{rack_, port, mac.value()});
+  // The previous ones go first: the silent owner of the node is theirs.
+  if (auto it = node_readers_.find(*key); it != node_readers_.end()) node_readers_.erase(it);
+  const dds::Qos qos =
+      dds::command_reader_qos(partition_, max_commander_lease_, milliseconds(refresh_ms));
+  try {
+    auto made = std::make_unique<CommandClass>();
+    made->refresh_ms = refresh_ms;
+    if (device) {
+      if (!device_command_topic_) return;  // DDS Security grants no device command
+      made->device_topic.emplace(participant_);
+      made->device_topic->filter(&commands_node<dnbridge_DeviceCommand, NodeKey>, key.get());
+      made->devices.emplace(participant_, *made->device_topic, qos, command_listener_.get());
+    } else {
+      made->pump_topic.emplace(participant_);
+      made->pump_topic->filter(&commands_node<dnbridge_PumpCommand, NodeKey>, key.get());
+      made->pumps.emplace(participant_, *made->pump_topic, qos, command_listener_.get());
+    }
+    made->node = std::move(key);
+    const NodeKey& k = *made->node;
+    command_log_.debug(
+        "port {} node {}: its commander went silent; its commands are taken by a reader of its "
+        "own, made afresh, so that the next live commander by strength takes it over",
+        port, mac.value());
+    node_readers_.emplace(k, std::move(made));
+  } catch (const std::exception& e) {
+    // The node's class takes its commands: a weaker commander does not take
+    // over from the silent one.
+    command_log_.error("port {} node {}: no command reader of its own: {}", port, mac.value(),
+                       e.what());
+  }
+}
+
+void DdsInput::drop_stale_node_readers() {
+  for (auto it = node_readers_.begin(); it != node_readers_.end();) {
+    const NodeKey& k = it->first;
+    port::PortLoop* loop = port_of(k.port);
+    const auto mac = *devicenet::MacId::from(k.mac);
+    const bool device = static_cast<bool>(it->second->devices);
+    const bool same = loop && loop->has_node(mac) && loop->has_pump(mac) != device &&
+                      loop->command_refresh_ms(mac) == it->second->refresh_ms;
+    it = same ? std::next(it) : node_readers_.erase(it);
   }
 }
 
@@ -377,12 +468,19 @@ void DdsInput::deliver_commands() {
 
 void DdsInput::take_commands() {
   for (const auto& cls : command_classes_) {
-    const CommandClass& from = *cls;
-    take_batches([&] { return from.pumps.take(command_buffer_); }, command_buffer_.capacity(), 0,
+    take_commands(*cls);
+  }
+  for (const auto& [key, cls] : node_readers_) take_commands(*cls);
+}
+
+void DdsInput::take_commands(const CommandClass& from) {
+  if (from.pumps) {
+    take_batches([&] { return from.pumps->take(command_buffer_); }, command_buffer_.capacity(), 0,
                  command_log_, "pump commands", [&](std::size_t i) {
                    on_command(command_buffer_.data(i), command_buffer_.info(i), from);
                  });
-    if (!from.devices) continue;
+  }
+  if (from.devices) {
     take_batches([&] { return from.devices->take(device_command_buffer_); },
                  device_command_buffer_.capacity(), 0, command_log_, "device commands",
                  [&](std::size_t i) {
@@ -400,11 +498,15 @@ port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info
   const bool node = loop && mac && loop->has_node(*mac);
   const bool pump = node && loop->has_pump(*mac);
   // Every class's readers have every instance: a node's commands are its
-  // own class's, and a refusal is said once, by the class without refresh.
+  // own readers' when it has them, else its class's, and a refusal is said
+  // once, by the class without refresh.
   if (node && pump != device) {
-    return loop->command_refresh_ms(*mac) == from.refresh_ms ? loop : nullptr;
+    if (loop->command_refresh_ms(*mac) != from.refresh_ms) return nullptr;
+    const NodeKey key{rack_, loop->name(), mac->value()};
+    if (from.node) return from.node->port == key.port && from.node->mac == key.mac ? loop : nullptr;
+    return node_readers_.count(key) == 0 ? loop : nullptr;
   }
-  if (from.refresh_ms != 0) return nullptr;
+  if (from.refresh_ms != 0 || from.node) return nullptr;
   command_warn_limit_.warn(
       command_log_, port::steady_now(), "{} command{} for port \"{}\" MAC {} refused: {}",
       device ? "device" : "pump",

@@ -8,9 +8,12 @@
 // thread at its end. There is one pair of command readers per command
 // refresh the rack's nodes have (their requested deadline:
 // dds::command_reader_qos), each taking only its own nodes' commands, all
-// with the rack's lease bound. Requests are taken on the input's own thread,
-// from a waitset.
+// with the rack's lease bound. A node whose commander went silent (its
+// command not written again within the node's refresh) has its commands
+// taken from then on by readers of its own, made afresh: see node_readers_.
+// Requests are taken on the input's own thread, from a waitset.
 // Requests for other racks are left to their bridges.
+#include <array>
 #include <atomic>
 #include <functional>
 #include <map>
@@ -18,6 +21,7 @@
 #include <span>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "adapters/daemon/dds_publisher.hpp"
@@ -127,13 +131,16 @@ class DdsInput {
   // Logs the command path's waiting lines (HandoffLogSink), and how many
   // were dropped, with this input's logger.
   void drain_command_log();
+  // The command readers of the nodes with one command refresh (0: none),
+  // or of one node (node_readers_).
+  struct CommandClass;
+  // Every command reader's commands; one reader pair's.
   void take_commands();
+  void take_commands(const CommandClass& from);
   bool take_requests();  // true when requests may remain
   void take_scan_requests();
   void on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample);
   void take_reload_requests();
-  // The command readers of the nodes with one command refresh (0: none).
-  struct CommandClass;
   void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info,
                   const CommandClass& from);
   void on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info,
@@ -152,6 +159,30 @@ class DdsInput {
   // nodes of that refresh then take no command: their commands lapse).
   // Under command_take_mutex_.
   void ensure_command_class(std::uint32_t refresh_ms);
+  // node_readers_: a node's own readers, for a node whose commander went
+  // silent. Exclusive
+  // ownership keeps a silent writer that is still live the owner of its
+  // instance in every reader that has it (Cyclone DDS renews an instance's
+  // deadline on the samples ownership refuses, so the owner never misses
+  // it while a weaker writer writes): a weaker live commander would never
+  // take over. A reader made afresh, volatile, has no owner for the node:
+  // the next sample of any live commander of the node owns it there, and a
+  // stronger one's takes it back. At most one reader per node, made again at
+  // each silence of its commander (the port loop counts them:
+  // PortLoop::silences), dropped when a reload changes the node's refresh or
+  // kind. Under command_take_mutex_.
+  struct NodeKey {
+    std::string rack, port;
+    std::uint8_t mac;
+    bool operator<(const NodeKey& o) const {
+      return std::tie(port, mac) < std::tie(o.port, o.mac);
+    }
+  };
+  void make_readers_of_silenced_nodes();
+  void make_node_readers(const std::string& port, devicenet::MacId mac, bool device,
+                         std::uint32_t refresh_ms);
+  // Drops the node readers of nodes whose kind or refresh changed since.
+  void drop_stale_node_readers();
   bool classes_closed_ = false;  // stop(): no class is made after it (under the mutex)
   std::uint64_t refresh_generations() const;
   void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
@@ -183,12 +214,25 @@ class DdsInput {
   std::optional<dds::Topic<dnbridge_DeviceCommand>> device_command_topic_;
   struct CommandClass {
     std::uint32_t refresh_ms;  // 0: the nodes without a command refresh
-    dds::Reader<dnbridge_PumpCommand> pumps;
+    // A node's own readers: the node (their topics' filter's argument);
+    // null for a class of nodes.
+    std::unique_ptr<NodeKey> node;
+    // A node's own readers' topics, filtered to the node; a class's readers
+    // are on the topics of every command.
+    std::optional<dds::Topic<dnbridge_PumpCommand>> pump_topic;
+    std::optional<dds::Topic<dnbridge_DeviceCommand>> device_topic;
+    std::optional<dds::Reader<dnbridge_PumpCommand>> pumps;
     std::optional<dds::Reader<dnbridge_DeviceCommand>> devices;
   };
   // Guarded by command_take_mutex_; classes are added, never removed, while
   // the input runs (a listener call may be on any of them).
   std::vector<std::unique_ptr<CommandClass>> command_classes_;
+  // Guarded by command_take_mutex_: a reader deleted under it may have a
+  // listener call in progress, which finds the mutex taken and returns.
+  std::map<NodeKey, std::unique_ptr<CommandClass>> node_readers_;
+  // The port loops' silence counts as last looked at (the input thread's).
+  std::map<std::string, std::array<std::uint32_t, devicenet::MacId::kMax + 1>, std::less<>>
+      silences_seen_;
   std::uint64_t classes_for_generation_ = ~0ull;  // the ports' refresh generations then
   dds::Reader<dnbridge_ExplicitRequest> requests_;
   // Absent when DDS Security does not grant the service (unless_denied).
@@ -206,6 +250,7 @@ class DdsInput {
   RateLimitedLog command_warn_limit_;  // these two: whichever thread takes commands,
   RateLimitedLog skew_limit_;          // through command_log_
   dds::GuardCondition log_waiting_;
+  dds::GuardCondition silenced_;  // a port loop counted a silence
   HandoffLogSink command_sink_;
   Logger command_log_;  // log_ through command_sink_
   // log_'s sink once constructed: the input's own lines come after the

@@ -149,8 +149,12 @@ std::string EndpointWatch::why_unmatched(const Remote& r,
       const auto ms = static_cast<std::uint32_t>(ms_of(*l->deadline));
       const std::string nodes =
           settings_.nodes_with_refresh ? settings_.nodes_with_refresh(ms) : std::string{};
-      refreshes.push_back(fmt::format("command_refresh_ms = {}{}", ms,
-                                      nodes.empty() ? "" : fmt::format(" ({})", nodes)));
+      std::string refresh = fmt::format("command_refresh_ms = {}{}", ms,
+                                        nodes.empty() ? "" : fmt::format(" ({})", nodes));
+      // A node's own reader has its class's deadline: said once.
+      if (std::find(refreshes.begin(), refreshes.end(), refresh) == refreshes.end()) {
+        refreshes.push_back(std::move(refresh));
+      }
     }
     if (!refreshes.empty()) {
       std::string list;

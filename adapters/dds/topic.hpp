@@ -4,6 +4,7 @@
 // specialisations are in topics.hpp.
 #include <dds/dds.h>
 
+#include <memory>
 #include <string>
 
 #include "adapters/dds/entity.hpp"
@@ -28,6 +29,33 @@ class Topic : public Entity {
                                       name.c_str(), nullptr, nullptr),
                      "creating topic \"" + name + "\" of type " +
                          TopicTraits<T>::kDescriptor->m_typename)) {}
+
+  // Deleted before its filter goes.
+  ~Topic() { reset(); }
+  Topic(Topic&&) noexcept = default;
+  Topic& operator=(Topic&&) noexcept = default;
+
+  // Only the samples `accept(sample, arg)` takes reach the readers made on
+  // this topic entity from then on: Cyclone's topic filter, run as each
+  // sample with data arrives (a dispose or unregister still passes). For a
+  // topic entity of its readers' own; `arg` must outlive them. Throws Error.
+  void filter(bool (*accept)(const T& sample, const void* arg), const void* arg) {
+    filter_ = std::make_unique<Filter>(Filter{accept, arg});
+    check(dds_set_topic_filter_and_arg(handle(), &Topic::call, filter_.get()),
+          "setting a filter on a topic of type " +
+              std::string(TopicTraits<T>::kDescriptor->m_typename));
+  }
+
+ private:
+  struct Filter {
+    bool (*accept)(const T&, const void*) = nullptr;
+    const void* arg = nullptr;
+  };
+  static bool call(const void* sample, void* filter) {
+    const auto* f = static_cast<const Filter*>(filter);
+    return f->accept(*static_cast<const T*>(sample), f->arg);
+  }
+  std::unique_ptr<Filter> filter_;  // where Cyclone has it: kept when the topic moves
 };
 
 }  // namespace dnbridge::dds

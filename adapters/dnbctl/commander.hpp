@@ -25,8 +25,16 @@ struct Outputs {
 };
 
 // How long the bridge waits, after dnbctl stops renewing its liveliness
-// (killed, frozen), before it takes a command as gone.
+// (killed, frozen), before it takes a command as gone; shorter when the
+// rack's bound is (PortStatus.max_commander_lease_ms).
 inline constexpr Duration kCommandLease = seconds(2);
+
+// What the node's bridge asks of a commander: the node's command refresh
+// (zero: none) and the liveliness lease to offer.
+struct CommandTerms {
+  Duration refresh = Duration::zero();
+  Duration lease = kCommandLease;
+};
 
 // How often a command is written again while it is held: every second, and
 // four times per command refresh when the node has one, so that a write
@@ -36,19 +44,21 @@ inline Duration rewrite_period(Duration refresh) {
 }
 
 // A writer of command topic T for the nodes of `rack` (in its partition:
-// only its bridge gets them). `refresh`: the node's command refresh
-// (NodeStatus.command_refresh_ms), offered as the writer's deadline; the
-// command must then be written again at least that often (rewrite_period).
+// only its bridge gets them), offering `terms.lease`. `terms.refresh`: the
+// node's command refresh, offered as the writer's deadline; the command
+// must then be written again at least that often (rewrite_period).
 template <class T>
 class CommandWriter {
  public:
   CommandWriter(Client& client, std::int32_t strength, const std::string& rack,
-                Duration refresh = Duration::zero())
+                const CommandTerms& terms = {})
       : topic_(client.participant()),
         writer_(client.participant(), topic_,
-                dds::command_writer_qos(
-                    std::vector{dds::rack_partition(rack)}, strength, kCommandLease,
-                    refresh > Duration::zero() ? std::optional(refresh) : std::nullopt)) {}
+                dds::command_writer_qos(std::vector{dds::rack_partition(rack)}, strength,
+                                        terms.lease,
+                                        terms.refresh > Duration::zero()
+                                            ? std::optional(terms.refresh)
+                                            : std::nullopt)) {}
 
   // Until a command reader (a bridge) matched; false at the deadline.
   // Commands are volatile: one written before a bridge matched is lost.

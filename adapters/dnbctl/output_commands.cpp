@@ -175,13 +175,22 @@ void hold_or_note(Client& client, const GlobalOptions& o, double hold_for_second
   }
 }
 
-// The node's command refresh, as its bridge publishes it (NodeStatus,
-// transient-local: at once); zero when off, or without a NodeStatus by
-// `deadline`.
-Duration command_refresh_of(Client& client, const NodeKey& key, Deadline deadline) {
-  client.wait_until(deadline, [&] { return client.node(key) != nullptr; });
-  const auto* n = client.node(key);
-  return n ? milliseconds(n->data->command_refresh_ms) : Duration::zero();
+// What the node's bridge asks of its commanders, as it publishes it
+// (NodeStatus.command_refresh_ms, PortStatus.max_commander_lease_ms; both
+// transient-local: at once): what is not here by `deadline` is taken as
+// asking nothing more than dnbctl offers anyway.
+CommandTerms command_terms_of(Client& client, const NodeKey& key, Deadline deadline) {
+  const auto port = [&]() -> const dnbridge_PortStatus* {
+    auto it = client.ports().find(PortKey{key.rack, key.port});
+    return it == client.ports().end() ? nullptr : &*it->second.data;
+  };
+  client.wait_until(deadline, [&] { return client.node(key) != nullptr && port() != nullptr; });
+  CommandTerms terms;
+  if (const auto* n = client.node(key)) terms.refresh = milliseconds(n->data->command_refresh_ms);
+  if (const auto* p = port(); p && p->max_commander_lease_ms > 0) {
+    terms.lease = std::min<Duration>(terms.lease, milliseconds(p->max_commander_lease_ms));
+  }
+  return terms;
 }
 
 // Which kind of node a command is for: each has its own state and command
@@ -305,8 +314,8 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
     case Output::kBallast: wanted.n2_ballast_on = *on; break;
     case Output::kAnalog: wanted.analog_output_raw = analog->raw; break;
   }
-  const Duration refresh = command_refresh_of(client, key, deadline_after(o.timeout()));
-  Commander commander(client, args.strength, key.rack, refresh);
+  const CommandTerms terms = command_terms_of(client, key, deadline_after(o.timeout()));
+  Commander commander(client, args.strength, key.rack, terms);
   const Deadline deadline = deadline_after(o.timeout());
   wait_for_bridge(client, commander, key, deadline,
                   "commands (a bridge of a version before partitions reads them elsewhere)",
@@ -315,7 +324,7 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   // Written, then again every rewrite period, until the echo shows it applied
   // or the bridge refused it.
   const std::uint64_t samples_before = client.pump(key)->samples;
-  Rewriter rewriter(name, rewrite_period(refresh),
+  Rewriter rewriter(name, rewrite_period(terms.refresh),
                     [&] { return commander.write(key, wanted, issuer); });
   const std::string failure = command_until_applied(
       client, key, deadline, rewriter,
@@ -456,12 +465,12 @@ Exit run_device_outputs(const GlobalOptions& o, const DeviceOutputArgs& args) {
   Client client = make_client(o);
   const NodeKey key = node_of_kind(client, o, *ref, NodeKind::kDevice);
   const std::string name = node_name(key.rack, key.port, key.mac);
-  const Duration refresh = command_refresh_of(client, key, deadline_after(o.timeout()));
-  DeviceCommander commander(client, args.strength, key.rack, refresh);
+  const CommandTerms terms = command_terms_of(client, key, deadline_after(o.timeout()));
+  DeviceCommander commander(client, args.strength, key.rack, terms);
   const Deadline deadline = deadline_after(o.timeout());
   wait_for_bridge(client, commander, key, deadline, "device commands", o.timeout_seconds);
   const std::uint64_t samples_before = client.device(key)->samples;
-  Rewriter rewriter(name, rewrite_period(refresh),
+  Rewriter rewriter(name, rewrite_period(terms.refresh),
                     [&] { return commander.write(key, wanted, issuer); });
   const std::string failure = command_until_applied(
       client, key, deadline, rewriter,

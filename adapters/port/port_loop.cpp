@@ -53,9 +53,17 @@ void PortLoop::note_scan_list() {
   refresh_generation_.fetch_add(1, std::memory_order_release);
 }
 
+void PortLoop::watch_silences(std::function<void()> watch) {
+  std::lock_guard lock(silence_watch_mutex_);
+  silence_watch_ = std::move(watch);
+}
+
 void PortLoop::expire_silent_commanders(TimePoint now) {
+  bool any = false;
   const auto say = [&](const auto& silenced, const auto& view_of) {
     for (const auto& s : silenced) {
+      any = true;
+      silences_[s.mac.value()].fetch_add(1, std::memory_order_release);
       const auto* v = view_of(s.mac);
       silent_log_.warn(log_, now, "node {}: commander {} silent for {} ms (command_refresh_ms): {}",
                 s.mac.value(), s.issuer,
@@ -66,6 +74,9 @@ void PortLoop::expire_silent_commanders(TimePoint now) {
   };
   say(rack().expire_silent_commanders(now), [&](MacId m) { return rack().pump(m); });
   say(devices().expire_silent_commanders(now), [&](MacId m) { return devices().device(m); });
+  if (!any) return;
+  std::lock_guard lock(silence_watch_mutex_);
+  if (silence_watch_) silence_watch_();
 }
 
 PortLoop::~PortLoop() {

@@ -126,6 +126,14 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   std::uint64_t refresh_generation() const {
     return refresh_generation_.load(std::memory_order_acquire);
   }
+  // How many times the node's command lapsed because its commander stopped
+  // writing it (command_refresh_ms) (any thread). `watch` is called on the
+  // port's thread after each such lapse, so it must return at once; empty:
+  // none. Set and cleared from any thread.
+  std::uint32_t silences(devicenet::MacId mac) const {
+    return silences_[mac.value()].load(std::memory_order_acquire);
+  }
+  void watch_silences(std::function<void()> watch);
 
   // For a service manager, from any thread. The port has finished its
   // start-up checks once its master left the duplicate MAC ID check, either
@@ -262,6 +270,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // Commands not written again within their node's command refresh: idle.
   void expire_silent_commanders(TimePoint now);
   RateLimitedLog silent_log_;  // a commander writing just slower than its refresh
+  std::array<std::atomic<std::uint32_t>, devicenet::MacId::kMax + 1> silences_{};
+  std::mutex silence_watch_mutex_;
+  std::function<void()> silence_watch_;
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
   std::deque<rack::ExplicitCall> calls_;

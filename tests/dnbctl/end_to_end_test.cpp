@@ -1,6 +1,7 @@
 // The real dnbctl program, run as a child process, against a bridge of the
 // simulated rack (eight CDN127 pumps at MACs 1..8 on port "A") running in
-// this process, under a rack name and a node name that are not ASCII. Both are pinned to loopback
+// this process, under a rack name and a node name that are not ASCII, taking commands from
+// writers offering a lease of at most 1.5 s. Both are pinned to loopback
 // on a domain and discovery tag of this process's own (test_domain.hpp). Node 3 holds its last
 // outputs when no commander is left, so what one dnbctl run commanded is still applied when the
 // next one reads it.
@@ -57,6 +58,9 @@ class DnbctlEndToEnd : public ::testing::Test {
     config.source = "dnbctl-e2e.toml";
     config.domain_id = test_domain();
     config.rack = kRack;
+    // Below the lease dnbctl offers on its own (dnbctl::kCommandLease): it
+    // offers the rack's bound, read from PortStatus, or commands nothing.
+    config.max_commander_lease = milliseconds(1500);
     for (auto& node : config.ports.at(0).nodes) {
       if (node.pump.node.mac.value() == 3) {
         node.pump.no_commander = daemon::NoCommanderPolicy::kHoldLastOutputs;
