@@ -89,6 +89,73 @@ void take_all(dds::Reader<T>& reader, Logger& log, const char* what, Fn fn) {
 
 }  // namespace
 
+// One reader of a command topic, with what it takes samples into.
+class DdsInput::CommandReader {
+ public:
+  virtual ~CommandReader() = default;
+  // Takes every sample waiting and hands each to the input (on_command).
+  virtual void take(DdsInput& input, const CommandClass& from) = 0;
+  virtual const dds::Entity& entity() const = 0;
+};
+
+// A command topic the input reads: the profile it commands, and its readers.
+class DdsInput::CommandTopic {
+ public:
+  virtual ~CommandTopic() = default;
+  virtual std::string_view profile() const = 0;
+  virtual std::string_view name() const = 0;
+  // Its readers are needed to run: a failure to make one is not only a
+  // topic that DDS Security does not grant (the publisher's own topic).
+  virtual bool required() const = 0;
+  // A reader for a class of nodes (`node` null) or for one node, its own
+  // topic entity filtered to it (`node` must outlive the reader). Throws
+  // dds::Error.
+  virtual std::unique_ptr<CommandReader> reader(const dds::Participant& participant,
+                                                const dds::Qos& qos, const dds_listener_t* listener,
+                                                const NodeKey* node) const = 0;
+};
+
+template <class Command>
+class DdsInput::TypedCommandTopic final : public CommandTopic {
+ public:
+  // On `shared`, the participant's topic of it (the publisher's), or on one of its own.
+  explicit TypedCommandTopic(const dds::Topic<Command>* shared) : shared_(shared) {}
+  explicit TypedCommandTopic(dds::Topic<Command>&& own) : own_(std::move(own)), shared_(&*own_) {}
+
+  std::string_view profile() const override { return kProfileCommanded<Command>; }
+  std::string_view name() const override { return dds::TopicTraits<Command>::kName; }
+  bool required() const override { return !own_; }
+
+  std::unique_ptr<CommandReader> reader(const dds::Participant& participant, const dds::Qos& qos,
+                                        const dds_listener_t* listener,
+                                        const NodeKey* node) const override {
+    auto made = std::make_unique<Reader>();
+    const dds::Topic<Command>* topic = shared_;
+    if (node) {
+      made->filtered.emplace(participant);
+      made->filtered->filter(&commands_node<Command, NodeKey>, node);
+      topic = &*made->filtered;
+    }
+    made->reader.emplace(participant, *topic, qos, listener);
+    return made;
+  }
+
+ private:
+  struct Reader final : CommandReader {
+    std::optional<dds::Topic<Command>> filtered;  // before the reader: it outlives it
+    std::optional<dds::Reader<Command>> reader;
+    dds::TakeBuffer<Command> buffer{kBatch};
+    void take(DdsInput& input, const CommandClass& from) override {
+      take_batches([&] { return reader->take(buffer); }, buffer.capacity(), 0, input.command_log_,
+                   dds::TopicTraits<Command>::kName,
+                   [&](std::size_t i) { input.on_command(buffer.data(i), buffer.info(i), from); });
+    }
+    const dds::Entity& entity() const override { return *reader; }
+  };
+  std::optional<dds::Topic<Command>> own_;
+  const dds::Topic<Command>* shared_;
+};
+
 void HandoffLogSink::write_structured(LogLevel level, std::string_view component,
                                       std::string_view message, std::span<const LogField> fields) {
   {
@@ -145,13 +212,10 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       partition_{dds::rack_partition(rack_)},
       commands_held_(participant),
       participant_(participant),
-      command_topic_(publisher.command_topic()),
       max_commander_lease_(max_commander_lease),
       command_listener_([this] { on_commands_available(); }),
       requests_(participant, publisher.request_topic(), dds::request_reader_qos(partition_)),
       reload_(std::move(reload)),
-      command_buffer_(kBatch),
-      device_command_buffer_(kBatch),
       request_buffer_(kBatch),
       stop_(participant),
       waitset_(participant),
@@ -161,9 +225,14 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       command_log_(log_.to(command_sink_)),
       own_sink_(log_.sink(), [this] { drain_command_log(); }) {
   log_ = log_.to(own_sink_);
-  device_command_topic_ =
-      unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)",
-                    [&] { return dds::Topic<dnbridge_DeviceCommand>(participant); });
+  command_topics_.push_back(
+      std::make_unique<TypedCommandTopic<dnbridge_PumpCommand>>(&publisher.command_topic()));
+  if (auto devices = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)", [&] {
+        return dds::Topic<dnbridge_DeviceCommand>(participant);
+      })) {
+    command_topics_.push_back(
+        std::make_unique<TypedCommandTopic<dnbridge_DeviceCommand>>(std::move(*devices)));
+  }
   {
     std::lock_guard lock(command_take_mutex_);
     ensure_command_classes();
@@ -231,8 +300,7 @@ void DdsInput::stop() {
     std::lock_guard lock(command_take_mutex_);
     classes_closed_ = true;
     const auto detach = [](const CommandClass& c) {
-      if (c.pumps) (void)dds::DataListener::detach(*c.pumps);
-      if (c.devices) (void)dds::DataListener::detach(*c.devices);
+      for (const auto& r : c.readers) (void)dds::DataListener::detach(r->entity());
     };
     for (const auto& c : command_classes_) detach(*c);
     for (const auto& [key, c] : node_readers_) detach(*c);
@@ -354,12 +422,16 @@ void DdsInput::ensure_command_class(std::uint32_t ms) {
   try {
     auto made = std::make_unique<CommandClass>();
     made->refresh_ms = ms;
-    made->pumps.emplace(participant_, command_topic_, qos, command_listener_.get());
-    if (device_command_topic_) {
-      made->devices = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)", [&] {
-        return dds::Reader<dnbridge_DeviceCommand>(participant_, *device_command_topic_, qos,
-                                                   command_listener_.get());
-      });
+    for (const auto& topic : command_topics_) {
+      const auto make = [&] {
+        return topic->reader(participant_, qos, command_listener_.get(), nullptr);
+      };
+      if (topic->required()) {
+        made->readers.push_back(make());
+      } else if (auto r =
+                     unless_denied(log_, fmt::format("the commands of {}", topic->name()), make)) {
+        made->readers.push_back(std::move(*r));
+      }
     }
     if (ms != 0) {
       log_.info(
@@ -384,32 +456,28 @@ void DdsInput::make_readers_of_silenced_nodes() {
       seen[m] = silences;
       const std::uint32_t refresh = loop->command_refresh_ms(mac);
       if (!loop->has_node(mac) || refresh == 0) continue;  // a reload came since
-      make_node_readers(name, mac, !loop->has_pump(mac), refresh);
+      make_node_readers(name, mac, loop->profile_of(mac), refresh);
     }
   }
 }
 
-void DdsInput::make_node_readers(const std::string& port, devicenet::MacId mac, bool device,
-                                 std::uint32_t refresh_ms) {
+void DdsInput::make_node_readers(const std::string& port, devicenet::MacId mac,
+                                 std::string_view profile, std::uint32_t refresh_ms) {
   if (classes_closed_) return;
   auto key = std::make_unique<NodeKey>(NodeKey{rack_, port, mac.value()});
   // The previous ones go first: the silent owner of the node is theirs.
   if (auto it = node_readers_.find(*key); it != node_readers_.end()) node_readers_.erase(it);
+  const auto topic = std::find_if(command_topics_.begin(), command_topics_.end(),
+                                  [&](const auto& t) { return t->profile() == profile; });
+  if (topic == command_topics_.end()) return;  // DDS Security grants no command of the profile
   const dds::Qos qos =
       dds::command_reader_qos(partition_, max_commander_lease_, milliseconds(refresh_ms));
   try {
     auto made = std::make_unique<CommandClass>();
     made->refresh_ms = refresh_ms;
-    if (device) {
-      if (!device_command_topic_) return;  // DDS Security grants no device command
-      made->device_topic.emplace(participant_);
-      made->device_topic->filter(&commands_node<dnbridge_DeviceCommand, NodeKey>, key.get());
-      made->devices.emplace(participant_, *made->device_topic, qos, command_listener_.get());
-    } else {
-      made->pump_topic.emplace(participant_);
-      made->pump_topic->filter(&commands_node<dnbridge_PumpCommand, NodeKey>, key.get());
-      made->pumps.emplace(participant_, *made->pump_topic, qos, command_listener_.get());
-    }
+    made->profile = (*topic)->profile();
+    made->readers.push_back(
+        (*topic)->reader(participant_, qos, command_listener_.get(), key.get()));
     made->node = std::move(key);
     const NodeKey& k = *made->node;
     command_log_.debug(
@@ -430,8 +498,7 @@ void DdsInput::drop_stale_node_readers() {
     const NodeKey& k = it->first;
     port::PortLoop* loop = port_of(k.port);
     const auto mac = *devicenet::MacId::from(k.mac);
-    const bool device = static_cast<bool>(it->second->devices);
-    const bool same = loop && loop->has_node(mac) && loop->has_pump(mac) != device &&
+    const bool same = loop && loop->profile_of(mac) == it->second->profile &&
                       loop->command_refresh_ms(mac) == it->second->refresh_ms;
     it = same ? std::next(it) : node_readers_.erase(it);
   }
@@ -474,33 +541,20 @@ void DdsInput::take_commands() {
 }
 
 void DdsInput::take_commands(const CommandClass& from) {
-  if (from.pumps) {
-    take_batches([&] { return from.pumps->take(command_buffer_); }, command_buffer_.capacity(), 0,
-                 command_log_, "pump commands", [&](std::size_t i) {
-                   on_command(command_buffer_.data(i), command_buffer_.info(i), from);
-                 });
-  }
-  if (from.devices) {
-    take_batches([&] { return from.devices->take(device_command_buffer_); },
-                 device_command_buffer_.capacity(), 0, command_log_, "device commands",
-                 [&](std::size_t i) {
-                   on_device_command(device_command_buffer_.data(i),
-                                     device_command_buffer_.info(i), from);
-                 });
-  }
+  for (const auto& reader : from.readers) reader->take(*this, from);
 }
 
 template <class Command>
-port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info, bool device,
+port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info,
                                    const CommandClass& from) {
+  constexpr std::string_view kProfile = kProfileCommanded<Command>;
   port::PortLoop* loop = port_of(dds::view(c.port));
   const auto mac = devicenet::MacId::from(c.mac);
-  const bool node = loop && mac && loop->has_node(*mac);
-  const bool pump = node && loop->has_pump(*mac);
+  const std::string_view profile = loop && mac ? loop->profile_of(*mac) : std::string_view{};
   // Every class's readers have every instance: a node's commands are its
   // own readers' when it has them, else its class's, and a refusal is said
   // once, by the class without refresh.
-  if (node && pump != device) {
+  if (profile == kProfile && !profile.empty()) {
     if (loop->command_refresh_ms(*mac) != from.refresh_ms) return nullptr;
     const NodeKey key{rack_, loop->name(), mac->value()};
     if (from.node) return from.node->port == key.port && from.node->mac == key.mac ? loop : nullptr;
@@ -508,24 +562,25 @@ port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info
   }
   if (from.refresh_ms != 0 || from.node) return nullptr;
   command_warn_limit_.warn(
-      command_log_, port::steady_now(), "{} command{} for port \"{}\" MAC {} refused: {}",
-      device ? "device" : "pump",
+      command_log_, port::steady_now(), "{} sample{} for port \"{}\" MAC {} refused: {}",
+      dds::TopicTraits<Command>::kName,
       info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "", dds::view(c.port),
       c.mac,
-      !node  ? "not in this rack's configuration"
-      : pump ? "the node is a pump (a CDN127): PumpCommand commands it"
-             : "the node is not a pump (its profile is \"eds\"): DeviceCommand commands it");
+      profile.empty() ? std::string("not in this rack's configuration")
+                      : fmt::format("the node's profile is \"{}\"; {} commands the nodes of "
+                                    "profile \"{}\"",
+                                    profile, dds::TopicTraits<Command>::kName, kProfile));
   return nullptr;
 }
 
-void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info,
-                          const CommandClass& from) {
-  if (dds::view(c.rack) != rack_) return;  // another bridge's pump
-  port::PortLoop* loop = loop_for(c, info, false, from);
+template <class Command>
+void DdsInput::on_command(const Command& c, const dds::SampleInfo& info, const CommandClass& from) {
+  if (dds::view(c.rack) != rack_) return;  // another bridge's node
+  port::PortLoop* loop = loop_for(c, info, from);
   if (!loop) return;
   if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
   const auto mac = devicenet::MacId::from(c.mac);
-  // No live commander left for this pump (all writers gone, or disposed):
+  // No live commander left for this node (all writers gone, or disposed):
   // idle. A command taken after its writer left carries that state itself,
   // with no sample of its own to tell it; it is not applied: a commander
   // that is gone commands nothing, not even for a moment.
@@ -535,24 +590,7 @@ void DdsInput::on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& 
   }
   if (!info.valid_data()) return;
   note_clock_skew(c, info);
-  loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
-}
-
-void DdsInput::on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info,
-                                 const CommandClass& from) {
-  if (dds::view(c.rack) != rack_) return;  // another bridge's device
-  port::PortLoop* loop = loop_for(c, info, true, from);
-  if (!loop) return;
-  if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
-  const auto mac = devicenet::MacId::from(c.mac);
-  // As for a pump (on_command): no live commander left, idle.
-  if (info.instance_state() != dds::InstanceState::kAlive) {
-    loop->release_device_command(*mac);
-    return;
-  }
-  if (!info.valid_data()) return;
-  note_clock_skew(c, info);
-  loop->command(*mac, outputs_of(c), std::string(dds::view(c.issuer)));
+  loop->command(*mac, command_of(c), std::string(dds::view(c.issuer)));
 }
 
 template <class Command>

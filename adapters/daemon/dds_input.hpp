@@ -1,11 +1,15 @@
 #pragma once
-// What reaches the bridge from DDS: pump commands, explicit requests, bus
-// scan requests and reload requests for this rack, each handed to its port's
-// loop through the loop's inbox; nothing here touches master state.
+// What reaches the bridge from DDS: commands, explicit requests, bus scan
+// requests and reload requests for this rack, each handed to its port's
+// loop through the loop's inbox; nothing here touches master state. Every
+// command topic (one per profile: PumpCommand commands the CDN127s,
+// DeviceCommand the devices described by their EDS) takes one path: a
+// CommandTopic makes its readers, a sample becomes a rack::NodeCommand
+// (samples.hpp, command_of) for the node's port loop.
 // Commands are taken by a listener, on the Cyclone thread that delivers
 // them, and handed over at once (take, push, wake: nothing that waits);
 // under a flood, at most once per hold-off, the rest by the input's own
-// thread at its end. There is one pair of command readers per command
+// thread at its end. There is one reader per command topic and command
 // refresh the rack's nodes have (their requested deadline:
 // dds::command_reader_qos), each taking only its own nodes' commands, all
 // with the rack's lease bound. A node whose commander went silent (its
@@ -132,26 +136,30 @@ class DdsInput {
   // were dropped, with this input's logger.
   void drain_command_log();
   // The command readers of the nodes with one command refresh (0: none),
-  // or of one node (node_readers_).
+  // or of one node (node_readers_): one per command topic (of the node's
+  // profile, for a node's own).
   struct CommandClass;
-  // Every command reader's commands; one reader pair's.
+  // A command topic and its readers; one reader of it (dds_input.cpp).
+  class CommandTopic;
+  class CommandReader;
+  template <class Command>
+  class TypedCommandTopic;
+  // Every command reader's commands; one class's.
   void take_commands();
   void take_commands(const CommandClass& from);
   bool take_requests();  // true when requests may remain
   void take_scan_requests();
   void on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample);
   void take_reload_requests();
-  void on_command(const dnbridge_PumpCommand& c, const dds::SampleInfo& info,
-                  const CommandClass& from);
-  void on_device_command(const dnbridge_DeviceCommand& c, const dds::SampleInfo& info,
-                         const CommandClass& from);
-  // The port loop a command sample is for, when the MAC is a node of that
-  // loop of the kind the topic commands (`device`: DeviceCommand) and of the
-  // reader's command refresh; else null, and a refusal (a node not in the
-  // rack, or of the other kind) is logged (rate-limited).
+  // A command sample taken by a reader of `from`, of any command topic.
   template <class Command>
-  port::PortLoop* loop_for(const Command& c, const dds::SampleInfo& info, bool device,
-                           const CommandClass& from);
+  void on_command(const Command& c, const dds::SampleInfo& info, const CommandClass& from);
+  // The port loop a command sample is for, when the MAC is a node of that
+  // loop of the profile the topic commands and of the reader's command
+  // refresh; else null, and a refusal (a node not in the rack, or of
+  // another profile) is logged (rate-limited).
+  template <class Command>
+  port::PortLoop* loop_for(const Command& c, const dds::SampleInfo& info, const CommandClass& from);
   // A class of command readers for every command refresh the ports' nodes
   // have now (none is deleted before stop). Under command_take_mutex_.
   void ensure_command_classes();
@@ -179,9 +187,9 @@ class DdsInput {
     }
   };
   void make_readers_of_silenced_nodes();
-  void make_node_readers(const std::string& port, devicenet::MacId mac, bool device,
+  void make_node_readers(const std::string& port, devicenet::MacId mac, std::string_view profile,
                          std::uint32_t refresh_ms);
-  // Drops the node readers of nodes whose kind or refresh changed since.
+  // Drops the node readers of nodes whose profile or refresh changed since.
   void drop_stale_node_readers();
   bool classes_closed_ = false;  // stop(): no class is made after it (under the mutex)
   std::uint64_t refresh_generations() const;
@@ -206,23 +214,18 @@ class DdsInput {
   std::atomic<TimePoint::rep> next_command_take_{0};  // steady clock ticks
   dds::GuardCondition commands_held_;
   const dds::Participant& participant_;
-  const dds::Topic<dnbridge_PumpCommand>& command_topic_;
   Duration max_commander_lease_;
   dds::DataListener command_listener_;  // before the readers: it outlives them
-  // DeviceCommand's topic; none when DDS Security does not grant it
-  // (unless_denied).
-  std::optional<dds::Topic<dnbridge_DeviceCommand>> device_command_topic_;
+  // The command topics, before the readers: they outlive them. A topic DDS
+  // Security does not grant is absent (unless_denied).
+  std::vector<std::unique_ptr<CommandTopic>> command_topics_;
   struct CommandClass {
     std::uint32_t refresh_ms;  // 0: the nodes without a command refresh
-    // A node's own readers: the node (their topics' filter's argument);
+    // A node's own readers: the node (their topic's filter's argument);
     // null for a class of nodes.
     std::unique_ptr<NodeKey> node;
-    // A node's own readers' topics, filtered to the node; a class's readers
-    // are on the topics of every command.
-    std::optional<dds::Topic<dnbridge_PumpCommand>> pump_topic;
-    std::optional<dds::Topic<dnbridge_DeviceCommand>> device_topic;
-    std::optional<dds::Reader<dnbridge_PumpCommand>> pumps;
-    std::optional<dds::Reader<dnbridge_DeviceCommand>> devices;
+    std::string_view profile;  // a node's own: the node's profile
+    std::vector<std::unique_ptr<CommandReader>> readers;
   };
   // Guarded by command_take_mutex_; classes are added, never removed, while
   // the input runs (a listener call may be on any of them).
@@ -239,8 +242,6 @@ class DdsInput {
   std::optional<dds::Reader<dnbridge_BusScanRequest>> scan_requests_;
   std::optional<dds::Reader<dnbridge_ReloadRequest>> reload_requests_;
   std::function<void(ReloadCall)> reload_;
-  dds::TakeBuffer<dnbridge_PumpCommand> command_buffer_;
-  dds::TakeBuffer<dnbridge_DeviceCommand> device_command_buffer_;
   dds::TakeBuffer<dnbridge_ExplicitRequest> request_buffer_;
   std::vector<std::vector<unsigned char>> request_cdr_;
   dds::GuardCondition stop_;

@@ -372,24 +372,26 @@ void fill_reload_reply(dnbridge_ReloadReply& out, std::string_view rack, const R
   set_strings(out.problems, r.problems);
 }
 
-port::PortLoop::DeviceOutputs outputs_of(const dnbridge_DeviceCommand& c) {
+rack::NodeCommand command_of(const dnbridge_DeviceCommand& c) {
   const auto bytes = dds::view(c.outputs);
   if (!bytes.empty() && c.fields._length > 0) {
-    return rack::MalformedCommand{"outputs and fields both given: a command gives one"};
+    return rack::NodeCommand(
+        rack::MalformedCommand{"outputs and fields both given: a command gives one"});
   }
-  if (!bytes.empty()) return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
+  if (!bytes.empty())
+    return rack::NodeCommand(std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
   std::vector<eds::FieldSetting> fields;
   const std::span<const dnbridge_DeviceFieldValue> given(c.fields._buffer, c.fields._length);
   for (const auto& f : given) fields.push_back({std::string(dds::view(f.name)), f.value});
-  return fields;
+  return rack::NodeCommand(std::move(fields));
 }
 
-cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& c) {
+rack::NodeCommand command_of(const dnbridge_PumpCommand& c) {
   cdn127::PumpOutputs o;
   o.pump_on = c.pump_on;
   o.n2_ballast_on = c.n2_ballast_on;
   o.analog_out_raw = c.analog_output_raw;  // checked by the rack model, never clipped
-  return o;
+  return rack::NodeCommand(o);
 }
 
 rack::ExplicitCall call_of(const dnbridge_ExplicitRequest& r) {

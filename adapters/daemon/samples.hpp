@@ -32,11 +32,21 @@ void fill_bus_scan_reply(dnbridge_BusScanReply& out, std::string_view rack, std:
 void fill_reload_reply(dnbridge_ReloadReply& out, std::string_view rack, const ReloadCall& call,
                        const ReloadReport& report);
 
-// A command sample's outputs, as the rack model takes them.
-profiles::cdn127::PumpOutputs outputs_of(const dnbridge_PumpCommand& command);
-// A device command's outputs: its bytes, or its fields when it has none;
-// refused when it has both.
-port::PortLoop::DeviceOutputs outputs_of(const dnbridge_DeviceCommand& command);
+// A command sample's outputs in the form its profile's rack takes them: a
+// pump's PumpOutputs; a device's bytes, or its fields when it has none, or
+// a malformed command (refused) when it has both.
+rack::NodeCommand command_of(const dnbridge_PumpCommand& command);
+rack::NodeCommand command_of(const dnbridge_DeviceCommand& command);
+
+// The profile whose nodes a command topic commands.
+template <class Command>
+inline constexpr std::string_view kProfileCommanded = {};
+template <>
+inline constexpr std::string_view kProfileCommanded<dnbridge_PumpCommand> =
+    rack::PumpProfile::kName;
+template <>
+inline constexpr std::string_view kProfileCommanded<dnbridge_DeviceCommand> =
+    rack::DeviceProfile::kName;
 // A request sample as the explicit gateway takes it.
 rack::ExplicitCall call_of(const dnbridge_ExplicitRequest& request);
 

@@ -1,15 +1,18 @@
 #pragma once
-// A PumpCommand (DeviceCommand) writer: dnbctl as a supervisor of one pump
-// (device) for as long as it runs. Exclusive ownership: of the live writers of a pump's instance
-// the strongest commands it. When this writer goes (dnbctl exits), the pump passes to the next
-// strongest commander or, with none left, to the bridge's no-commander policy (idle, or hold the
-// last outputs).
+// A command writer (PumpCommand, DeviceCommand: one topic per profile):
+// dnbctl as a supervisor of one node for as long as it runs. Exclusive
+// ownership: of the live writers of a node's instance the strongest
+// commands it. When this writer goes (dnbctl exits), the node passes to the
+// next strongest commander or, with none left, to the bridge's no-commander
+// policy (idle, or hold the last outputs).
 #include <algorithm>
 #include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "adapters/dds/fields.hpp"
+#include "adapters/dds/sample.hpp"
 #include "adapters/dds/topic.hpp"
 #include "adapters/dds/topics.hpp"
 #include "adapters/dds/writer.hpp"
@@ -43,22 +46,32 @@ inline Duration rewrite_period(Duration refresh) {
   return refresh > Duration::zero() ? std::min<Duration>(seconds(1), refresh / 4) : seconds(1);
 }
 
+// A device's outputs (DeviceCommand): its bytes, or its fields by name.
+struct DeviceOutputs {
+  std::vector<std::uint8_t> bytes;
+  std::vector<std::pair<std::string, double>> fields;  // used when `bytes` is empty
+};
+
+// A command sample's outputs, one filler per command topic (each commands
+// the nodes of one profile).
+void fill_command(dnbridge_PumpCommand& command, const Outputs& outputs);
+void fill_command(dnbridge_DeviceCommand& command, const DeviceOutputs& outputs);
+
 // A writer of command topic T for the nodes of `rack` (in its partition:
 // only its bridge gets them), offering `terms.lease`. `terms.refresh`: the
 // node's command refresh, offered as the writer's deadline; the command
 // must then be written again at least that often (rewrite_period).
 template <class T>
-class CommandWriter {
+class Commander {
  public:
-  CommandWriter(Client& client, std::int32_t strength, const std::string& rack,
-                const CommandTerms& terms = {})
+  Commander(Client& client, std::int32_t strength, const std::string& rack,
+            const CommandTerms& terms = {})
       : topic_(client.participant()),
-        writer_(client.participant(), topic_,
-                dds::command_writer_qos(std::vector{dds::rack_partition(rack)}, strength,
-                                        terms.lease,
-                                        terms.refresh > Duration::zero()
-                                            ? std::optional(terms.refresh)
-                                            : std::nullopt)) {}
+        writer_(
+            client.participant(), topic_,
+            dds::command_writer_qos(
+                std::vector{dds::rack_partition(rack)}, strength, terms.lease,
+                terms.refresh > Duration::zero() ? std::optional(terms.refresh) : std::nullopt)) {}
 
   // Until a command reader (a bridge) matched; false at the deadline.
   // Commands are volatile: one written before a bridge matched is lost.
@@ -71,27 +84,21 @@ class CommandWriter {
   // Command readers (bridges) matched now: with partitions, its rack's only.
   std::uint32_t matched() const { return writer_.matched_subscriptions().value_or(0); }
 
- protected:
+  // The node's command, its outputs as fill_command takes them for T.
+  template <class Outputs>
+  Status write(const NodeKey& key, const Outputs& outputs, const std::string& issuer) {
+    dds::Owned<T> c;
+    dds::set_string(c->rack, key.rack);
+    dds::set_string(c->port, key.port);
+    c->mac = key.mac;
+    fill_command(*c, outputs);
+    dds::set_string(c->issuer, issuer);
+    return writer_.write(*c);
+  }
+
+ private:
   dds::Topic<T> topic_;
   dds::Writer<T> writer_;
-};
-
-class Commander : public CommandWriter<dnbridge_PumpCommand> {
- public:
-  using CommandWriter::CommandWriter;
-  Status write(const NodeKey& key, const Outputs& outputs, const std::string& issuer);
-};
-
-// A device's outputs (DeviceCommand): its bytes, or its fields by name.
-struct DeviceOutputs {
-  std::vector<std::uint8_t> bytes;
-  std::vector<std::pair<std::string, double>> fields;  // used when `bytes` is empty
-};
-
-class DeviceCommander : public CommandWriter<dnbridge_DeviceCommand> {
- public:
-  using CommandWriter::CommandWriter;
-  Status write(const NodeKey& key, const DeviceOutputs& outputs, const std::string& issuer);
 };
 
 }  // namespace dnbridge::dnbctl

@@ -315,7 +315,7 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
     case Output::kAnalog: wanted.analog_output_raw = analog->raw; break;
   }
   const CommandTerms terms = command_terms_of(client, key, deadline_after(o.timeout()));
-  Commander commander(client, args.strength, key.rack, terms);
+  Commander<dnbridge_PumpCommand> commander(client, args.strength, key.rack, terms);
   const Deadline deadline = deadline_after(o.timeout());
   wait_for_bridge(client, commander, key, deadline,
                   "commands (a bridge of a version before partitions reads them elsewhere)",
@@ -466,7 +466,7 @@ Exit run_device_outputs(const GlobalOptions& o, const DeviceOutputArgs& args) {
   const NodeKey key = node_of_kind(client, o, *ref, NodeKind::kDevice);
   const std::string name = node_name(key.rack, key.port, key.mac);
   const CommandTerms terms = command_terms_of(client, key, deadline_after(o.timeout()));
-  DeviceCommander commander(client, args.strength, key.rack, terms);
+  Commander<dnbridge_DeviceCommand> commander(client, args.strength, key.rack, terms);
   const Deadline deadline = deadline_after(o.timeout());
   wait_for_bridge(client, commander, key, deadline, "device commands", o.timeout_seconds);
   const std::uint64_t samples_before = client.device(key)->samples;

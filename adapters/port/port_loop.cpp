@@ -21,6 +21,9 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
   port_.emplace(config_.scanner, rack::PortNodes{config_.pumps, config_.devices}, backend_->sink(),
                 log_);
   port_->observe(static_cast<devicenet::ScannerObserver&>(*this));
+  for (const rack::ProfileNodes* nodes : port_->profiles()) {
+    profile_names_.push_back(nodes->profile());
+  }
   gateway_.emplace(scanner(), rack::ExplicitGateway::Limits{}, config_.explicit_policy, log_);
   const auto policy = [](const std::vector<rack::PublishPolicy>& list, std::size_t i) {
     return i < list.size() ? list[i] : rack::PublishPolicy{};
@@ -35,21 +38,24 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
 }
 
 void PortLoop::note_scan_list() {
-  std::uint64_t pumps = 0;
-  std::uint64_t devices = 0;
-  for (const auto& p : config_.pumps) pumps |= std::uint64_t{1} << p.node.mac.value();
-  for (const auto& d : config_.devices) devices |= std::uint64_t{1} << d.node.mac.value();
-  pump_list_.store(pumps, std::memory_order_relaxed);
-  scan_list_.store(pumps | devices, std::memory_order_relaxed);
+  std::uint64_t macs = 0;
+  std::array<std::uint8_t, MacId::kMax + 1> profile{};
   std::array<std::uint32_t, MacId::kMax + 1> refresh{};
-  const auto ms_of = [](Duration d) {
-    return static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(d).count());
-  };
-  for (const auto& p : config_.pumps) refresh[p.node.mac.value()] = ms_of(p.command_refresh);
-  for (const auto& d : config_.devices) refresh[d.node.mac.value()] = ms_of(d.command_refresh);
-  for (std::size_t i = 0; i < refresh.size(); ++i) {
-    refresh_ms_[i].store(refresh[i], std::memory_order_relaxed);
+  const auto profiles = port_->profiles();
+  for (std::size_t p = 0; p < profiles.size(); ++p) {
+    for (std::size_t i = 0; i < profiles[p]->size(); ++i) {
+      const rack::NodeView& v = profiles[p]->view(i);
+      macs |= std::uint64_t{1} << v.mac.value();
+      profile[v.mac.value()] = static_cast<std::uint8_t>(p + 1);
+      refresh[v.mac.value()] = static_cast<std::uint32_t>(
+          std::chrono::duration_cast<milliseconds>(v.command_refresh).count());
+    }
   }
+  for (std::size_t m = 0; m <= MacId::kMax; ++m) {
+    profile_of_[m].store(profile[m], std::memory_order_relaxed);
+    refresh_ms_[m].store(refresh[m], std::memory_order_relaxed);
+  }
+  scan_list_.store(macs, std::memory_order_relaxed);
   refresh_generation_.fetch_add(1, std::memory_order_release);
 }
 
@@ -60,20 +66,16 @@ void PortLoop::watch_silences(std::function<void()> watch) {
 
 void PortLoop::expire_silent_commanders(TimePoint now) {
   bool any = false;
-  const auto say = [&](const auto& silenced, const auto& view_of) {
-    for (const auto& s : silenced) {
+  for (rack::ProfileNodes* nodes : port_->profiles()) {
+    for (const auto& s : nodes->expire_silent_commanders(now)) {
       any = true;
       silences_[s.mac.value()].fetch_add(1, std::memory_order_release);
-      const auto* v = view_of(s.mac);
-      silent_log_.warn(log_, now, "node {}: commander {} silent for {} ms (command_refresh_ms): {}",
-                s.mac.value(), s.issuer,
-                std::chrono::duration_cast<milliseconds>(s.silent_for).count(),
-                v && v->outputs_requested ? "outputs held (no_commander = \"hold\")"
-                                          : "no live commander left");
+      silent_log_.warn(
+          log_, now, "node {}: commander {} silent for {} ms (command_refresh_ms): {}",
+          s.mac.value(), s.issuer, std::chrono::duration_cast<milliseconds>(s.silent_for).count(),
+          s.outputs_held ? "outputs held (no_commander = \"hold\")" : "no live commander left");
     }
-  };
-  say(rack().expire_silent_commanders(now), [&](MacId m) { return rack().pump(m); });
-  say(devices().expire_silent_commanders(now), [&](MacId m) { return devices().device(m); });
+  }
   if (!any) return;
   std::lock_guard lock(silence_watch_mutex_);
   if (silence_watch_) silence_watch_();
@@ -103,15 +105,10 @@ std::string PortLoop::problem() const {
   return problem_;
 }
 
-void PortLoop::command(MacId mac, const profiles::cdn127::PumpOutputs& outputs,
-                       std::string issuer) {
-  push(Command{mac, outputs, std::move(issuer)});
+void PortLoop::command(MacId mac, rack::NodeCommand command, std::string issuer) {
+  push(Command{mac, std::move(command), std::move(issuer)});
 }
-void PortLoop::command(MacId mac, DeviceOutputs outputs, std::string issuer) {
-  push(DeviceCommand{mac, std::move(outputs), std::move(issuer)});
-}
-void PortLoop::release_command(MacId mac) { push(Release{mac, false}); }
-void PortLoop::release_device_command(MacId mac) { push(Release{mac, true}); }
+void PortLoop::release_command(MacId mac) { push(Release{mac}); }
 void PortLoop::explicit_request(rack::ExplicitCall call) {
   bool queued = false;
   {
@@ -334,28 +331,17 @@ bool PortLoop::drain_inbox(TimePoint now) {
   for (auto& item : items) {
     if (auto* c = std::get_if<Command>(&item)) {
       // The MAC was checked against the scan list where the command came
-      // in (has_pump); here the rack finds its pump by it at once.
-      if (auto s = rack().command(c->mac, c->outputs, c->issuer, now); !s) {
-        const rack::PumpView* pump = rack().pump(c->mac);
-        log_.warn("command refused: {}",
-                  pump ? pump->last_command_refused
-                       : fmt::format("from {}: MAC {} is not a pump of this port's scan list",
-                                     c->issuer, c->mac.value()));
-      }
-    } else if (auto* d = std::get_if<DeviceCommand>(&item)) {
-      const auto s = std::visit(
-          [&](const auto& outputs) { return devices().command(d->mac, outputs, d->issuer, now); },
-          d->outputs);
-      if (!s) {
-        const rack::DeviceView* device = devices().device(d->mac);
-        log_.warn("command refused: {}",
-                  device ? device->last_command_refused
-                         : fmt::format("from {}: MAC {} is not a device of this port's scan list",
-                                       d->issuer, d->mac.value()));
+      // in (profile_of); a reload may have changed it since.
+      rack::ProfileNodes* nodes = port_->nodes_of(c->mac);
+      if (!nodes) {
+        log_.warn("command refused: from {}: MAC {} is not in this port's scan list", c->issuer,
+                  c->mac.value());
+      } else if (auto s = nodes->command(c->mac, c->command, c->issuer, now); !s) {
+        log_.warn("command refused: {}", nodes->node(c->mac)->last_command_refused);
       }
     } else if (auto* r = std::get_if<Release>(&item)) {
-      if (r->device ? devices().release_command(r->mac, now)
-                    : rack().release_command(r->mac, now)) {
+      rack::ProfileNodes* nodes = port_->nodes_of(r->mac);
+      if (nodes && nodes->release_command(r->mac, now)) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
     } else if (auto* scan = std::get_if<ScanCall>(&item)) {
@@ -436,8 +422,10 @@ void PortLoop::run() {
     if (stopping && !calls_waiting_ && (scanner().stopped() || now >= stop_deadline)) break;
 
     TimePoint wake = std::min({scanner().next_deadline(), stop_deadline,
-                               port_status_time_ + config_.status_period, gateway_->next_expiry(),
-                               rack().next_refresh_deadline(), devices().next_refresh_deadline()});
+                               port_status_time_ + config_.status_period, gateway_->next_expiry()});
+    for (const rack::ProfileNodes* nodes : port_->profiles()) {
+      wake = std::min(wake, nodes->next_refresh_deadline());
+    }
     for (const auto& p : published_) {
       wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
     }

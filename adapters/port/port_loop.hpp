@@ -16,6 +16,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <variant>
 #include <vector>
@@ -72,17 +73,12 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void stop();
   void join();
 
-  // From any thread: queued for the port's thread, which is woken.
-  void command(devicenet::MacId mac, const profiles::cdn127::PumpOutputs& outputs,
-               std::string issuer);
-  // A device's (profile "eds") outputs, as bytes or as its fields, or a
-  // command that is refused as it came.
-  using DeviceOutputs = std::variant<std::vector<std::uint8_t>, std::vector<eds::FieldSetting>,
-                                     rack::MalformedCommand>;
-  void command(devicenet::MacId mac, DeviceOutputs outputs, std::string issuer);
-  // No live commander left for the pump at `mac`; for the device at `mac`.
+  // From any thread: queued for the port's thread, which is woken. New
+  // outputs for the node at `mac`, in a form its profile takes
+  // (rack::ProfileNodes::command).
+  void command(devicenet::MacId mac, rack::NodeCommand command, std::string issuer);
+  // No live commander left for the node at `mac`.
   void release_command(devicenet::MacId mac);
-  void release_device_command(devicenet::MacId mac);
   // Past kMaxQueuedCalls requests waiting for the loop, answered at once
   // with "out of buffers" (on the caller's thread, through the publisher).
   void explicit_request(rack::ExplicitCall call);
@@ -111,12 +107,14 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void post(std::function<void(CanBackend&)> fn);
 
   const std::string& name() const { return config_.port; }
-  // Whether `mac` is in the port's scan list; whether it is a pump (a CDN127) (any thread).
+  // Whether `mac` is in the port's scan list; the profile of the node at
+  // `mac` ("cdn127", "eds"), empty when none (any thread).
   bool has_node(devicenet::MacId mac) const {
     return (scan_list_.load(std::memory_order_relaxed) >> mac.value()) & 1u;
   }
-  bool has_pump(devicenet::MacId mac) const {
-    return (pump_list_.load(std::memory_order_relaxed) >> mac.value()) & 1u;
+  std::string_view profile_of(devicenet::MacId mac) const {
+    const std::uint8_t p = profile_of_[mac.value()].load(std::memory_order_relaxed);
+    return p == 0 ? std::string_view{} : profile_names_[p - 1];
   }
   // The node's command_refresh_ms, 0 when off or not a node (any thread).
   std::uint32_t command_refresh_ms(devicenet::MacId mac) const {
@@ -156,25 +154,19 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
  private:
   struct Command {
     devicenet::MacId mac;
-    profiles::cdn127::PumpOutputs outputs;
-    std::string issuer;
-  };
-  struct DeviceCommand {
-    devicenet::MacId mac;
-    DeviceOutputs outputs;
+    rack::NodeCommand command;
     std::string issuer;
   };
   struct Release {
     devicenet::MacId mac;
-    bool device = false;  // a device's (profile "eds"), not a pump's
   };
   struct Stop {};
   struct Reconfigure {
     std::shared_ptr<PortLoopConfig> config;
     std::shared_ptr<std::promise<PortChange>> done;
   };
-  using Item = std::variant<Command, DeviceCommand, Release, Stop, ScanCall, Reconfigure,
-                            std::function<void(CanBackend&)>>;
+  using Item =
+      std::variant<Command, Release, Stop, ScanCall, Reconfigure, std::function<void(CanBackend&)>>;
   void apply(const Reconfigure& r, TimePoint now);
   void note_scan_list();
 
@@ -264,7 +256,9 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   Duration longest_pass_{};
 
   std::atomic<std::uint64_t> scan_list_{0};  // bit per MAC; set on the port's thread
-  std::atomic<std::uint64_t> pump_list_{0};  // the same, of the pumps
+  // Per MAC, 1 + the index of its profile in profile_names_; 0: none.
+  std::array<std::atomic<std::uint8_t>, devicenet::MacId::kMax + 1> profile_of_{};
+  std::vector<std::string_view> profile_names_;  // the rack port's profiles; fixed
   std::array<std::atomic<std::uint32_t>, devicenet::MacId::kMax + 1> refresh_ms_{};
   std::atomic<std::uint64_t> refresh_generation_{0};
   // Commands not written again within their node's command refresh: idle.

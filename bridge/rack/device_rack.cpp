@@ -130,4 +130,18 @@ Status DeviceRack::command(MacId mac, const MalformedCommand& command, std::stri
   return refuse(*v, Errc::kMalformed, fmt::format("from {}: {}", issuer, command.why));
 }
 
+Status DeviceRack::command(MacId mac, const NodeCommand& command, std::string_view issuer,
+                           TimePoint now) {
+  if (const auto* bytes = command.as<std::vector<std::uint8_t>>()) {
+    return this->command(mac, *bytes, issuer, now);
+  }
+  if (const auto* fields = command.as<std::vector<eds::FieldSetting>>()) {
+    return this->command(mac, *fields, issuer, now);
+  }
+  if (const auto* malformed = command.as<MalformedCommand>()) {
+    return this->command(mac, *malformed, issuer, now);
+  }
+  return refuse_other_form(mac, issuer);
+}
+
 }  // namespace dnbridge::rack

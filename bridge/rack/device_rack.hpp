@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bridge/profiles/eds/eds_file.hpp"
@@ -55,6 +56,7 @@ struct DeviceView : NodeView {
 };
 
 struct DeviceProfile {
+  static constexpr std::string_view kName = "eds";
   using Config = DeviceConfig;
   using View = DeviceView;
   using Outputs = std::vector<std::uint8_t>;
@@ -100,6 +102,9 @@ class DeviceRack final : public NodeRack<DeviceProfile> {
   // Refused, counted and its reason kept as any refusal.
   Status command(devicenet::MacId mac, const MalformedCommand& command, std::string_view issuer,
                  TimePoint now);
+  // A NodeCommand of any of the three forms above; any other is refused.
+  Status command(devicenet::MacId mac, const NodeCommand& command, std::string_view issuer,
+                 TimePoint now) override;
 
   const std::vector<DeviceView>& devices() const { return nodes(); }
   const DeviceView* device(devicenet::MacId mac) const { return node(mac); }

@@ -9,6 +9,7 @@
 // NodeRack<Profile> is that logic once; a profile says what its data is:
 //
 //   struct Profile {
+//     static constexpr std::string_view kName = ...;  // as the rack file names it
 //     using Config = ...;   // .node (devicenet::NodeConfig), .no_commander, .resume,
 //                           // .command_refresh
 //     using View = ...;     // derives from NodeView; .outputs_requested (std::optional<Outputs>)
@@ -23,7 +24,8 @@
 //   };
 //
 // PumpRack (the CDN127) and DeviceRack (nodes described by their EDS) are
-// its two profiles.
+// its two profiles; each adds the command forms its profile takes and the
+// ProfileNodes::command that picks them from a NodeCommand.
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -33,81 +35,13 @@
 #include <vector>
 
 #include "bridge/devicenet/master/scanner.hpp"
+#include "bridge/rack/node_view.hpp"
+#include "bridge/rack/profile_nodes.hpp"
 
 namespace dnbridge::rack {
 
-// What the bridge does with a node's outputs when no live commander is left.
-enum class NoCommanderPolicy : std::uint8_t {
-  kIdle,             // idle polls: the device applies its own configured idle actions
-  kHoldLastOutputs,  // keep polling the last commanded outputs
-};
-
-// What a node's outputs do when it is back after a loss (poll timeout,
-// power cycle, bus-off, interface down, device fault).
-enum class ResumePolicy : std::uint8_t {
-  kFreshCommand,  // idle until a command taken after its return
-  kLastCommand,   // the last command again, at once (unsafe: a pump may start
-                  // on its own after a power cycle)
-};
-
-// Why a node's outputs are idle (the bridge polls idle: the device holds
-// its configured idle state).
-enum class IdleCause : std::uint8_t {
-  kNoCommandYet,  // nothing commanded since the bridge started
-  kNoCommander,   // the last commander went away
-  kAfterLoss,     // back after a loss: a new command is needed (ResumePolicy::kFreshCommand)
-  kReconfigured,  // configured again after a reload: a new command is needed
-  kCommanderSilent,  // the command was not written again within the node's command refresh
-};
-std::string_view to_string(IdleCause cause) noexcept;
-
-// The part of a node's view every profile has.
-struct NodeView {
-  devicenet::MacId mac;
-  std::string name;
-  bool online = false;
-  devicenet::NodeState state = devicenet::NodeState::kAbsent;
-  std::string reason;
-  TimePoint state_since{};
-
-  // Inputs from the last poll response are in the profile's view (valid
-  // once `has_inputs`).
-  bool has_inputs = false;
-  // The device answers idle polls without data: while idle its inputs are
-  // not known (has_inputs is false), rather than shown as they last were.
-  bool inputs_withheld_when_idle = false;
-  TimePoint inputs_time{};  // CAN receive time of that response
-
-  // The device applied idle outputs with its last answered poll.
-  bool outputs_idle = true;
-  // Who asked for the outputs requested (the profile's view has them).
-  std::string commanded_by;
-  // Why the outputs are idle, when no command is in force.
-  IdleCause idle_cause = IdleCause::kNoCommandYet;
-  // Zero: off. Otherwise a command not written again for this long is no
-  // longer in force (IdleCause::kCommanderSilent).
-  Duration command_refresh{};
-  // IdleCause::kCommanderSilent: how long the commander had been silent
-  // when its command lapsed (its refresh).
-  Duration silent_for{};
-  // "idle: ..." when no command is in force; empty otherwise.
-  std::string idle_text(bool command_in_force) const;
-  // The device's minor faults (Identity.Status), in words; empty when none.
-  std::string minor_faults;
-
-  std::uint64_t commands_accepted = 0;
-  std::uint64_t commands_refused = 0;
-  std::string last_command_refused;  // why the last refused command was refused
-
-  devicenet::NodeIdentity identity;
-  std::optional<std::uint8_t> device_state;
-  std::uint64_t changes = 0;         // bumped on every change, for publishers
-  std::uint64_t status_changes = 0;  // bumped on changes of state, identity,
-                                     // device state and command refusals only
-};
-
 template <class Profile>
-class NodeRack : public devicenet::ScannerObserver {
+class NodeRack : public ProfileNodes {
  public:
   using Config = typename Profile::Config;
   using View = typename Profile::View;
@@ -122,24 +56,15 @@ class NodeRack : public devicenet::ScannerObserver {
   // Attach after the scanner is built (the scanner reports to this rack).
   void attach(devicenet::Scanner& scanner) { scanner_ = &scanner; }
 
-  // No live commander left: the node goes idle (zero-length polls, so the
-  // device applies its own configured idle actions) or, if configured so,
-  // keeps its last outputs.
-  Status release_command(devicenet::MacId mac, TimePoint now) {
+  std::string_view profile() const noexcept override { return Profile::kName; }
+
+  Status release_command(devicenet::MacId mac, TimePoint now) override {
     return release(mac, IdleCause::kNoCommander, now);
   }
 
-  // The command refresh: a command in force on an online node that was not
-  // written again by its lapse time (the node's command_refresh after it
-  // was taken) counts as having no live commander (release_command, with
-  // IdleCause::kCommanderSilent). Returns the nodes released so, with the
-  // issuer that fell silent and how long it had been.
-  struct Silenced {
-    devicenet::MacId mac;
-    std::string issuer;
-    Duration silent_for{};
-  };
-  std::vector<Silenced> expire_silent_commanders(TimePoint now) {
+  // A command lapses at its lapse time: the node's command_refresh after it
+  // was taken.
+  std::vector<Silenced> expire_silent_commanders(TimePoint now) override {
     std::vector<Silenced> out;
     for (std::size_t i = 0; i < views_.size(); ++i) {
       const Entry& e = entries_[i];
@@ -148,12 +73,12 @@ class NodeRack : public devicenet::ScannerObserver {
       Silenced s{views_[i].mac, views_[i].commanded_by, e.lapse_at - e.last_command};
       views_[i].silent_for = s.silent_for;
       (void)release(s.mac, IdleCause::kCommanderSilent, now);
+      s.outputs_held = views_[i].outputs_requested.has_value();
       out.push_back(std::move(s));
     }
     return out;
   }
-  // When expire_silent_commanders has next something to do; kNever if not.
-  TimePoint next_refresh_deadline() const {
+  TimePoint next_refresh_deadline() const override {
     TimePoint next = kNever;
     for (std::size_t i = 0; i < views_.size(); ++i) {
       if (lapse_due(views_[i], entries_[i])) next = std::min(next, entries_[i].lapse_at);
@@ -237,10 +162,12 @@ class NodeRack : public devicenet::ScannerObserver {
   }
 
   const std::vector<View>& nodes() const { return views_; }
-  const View* node(devicenet::MacId mac) const {
+  const View* node(devicenet::MacId mac) const override {
     const int i = index_[mac.value()];
     return i < 0 ? nullptr : &views_[static_cast<std::size_t>(i)];
   }
+  std::size_t size() const override { return views_.size(); }
+  const View& view(std::size_t i) const override { return views_[i]; }
   devicenet::PortState port_state() const { return port_state_; }
   const std::string& port_reason() const { return port_reason_; }
 
@@ -335,6 +262,16 @@ class NodeRack : public devicenet::ScannerObserver {
     ++view.changes;
     ++view.status_changes;
     return why;
+  }
+
+  // A command in a form the profile does not take (one meant for another
+  // profile's node): refused, counted.
+  Status refuse_other_form(devicenet::MacId mac, std::string_view issuer) {
+    View* v = find(mac);
+    if (!v) return Errc::kOutOfRange;
+    return refuse(*v, Errc::kUnsupported,
+                  "from " + std::string(issuer) + ": not a command for a node of profile \"" +
+                      std::string(Profile::kName) + "\"");
   }
 
   // Only an online node is commanded: a command kept for a node that is

@@ -109,4 +109,12 @@ Status PumpRack::command(MacId mac, const cdn127::PumpOutputs& outputs, std::str
   return apply_command(*v, Bytes(buf.data(), *size), outputs, issuer, now);
 }
 
+Status PumpRack::command(MacId mac, const NodeCommand& command, std::string_view issuer,
+                         TimePoint now) {
+  if (const auto* outputs = command.as<cdn127::PumpOutputs>()) {
+    return this->command(mac, *outputs, issuer, now);
+  }
+  return refuse_other_form(mac, issuer);
+}
+
 }  // namespace dnbridge::rack

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bridge/devicenet/master/scanner.hpp"
@@ -62,6 +63,7 @@ struct PumpView : NodeView {
 // The CDN127 as a NodeRack profile: its poll data decoded with the I/O
 // configuration's format.
 struct PumpProfile {
+  static constexpr std::string_view kName = "cdn127";
   using Config = PumpConfig;
   using View = PumpView;
   using Outputs = profiles::cdn127::PumpOutputs;
@@ -100,6 +102,9 @@ class PumpRack final : public NodeRack<PumpProfile> {
                  TimePoint now) {
     return command(mac, outputs, "local", now);
   }
+  // A NodeCommand of PumpOutputs; any other form is refused.
+  Status command(devicenet::MacId mac, const NodeCommand& command, std::string_view issuer,
+                 TimePoint now) override;
 
   const std::vector<PumpView>& pumps() const { return nodes(); }
   const PumpView* pump(devicenet::MacId mac) const { return node(mac); }

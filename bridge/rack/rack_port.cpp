@@ -94,11 +94,17 @@ devicenet::ScannerConfig RackPort::scan_list(devicenet::ScannerConfig port,
                                     nodes.devices);
 }
 
+ProfileNodes* RackPort::nodes_of(MacId mac) const {
+  for (ProfileNodes* nodes : profiles_) {
+    if (nodes->node(mac) != nullptr) return nodes;
+  }
+  return nullptr;
+}
+
 RackPort::RackPort(devicenet::ScannerConfig port, const PortNodes& nodes, can::FrameSink& sink,
                    Logger log, const std::function<void(devicenet::ScannerConfig&)>& adjust)
     : in_force_(nodes), pumps_(nodes.pumps), devices_(nodes.devices) {
-  observers_.add(pumps_);
-  observers_.add(devices_);
+  for (ProfileNodes* profile : profiles_) observers_.add(*profile);
   auto list = scan_list(std::move(port), nodes);
   if (adjust) adjust(list);
   scanner_.emplace(std::move(list), sink, observers_, std::move(log));

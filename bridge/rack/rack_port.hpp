@@ -5,8 +5,10 @@
 // (CDN127s) and the devices described by their EDS files, the rack models
 // (PumpRack, then DeviceRack) hearing the master's events first, then the
 // observers added, in the order added.
+#include <array>
 #include <functional>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "bridge/can/frame_sink.hpp"
@@ -91,11 +93,16 @@ class RackPort {
   const PumpRack& pumps() const { return pumps_; }
   DeviceRack& devices() { return devices_; }
   const DeviceRack& devices() const { return devices_; }
+  // Every profile's nodes, in the order they hear the master's events.
+  std::span<ProfileNodes* const> profiles() const { return profiles_; }
+  // The nodes of the profile the node at `mac` has; null when no node has it.
+  ProfileNodes* nodes_of(devicenet::MacId mac) const;
 
  private:
   PortNodes in_force_;
   PumpRack pumps_;
   DeviceRack devices_;
+  std::array<ProfileNodes*, 2> profiles_{&pumps_, &devices_};
   devicenet::ObserverFanout observers_;
   std::optional<devicenet::Scanner> scanner_;
 };

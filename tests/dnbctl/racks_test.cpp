@@ -189,7 +189,7 @@ TEST_F(DnbctlRacks, ShowsEachRacksNodesByClassWithTheReason) {
   ASSERT_TRUE(north_ && south_ && east_);
   // A supervisor of north's pump 1, live for the whole test.
   Client supervisor(test_domain(), "racks test supervisor");
-  Commander commander(supervisor, 10, "rack-north");
+  Commander<dnbridge_PumpCommand> commander(supervisor, 10, "rack-north");
   ASSERT_TRUE(commander.wait_matched(supervisor, deadline_after(kReady)));
   const auto state = [&](const char* rack, unsigned m) {
     const auto* n = supervisor.node({rack, "A", static_cast<std::uint8_t>(m)});

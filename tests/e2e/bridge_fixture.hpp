@@ -31,6 +31,7 @@
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/daemon.hpp"
 #include "adapters/daemon/simulated_backends.hpp"
+#include "adapters/dds/fields.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/reader.hpp"
 #include "adapters/dds/topics.hpp"
@@ -185,6 +186,42 @@ class Subscription {
   dds::ReadCondition fresh_;
   dds::WaitSet waitset_;
   std::vector<Received<T>> history_;
+};
+
+// A supervisor process that commands nodes through command topic T (one
+// per profile: PumpCommand, DeviceCommand): a participant of its own.
+template <class T>
+class TestCommander {
+ public:
+  TestCommander(const char* issuer, std::int32_t strength)
+      : issuer_(issuer),
+        participant_(test_domain(), issuer),
+        topic_(participant_),
+        writer_(participant_, topic_,
+                dds::command_writer_qos(dds::rack_partitions(kRack), strength, seconds(1))) {}
+
+  // Node `mac`'s command, its outputs set by `fill(T&)`, stamped `ahead` of
+  // this host's clock (a commander whose clock is wrong) when not zero.
+  template <class Fill>
+  bool write(unsigned mac, Fill fill, Duration ahead = Duration::zero()) {
+    dds::Owned<T> c;
+    dds::set_string(c->rack, kRack);
+    dds::set_string(c->port, kPort);
+    c->mac = static_cast<std::uint8_t>(mac);
+    dds::set_string(c->issuer, issuer_);
+    fill(*c);
+    if (ahead != Duration::zero()) return writer_.write(*c, dds::dds_now() + ahead).ok();
+    return writer_.write(*c).ok();
+  }
+  // Until the bridge has matched this commander.
+  bool matched() { return dds::testing::until_matched(participant_, writer_); }
+  bool acked() { return writer_.wait_for_acks(kEventTimeout).ok(); }
+
+ private:
+  std::string issuer_;
+  dds::Participant participant_;
+  dds::Topic<T> topic_;
+  dds::Writer<T> writer_;
 };
 
 // The entity name of the participant whose writer `reader` is matched with,

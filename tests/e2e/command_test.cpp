@@ -10,40 +10,21 @@
 namespace dnbridge::e2e {
 namespace {
 
-// A supervisor process that commands pumps: a participant of its own.
-class Commander {
+// A supervisor process that commands pumps.
+class Commander : public TestCommander<dnbridge_PumpCommand> {
  public:
-  Commander(const char* issuer, std::int32_t strength)
-      : issuer_(issuer),
-        participant_(test_domain(), issuer),
-        topic_(participant_),
-        writer_(participant_, topic_,
-                dds::command_writer_qos(dds::rack_partitions(kRack), strength, seconds(1))) {}
-
-  // With the source timestamp `ahead` of this host's clock (a commander
-  // whose clock is wrong).
+  using TestCommander::TestCommander;
   bool write(unsigned mac, bool pump_on, bool n2_ballast_on, std::uint16_t analog,
              Duration ahead = Duration::zero()) {
-    dds::Owned<dnbridge_PumpCommand> c;
-    dds::set_string(c->rack, kRack);
-    dds::set_string(c->port, kPort);
-    c->mac = static_cast<std::uint8_t>(mac);
-    c->pump_on = pump_on;
-    c->n2_ballast_on = n2_ballast_on;
-    c->analog_output_raw = analog;
-    dds::set_string(c->issuer, issuer_);
-    if (ahead != Duration::zero()) return writer_.write(*c, dds::dds_now() + ahead).ok();
-    return writer_.write(*c).ok();
+    return TestCommander::write(
+        mac,
+        [&](dnbridge_PumpCommand& c) {
+          c.pump_on = pump_on;
+          c.n2_ballast_on = n2_ballast_on;
+          c.analog_output_raw = analog;
+        },
+        ahead);
   }
-  // Until the bridge has matched this commander.
-  bool matched() { return dds::testing::until_matched(participant_, writer_); }
-  bool acked() { return writer_.wait_for_acks(kEventTimeout).ok(); }
-
- private:
-  std::string issuer_;
-  dds::Participant participant_;
-  dds::Topic<dnbridge_PumpCommand> topic_;
-  dds::Writer<dnbridge_PumpCommand> writer_;
 };
 
 using profiles::cdn127::PumpOutputs;

@@ -13,55 +13,33 @@ namespace {
 
 constexpr unsigned kDevice = 20;
 
-// A supervisor that commands devices: a participant of its own.
-class DeviceCommander {
+// A supervisor process that commands devices: their bytes, their fields,
+// or both (a malformed command).
+class Supervisor : public TestCommander<dnbridge_DeviceCommand> {
  public:
-  DeviceCommander(const char* issuer, std::int32_t strength)
-      : issuer_(issuer),
-        participant_(test_domain(), issuer),
-        topic_(participant_),
-        writer_(participant_, topic_,
-                dds::command_writer_qos(dds::rack_partitions(kRack), strength, seconds(1))) {}
-
+  using TestCommander::TestCommander;
   bool write_fields(unsigned mac, const std::vector<std::pair<std::string, double>>& fields) {
     return write_both(mac, {}, fields);
   }
+  bool write_bytes(unsigned mac, const std::vector<std::uint8_t>& outputs) {
+    return write_both(mac, outputs, {});
+  }
   bool write_both(unsigned mac, const std::vector<std::uint8_t>& outputs,
                   const std::vector<std::pair<std::string, double>>& fields) {
-    dds::Owned<dnbridge_DeviceCommand> c;
-    key(*c, mac);
-    dds::set_octets(c->outputs, outputs);
-    auto& seq = c->fields;
-    seq._length = seq._maximum = static_cast<std::uint32_t>(fields.size());
-    seq._release = true;
-    seq._buffer = dds_sequence_dnbridge_DeviceFieldValue_allocbuf(fields.size());
-    for (std::size_t i = 0; i < fields.size(); ++i) {
-      seq._buffer[i].name = nullptr;
-      dds::set_string(seq._buffer[i].name, fields[i].first);
-      seq._buffer[i].value = fields[i].second;
-    }
-    return writer_.write(*c).ok();
+    return write(mac, [&](dnbridge_DeviceCommand& c) {
+      dds::set_octets(c.outputs, outputs);
+      if (fields.empty()) return;
+      auto& seq = c.fields;
+      seq._length = seq._maximum = static_cast<std::uint32_t>(fields.size());
+      seq._release = true;
+      seq._buffer = dds_sequence_dnbridge_DeviceFieldValue_allocbuf(fields.size());
+      for (std::size_t i = 0; i < fields.size(); ++i) {
+        seq._buffer[i].name = nullptr;
+        dds::set_string(seq._buffer[i].name, fields[i].first);
+        seq._buffer[i].value = fields[i].second;
+      }
+    });
   }
-  bool write_bytes(unsigned mac, const std::vector<std::uint8_t>& outputs) {
-    dds::Owned<dnbridge_DeviceCommand> c;
-    key(*c, mac);
-    dds::set_octets(c->outputs, outputs);
-    return writer_.write(*c).ok();
-  }
-  bool matched() { return dds::testing::until_matched(participant_, writer_); }
-
- private:
-  void key(dnbridge_DeviceCommand& c, unsigned mac) {
-    dds::set_string(c.rack, kRack);
-    dds::set_string(c.port, kPort);
-    c.mac = static_cast<std::uint8_t>(mac);
-    dds::set_string(c.issuer, issuer_);
-  }
-
-  std::string issuer_;
-  dds::Participant participant_;
-  dds::Topic<dnbridge_DeviceCommand> topic_;
-  dds::Writer<dnbridge_DeviceCommand> writer_;
 };
 
 class DeviceTest : public BridgeTest {
@@ -145,7 +123,7 @@ TEST_F(DeviceTest, DeviceStateCarriesTheDataAndTheEdsFields) {
 
 TEST_F(DeviceTest, ADeviceCommandReachesTheDeviceAndItsDepartureLeavesTheIdleState) {
   ASSERT_NO_FATAL_FAILURE(start_with_device());
-  auto supervisor = std::make_unique<DeviceCommander>("supervisor-d", 10);
+  auto supervisor = std::make_unique<Supervisor>("supervisor-d", 10);
   ASSERT_TRUE(supervisor->matched());
   ASSERT_TRUE(supervisor->write_fields(kDevice, {{"Digital outputs", 0x81}}));
   ASSERT_TRUE(devices_.until([&] { return echoes(0x81, "supervisor-d"); }));
@@ -187,13 +165,13 @@ TEST_F(DeviceTest, ADeviceCommandReachesTheDeviceAndItsDepartureLeavesTheIdleSta
 
 TEST_F(DeviceTest, EachCommandTopicCommandsOnlyItsKindOfNode) {
   ASSERT_NO_FATAL_FAILURE(start_with_device());
-  DeviceCommander devices("supervisor-d", 10);
+  Supervisor devices("supervisor-d", 10);
   ASSERT_TRUE(devices.matched());
   ASSERT_TRUE(devices.write_bytes(1, {0x01, 0x00}));  // MAC 1 is a pump
   ASSERT_TRUE(devices_.until([&] {
     return log_.contains(LogLevel::kWarn,
-                         "device command from supervisor-d for port \"A\" MAC 1 refused: the node "
-                         "is a pump");
+                         "dnbridge/DeviceCommand sample from supervisor-d for port \"A\" MAC 1 "
+                         "refused: the node's profile is \"cdn127\"");
   }));
   EXPECT_EQ(devices_.latest(pump_mac(1)), nullptr);  // no DeviceState for a pump
   ASSERT_TRUE(pumps_.until([&] { return pumps_.latest(pump_mac(1)) != nullptr; }));

@@ -221,7 +221,8 @@ class PlantHost {
     auto& commander = commanders_[key.rack];
     if (!commander) {
       try {
-        commander = std::make_unique<dnbctl::Commander>(client_, 10, key.rack);
+        commander =
+            std::make_unique<dnbctl::Commander<dnbridge_PumpCommand>>(client_, 10, key.rack);
       } catch (const dds::Error& e) {
         commanders_.erase(key.rack);
         say("refused " + key.rack + " " + e.what());
@@ -263,7 +264,7 @@ class PlantHost {
   };
 
   dnbctl::Client client_;
-  std::map<std::string, std::unique_ptr<dnbctl::Commander>> commanders_;
+  std::map<std::string, std::unique_ptr<dnbctl::Commander<dnbridge_PumpCommand>>> commanders_;
   std::map<NodeKey, Unapplied> unapplied_;
   std::size_t expected_;
   std::chrono::milliseconds fresh_;

@@ -204,7 +204,7 @@ TEST(PortLoop, RunsARackOnItsOwnThread) {
   profiles::cdn127::PumpOutputs out;
   out.pump_on = true;
   out.analog_out_raw = 2000;
-  loop.command(mac(2), out, "supervisor-1");
+  loop.command(mac(2), rack::NodeCommand(out), "supervisor-1");
   ASSERT_TRUE(publisher.wait_for([&] {
     const auto& v = publisher.pumps[2];
     return !v.outputs_idle && v.outputs_applied == out && v.commanded_by == "supervisor-1";
@@ -392,15 +392,22 @@ TEST(PortLoop, BadCommandsAreRefusedAndReported) {
   ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps.count(4) && publisher.pumps[4].online; }));
   profiles::cdn127::PumpOutputs out;
   out.analog_out_raw = 9999;
-  loop.command(mac(4), out, "careless");
+  loop.command(mac(4), rack::NodeCommand(out), "careless");
   ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps[4].commands_refused == 1; }));
   EXPECT_NE(publisher.pumps[4].last_command_refused.find("9999"), std::string::npos);
+  // Outputs in the form of another profile (an EDS device's bytes).
+  loop.command(mac(4), rack::NodeCommand(std::vector<std::uint8_t>{1}), "careless");
+  ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps[4].commands_refused == 2; }));
+  EXPECT_EQ(publisher.pumps[4].last_command_refused,
+            "from careless: not a command for a node of profile \"cdn127\"");
   // Only the scan list's MACs are commanded; another one is refused where it
-  // comes in (DdsInput asks has_node), and the loop refuses it too.
+  // comes in (DdsInput asks profile_of), and the loop refuses it too.
   EXPECT_TRUE(loop.has_node(mac(4)));
+  EXPECT_EQ(loop.profile_of(mac(4)), "cdn127");
   EXPECT_FALSE(loop.has_node(mac(5)));
+  EXPECT_EQ(loop.profile_of(mac(5)), "");
   EXPECT_FALSE(loop.has_node(mac(63)));
-  loop.command(mac(5), profiles::cdn127::PumpOutputs{}, "careless");
+  loop.command(mac(5), rack::NodeCommand(profiles::cdn127::PumpOutputs{}), "careless");
   std::promise<void> handled;
   loop.post([&](CanBackend&) { handled.set_value(); });
   handled.get_future().wait();
@@ -523,7 +530,7 @@ TEST(PortLoop, RunsOnTheThreadedSimulatedBus) {
   profiles::cdn127::PumpOutputs out;
   out.pump_on = true;
   out.analog_out_raw = 1234;
-  loop.command(mac(2), out, "supervisor-1");
+  loop.command(mac(2), rack::NodeCommand(out), "supervisor-1");
   ASSERT_TRUE(publisher.wait_for([&] {
     const auto& v = publisher.pumps[2];
     return !v.outputs_idle && v.outputs_applied == out;
@@ -764,7 +771,7 @@ TEST(PortLoop, AReconfigurationIsAppliedOnThePortsThread) {
   }));
   profiles::cdn127::PumpOutputs out;
   out.pump_on = true;
-  loop.command(mac(3), out, "supervisor-1");
+  loop.command(mac(3), rack::NodeCommand(out), "supervisor-1");
   ASSERT_TRUE(publisher.wait_for([&] { return !publisher.pumps[3].outputs_idle; }));
   // Node 2 was idled and released (two exchanges, begun before node 3's
   // first Allocate), not left to its connections' watchdogs.
