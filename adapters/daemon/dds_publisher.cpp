@@ -1,5 +1,7 @@
 #include "adapters/daemon/dds_publisher.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <memory>
 
@@ -21,47 +23,6 @@ dds::Timestamp WallClock::to_wall(TimePoint monotonic) const {
   return dds::Timestamp(monotonic.time_since_epoch() + offset_);
 }
 
-DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack,
-                           Duration state_deadline, Logger log)
-    : rack_(std::move(rack)),
-      log_(std::move(log)),
-      partition_{dds::rack_partition(rack_)},
-      pump_topic_(participant),
-      node_topic_(participant),
-      port_topic_(participant),
-      command_topic_(participant),
-      request_topic_(participant),
-      reply_topic_(participant),
-      pump_writer_(participant, pump_topic_, dds::state_writer_qos(state_deadline)),
-      node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
-      port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
-      reply_writer_(participant, reply_topic_, dds::reply_writer_qos(partition_)),
-      devices_(unless_denied(
-          log_, "the devices' state (dnbridge/DeviceState)",
-          [&] { return DeviceOut(participant, dds::state_writer_qos(state_deadline)); })),
-      scan_(unless_denied(log_, "the bus scan (dnbridge/BusScanRequest, BusScanReply)",
-                          [&] {
-                            return Service<dnbridge_BusScanRequest, dnbridge_BusScanReply>(
-                                participant, dds::scan_reply_writer_qos(partition_));
-                          })),
-      reload_(unless_denied(log_, "reload over DDS (dnbridge/ReloadRequest, ReloadReply)",
-                            [&] {
-                              return Service<dnbridge_ReloadRequest, dnbridge_ReloadReply>(
-                                  participant, dds::scan_reply_writer_qos(partition_));
-                            })),
-      reply_out_("dds reply out", kReplyBacklog) {}
-
-void DdsPublisher::check_state(Status s, const char* what) {
-  if (!check(s, what)) state_write_failures_.fetch_add(1, std::memory_order_relaxed);
-}
-
-bool DdsPublisher::check(Status s, const char* what) {
-  if (s) return true;
-  std::lock_guard lock(log_mutex_);
-  error_limit_.error(log_, port::steady_now(), "writing {} failed: {}", what, s.error().message());
-  return false;
-}
-
 namespace {
 
 // A node's instance of a state topic.
@@ -76,40 +37,154 @@ dds::Owned<T> key_of(const std::string& rack, const std::string& port, std::uint
 
 }  // namespace
 
-void DdsPublisher::note_written(const std::string& port, std::uint8_t mac, Written kind) {
+class DdsPublisher::StateTopic {
+ public:
+  virtual ~StateTopic() = default;
+  virtual std::string_view profile() const = 0;
+  virtual const char* name() const = 0;
+  // The node's state sample (no writer, when DDS Security does not grant
+  // the topic: nothing, OK).
+  virtual Status write(const std::string& rack, const std::string& port, const rack::NodeView& node,
+                       dds::Timestamp at) = 0;
+  // The node's NodeStatus, its profile's part included.
+  virtual void fill_status(dnbridge_NodeStatus& out, const std::string& rack,
+                           const std::string& port, const rack::NodeView& node,
+                           const port::NodeStatusView& status) const = 0;
+  virtual Status dispose(const std::string& rack, const std::string& port, std::uint8_t mac,
+                         dds::Timestamp at) = 0;
+  virtual Status unregister(const std::string& rack, const std::string& port, std::uint8_t mac,
+                            dds::Timestamp at) = 0;
+  virtual void wait_for_acks(Duration timeout) = 0;
+};
+
+// A profile's state topic of type State, whose nodes' views are View.
+template <class State, class View>
+class DdsPublisher::TypedStateTopic final : public StateTopic {
+ public:
+  using Fill = void (*)(State&, std::string_view, std::string_view, const View&);
+  // `required`: a writer DDS Security does not grant is an error (thrown),
+  // not a topic left out.
+  TypedStateTopic(const dds::Participant& participant, const dds::Qos& qos, Logger& log,
+                  std::string_view profile, Fill fill, bool required)
+      : profile_(profile), fill_(fill) {
+    const auto make = [&] { return Out(participant, qos); };
+    if (required) {
+      out_.emplace(participant, qos);
+    } else {
+      out_ = unless_denied(log, fmt::format("the state of profile \"{}\" ({})", profile, name()),
+                           make);
+    }
+  }
+  std::string_view profile() const override { return profile_; }
+  const char* name() const override { return dds::TopicTraits<State>::kName; }
+  Status write(const std::string& rack, const std::string& port, const rack::NodeView& node,
+               dds::Timestamp at) override {
+    if (!out_) return {};
+    dds::Owned<State> sample;
+    fill_(*sample, rack, port, static_cast<const View&>(node));
+    return out_->writer.write(*sample, at);
+  }
+  void fill_status(dnbridge_NodeStatus& out, const std::string& rack, const std::string& port,
+                   const rack::NodeView& node, const port::NodeStatusView& status) const override {
+    fill_node_status(out, rack, port, static_cast<const View&>(node), status);
+  }
+  Status dispose(const std::string& rack, const std::string& port, std::uint8_t mac,
+                 dds::Timestamp at) override {
+    if (!out_) return {};
+    return out_->writer.dispose(*key_of<State>(rack, port, mac), at);
+  }
+  Status unregister(const std::string& rack, const std::string& port, std::uint8_t mac,
+                    dds::Timestamp at) override {
+    if (!out_) return {};
+    return out_->writer.unregister_instance(*key_of<State>(rack, port, mac), at);
+  }
+  void wait_for_acks(Duration timeout) override {
+    if (out_) (void)out_->writer.wait_for_acks(timeout);
+  }
+
+ private:
+  struct Out {
+    Out(const dds::Participant& participant, const dds::Qos& qos)
+        : topic(participant), writer(participant, topic, qos) {}
+    dds::Topic<State> topic;
+    dds::Writer<State> writer;
+  };
+  std::string_view profile_;
+  Fill fill_;
+  std::optional<Out> out_;
+};
+
+DdsPublisher::~DdsPublisher() = default;
+
+DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack,
+                           Duration state_deadline, Logger log)
+    : rack_(std::move(rack)),
+      log_(std::move(log)),
+      partition_{dds::rack_partition(rack_)},
+      node_topic_(participant),
+      port_topic_(participant),
+      command_topic_(participant),
+      request_topic_(participant),
+      reply_topic_(participant),
+      node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
+      port_writer_(participant, port_topic_, dds::state_writer_qos(state_deadline)),
+      reply_writer_(participant, reply_topic_, dds::reply_writer_qos(partition_)),
+      scan_(unless_denied(log_, "the bus scan (dnbridge/BusScanRequest, BusScanReply)",
+                          [&] {
+                            return Service<dnbridge_BusScanRequest, dnbridge_BusScanReply>(
+                                participant, dds::scan_reply_writer_qos(partition_));
+                          })),
+      reload_(unless_denied(log_, "reload over DDS (dnbridge/ReloadRequest, ReloadReply)",
+                            [&] {
+                              return Service<dnbridge_ReloadRequest, dnbridge_ReloadReply>(
+                                  participant, dds::scan_reply_writer_qos(partition_));
+                            })),
+      reply_out_("dds reply out", kReplyBacklog) {
+  const dds::Qos qos = dds::state_writer_qos(state_deadline);
+  state_topics_.push_back(std::make_unique<TypedStateTopic<dnbridge_PumpState, rack::PumpView>>(
+      participant, qos, log_, rack::PumpProfile::kName, &fill_pump_state, true));
+  state_topics_.push_back(std::make_unique<TypedStateTopic<dnbridge_DeviceState, rack::DeviceView>>(
+      participant, qos, log_, rack::DeviceProfile::kName, &fill_device_state, false));
+}
+
+DdsPublisher::StateTopic* DdsPublisher::state_topic(std::string_view profile) const {
+  for (const auto& t : state_topics_) {
+    if (t->profile() == profile) return t.get();
+  }
+  return nullptr;
+}
+
+void DdsPublisher::check_state(Status s, const char* what) {
+  if (!check(s, what)) state_write_failures_.fetch_add(1, std::memory_order_relaxed);
+}
+
+bool DdsPublisher::check(Status s, const char* what) {
+  if (s) return true;
+  std::lock_guard lock(log_mutex_);
+  error_limit_.error(log_, port::steady_now(), "writing {} failed: {}", what, s.error().message());
+  return false;
+}
+
+void DdsPublisher::note_written(const std::string& port, std::uint8_t mac, StateTopic& topic) {
   std::lock_guard lock(mutex_);
-  written_[port][mac] = kind;
+  written_[port][mac] = &topic;
 }
 
-void DdsPublisher::pump_state(const std::string& port, const rack::PumpView& pump,
+void DdsPublisher::node_state(const std::string& port, const rack::NodeView& node,
                               TimePoint source_time) {
-  note_written(port, pump.mac.value(), Written::kPump);
-  dds::Owned<dnbridge_PumpState> sample;
-  fill_pump_state(*sample, rack_, port, pump);
-  check_state(pump_writer_.write(*sample, clock_.to_wall(source_time)), "PumpState");
+  StateTopic* topic = state_topic(node.profile);
+  if (!topic) return;
+  note_written(port, node.mac.value(), *topic);
+  check_state(topic->write(rack_, port, node, clock_.to_wall(source_time)), topic->name());
 }
 
-void DdsPublisher::node_status(const std::string& port, const rack::PumpView& pump,
-                               const port::NodeStatusView& node, TimePoint source_time) {
+void DdsPublisher::node_status(const std::string& port, const rack::NodeView& node,
+                               const port::NodeStatusView& status, TimePoint source_time) {
+  StateTopic* topic = state_topic(node.profile);
+  if (!topic) return;
+  note_written(port, node.mac.value(), *topic);
   dds::Owned<dnbridge_NodeStatus> sample;
-  fill_node_status(*sample, rack_, port, pump, node);
-  check_state(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
-}
-
-void DdsPublisher::device_state(const std::string& port, const rack::DeviceView& device,
-                                TimePoint source_time) {
-  if (!devices_) return;
-  note_written(port, device.mac.value(), Written::kDevice);
-  dds::Owned<dnbridge_DeviceState> sample;
-  fill_device_state(*sample, rack_, port, device);
-  check_state(devices_->writer.write(*sample, clock_.to_wall(source_time)), "DeviceState");
-}
-
-void DdsPublisher::device_status(const std::string& port, const rack::DeviceView& device,
-                                 const port::NodeStatusView& node, TimePoint source_time) {
-  note_written(port, device.mac.value(), Written::kDevice);
-  dds::Owned<dnbridge_NodeStatus> sample;
-  fill_node_status(*sample, rack_, port, device, node);
+  topic->fill_status(*sample, rack_, port, node, status);
   check_state(node_writer_.write(*sample, clock_.to_wall(source_time)), "NodeStatus");
 }
 
@@ -162,49 +237,43 @@ std::uint64_t DdsPublisher::replies_undelivered(const std::string& port) const {
   return it == undelivered_.end() ? 0 : it->second;
 }
 
-void DdsPublisher::release_node(const std::string& port, std::uint8_t mac, Written kind,
+void DdsPublisher::release_node(const std::string& port, std::uint8_t mac, StateTopic& topic,
                                 bool dispose) {
   const auto now = dds::dds_now();
   const auto node_key = key_of<dnbridge_NodeStatus>(rack_, port, mac);
-  if (kind == Written::kPump) {
-    const auto key = key_of<dnbridge_PumpState>(rack_, port, mac);
-    if (dispose) check_state(pump_writer_.dispose(*key, now), "PumpState disposal");
-    check_state(pump_writer_.unregister_instance(*key, now), "PumpState unregistration");
-  } else if (devices_) {
-    const auto key = key_of<dnbridge_DeviceState>(rack_, port, mac);
-    if (dispose) check_state(devices_->writer.dispose(*key, now), "DeviceState disposal");
-    check_state(devices_->writer.unregister_instance(*key, now), "DeviceState unregistration");
-  }
+  const std::string what = topic.name();
+  if (dispose) check_state(topic.dispose(rack_, port, mac, now), (what + " disposal").c_str());
+  check_state(topic.unregister(rack_, port, mac, now), (what + " unregistration").c_str());
   if (dispose) check_state(node_writer_.dispose(*node_key, now), "NodeStatus disposal");
   check_state(node_writer_.unregister_instance(*node_key, now), "NodeStatus unregistration");
 }
 
 void DdsPublisher::node_removed(const std::string& port, devicenet::MacId mac) {
-  std::optional<Written> kind;
+  StateTopic* topic = nullptr;
   {
     std::lock_guard lock(mutex_);
     auto& macs = written_[port];
     if (auto it = macs.find(mac.value()); it != macs.end()) {
-      kind = it->second;
+      topic = it->second;
       macs.erase(it);
     }
   }
   // Disposed: the node is no longer the rack's (or no longer of that
   // profile), which unregistering (the bridge gone) would not say. Only
   // what was written.
-  if (kind) release_node(port, mac.value(), *kind, true);
+  if (topic) release_node(port, mac.value(), *topic, true);
 }
 
 void DdsPublisher::port_stopped(const std::string& port) {
   // Unregister, never dispose: the last samples (online false, stopped) stay
   // what late readers see until the bridge is back.
-  std::map<std::uint8_t, Written> macs;
+  std::map<std::uint8_t, StateTopic*> macs;
   {
     std::lock_guard lock(mutex_);
     macs = std::move(written_[port]);
     written_.erase(port);
   }
-  for (const auto& [mac, kind] : macs) release_node(port, mac, kind, false);
+  for (const auto& [mac, topic] : macs) release_node(port, mac, *topic, false);
   dds::Owned<dnbridge_PortStatus> port_key;
   dds::set_string(port_key->rack, rack_);
   dds::set_string(port_key->port, port);
@@ -223,7 +292,7 @@ void DdsPublisher::flush(Duration timeout) {
   const TimePoint deadline = port::steady_now() + timeout;
   auto left = [&] { return std::max(Duration::zero(), deadline - port::steady_now()); };
   (void)reply_out_.drain(left());
-  (void)pump_writer_.wait_for_acks(left());
+  for (const auto& topic : state_topics_) topic->wait_for_acks(left());
   (void)node_writer_.wait_for_acks(left());
   (void)port_writer_.wait_for_acks(left());
   (void)reply_writer_.wait_for_acks(left());

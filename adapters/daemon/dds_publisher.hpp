@@ -18,10 +18,13 @@
 // to the wall clock as its source timestamp.
 #include <atomic>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "adapters/daemon/outbox.hpp"
 #include "adapters/daemon/reload.hpp"
@@ -81,15 +84,12 @@ class DdsPublisher final : public port::PortPublisher {
   // instance is written at least that often while its port runs).
   DdsPublisher(const dds::Participant& participant, std::string rack, Duration state_deadline,
                Logger log);
+  ~DdsPublisher() override;
 
-  void pump_state(const std::string& port, const rack::PumpView& pump,
+  void node_state(const std::string& port, const rack::NodeView& node,
                   TimePoint source_time) override;
-  void node_status(const std::string& port, const rack::PumpView& pump,
-                   const port::NodeStatusView& node, TimePoint source_time) override;
-  void device_state(const std::string& port, const rack::DeviceView& device,
-                    TimePoint source_time) override;
-  void device_status(const std::string& port, const rack::DeviceView& device,
-                     const port::NodeStatusView& node, TimePoint source_time) override;
+  void node_status(const std::string& port, const rack::NodeView& node,
+                   const port::NodeStatusView& status, TimePoint source_time) override;
   void port_status(const port::PortStatusView& status, TimePoint source_time) override;
   void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) override;
   void bus_scan_reply(const std::string& port, const port::BusScanAnswer& answer) override;
@@ -138,12 +138,19 @@ class DdsPublisher final : public port::PortPublisher {
   bool check(Status s, const char* what);
   // The same for a state topic's write, disposal or unregistration, counted.
   void check_state(Status s, const char* what);
-  // Which state topic a node's samples are on, besides NodeStatus.
-  enum class Written : std::uint8_t { kPump, kDevice };
-  void note_written(const std::string& port, std::uint8_t mac, Written kind);
-  // A node's state instance (PumpState or DeviceState) and NodeStatus
-  // unregistered, after being disposed when `dispose`.
-  void release_node(const std::string& port, std::uint8_t mac, Written kind, bool dispose);
+  // A profile's state topic (PumpState for "cdn127", DeviceState for
+  // "eds"): its writer, and how its sample and its part of NodeStatus are
+  // filled (samples.hpp). One per profile (dds_publisher.cpp).
+  class StateTopic;
+  template <class State, class View>
+  class TypedStateTopic;
+  // The state topic of `profile`; null for a profile it does not know.
+  StateTopic* state_topic(std::string_view profile) const;
+  // The state topic a node's samples were written on, besides NodeStatus.
+  void note_written(const std::string& port, std::uint8_t mac, StateTopic& topic);
+  // A node's state instance and NodeStatus unregistered, after being
+  // disposed when `dispose`.
+  void release_node(const std::string& port, std::uint8_t mac, StateTopic& topic, bool dispose);
 
   std::string rack_;
   Logger log_;
@@ -153,32 +160,22 @@ class DdsPublisher final : public port::PortPublisher {
   // The rack's partition, where its replies go (dds::rack_partition).
   std::vector<std::string> partition_;
   WallClock clock_;
-  dds::Topic<dnbridge_PumpState> pump_topic_;
   dds::Topic<dnbridge_NodeStatus> node_topic_;
   dds::Topic<dnbridge_PortStatus> port_topic_;
   dds::Topic<dnbridge_PumpCommand> command_topic_;
   dds::Topic<dnbridge_ExplicitRequest> request_topic_;
   dds::Topic<dnbridge_ExplicitReply> reply_topic_;
-  dds::Writer<dnbridge_PumpState> pump_writer_;
+  std::vector<std::unique_ptr<StateTopic>> state_topics_;
   dds::Writer<dnbridge_NodeStatus> node_writer_;
   dds::Writer<dnbridge_PortStatus> port_writer_;
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;
-  // The devices described by their EDS: DeviceState's topic and writer;
-  // none when DDS Security does not grant the topic (unless_denied).
-  struct DeviceOut {
-    DeviceOut(const dds::Participant& participant, const dds::Qos& qos)
-        : topic(participant), writer(participant, topic, qos) {}
-    dds::Topic<dnbridge_DeviceState> topic;
-    dds::Writer<dnbridge_DeviceState> writer;
-  };
-  std::optional<DeviceOut> devices_;
   std::optional<Service<dnbridge_BusScanRequest, dnbridge_BusScanReply>> scan_;
   std::optional<Service<dnbridge_ReloadRequest, dnbridge_ReloadReply>> reload_;
 
   void undelivered(const std::string& port);
 
   mutable std::mutex mutex_;
-  std::map<std::string, std::map<std::uint8_t, Written>> written_;  // per port, by MAC
+  std::map<std::string, std::map<std::uint8_t, StateTopic*>> written_;  // per port, by MAC
   std::map<std::string, std::uint64_t> undelivered_;  // per port
   std::mutex log_mutex_;
   RateLimitedLog error_limit_;

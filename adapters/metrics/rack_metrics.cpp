@@ -69,24 +69,24 @@ Labels with(Labels labels, std::string name, std::string value) {
 RackMetrics::RackMetrics(std::string rack, std::function<ProcessCounters()> process)
     : rack_(std::move(rack)), process_(std::move(process)) {}
 
-RackMetrics::NodeEntry& RackMetrics::note_pump(const std::string& port,
-                                               const rack::PumpView& pump) {
-  auto& node = ports_[port].nodes[pump.mac.value()];
-  node.name = pump.name;
-  node.commands_accepted = pump.commands_accepted;
-  node.commands_refused = pump.commands_refused;
+RackMetrics::NodeEntry& RackMetrics::note_node(const std::string& port,
+                                               const rack::NodeView& view) {
+  auto& node = ports_[port].nodes[view.mac.value()];
+  node.name = view.name;
+  node.commands_accepted = view.commands_accepted;
+  node.commands_refused = view.commands_refused;
   return node;
 }
 
-void RackMetrics::pump_state(const std::string& port, const rack::PumpView& pump, TimePoint) {
+void RackMetrics::node_state(const std::string& port, const rack::NodeView& view, TimePoint) {
   std::lock_guard lock(mutex_);
-  note_pump(port, pump);
+  note_node(port, view);
 }
 
-void RackMetrics::node_status(const std::string& port, const rack::PumpView& pump,
+void RackMetrics::node_status(const std::string& port, const rack::NodeView& view,
                               const port::NodeStatusView& status, TimePoint) {
   std::lock_guard lock(mutex_);
-  auto& node = note_pump(port, pump);
+  auto& node = note_node(port, view);
   node.has_status = true;
   node.state = status.state;
   node.counters = status.counters;

@@ -65,9 +65,9 @@ class RackMetrics final : public port::PortPublisher, public prometheus::Collect
   RackMetrics(std::string rack, std::function<ProcessCounters()> process);
 
   // port::PortPublisher: keeps the last views (the ports' threads).
-  void pump_state(const std::string& port, const rack::PumpView& pump, TimePoint) override;
-  void node_status(const std::string& port, const rack::PumpView& pump,
-                   const port::NodeStatusView& node, TimePoint) override;
+  void node_state(const std::string& port, const rack::NodeView& node, TimePoint) override;
+  void node_status(const std::string& port, const rack::NodeView& node,
+                   const port::NodeStatusView& status, TimePoint) override;
   void port_status(const port::PortStatusView& status, TimePoint) override;
   void explicit_reply(const std::string&, const rack::ExplicitAnswer&) override {}
   void bus_scan_reply(const std::string&, const port::BusScanAnswer&) override {}
@@ -93,8 +93,8 @@ class RackMetrics final : public port::PortPublisher, public prometheus::Collect
     std::map<unsigned, NodeEntry> nodes;  // by MAC
   };
 
-  // The pump's name and command counters, into its entry (mutex_ held).
-  NodeEntry& note_pump(const std::string& port, const rack::PumpView& pump);
+  // The node's name and command counters, into its entry (mutex_ held).
+  NodeEntry& note_node(const std::string& port, const rack::NodeView& view);
 
   std::string rack_;
   std::function<ProcessCounters()> process_;

@@ -25,15 +25,12 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
     profile_names_.push_back(nodes->profile());
   }
   gateway_.emplace(scanner(), rack::ExplicitGateway::Limits{}, config_.explicit_policy, log_);
-  const auto policy = [](const std::vector<rack::PublishPolicy>& list, std::size_t i) {
-    return i < list.size() ? list[i] : rack::PublishPolicy{};
-  };
-  for (std::size_t i = 0; i < config_.pumps.size(); ++i) {
-    published_.push_back({rack::PumpStateGate(policy(config_.publish, i))});
+  rack::ScanListChange all;
+  for (const rack::ProfileNodes* nodes : port_->profiles()) {
+    for (std::size_t i = 0; i < nodes->size(); ++i) all.added.push_back(nodes->view(i).mac);
   }
-  for (std::size_t i = 0; i < config_.devices.size(); ++i) {
-    published_devices_.push_back({rack::DeviceStateGate(policy(config_.device_publish, i))});
-  }
+  std::vector<MacId> unused;
+  carry_published(all, unused);
   note_scan_list();
 }
 
@@ -142,14 +139,9 @@ std::future<PortChange> PortLoop::reconfigure(PortLoopConfig next) {
 void PortLoop::apply(const Reconfigure& r, TimePoint now) {
   PortLoopConfig& next = *r.config;
   PortChange change;
-  // The published entries follow the racks' views, in their order: which MAC each is.
-  const auto macs_of = [](const auto& views) {
-    std::vector<MacId> out;
-    for (const auto& v : views) out.push_back(v.mac);
-    return out;
-  };
-  const std::vector<MacId> pumps_before = macs_of(rack().pumps());
-  const std::vector<MacId> devices_before = macs_of(devices().devices());
+  // A node of another profile after the reload: its instances of the old one go.
+  std::array<std::string_view, MacId::kMax + 1> profile_before{};
+  for (unsigned m = 0; m <= MacId::kMax; ++m) profile_before[m] = profile_of(*MacId::from(m));
   try {
     change.scan_list =
         port_->reconfigure(next.scanner, rack::PortNodes{next.pumps, next.devices}, now);
@@ -160,33 +152,22 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
     return;
   }
   const auto& sc = change.scan_list;
-  const auto policy_in = [](const auto& configs, const std::vector<rack::PublishPolicy>& policies) {
-    return [&configs, &policies](MacId mac) {
-      for (std::size_t i = 0; i < configs.size() && i < policies.size(); ++i) {
-        if (configs[i].node.mac == mac) return policies[i];
-      }
-      return rack::PublishPolicy{};
-    };
-  };
-  carry_published(pumps_before, rack().pumps(), published_, sc, policy_in(next.pumps, next.publish),
-                  change.publish_changed);
-  carry_published(devices_before, devices().devices(), published_devices_, sc,
-                  policy_in(next.devices, next.device_publish), change.publish_changed);
+  config_.pumps = std::move(next.pumps);
+  config_.publish = std::move(next.publish);
+  config_.devices = std::move(next.devices);
+  config_.device_publish = std::move(next.device_publish);
+  carry_published(sc, change.publish_changed);
   for (MacId mac : sc.removed) publisher_.node_removed(config_.port, mac);
-  // A node of another profile now: its instances of the old one go (disposed).
   for (MacId mac : sc.reconfigured) {
-    const bool was_pump =
-        std::find(pumps_before.begin(), pumps_before.end(), mac) != pumps_before.end();
-    if (was_pump != (rack().pump(mac) != nullptr)) publisher_.node_removed(config_.port, mac);
+    const rack::ProfileNodes* nodes = port_->nodes_of(mac);
+    if (!nodes || nodes->profile() != profile_before[mac.value()]) {
+      publisher_.node_removed(config_.port, mac);
+    }
   }
   if (!(gateway_->policy() == next.explicit_policy)) {
     gateway_->set_policy(next.explicit_policy);
     change.explicit_policy_changed = true;
   }
-  config_.pumps = std::move(next.pumps);
-  config_.publish = std::move(next.publish);
-  config_.devices = std::move(next.devices);
-  config_.device_publish = std::move(next.device_publish);
   config_.explicit_policy = next.explicit_policy;
   note_scan_list();
   port_dirty_ = true;
@@ -210,32 +191,38 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
   r.done->set_value(std::move(change));
 }
 
-template <class View, class Gate>
-void PortLoop::carry_published(const std::vector<MacId>& before, const std::vector<View>& views,
-                               std::vector<Published<Gate>>& published,
-                               const rack::ScanListChange& sc,
-                               const std::function<rack::PublishPolicy(MacId)>& policy_of,
-                               std::vector<MacId>& policy_changed) {
+rack::PublishPolicy PortLoop::policy_of(MacId mac) const {
+  const auto in = [&](const auto& configs, const std::vector<rack::PublishPolicy>& policies) {
+    for (std::size_t i = 0; i < configs.size() && i < policies.size(); ++i) {
+      if (configs[i].node.mac == mac) return std::optional(policies[i]);
+    }
+    return std::optional<rack::PublishPolicy>();
+  };
+  return in(config_.pumps, config_.publish)
+      .value_or(in(config_.devices, config_.device_publish).value_or(rack::PublishPolicy{}));
+}
+
+void PortLoop::carry_published(const rack::ScanListChange& sc, std::vector<MacId>& policy_changed) {
   const auto listed = [](const std::vector<MacId>& macs, MacId mac) {
     return std::find(macs.begin(), macs.end(), mac) != macs.end();
   };
-  // A node kept keeps its gate (a new one if its policy changed), a new or
-  // re-configured one starts afresh.
-  std::array<std::optional<Published<Gate>>, MacId::kMax + 1> kept;
-  for (std::size_t i = 0; i < before.size(); ++i) kept[before[i].value()] = std::move(published[i]);
-  published.clear();
-  for (const auto& v : views) {
-    const rack::PublishPolicy policy = policy_of(v.mac);
-    auto& old = kept[v.mac.value()];
-    if (!old || listed(sc.added, v.mac) || listed(sc.reconfigured, v.mac)) {
-      published.push_back({Gate(policy)});
+  for (unsigned m = 0; m <= MacId::kMax; ++m) {
+    const MacId mac = *MacId::from(m);
+    auto& p = published_[m];
+    const rack::ProfileNodes* nodes = port_->nodes_of(mac);
+    if (!nodes) {
+      p.reset();
       continue;
     }
-    if (!(old->gate.policy() == policy)) {
-      old->gate = Gate(policy);
-      policy_changed.push_back(v.mac);
+    const rack::PublishPolicy policy = policy_of(mac);
+    if (!p || listed(sc.added, mac) || listed(sc.reconfigured, mac)) {
+      p.emplace(Published{nodes->state_gate(policy)});
+      continue;
     }
-    published.push_back(std::move(*old));
+    if (!(p->gate->policy() == policy)) {
+      p->gate = nodes->state_gate(policy);
+      policy_changed.push_back(mac);
+    }
   }
 }
 
@@ -427,10 +414,7 @@ void PortLoop::run() {
       wake = std::min(wake, nodes->next_refresh_deadline());
     }
     for (const auto& p : published_) {
-      wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
-    }
-    for (const auto& p : published_devices_) {
-      wake = std::min({wake, p.gate.deadline(), p.status_time + config_.status_period});
+      if (p) wake = std::min({wake, p->gate->deadline(), p->status_time + config_.status_period});
     }
     if (calls_waiting_) wake = now;
     note_busy(pass_start);
@@ -460,48 +444,37 @@ void PortLoop::start_master_when_up(TimePoint now) {
   }
 }
 
-template <class View, class Gate, class State, class Status>
-void PortLoop::publish_views(const std::vector<View>& views,
-                             std::vector<Published<Gate>>& published, TimePoint now, bool force,
-                             State state, Status status) {
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    const View& v = views[i];
-    Published<Gate>& p = published[i];
-    // The source time is that of the latest event the sample reflects; a
-    // node nothing has happened to yet has been absent since the loop started.
-    TimePoint source = std::max(v.state_since, started_);
-    if (v.has_inputs) source = std::max(source, v.inputs_time);
-    // Unchanged since the gate was last asked, a node is due only by time.
-    if (force || v.changes != p.checked || now >= p.gate.deadline()) {
-      p.checked = v.changes;
-      if (force || p.gate.due(v, now)) {
-        state(v, source);
-        p.gate.published(v, now);
+void PortLoop::publish_nodes(TimePoint now, bool force) {
+  for (const rack::ProfileNodes* nodes : port_->profiles()) {
+    for (std::size_t i = 0; i < nodes->size(); ++i) {
+      const rack::NodeView& v = nodes->view(i);
+      Published& p = *published_[v.mac.value()];
+      // The source time is that of the latest event the sample reflects; a
+      // node nothing has happened to yet has been absent since the loop started.
+      TimePoint source = std::max(v.state_since, started_);
+      if (v.has_inputs) source = std::max(source, v.inputs_time);
+      // Unchanged since the gate was last asked, a node is due only by time.
+      if (force || v.changes != p.checked || now >= p.gate->deadline()) {
+        p.checked = v.changes;
+        if (force || p.gate->due(v, now)) {
+          publisher_.node_state(config_.port, v, source);
+          p.gate->published(v, now);
+        }
       }
-    }
-    if (force || !p.status_once || v.status_changes != p.changes ||
-        now >= p.status_time + config_.status_period) {
-      status(v, NodeStatusView::of(*scanner().node(v.mac)), std::max(source, p.status_time));
-      p.changes = v.status_changes;
-      p.status_time = now;
-      p.status_once = true;
+      if (force || !p.status_once || v.status_changes != p.changes ||
+          now >= p.status_time + config_.status_period) {
+        publisher_.node_status(config_.port, v, NodeStatusView::of(*scanner().node(v.mac)),
+                               std::max(source, p.status_time));
+        p.changes = v.status_changes;
+        p.status_time = now;
+        p.status_once = true;
+      }
     }
   }
 }
 
 void PortLoop::publish(TimePoint now, bool force) {
-  publish_views(
-      rack().pumps(), published_, now, force,
-      [&](const rack::PumpView& v, TimePoint t) { publisher_.pump_state(config_.port, v, t); },
-      [&](const rack::PumpView& v, const NodeStatusView& n, TimePoint t) {
-        publisher_.node_status(config_.port, v, n, t);
-      });
-  publish_views(
-      devices().devices(), published_devices_, now, force,
-      [&](const rack::DeviceView& v, TimePoint t) { publisher_.device_state(config_.port, v, t); },
-      [&](const rack::DeviceView& v, const NodeStatusView& n, TimePoint t) {
-        publisher_.device_status(config_.port, v, n, t);
-      });
+  publish_nodes(now, force);
   if (force || port_dirty_ || now >= port_status_time_ + config_.status_period) publish_port(now);
 }
 
@@ -526,12 +499,12 @@ void PortLoop::publish_port(TimePoint now) {
     std::lock_guard lock(problem_mutex_);
     if (problem != problem_) problem_ = problem;
   }
-  const auto online = [](const auto& views) {
-    return std::count_if(views.begin(), views.end(), [](const auto& v) { return v.online; });
-  };
-  s.nodes_configured =
-      static_cast<std::uint16_t>(rack().pumps().size() + devices().devices().size());
-  s.nodes_online = static_cast<std::uint16_t>(online(rack().pumps()) + online(devices().devices()));
+  for (const rack::ProfileNodes* nodes : port_->profiles()) {
+    for (std::size_t i = 0; i < nodes->size(); ++i) {
+      ++s.nodes_configured;
+      if (nodes->view(i).online) ++s.nodes_online;
+    }
+  }
   // Rates are measured over whole status periods; a state change in between
   // publishes the last measured ones.
   if (now - metrics_time_ >= config_.status_period) update_metrics(s.bus, now);
@@ -562,10 +535,11 @@ void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
   const double elapsed = std::chrono::duration<double>(now - metrics_time_).count();
   double cycle_sum = 0;
   unsigned cycles = 0;
-  const auto add_cycles = [&](const auto& views, auto& published) {
-    for (std::size_t i = 0; i < views.size(); ++i) {
-      const auto* node = scanner().node(views[i].mac);
-      std::uint64_t& last = published[i].polls;
+  for (const rack::ProfileNodes* nodes : port_->profiles()) {
+    for (std::size_t i = 0; i < nodes->size(); ++i) {
+      const MacId mac = nodes->view(i).mac;
+      const auto* node = scanner().node(mac);
+      std::uint64_t& last = published_[mac.value()]->polls;
       const std::uint64_t polls = node->counters().polls;
       if (node->state() == devicenet::NodeState::kOnline && polls > last) {
         cycle_sum += 1000.0 * elapsed / static_cast<double>(polls - last);
@@ -573,9 +547,7 @@ void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
       }
       last = polls;
     }
-  };
-  add_cycles(rack().pumps(), published_);
-  add_cycles(devices().devices(), published_devices_);
+  }
   metrics_.frames_per_second = static_cast<double>(bus.frames - last_counters_.frames) / elapsed;
   const auto bitrate = backend_->bitrate();
   metrics_.bus_load_percent = bitrate

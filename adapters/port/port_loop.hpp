@@ -206,32 +206,28 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   PortPublisher& publisher_;
   Logger log_;
   std::optional<rack::RackPort> port_;  // the master and the rack model
-  rack::PumpRack& rack() { return port_->pumps(); }
-  rack::DeviceRack& devices() { return port_->devices(); }
   devicenet::Scanner& scanner() { return port_->scanner(); }
   std::optional<rack::ExplicitGateway> gateway_;
 
   // What was published of a node, and when its state is next due.
-  template <class Gate>
   struct Published {
-    Gate gate;
+    std::unique_ptr<rack::StateGate> gate;  // its profile's (ProfileNodes::state_gate)
     std::uint64_t checked = ~0ull;  // the view's changes when the gate was last asked
     std::uint64_t changes = ~0ull;  // the view's status_changes at the last NodeStatus
     TimePoint status_time{};
     bool status_once = false;
     std::uint64_t polls = 0;  // the node's polls at the last metrics update
   };
-  std::vector<Published<rack::PumpStateGate>> published_;            // in the rack's order of pumps
-  std::vector<Published<rack::DeviceStateGate>> published_devices_;  // and of devices
-  // Publishes each view of `views` whose state or status is due.
-  template <class View, class Gate, class State, class Status>
-  void publish_views(const std::vector<View>& views, std::vector<Published<Gate>>& published,
-                     TimePoint now, bool force, State state, Status status);
-  // After a reload: `published` follows the rack's new views, in their order.
-  template <class View, class Gate>
-  void carry_published(const std::vector<devicenet::MacId>& before, const std::vector<View>& views,
-                       std::vector<Published<Gate>>& published, const rack::ScanListChange& sc,
-                       const std::function<rack::PublishPolicy(devicenet::MacId)>& policy_of,
+  // By MAC, for every node of the scan list.
+  std::array<std::optional<Published>, devicenet::MacId::kMax + 1> published_;
+  // The node's publish policy in the configuration.
+  rack::PublishPolicy policy_of(devicenet::MacId mac) const;
+  // Publishes each node whose state or status is due, profile by profile.
+  void publish_nodes(TimePoint now, bool force);
+  // After a reload: a node kept keeps what was published of it (a new gate
+  // if its policy changed, named in `policy_changed`); a new or configured
+  // again one starts afresh; a removed one goes.
+  void carry_published(const rack::ScanListChange& sc,
                        std::vector<devicenet::MacId>& policy_changed);
   TimePoint started_{};              // when run() began
   bool master_started_ = false;

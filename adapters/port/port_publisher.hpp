@@ -90,17 +90,14 @@ class PortPublisher {
   virtual ~PortPublisher() = default;
   // `source_time` is the monotonic time of the event the sample comes from
   // (a frame's receive time, or a timer's); the publisher maps it to the
-  // wall clock DDS timestamps use.
-  virtual void pump_state(const std::string& port, const rack::PumpView& pump,
+  // wall clock DDS timestamps use. A node's state, on its profile's topic
+  // (`node.profile`: PumpState for "cdn127", DeviceState for "eds"), and
+  // its NodeStatus; the view is that profile's (rack::PumpView,
+  // rack::DeviceView).
+  virtual void node_state(const std::string& port, const rack::NodeView& node,
                           TimePoint source_time) = 0;
-  virtual void node_status(const std::string& port, const rack::PumpView& pump,
-                           const NodeStatusView& node, TimePoint source_time) = 0;
-  // A device described by its EDS file (profile "eds"): its DeviceState and
-  // its NodeStatus. Publishers without a use for them leave them out.
-  virtual void device_state(const std::string& /*port*/, const rack::DeviceView& /*device*/,
-                            TimePoint /*source_time*/) {}
-  virtual void device_status(const std::string& /*port*/, const rack::DeviceView& /*device*/,
-                             const NodeStatusView& /*node*/, TimePoint /*source_time*/) {}
+  virtual void node_status(const std::string& port, const rack::NodeView& node,
+                           const NodeStatusView& status, TimePoint source_time) = 0;
   virtual void port_status(const PortStatusView& status, TimePoint source_time) = 0;
   // `port`: the port whose gateway answers; empty for a request no port took.
   virtual void explicit_reply(const std::string& port, const rack::ExplicitAnswer& answer) = 0;

@@ -9,25 +9,15 @@ class PublisherTee final : public PortPublisher {
  public:
   PublisherTee(PortPublisher& first, PortPublisher& second) : first_(first), second_(second) {}
 
-  void pump_state(const std::string& port, const rack::PumpView& pump,
+  void node_state(const std::string& port, const rack::NodeView& node,
                   TimePoint source_time) override {
-    first_.pump_state(port, pump, source_time);
-    second_.pump_state(port, pump, source_time);
+    first_.node_state(port, node, source_time);
+    second_.node_state(port, node, source_time);
   }
-  void node_status(const std::string& port, const rack::PumpView& pump, const NodeStatusView& node,
-                   TimePoint source_time) override {
-    first_.node_status(port, pump, node, source_time);
-    second_.node_status(port, pump, node, source_time);
-  }
-  void device_state(const std::string& port, const rack::DeviceView& device,
-                    TimePoint source_time) override {
-    first_.device_state(port, device, source_time);
-    second_.device_state(port, device, source_time);
-  }
-  void device_status(const std::string& port, const rack::DeviceView& device,
-                     const NodeStatusView& node, TimePoint source_time) override {
-    first_.device_status(port, device, node, source_time);
-    second_.device_status(port, device, node, source_time);
+  void node_status(const std::string& port, const rack::NodeView& node,
+                   const NodeStatusView& status, TimePoint source_time) override {
+    first_.node_status(port, node, status, source_time);
+    second_.node_status(port, node, status, source_time);
   }
   void port_status(const PortStatusView& status, TimePoint source_time) override {
     first_.port_status(status, source_time);

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "bridge/common/bytes.hpp"
+#include "bridge/rack/publish_gate.hpp"
 
 namespace dnbridge::rack {
 
@@ -142,6 +143,10 @@ Status DeviceRack::command(MacId mac, const NodeCommand& command, std::string_vi
     return this->command(mac, *malformed, issuer, now);
   }
   return refuse_other_form(mac, issuer);
+}
+
+std::unique_ptr<StateGate> DeviceRack::state_gate(const PublishPolicy& policy) const {
+  return std::make_unique<DeviceStateGate>(policy);
 }
 
 }  // namespace dnbridge::rack

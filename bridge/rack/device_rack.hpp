@@ -105,6 +105,7 @@ class DeviceRack final : public NodeRack<DeviceProfile> {
   // A NodeCommand of any of the three forms above; any other is refused.
   Status command(devicenet::MacId mac, const NodeCommand& command, std::string_view issuer,
                  TimePoint now) override;
+  std::unique_ptr<StateGate> state_gate(const PublishPolicy& policy) const override;
 
   const std::vector<DeviceView>& devices() const { return nodes(); }
   const DeviceView* device(devicenet::MacId mac) const { return node(mac); }

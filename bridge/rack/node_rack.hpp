@@ -96,6 +96,7 @@ class NodeRack : public ProfileNodes {
     entries_.push_back(entry_of(c));
     index_[c.node.mac.value()] = static_cast<int>(views_.size());
     views_.push_back(Profile::view_of(c, entries_.back().slot));
+    views_.back().profile = Profile::kName;
     views_.back().command_refresh = c.command_refresh;
   }
   void remove(devicenet::MacId mac) {
@@ -120,6 +121,7 @@ class NodeRack : public ProfileNodes {
     // Its counters go on (they are the node's, whatever its settings); the
     // rest starts again.
     View fresh = Profile::view_of(c, entries_[index].slot);
+    fresh.profile = Profile::kName;
     fresh.commands_accepted = v.commands_accepted;
     fresh.commands_refused = v.commands_refused;
     Profile::carry_over(v, fresh);

@@ -40,6 +40,7 @@ std::string_view to_string(IdleCause cause) noexcept;
 
 // The part of a node's view every profile has.
 struct NodeView {
+  std::string_view profile;  // the node's profile's name (ProfileNodes::profile)
   devicenet::MacId mac;
   std::string name;
   bool online = false;

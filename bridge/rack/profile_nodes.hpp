@@ -9,6 +9,7 @@
 // is one path for all of them.
 #include <any>
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -37,6 +38,9 @@ class NodeCommand {
  private:
   std::any outputs_;
 };
+
+struct PublishPolicy;
+class StateGate;
 
 class ProfileNodes : public devicenet::ScannerObserver {
  public:
@@ -73,6 +77,9 @@ class ProfileNodes : public devicenet::ScannerObserver {
   virtual std::vector<Silenced> expire_silent_commanders(TimePoint now) = 0;
   // When expire_silent_commanders has next something to do; kNever if not.
   virtual TimePoint next_refresh_deadline() const = 0;
+
+  // When one of these nodes' state is worth a new sample (publish_gate.hpp).
+  virtual std::unique_ptr<StateGate> state_gate(const PublishPolicy& policy) const = 0;
 };
 
 }  // namespace dnbridge::rack

@@ -28,7 +28,8 @@ std::array<int, 2> PumpStateGate::analog(const PumpView& v) {
   return a;
 }
 
-bool PumpStateGate::due(const PumpView& view, TimePoint now) const {
+bool PumpStateGate::due(const NodeView& node, TimePoint now) const {
+  const auto& view = static_cast<const PumpView&>(node);
   if (!published_once_ || now >= last_time_ + policy_.max_period) return true;
   if (!(discrete(view) == last_)) return true;
   if (view.commanded_by != last_commander_) return true;
@@ -46,7 +47,8 @@ bool PumpStateGate::due(const PumpView& view, TimePoint now) const {
   return false;
 }
 
-void PumpStateGate::published(const PumpView& view, TimePoint now) {
+void PumpStateGate::published(const NodeView& node, TimePoint now) {
+  const auto& view = static_cast<const PumpView&>(node);
   published_once_ = true;
   last_time_ = now;
   last_ = discrete(view);
@@ -65,15 +67,15 @@ DeviceStateGate::Seen DeviceStateGate::seen(const DeviceView& v) {
   return s;
 }
 
-bool DeviceStateGate::due(const DeviceView& view, TimePoint now) const {
+bool DeviceStateGate::due(const NodeView& view, TimePoint now) const {
   if (!published_once_ || now >= last_time_ + policy_.max_period) return true;
-  return !(seen(view) == last_);
+  return !(seen(static_cast<const DeviceView&>(view)) == last_);
 }
 
-void DeviceStateGate::published(const DeviceView& view, TimePoint now) {
+void DeviceStateGate::published(const NodeView& view, TimePoint now) {
   published_once_ = true;
   last_time_ = now;
-  last_ = seen(view);
+  last_ = seen(static_cast<const DeviceView&>(view));
 }
 
 }  // namespace dnbridge::rack

@@ -22,17 +22,31 @@ struct PublishPolicy {
   friend bool operator==(const PublishPolicy&, const PublishPolicy&) = default;
 };
 
-class PumpStateGate {
+// A node's gate, whatever its profile; its profile's rack makes it
+// (ProfileNodes::state_gate) and gives it that profile's views only.
+class StateGate {
+ public:
+  virtual ~StateGate() = default;
+  // True if `view` differs enough from what was last published, or the
+  // maximum period has passed.
+  virtual bool due(const NodeView& view, TimePoint now) const = 0;
+  virtual void published(const NodeView& view, TimePoint now) = 0;
+  // When the maximum period next forces a sample (kNever before the first).
+  virtual TimePoint deadline() const = 0;
+  virtual const PublishPolicy& policy() const = 0;
+};
+
+class PumpStateGate final : public StateGate {
  public:
   explicit PumpStateGate(PublishPolicy policy) : policy_(policy) {}
 
-  // True if `view` differs enough from what was last published, or the
-  // maximum period has passed.
-  bool due(const PumpView& view, TimePoint now) const;
-  void published(const PumpView& view, TimePoint now);
-  // When the maximum period next forces a sample (kNever before the first).
-  TimePoint deadline() const { return published_once_ ? last_time_ + policy_.max_period : kNever; }
-  const PublishPolicy& policy() const { return policy_; }
+  // Of a PumpView.
+  bool due(const NodeView& view, TimePoint now) const override;
+  void published(const NodeView& view, TimePoint now) override;
+  TimePoint deadline() const override {
+    return published_once_ ? last_time_ + policy_.max_period : kNever;
+  }
+  const PublishPolicy& policy() const override { return policy_; }
 
  private:
   // The discrete part of a view: any difference is published.
@@ -58,14 +72,17 @@ class PumpStateGate {
   std::string last_commander_;
 };
 
-class DeviceStateGate {
+class DeviceStateGate final : public StateGate {
  public:
   explicit DeviceStateGate(PublishPolicy policy) : policy_(policy) {}
 
-  bool due(const DeviceView& view, TimePoint now) const;
-  void published(const DeviceView& view, TimePoint now);
-  TimePoint deadline() const { return published_once_ ? last_time_ + policy_.max_period : kNever; }
-  const PublishPolicy& policy() const { return policy_; }
+  // Of a DeviceView.
+  bool due(const NodeView& view, TimePoint now) const override;
+  void published(const NodeView& view, TimePoint now) override;
+  TimePoint deadline() const override {
+    return published_once_ ? last_time_ + policy_.max_period : kNever;
+  }
+  const PublishPolicy& policy() const override { return policy_; }
 
  private:
   struct Seen {

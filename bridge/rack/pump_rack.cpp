@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "bridge/profiles/cdn127/node_profile.hpp"
+#include "bridge/rack/publish_gate.hpp"
 
 namespace dnbridge::rack {
 
@@ -115,6 +116,10 @@ Status PumpRack::command(MacId mac, const NodeCommand& command, std::string_view
     return this->command(mac, *outputs, issuer, now);
   }
   return refuse_other_form(mac, issuer);
+}
+
+std::unique_ptr<StateGate> PumpRack::state_gate(const PublishPolicy& policy) const {
+  return std::make_unique<PumpStateGate>(policy);
 }
 
 }  // namespace dnbridge::rack

@@ -6,6 +6,7 @@
 // Commands are checked here before they reach the master.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -105,6 +106,7 @@ class PumpRack final : public NodeRack<PumpProfile> {
   // A NodeCommand of PumpOutputs; any other form is refused.
   Status command(devicenet::MacId mac, const NodeCommand& command, std::string_view issuer,
                  TimePoint now) override;
+  std::unique_ptr<StateGate> state_gate(const PublishPolicy& policy) const override;
 
   const std::vector<PumpView>& pumps() const { return nodes(); }
   const PumpView* pump(devicenet::MacId mac) const { return node(mac); }

@@ -726,12 +726,13 @@ TEST_F(CarelessClientTest, AStateReaderThatAcknowledgesNothingNeverHoldsThePortT
   const auto publish_all = [&](const std::string& round) {
     Duration longest{};
     rack::PumpView view;
+    view.profile = rack::PumpProfile::kName;
     view.name = round + std::string(100, '.');
     for (unsigned p = 0; p < kPorts; ++p) {
       for (unsigned mac = 1; mac <= kMacs; ++mac) {
         view.mac = devicenet::MacId::from_bits(mac);
         const auto start = SteadyClock::now();
-        publisher.pump_state(port_name(p), view, port::steady_now());
+        publisher.node_state(port_name(p), view, port::steady_now());
         longest = std::max<Duration>(longest, SteadyClock::now() - start);
       }
     }
@@ -756,13 +757,14 @@ TEST_F(CarelessClientTest, AStateReaderThatAcknowledgesNothingNeverHoldsThePortT
 
   // The client's reader has a sample: the writer has matched it.
   rack::PumpView first;
+  first.profile = rack::PumpProfile::kName;
   first.mac = devicenet::MacId::from_bits(1);
   first.name = "first";
   const auto receiving = [&] {
     std::optional<std::string> line;
     const auto deadline = SteadyClock::now() + seconds(30);
     while (!line && SteadyClock::now() < deadline) {
-      publisher.pump_state(port_name(0), first, port::steady_now());
+      publisher.node_state(port_name(0), first, port::steady_now());
       line = client.read_line(milliseconds(100));
     }
     return line;

@@ -33,17 +33,19 @@ MacId mac(unsigned v) { return MacId::from(v).value(); }
 
 class RecordingPublisher final : public PortPublisher {
  public:
-  void pump_state(const std::string&, const rack::PumpView& pump, TimePoint t) override {
+  // The pumps' states (the only profile these tests configure).
+  void node_state(const std::string&, const rack::NodeView& node, TimePoint t) override {
+    ASSERT_EQ(node.profile, rack::PumpProfile::kName);
     std::lock_guard lock(mutex_);
-    pumps[pump.mac.value()] = pump;
-    pump_times[pump.mac.value()] = t;
+    pumps[node.mac.value()] = static_cast<const rack::PumpView&>(node);
+    pump_times[node.mac.value()] = t;
     ++pump_samples;
     changed_.notify_all();
   }
-  void node_status(const std::string&, const rack::PumpView& pump, const NodeStatusView& node,
+  void node_status(const std::string&, const rack::NodeView& node, const NodeStatusView& status,
                    TimePoint) override {
     std::lock_guard lock(mutex_);
-    node_states[pump.mac.value()] = node.state;
+    node_states[node.mac.value()] = status.state;
     ++status_samples;
     changed_.notify_all();
   }
