@@ -27,7 +27,7 @@ enum Token : dds::WaitSet::Token {
 constexpr Duration kClockSkewReported = seconds(1);
 
 // Commands are not taken again sooner than this after a take: under a flood
-// each pump's newest command is applied once per hold-off, at most 1 ms late;
+// each node's newest command is applied once per hold-off, at most 1 ms late;
 // one that comes alone is taken at once, on Cyclone's thread.
 constexpr Duration kCommandHoldoff = milliseconds(1);
 
@@ -278,7 +278,7 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
     for (unsigned m = 0; m <= devicenet::MacId::kMax; ++m) {
       seen[m] = loop->silences(*devicenet::MacId::from(m));
     }
-    loop->watch_silences([this] { (void)silenced_.trigger(); });
+    loop->watch_command_state([this] { (void)silenced_.trigger(); });
   }
 }
 
@@ -294,7 +294,7 @@ void DdsInput::start() {
 
 void DdsInput::stop() {
   accepting_ = false;
-  for (const auto& [name, loop] : ports_) loop->watch_silences({});
+  for (const auto& [name, loop] : ports_) loop->watch_command_state({});
   // No listener call after this: none is handing a command to a port.
   {
     std::lock_guard lock(command_take_mutex_);
@@ -464,15 +464,17 @@ void DdsInput::make_readers_of_silenced_nodes() {
 void DdsInput::make_node_readers(const std::string& port, devicenet::MacId mac,
                                  std::string_view profile, std::uint32_t refresh_ms) {
   if (classes_closed_) return;
-  auto key = std::make_unique<NodeKey>(NodeKey{rack_, port, mac.value()});
-  // The previous ones go first: the silent owner of the node is theirs.
-  if (auto it = node_readers_.find(*key); it != node_readers_.end()) node_readers_.erase(it);
+  // The previous one goes first: the silent owner of the node is its.
+  if (auto it = node_readers_.find(NodeRef{port, mac.value()}); it != node_readers_.end()) {
+    node_readers_.erase(it);
+  }
   const auto topic = std::find_if(command_topics_.begin(), command_topics_.end(),
                                   [&](const auto& t) { return t->profile() == profile; });
   if (topic == command_topics_.end()) return;  // DDS Security grants no command of the profile
   const dds::Qos qos =
       dds::command_reader_qos(partition_, max_commander_lease_, milliseconds(refresh_ms));
   try {
+    auto key = std::make_unique<NodeKey>(NodeKey{rack_, port, mac.value()});
     auto made = std::make_unique<CommandClass>();
     made->refresh_ms = refresh_ms;
     made->profile = (*topic)->profile();
@@ -516,7 +518,7 @@ void DdsInput::deliver_commands() {
     while (accepting_ && commands_pending_.exchange(false)) {
       const TimePoint now = port::steady_now();
       if (now < TimePoint{Duration(next_command_take_.load())}) {
-        // Held off: the samples stay in the reader (keep-last 1 per pump:
+        // Held off: the samples stay in the reader (keep-last 1 per node:
         // the newest of each is taken at the end of the hold-off, by the
         // input thread), and meanwhile a sample costs this check only.
         commands_pending_ = true;
@@ -555,10 +557,17 @@ port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info
   // own readers' when it has them, else its class's, and a refusal is said
   // once, by the class without refresh.
   if (profile == kProfile && !profile.empty()) {
-    if (loop->command_refresh_ms(*mac) != from.refresh_ms) return nullptr;
-    const NodeKey key{rack_, loop->name(), mac->value()};
-    if (from.node) return from.node->port == key.port && from.node->mac == key.mac ? loop : nullptr;
-    return node_readers_.count(key) == 0 ? loop : nullptr;
+    const std::uint32_t refresh = loop->command_refresh_ms(*mac);
+    if (refresh != from.refresh_ms) return nullptr;
+    if (from.node) {
+      return from.node->port == loop->name() && from.node->mac == mac->value() ? loop : nullptr;
+    }
+    // The node's own reader, while it is of the node's refresh and profile
+    // (a reload may have changed either: then its class takes them).
+    const auto own = node_readers_.find(NodeRef{loop->name(), mac->value()});
+    const bool taken_by_own = own != node_readers_.end() && own->second->refresh_ms == refresh &&
+                              own->second->profile == profile;
+    return taken_by_own ? nullptr : loop;
   }
   if (from.refresh_ms != 0 || from.node) return nullptr;
   command_warn_limit_.warn(

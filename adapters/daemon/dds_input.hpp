@@ -24,6 +24,7 @@
 #include <mutex>
 #include <span>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -177,13 +178,28 @@ class DdsInput {
   // the next sample of any live commander of the node owns it there, and a
   // stronger one's takes it back. At most one reader per node, made again at
   // each silence of its commander (the port loop counts them:
-  // PortLoop::silences), dropped when a reload changes the node's refresh or
-  // kind. Under command_take_mutex_.
+  // PortLoop::silences). A reload that changes the node's refresh or profile
+  // makes it stale: from then on its class takes the node's commands
+  // (loop_for), and the input drops it when the port loop wakes it. Under
+  // command_take_mutex_.
   struct NodeKey {
     std::string rack, port;
     std::uint8_t mac;
-    bool operator<(const NodeKey& o) const {
-      return std::tie(port, mac) < std::tie(o.port, o.mac);
+  };
+  // A node by port and MAC, found without a copy of its port's name.
+  struct NodeRef {
+    std::string_view port;
+    std::uint8_t mac;
+  };
+  struct NodeOrder {
+    using is_transparent = void;
+    static NodeRef ref(const NodeKey& k) { return {k.port, k.mac}; }
+    static NodeRef ref(NodeRef r) { return r; }
+    template <class A, class B>
+    bool operator()(const A& a, const B& b) const {
+      const NodeRef x = ref(a);
+      const NodeRef y = ref(b);
+      return std::tie(x.port, x.mac) < std::tie(y.port, y.mac);
     }
   };
   void make_readers_of_silenced_nodes();
@@ -232,7 +248,7 @@ class DdsInput {
   std::vector<std::unique_ptr<CommandClass>> command_classes_;
   // Guarded by command_take_mutex_: a reader deleted under it may have a
   // listener call in progress, which finds the mutex taken and returns.
-  std::map<NodeKey, std::unique_ptr<CommandClass>> node_readers_;
+  std::map<NodeKey, std::unique_ptr<CommandClass>, NodeOrder> node_readers_;
   // The port loops' silence counts as last looked at (the input thread's).
   std::map<std::string, std::array<std::uint32_t, devicenet::MacId::kMax + 1>, std::less<>>
       silences_seen_;

@@ -40,10 +40,12 @@ class Topic : public Entity {
   // sample with data arrives (a dispose or unregister still passes). For a
   // topic entity of its readers' own; `arg` must outlive them. Throws Error.
   void filter(bool (*accept)(const T& sample, const void* arg), const void* arg) {
-    filter_ = std::make_unique<Filter>(Filter{accept, arg});
-    check(dds_set_topic_filter_and_arg(handle(), &Topic::call, filter_.get()),
+    // The one in force is freed only once Cyclone has the new one.
+    auto next = std::make_unique<Filter>(Filter{accept, arg});
+    check(dds_set_topic_filter_and_arg(handle(), &Topic::call, next.get()),
           "setting a filter on a topic of type " +
               std::string(TopicTraits<T>::kDescriptor->m_typename));
+    filter_ = std::move(next);
   }
 
  private:

@@ -54,11 +54,13 @@ void PortLoop::note_scan_list() {
   }
   scan_list_.store(macs, std::memory_order_relaxed);
   refresh_generation_.fetch_add(1, std::memory_order_release);
+  std::lock_guard lock(command_watch_mutex_);
+  if (command_watch_) command_watch_();
 }
 
-void PortLoop::watch_silences(std::function<void()> watch) {
-  std::lock_guard lock(silence_watch_mutex_);
-  silence_watch_ = std::move(watch);
+void PortLoop::watch_command_state(std::function<void()> watch) {
+  std::lock_guard lock(command_watch_mutex_);
+  command_watch_ = std::move(watch);
 }
 
 void PortLoop::expire_silent_commanders(TimePoint now) {
@@ -74,8 +76,8 @@ void PortLoop::expire_silent_commanders(TimePoint now) {
     }
   }
   if (!any) return;
-  std::lock_guard lock(silence_watch_mutex_);
-  if (silence_watch_) silence_watch_();
+  std::lock_guard lock(command_watch_mutex_);
+  if (command_watch_) command_watch_();
 }
 
 PortLoop::~PortLoop() {
@@ -103,9 +105,9 @@ std::string PortLoop::problem() const {
 }
 
 void PortLoop::command(MacId mac, rack::NodeCommand command, std::string issuer) {
-  push(Command{mac, std::move(command), std::move(issuer)});
+  push(Command{mac, profile_of(mac), std::move(command), std::move(issuer)});
 }
-void PortLoop::release_command(MacId mac) { push(Release{mac}); }
+void PortLoop::release_command(MacId mac) { push(Release{mac, profile_of(mac)}); }
 void PortLoop::explicit_request(rack::ExplicitCall call) {
   bool queued = false;
   {
@@ -320,15 +322,19 @@ bool PortLoop::drain_inbox(TimePoint now) {
       // The MAC was checked against the scan list where the command came
       // in (profile_of); a reload may have changed it since.
       rack::ProfileNodes* nodes = port_->nodes_of(c->mac);
-      if (!nodes) {
-        log_.warn("command refused: from {}: MAC {} is not in this port's scan list", c->issuer,
-                  c->mac.value());
+      if (!nodes || nodes->profile() != c->profile) {
+        log_.warn("command refused: from {}: MAC {} is {}", c->issuer, c->mac.value(),
+                  c->profile.empty()
+                      ? std::string("not in this port's scan list")
+                      : fmt::format("no longer a node of profile \"{}\" (a reload)", c->profile));
       } else if (auto s = nodes->command(c->mac, c->command, c->issuer, now); !s) {
         log_.warn("command refused: {}", nodes->node(c->mac)->last_command_refused);
       }
     } else if (auto* r = std::get_if<Release>(&item)) {
+      // A release for a node of another profile (a reload came between)
+      // is not this node's.
       rack::ProfileNodes* nodes = port_->nodes_of(r->mac);
-      if (nodes && nodes->release_command(r->mac, now)) {
+      if (nodes && nodes->profile() == r->profile && nodes->release_command(r->mac, now)) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
     } else if (auto* scan = std::get_if<ScanCall>(&item)) {

@@ -1,9 +1,9 @@
 #pragma once
 // One CAN port's event loop, on a thread of its own. It owns the port's
-// DeviceNet master (Scanner), the rack model of its pumps, the explicit
-// gateway and the CAN backend; nothing else touches them. Other threads
-// (the DDS input) talk to it through its inbox, which wakes it. State is
-// published from here.
+// DeviceNet master (Scanner), the rack model of its nodes (every profile's:
+// rack::RackPort), the explicit gateway and the CAN backend; nothing else touches them. Other
+// threads (the DDS input) talk to it through its inbox, which wakes it. State is published from
+// here.
 #include <array>
 #include <atomic>
 #include <bit>
@@ -96,7 +96,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   static constexpr std::size_t kMaxScanWaiters = 64;
   static constexpr Duration kScanHoldoff = seconds(30);
   // A configuration read again (a reload): the port's scan list, its
-  // timings, its pumps' publish policies and the explicit policy, applied
+  // timings, its nodes' publish policies and the explicit policy, applied
   // on the port's thread at its next pass, only where they differ
   // (rack::RackPort::reconfigure); nodes not changed keep polling,
   // untouched. The port's name, interface and master stay as they are
@@ -125,13 +125,15 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     return refresh_generation_.load(std::memory_order_acquire);
   }
   // How many times the node's command lapsed because its commander stopped
-  // writing it (command_refresh_ms) (any thread). `watch` is called on the
-  // port's thread after each such lapse, so it must return at once; empty:
-  // none. Set and cleared from any thread.
+  // writing it (command_refresh_ms) (any thread).
   std::uint32_t silences(devicenet::MacId mac) const {
     return silences_[mac.value()].load(std::memory_order_acquire);
   }
-  void watch_silences(std::function<void()> watch);
+  // `watch` is called on the port's thread after a pass that counted a
+  // silence, and after the scan list changed (a node's profile or refresh
+  // may have), so it must return at once; empty: none. Set and cleared from
+  // any thread.
+  void watch_command_state(std::function<void()> watch);
 
   // For a service manager, from any thread. The port has finished its
   // start-up checks once its master left the duplicate MAC ID check, either
@@ -152,13 +154,16 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   std::string problem() const;
 
  private:
+  // Each for the node of the profile the MAC had when it was queued.
   struct Command {
     devicenet::MacId mac;
+    std::string_view profile;
     rack::NodeCommand command;
     std::string issuer;
   };
   struct Release {
     devicenet::MacId mac;
+    std::string_view profile;
   };
   struct Stop {};
   struct Reconfigure {
@@ -175,7 +180,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // must reach the bus to mean anything.
   void start_master_when_up(TimePoint now);
   void push(Item item);
-  // Commands first, then at most kCallsPerPass explicit requests: a pump
+  // Commands first, then at most kCallsPerPass explicit requests: a node's
   // command never waits behind explicit traffic, nor the bus behind a flood
   // of requests. False once a Stop was seen.
   bool drain_inbox(TimePoint now);
@@ -261,8 +266,8 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void expire_silent_commanders(TimePoint now);
   RateLimitedLog silent_log_;  // a commander writing just slower than its refresh
   std::array<std::atomic<std::uint32_t>, devicenet::MacId::kMax + 1> silences_{};
-  std::mutex silence_watch_mutex_;
-  std::function<void()> silence_watch_;
+  std::mutex command_watch_mutex_;
+  std::function<void()> command_watch_;
   std::mutex inbox_mutex_;
   std::vector<Item> inbox_;
   std::deque<rack::ExplicitCall> calls_;

@@ -273,5 +273,53 @@ TEST_F(CommanderBoundTest, AWeakerLiveCommanderTakesOverFromASilentStrongerOne) 
   EXPECT_TRUE(device_pump_on());
 }
 
+// A reload that changes the refresh of a node whose commands its own reader
+// takes (its commander went silent once) leaves the command in force: the
+// node's class of the new refresh takes its commands at once, and the
+// command does not lapse while its commander keeps writing.
+TEST_F(CommanderBoundTest, AReloadThatChangesTheRefreshOfANodeWithItsOwnReaderKeepsItsCommand) {
+  static constexpr auto kLonger = milliseconds(800);
+  daemon::ReloadSource reload;
+  reload.load = [] {
+    auto c = refresh_config();
+    for (auto& n : c.ports.at(0).nodes) {
+      if (n.pump.node.mac.value() == kMac) n.pump.command_refresh = kLonger;
+    }
+    return c;
+  };
+  ASSERT_NO_FATAL_FAILURE(start_online(refresh_config(), std::move(reload)));
+  auto& c = commander("refreshing", 10, kLease, kRefresh);
+  ASSERT_EQ(c.read_line(milliseconds(15000)), "matched");
+  ASSERT_TRUE(c.send_line("refresh 125"));
+  ASSERT_EQ(c.read_line(milliseconds(5000)), "refreshing");
+  ASSERT_TRUE(pumps_.until([&] { return echoes("refreshing"); }));
+  // Silent once: from then on the node's own reader takes its commands.
+  ASSERT_TRUE(c.send_line("silent"));
+  ASSERT_EQ(c.read_line(milliseconds(5000)), "silent");
+  ASSERT_TRUE(pumps_.until([&] { return idle("idle: commander silent for 500 ms"); }));
+  ASSERT_TRUE(c.send_line("refresh 125"));
+  ASSERT_EQ(c.read_line(milliseconds(5000)), "refreshing");
+  ASSERT_TRUE(pumps_.until([&] { return echoes("refreshing"); }));
+
+  const auto r = bridge_->reload();
+  ASSERT_EQ(r.status, daemon::ReloadStatus::kApplied) << r.message;
+  ASSERT_TRUE(nodes_.until([&] {
+    const auto* n = nodes_.latest(pump_mac(kMac));
+    return n && n->command_refresh_ms == 800;
+  }));
+  const std::size_t after = pumps_.history().size();
+  // Three of the new refreshes: a command no reader took would have lapsed.
+  (void)pumps_.until([] { return false; }, 3 * kLonger, milliseconds(50));
+  const auto& h = pumps_.history();
+  for (std::size_t i = after; i < h.size(); ++i) {
+    const auto& sample = h[i].sample;
+    if (!sample.valid_data() || sample.data().mac != kMac) continue;
+    EXPECT_FALSE(sample.data().outputs_idle)
+        << "the command lapsed after the reload: " << dds::view(sample.data().idle_reason);
+  }
+  EXPECT_TRUE(echoes("refreshing"));
+  EXPECT_FALSE(log_.contains(LogLevel::kWarn, "commander refreshing silent for 800 ms"));
+}
+
 }  // namespace
 }  // namespace dnbridge::e2e

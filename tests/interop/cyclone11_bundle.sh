@@ -25,8 +25,8 @@ fi
 sum=$(sha256sum "$bundle" | cut -d' ' -f1)
 
 exec 9>/tmp/pydds.lock
-if ! flock -w 300 9; then
-  echo "cyclone11_bundle.sh: /tmp/pydds.lock still held after 300 s" >&2
+if ! flock -w 60 9; then
+  echo "cyclone11_bundle.sh: /tmp/pydds.lock still held after 60 s" >&2
   exit 1
 fi
 
