@@ -28,9 +28,8 @@ std::array<int, 2> PumpStateGate::analog(const PumpView& v) {
   return a;
 }
 
-bool PumpStateGate::due(const NodeView& node, TimePoint now) const {
+bool PumpStateGate::changed(const NodeView& node) const {
   const auto& view = static_cast<const PumpView&>(node);
-  if (!published_once_ || now >= last_time_ + policy_.max_period) return true;
   if (!(discrete(view) == last_)) return true;
   if (view.commanded_by != last_commander_) return true;
   const auto now_analog = analog(view);
@@ -42,15 +41,13 @@ bool PumpStateGate::due(const NodeView& node, TimePoint now) const {
     const double delta =
         std::abs(profiles::cdn127::raw_to_volts(static_cast<std::uint16_t>(after)) -
                  profiles::cdn127::raw_to_volts(static_cast<std::uint16_t>(before)));
-    if (delta > policy_.analog_deadband_volts) return true;
+    if (delta > policy().analog_deadband_volts) return true;
   }
   return false;
 }
 
-void PumpStateGate::published(const NodeView& node, TimePoint now) {
+void PumpStateGate::record(const NodeView& node) {
   const auto& view = static_cast<const PumpView&>(node);
-  published_once_ = true;
-  last_time_ = now;
   last_ = discrete(view);
   last_analog_ = analog(view);
   last_commander_ = view.commanded_by;
@@ -67,14 +64,11 @@ DeviceStateGate::Seen DeviceStateGate::seen(const DeviceView& v) {
   return s;
 }
 
-bool DeviceStateGate::due(const NodeView& view, TimePoint now) const {
-  if (!published_once_ || now >= last_time_ + policy_.max_period) return true;
+bool DeviceStateGate::changed(const NodeView& view) const {
   return !(seen(static_cast<const DeviceView&>(view)) == last_);
 }
 
-void DeviceStateGate::published(const NodeView& view, TimePoint now) {
-  published_once_ = true;
-  last_time_ = now;
+void DeviceStateGate::record(const NodeView& view) {
   last_ = seen(static_cast<const DeviceView&>(view));
 }
 

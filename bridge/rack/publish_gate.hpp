@@ -23,32 +23,46 @@ struct PublishPolicy {
 };
 
 // A node's gate, whatever its profile; its profile's rack makes it
-// (ProfileNodes::state_gate) and gives it that profile's views only.
+// (ProfileNodes::state_gate) and gives it that profile's views only. The
+// base keeps the maximum period; a profile's gate says only what in its
+// view is news (changed) and what it keeps of a published one (record).
 class StateGate {
  public:
+  explicit StateGate(PublishPolicy policy) : policy_(policy) {}
   virtual ~StateGate() = default;
   // True if `view` differs enough from what was last published, or the
   // maximum period has passed.
-  virtual bool due(const NodeView& view, TimePoint now) const = 0;
-  virtual void published(const NodeView& view, TimePoint now) = 0;
+  bool due(const NodeView& view, TimePoint now) const {
+    return !published_once_ || now >= deadline() || changed(view);
+  }
+  void published(const NodeView& view, TimePoint now) {
+    published_once_ = true;
+    last_time_ = now;
+    record(view);
+  }
   // When the maximum period next forces a sample (kNever before the first).
-  virtual TimePoint deadline() const = 0;
-  virtual const PublishPolicy& policy() const = 0;
+  TimePoint deadline() const { return published_once_ ? last_time_ + policy_.max_period : kNever; }
+  const PublishPolicy& policy() const { return policy_; }
+
+ private:
+  // Whether `view` differs enough from the one last recorded.
+  virtual bool changed(const NodeView& view) const = 0;
+  virtual void record(const NodeView& view) = 0;
+
+  PublishPolicy policy_;
+  bool published_once_ = false;
+  TimePoint last_time_{};
 };
 
 class PumpStateGate final : public StateGate {
  public:
-  explicit PumpStateGate(PublishPolicy policy) : policy_(policy) {}
-
-  // Of a PumpView.
-  bool due(const NodeView& view, TimePoint now) const override;
-  void published(const NodeView& view, TimePoint now) override;
-  TimePoint deadline() const override {
-    return published_once_ ? last_time_ + policy_.max_period : kNever;
-  }
-  const PublishPolicy& policy() const override { return policy_; }
+  using StateGate::StateGate;
 
  private:
+  // Of a PumpView.
+  bool changed(const NodeView& view) const override;
+  void record(const NodeView& view) override;
+
   // The discrete part of a view: any difference is published.
   struct Discrete {
     bool online = false;
@@ -64,9 +78,6 @@ class PumpStateGate final : public StateGate {
   static Discrete discrete(const PumpView& view);
   static std::array<int, 2> analog(const PumpView& view);
 
-  PublishPolicy policy_;
-  bool published_once_ = false;
-  TimePoint last_time_{};
   Discrete last_;
   std::array<int, 2> last_analog_{-1, -1};
   std::string last_commander_;
@@ -74,17 +85,13 @@ class PumpStateGate final : public StateGate {
 
 class DeviceStateGate final : public StateGate {
  public:
-  explicit DeviceStateGate(PublishPolicy policy) : policy_(policy) {}
-
-  // Of a DeviceView.
-  bool due(const NodeView& view, TimePoint now) const override;
-  void published(const NodeView& view, TimePoint now) override;
-  TimePoint deadline() const override {
-    return published_once_ ? last_time_ + policy_.max_period : kNever;
-  }
-  const PublishPolicy& policy() const override { return policy_; }
+  using StateGate::StateGate;
 
  private:
+  // Of a DeviceView.
+  bool changed(const NodeView& view) const override;
+  void record(const NodeView& view) override;
+
   struct Seen {
     bool online = false;
     bool inputs_valid = false;
@@ -96,9 +103,6 @@ class DeviceStateGate final : public StateGate {
   };
   static Seen seen(const DeviceView& view);
 
-  PublishPolicy policy_;
-  bool published_once_ = false;
-  TimePoint last_time_{};
   Seen last_;
 };
 

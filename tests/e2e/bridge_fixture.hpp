@@ -164,6 +164,18 @@ class Subscription {
     return nullptr;
   }
 
+  // The samples with data that `match` accepts, of those taken from
+  // history()[first] on, in order. Valid until the next take.
+  template <class Match>
+  std::vector<const T*> since(std::size_t first, Match match) const {
+    std::vector<const T*> found;
+    for (std::size_t i = first; i < history_.size(); ++i) {
+      const auto& sample = history_[i].sample;
+      if (sample.valid_data() && match(sample.data())) found.push_back(&sample.data());
+    }
+    return found;
+  }
+
   // Waits (bounded) until the reader is matched with `count` writers.
   bool matched(std::uint32_t count, Duration timeout = kEventTimeout) {
     if (!reader_.set_status_mask(DDS_SUBSCRIPTION_MATCHED_STATUS).ok()) return false;
@@ -230,7 +242,8 @@ inline std::string writer_participant_name(const dds::Participant& participant,
                                            const dds::Entity& reader) {
   dds_instance_handle_t writers[4];
   if (dds_get_matched_publications(reader.handle(), writers, 4) != 1) return {};
-  dds_builtintopic_endpoint_t* writer = dds_get_matched_publication_data(reader.handle(), writers[0]);
+  dds_builtintopic_endpoint_t* writer =
+      dds_get_matched_publication_data(reader.handle(), writers[0]);
   if (writer == nullptr) return {};
   const dds_guid_t key = writer->participant_key;
   dds_builtintopic_free_endpoint(writer);
@@ -238,8 +251,8 @@ inline std::string writer_participant_name(const dds::Participant& participant,
   dds::Entity participants(
       dds_create_reader(participant.handle(), DDS_BUILTIN_TOPIC_DCPSPARTICIPANT, nullptr, nullptr));
   // Woken by participants not seen yet; each pass reads them all.
-  dds::ReadCondition fresh(participants, DDS_NOT_READ_SAMPLE_STATE | DDS_ANY_VIEW_STATE |
-                                             DDS_ANY_INSTANCE_STATE);
+  dds::ReadCondition fresh(participants,
+                           DDS_NOT_READ_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ANY_INSTANCE_STATE);
   std::string name;
   while (name.empty() && dds::testing::wait_for(participant, fresh, kEventTimeout)) {
     void* samples[16] = {};

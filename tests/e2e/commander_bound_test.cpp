@@ -157,8 +157,7 @@ TEST_F(CommanderBoundTest, ACommanderThatUnregistersItsInstanceLosesThePumpAtOnc
   ASSERT_TRUE(pumps_.until([&] { return idle("idle: no live commander"); }, kPoll + kMargin,
                            milliseconds(20)))
       << "the pump stayed commanded after its commander unregistered the instance";
-  report("commander unregistered its instance (writer live) -> pump idle",
-         ms_since(unregistered));
+  report("commander unregistered its instance (writer live) -> pump idle", ms_since(unregistered));
   EXPECT_FALSE(device_pump_on());
 }
 
@@ -243,18 +242,16 @@ TEST_F(CommanderBoundTest, AWeakerLiveCommanderTakesOverFromASilentStrongerOne) 
     const double took = ms_since(silent);
     ASSERT_TRUE(weak_took) << "a weaker live commander did not take over from a silent one";
     // Through idle: the silent commander's command lapsed first.
-    bool idled = false;
-    const auto& h = pumps_.history();
-    for (std::size_t i = before; i < h.size(); ++i) {
-      const auto& sample = h[i].sample;
-      if (!sample.valid_data() || sample.data().mac != kMac) continue;
-      idled = idled || (sample.data().outputs_idle &&
-                        dds::view(sample.data().idle_reason) == "idle: commander silent for 500 ms");
-    }
+    const auto lapsed = [](const dnbridge_PumpState& s) {
+      return s.mac == kMac && s.outputs_idle &&
+             dds::view(s.idle_reason) == "idle: commander silent for 500 ms";
+    };
+    const bool idled = !pumps_.since(before, lapsed).empty();
     EXPECT_TRUE(idled) << "the pump went from the silent commander to the weaker one without idle";
-    report("stronger commander silent (500 ms refresh), weaker one writing every 125 ms -> "
-           "weaker one in control",
-           took);
+    report(
+        "stronger commander silent (500 ms refresh), weaker one writing every 125 ms -> "
+        "weaker one in control",
+        took);
     // The stronger one writing again takes the pump back.
     ASSERT_TRUE(strong.send_line("refresh 125"));
     ASSERT_EQ(strong.read_line(milliseconds(5000)), "refreshing");
@@ -310,12 +307,10 @@ TEST_F(CommanderBoundTest, AReloadThatChangesTheRefreshOfANodeWithItsOwnReaderKe
   const std::size_t after = pumps_.history().size();
   // Three of the new refreshes: a command no reader took would have lapsed.
   (void)pumps_.until([] { return false; }, 3 * kLonger, milliseconds(50));
-  const auto& h = pumps_.history();
-  for (std::size_t i = after; i < h.size(); ++i) {
-    const auto& sample = h[i].sample;
-    if (!sample.valid_data() || sample.data().mac != kMac) continue;
-    EXPECT_FALSE(sample.data().outputs_idle)
-        << "the command lapsed after the reload: " << dds::view(sample.data().idle_reason);
+  for (const dnbridge_PumpState* s :
+       pumps_.since(after, [](const dnbridge_PumpState& s) { return s.mac == kMac; })) {
+    EXPECT_FALSE(s->outputs_idle) << "the command lapsed after the reload: "
+                                  << dds::view(s->idle_reason);
   }
   EXPECT_TRUE(echoes("refreshing"));
   EXPECT_FALSE(log_.contains(LogLevel::kWarn, "commander refreshing silent for 800 ms"));
