@@ -68,13 +68,13 @@ enum class Fault : std::uint8_t {
 
 struct ControlCommand {
   Verb verb = Verb::kHelp;
-  std::optional<std::uint8_t> mac;  // none: every device
-  Input input = Input::kAlarm;      // kSet
-  bool on = false;                  // kSet of a digital input; kFault: set or cleared
+  std::optional<std::uint8_t> mac;         // none: every device
+  Input input = Input::kAlarm;             // kSet
+  bool on = false;                         // kSet of a digital input; kFault: set or cleared
   Fault fault = Fault::kMinorRecoverable;  // kFault
-  std::uint16_t raw = 0;            // kSet of an analog input, 12-bit counts
-  unsigned param = 0;               // kSet of kParam: N
-  double value = 0;                 // kSet of kParam: the value
+  std::uint16_t raw = 0;                   // kSet of an analog input, 12-bit counts
+  unsigned param = 0;                      // kSet of kParam: N
+  double value = 0;                        // kSet of kParam: the value
 };
 
 // An empty or comment line ("# ...") parses to nothing; an error is a

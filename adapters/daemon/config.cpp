@@ -284,8 +284,8 @@ std::optional<cdn127::DiscreteAction> read_discrete_action(const toml::node& n,
                                                            std::string_view key, Problems& r) {
   auto v = read_string(n, key, r);
   if (!v) return std::nullopt;
-  for (auto a : {cdn127::DiscreteAction::kOff, cdn127::DiscreteAction::kOn,
-                 cdn127::DiscreteAction::kHold}) {
+  for (auto a :
+       {cdn127::DiscreteAction::kOff, cdn127::DiscreteAction::kOn, cdn127::DiscreteAction::kHold}) {
     if (*v == cdn127::to_string(a)) return a;
   }
   r.error(
@@ -380,11 +380,12 @@ void read_resume(const Layers& layers, NodeSettings& s, Problems& r) {
   }
   if (layers.per_node() && s.pump.resume == rack::ResumePolicy::kLastCommand) {
     const Found f = layers.find("resume");
-    r.warning(f.value->source(),
-              fmt::format("node {} drives its last outputs again after a loss without a new "
-                          "command (resume = \"last-command\"): {} may start on its own "
-                          "after a power cycle",
-                          s.pump.node.mac.value(), s.is_eds() ? "what its outputs drive" : "a pump"));
+    r.warning(
+        f.value->source(),
+        fmt::format("node {} drives its last outputs again after a loss without a new "
+                    "command (resume = \"last-command\"): {} may start on its own "
+                    "after a power cycle",
+                    s.pump.node.mac.value(), s.is_eds() ? "what its outputs drive" : "a pump"));
   }
 }
 
@@ -1101,8 +1102,8 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadCo
     if (auto v = read_mac(*n, "master_mac", r)) config.master_mac = *v;
   }
   if (const toml::node* n = root.get("max_commander_lease_ms")) {
-    if (auto v = read_ms(*n, "max_commander_lease_ms", kMinCommanderLeaseMs, kMaxCommanderLeaseMs,
-                         r)) {
+    if (auto v =
+            read_ms(*n, "max_commander_lease_ms", kMinCommanderLeaseMs, kMaxCommanderLeaseMs, r)) {
       config.max_commander_lease = *v;
     }
   }

@@ -102,9 +102,9 @@ Daemon::Daemon(DaemonConfig config, LogSink& log, BackendFactory backends, Reloa
                                                       backends(p), publisher, log));
     by_name[p.name] = ports_.back().get();
   }
-  input_.emplace(participant_, publisher_, config_.rack, std::move(by_name),
-                 Logger(log, "dds input"), [this](ReloadCall call) { request_reload(call); },
-                 config_.max_commander_lease);
+  input_.emplace(
+      participant_, publisher_, config_.rack, std::move(by_name), Logger(log, "dds input"),
+      [this](ReloadCall call) { request_reload(call); }, config_.max_commander_lease);
   publisher_.set_max_commander_lease(config_.max_commander_lease);
   EndpointWatch::Settings watch;
   watch.rack = config_.rack;
@@ -184,7 +184,8 @@ std::string Daemon::nodes_with_refresh(std::uint32_t ms) const {
         macs += fmt::format("{}{}", macs.empty() ? "" : ", ", m);
       }
     }
-    if (!macs.empty()) out += fmt::format("{}port {}: {}", out.empty() ? "" : "; ", p->name(), macs);
+    if (!macs.empty())
+      out += fmt::format("{}port {}: {}", out.empty() ? "" : "; ", p->name(), macs);
   }
   return out;
 }
@@ -316,8 +317,8 @@ ReloadReport Daemon::reload() {
       try {
         loops.push_back(loop_config(plan.in_force, p, host_id_));
         const auto& loop = loops.back();
-        devicenet::Scanner::check(rack::RackPort::scan_list(
-            loop.scanner, rack::PortNodes{loop.pumps, loop.devices}));
+        devicenet::Scanner::check(
+            rack::RackPort::scan_list(loop.scanner, rack::PortNodes{loop.pumps, loop.devices}));
       } catch (const std::exception& e) {
         r.status = ReloadStatus::kRefused;
         r.problems.push_back(fmt::format("port {}: {}", p.name, e.what()));

@@ -14,8 +14,8 @@
 
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/dds_input.hpp"
-#include "adapters/daemon/endpoint_watch.hpp"
 #include "adapters/daemon/dds_publisher.hpp"
+#include "adapters/daemon/endpoint_watch.hpp"
 #include "adapters/daemon/reload.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/metrics/rack_metrics.hpp"

@@ -113,8 +113,8 @@ class DdsPublisher final : public port::PortPublisher {
   }
   // The rack's figures that every PortStatus carries (any thread).
   void set_max_commander_lease(Duration lease) {
-    max_commander_lease_ms_ = static_cast<std::uint32_t>(
-        std::chrono::duration_cast<milliseconds>(lease).count());
+    max_commander_lease_ms_ =
+        static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(lease).count());
   }
   void set_endpoint_counts(std::uint32_t commanders_refused, std::uint32_t endpoints_unmatched) {
     commanders_refused_ = commanders_refused;
@@ -176,7 +176,7 @@ class DdsPublisher final : public port::PortPublisher {
 
   mutable std::mutex mutex_;
   std::map<std::string, std::map<std::uint8_t, StateTopic*>> written_;  // per port, by MAC
-  std::map<std::string, std::uint64_t> undelivered_;  // per port
+  std::map<std::string, std::uint64_t> undelivered_;                    // per port
   std::mutex log_mutex_;
   RateLimitedLog error_limit_;
   std::atomic<std::uint64_t> state_write_failures_{0};

@@ -94,8 +94,8 @@ namespace {
 void fill_safe_state(dnbridge_NodeStatus& out, const rack::PumpView& v) {
   out.safe_state_known = v.safe_state.has_value();
   out.safe_state_source = v.safe_state_source == cdn127::SafeStateSource::kDevice
-                   ? dnbridge_SAFE_STATE_DEVICE
-                   : dnbridge_SAFE_STATE_CONFIGURED;
+                              ? dnbridge_SAFE_STATE_DEVICE
+                              : dnbridge_SAFE_STATE_CONFIGURED;
   const auto unknown = dnbridge_SAFE_ACTION_UNKNOWN;
   const auto& s = v.safe_state;
   out.pump_on_fault = s ? to_idl(s->pump_fault) : unknown;
@@ -123,8 +123,8 @@ void fill_node_common(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   set_string(out.name, v.name);
   out.state = to_idl(node.state);
   set_string(out.reason, node.reason);
-  out.command_refresh_ms =
-      static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(v.command_refresh).count());
+  out.command_refresh_ms = static_cast<std::uint32_t>(
+      std::chrono::duration_cast<milliseconds>(v.command_refresh).count());
 
   const auto& id = node.identity;
   out.vendor_id = id.vendor_id;

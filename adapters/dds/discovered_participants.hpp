@@ -23,9 +23,9 @@ using ParticipantGuid = std::array<std::uint8_t, 16>;
 
 struct DiscoveredParticipant {
   ParticipantGuid guid{};
-  std::string name;   // empty when it gave none (or the sample only tells it left)
+  std::string name;       // empty when it gave none (or the sample only tells it left)
   std::string user_data;  // its USER_DATA as text (host_user_data), when it gave some
-  bool alive = true;  // false: it left the domain (or was lost)
+  bool alive = true;      // false: it left the domain (or was lost)
   // Its lease (how long it stays known without a sign of life); none:
   // infinite, or not told.
   std::optional<Duration> lease;

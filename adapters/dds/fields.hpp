@@ -4,12 +4,12 @@
 // dds_sample_free), so they must be allocated with dds_alloc as well.
 #include <dds/dds.h>
 
-#include "dnbridge.h"  // dds_sequence_octet, as idlc generates it
-
 #include <cstdint>
 #include <cstring>
 #include <span>
 #include <string_view>
+
+#include "dnbridge.h"  // dds_sequence_octet, as idlc generates it
 
 namespace dnbridge::dds {
 

@@ -32,7 +32,8 @@ class Qos {
   Qos& keep_last(int32_t depth);
   Qos& keep_all();
   // Per-reader (or writer) history bounds; -1 is unlimited.
-  Qos& resource_limits(int32_t max_samples, int32_t max_instances, int32_t max_samples_per_instance);
+  Qos& resource_limits(int32_t max_samples, int32_t max_instances,
+                       int32_t max_samples_per_instance);
   // What a transient-local writer keeps for late joiners, per instance.
   Qos& durability_service_keep_last(int32_t depth);
   Qos& deadline(Duration period);

@@ -64,9 +64,12 @@ class SampleInfo {
   bool valid_data() const noexcept { return raw_.valid_data; }
   InstanceState instance_state() const noexcept {
     switch (raw_.instance_state) {
-      case DDS_IST_NOT_ALIVE_DISPOSED: return InstanceState::kNotAliveDisposed;
-      case DDS_IST_NOT_ALIVE_NO_WRITERS: return InstanceState::kNotAliveNoWriters;
-      case DDS_IST_ALIVE: break;
+      case DDS_IST_NOT_ALIVE_DISPOSED:
+        return InstanceState::kNotAliveDisposed;
+      case DDS_IST_NOT_ALIVE_NO_WRITERS:
+        return InstanceState::kNotAliveNoWriters;
+      case DDS_IST_ALIVE:
+        break;
     }
     return InstanceState::kAlive;
   }

@@ -18,7 +18,9 @@ static_assert(kInfinite.count() == DDS_INFINITY);
 
 inline constexpr dds_duration_t to_dds(Duration d) noexcept { return d.count(); }
 inline constexpr dds_time_t to_dds(Timestamp t) noexcept { return t.time_since_epoch().count(); }
-inline constexpr Timestamp from_dds(dds_time_t t) noexcept { return Timestamp(std::chrono::nanoseconds(t)); }
+inline constexpr Timestamp from_dds(dds_time_t t) noexcept {
+  return Timestamp(std::chrono::nanoseconds(t));
+}
 
 // Cyclone's own clock, the one dds_write stamps samples with.
 inline Timestamp dds_now() noexcept { return from_dds(dds_time()); }

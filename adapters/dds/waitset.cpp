@@ -5,7 +5,8 @@
 namespace dnbridge::dds {
 
 GuardCondition::GuardCondition(const Participant& participant)
-    : Entity(check(dds_create_guardcondition(participant.handle()), "creating a guard condition")) {}
+    : Entity(check(dds_create_guardcondition(participant.handle()), "creating a guard condition")) {
+}
 
 Result<bool> GuardCondition::take_triggered() const noexcept {
   bool triggered = false;

@@ -18,8 +18,9 @@ template <class T>
 class Writer : public Entity {
  public:
   Writer(const Participant& participant, const Topic<T>& topic, const Qos& qos)
-      : Entity(check(dds_create_writer(participant.handle(), topic.handle(), qos.get(), nullptr),
-                     std::string("creating a writer of ") + TopicTraits<T>::kDescriptor->m_typename)) {}
+      : Entity(check(
+            dds_create_writer(participant.handle(), topic.handle(), qos.get(), nullptr),
+            std::string("creating a writer of ") + TopicTraits<T>::kDescriptor->m_typename)) {}
 
   // Stamped with Cyclone's clock now.
   Status write(const T& sample) const noexcept { return to_status(dds_write(handle(), &sample)); }

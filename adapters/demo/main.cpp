@@ -33,7 +33,8 @@ class EventLog final : public devicenet::ScannerObserver {
  public:
   explicit EventLog(TimePoint start) : start_(start) {}
   void add(TimePoint at, const std::string& text) {
-    lines_.push_back(fmt::format("{:7.2f} s  {}", std::chrono::duration<double>(at - start_).count(), text));
+    lines_.push_back(
+        fmt::format("{:7.2f} s  {}", std::chrono::duration<double>(at - start_).count(), text));
     while (lines_.size() > 12) lines_.pop_front();
   }
   void on_port_state(devicenet::PortState s, const std::string& reason, TimePoint at) override {
@@ -51,8 +52,8 @@ class EventLog final : public devicenet::ScannerObserver {
 };
 
 TimePoint mono_now() {
-  return TimePoint(std::chrono::duration_cast<Duration>(
-      std::chrono::steady_clock::now().time_since_epoch()));
+  return TimePoint(
+      std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
 }
 
 }  // namespace
@@ -67,11 +68,14 @@ int main(int argc, char** argv) {
   double loss_percent = 0;
   bool plain = !isatty(STDOUT_FILENO);
   std::string pcap_path;
-  app.add_option("-n,--nodes", nodes, "Number of simulated pumps (MACs 1..N)")->check(CLI::Range(1, 63));
+  app.add_option("-n,--nodes", nodes, "Number of simulated pumps (MACs 1..N)")
+      ->check(CLI::Range(1, 63));
   app.add_option("-d,--duration", duration_s, "Seconds to run; 0 runs until Ctrl-C")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("-b,--bitrate", bitrate_k, "Bus bit rate in kbit/s")->check(CLI::IsMember({125, 250, 500}));
-  app.add_option("--loss", loss_percent, "Percentage of frames the bus loses")->check(CLI::Range(0.0, 50.0));
+  app.add_option("-b,--bitrate", bitrate_k, "Bus bit rate in kbit/s")
+      ->check(CLI::IsMember({125, 250, 500}));
+  app.add_option("--loss", loss_percent, "Percentage of frames the bus loses")
+      ->check(CLI::Range(0.0, 50.0));
   app.add_flag("--plain", plain, "Print snapshots instead of redrawing the screen");
   app.add_option("--pcap", pcap_path,
                  "Record every frame on the bus to FILE (pcap, SocketCAN link type); read it with\n"
@@ -97,8 +101,9 @@ int main(int argc, char** argv) {
     p.node.poll_period = milliseconds(50);
     p.node.expected_packet_rate = milliseconds(250);
     // The last pump uses the CDN118 layout: no analog inputs.
-    p.io = profiles::cdn127::preset(m == nodes && nodes > 1 ? profiles::cdn127::ConfigurationPreset::kCdn118
-                                                           : profiles::cdn127::ConfigurationPreset::kCdn127);
+    p.io = profiles::cdn127::preset(m == nodes && nodes > 1
+                                        ? profiles::cdn127::ConfigurationPreset::kCdn118
+                                        : profiles::cdn127::ConfigurationPreset::kCdn127);
     config.pumps.push_back(std::move(p));
     macs.push_back(m);
   }
@@ -123,8 +128,8 @@ int main(int argc, char** argv) {
   if (!pcap_path.empty()) {
     try {
       capture = std::make_unique<sim::BusCapture>(
-          rack.world().bus(),
-          sim::PcapWriter(pcap_path, virtual_start, std::chrono::system_clock::now().time_since_epoch()));
+          rack.world().bus(), sim::PcapWriter(pcap_path, virtual_start,
+                                              std::chrono::system_clock::now().time_since_epoch()));
     } catch (const std::system_error& e) {
       std::fprintf(stderr, "dnbridge-demo: %s\n", e.what());
       return 2;
@@ -136,9 +141,10 @@ int main(int argc, char** argv) {
   TimePoint next_render = virtual_start;
   std::size_t next_step = 0;
   unsigned cycle = 0;
-  const TimePoint end = duration_s > 0 ? virtual_start + std::chrono::duration_cast<Duration>(
-                                                             std::chrono::duration<double>(duration_s))
-                                       : kNever;
+  const TimePoint end = duration_s > 0
+                            ? virtual_start + std::chrono::duration_cast<Duration>(
+                                                  std::chrono::duration<double>(duration_s))
+                            : kNever;
   bool stopping = false;
   TimePoint stop_deadline = kNever;
 
@@ -182,9 +188,11 @@ int main(int argc, char** argv) {
       render();
       next_render = target + render_every;
     }
-    const TimePoint wake = std::min({rack.world().next_event(), next_render, target + milliseconds(50)});
+    const TimePoint wake =
+        std::min({rack.world().next_event(), next_render, target + milliseconds(50)});
     std::this_thread::sleep_until(std::chrono::steady_clock::time_point(
-        std::chrono::duration_cast<std::chrono::steady_clock::duration>((wake - offset).time_since_epoch())));
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            (wake - offset).time_since_epoch())));
   }
   render();
   bool capture_ok = true;
@@ -196,7 +204,8 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(frames), pcap_path.c_str());
     } else {
       std::fprintf(stderr, "dnbridge-demo: capture to %s incomplete: %llu write errors (%s)\n",
-                   pcap_path.c_str(), static_cast<unsigned long long>(capture->writer().write_errors()),
+                   pcap_path.c_str(),
+                   static_cast<unsigned long long>(capture->writer().write_errors()),
                    capture->writer().error().message().c_str());
     }
   }

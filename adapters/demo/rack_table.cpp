@@ -14,20 +14,21 @@ std::string analog(const std::optional<std::uint16_t>& raw) {
 
 }  // namespace
 
-std::string render_rack(sim::SimRack& rack, TimePoint started, const std::deque<std::string>& events) {
+std::string render_rack(sim::SimRack& rack, TimePoint started,
+                        const std::deque<std::string>& events) {
   const TimePoint now = rack.now();
   auto& bus = rack.world().bus();
   std::string out;
-  out += fmt::format(
-      "dnbridge demo: master MAC {} on a simulated {} kbit/s bus, t = {:.1f} s\n",
-      rack.scanner().config().master_mac.value(), bus.bitrate() / 1000,
-      std::chrono::duration<double>(now - started).count());
+  out += fmt::format("dnbridge demo: master MAC {} on a simulated {} kbit/s bus, t = {:.1f} s\n",
+                     rack.scanner().config().master_mac.value(), bus.bitrate() / 1000,
+                     std::chrono::duration<double>(now - started).count());
   out += fmt::format("port: {} ({}); bus load {:.1f} %, {} frames\n\n",
                      devicenet::to_string(rack.scanner().state()), rack.scanner().reason(),
                      100.0 * bus.bus_load(now), bus.stats().transmitted);
-  out += fmt::format("{:>3}  {:<8} {:<20} {:<9} {:<8} {:<7} {:<6} {:<6} {:<7} {:>7}  {:>7}  {:>7}  {:>7} {:>6}\n",
-                     "MAC", "name", "state", "command", "running", "warning", "alarm", "N2",
-                     "ilock", "AIN1", "AIN2", "AOUT", "polls", "errors");
+  out += fmt::format(
+      "{:>3}  {:<8} {:<20} {:<9} {:<8} {:<7} {:<6} {:<6} {:<7} {:>7}  {:>7}  {:>7}  {:>7} {:>6}\n",
+      "MAC", "name", "state", "command", "running", "warning", "alarm", "N2", "ilock", "AIN1",
+      "AIN2", "AOUT", "polls", "errors");
   for (const auto& v : rack.pumps().pumps()) {
     const auto* node = rack.scanner().node(v.mac);
     std::string command = "-";
@@ -39,7 +40,8 @@ std::string render_rack(sim::SimRack& rack, TimePoint started, const std::deque<
     const auto& pump = v.inputs.pump;
     const bool have = v.online && v.has_inputs && pump.has_value();
     out += fmt::format(
-        "{:>3}  {:<8} {:<20} {:<9} {:<8} {:<7} {:<6} {:<6} {:<7} {:>7}  {:>7}  {:>7}  {:>7} {:>6}\n",
+        "{:>3}  {:<8} {:<20} {:<9} {:<8} {:<7} {:<6} {:<6} {:<7} {:>7}  {:>7}  {:>7}  {:>7} "
+        "{:>6}\n",
         v.mac.value(), v.name, devicenet::to_string(v.state), command,
         have ? flag(pump->pump_running, "RUNNING", "stopped") : "-",
         have ? flag(pump->warning_active, "WARN", "ok") : "-",
@@ -49,7 +51,8 @@ std::string render_rack(sim::SimRack& rack, TimePoint started, const std::deque<
         v.online ? analog(v.inputs.analog_inputs_raw[0]) : "-",
         v.online ? analog(v.inputs.analog_inputs_raw[1]) : "-",
         v.online && !v.outputs_idle
-            ? fmt::format("{:5.2f} V", profiles::cdn127::raw_to_volts(v.outputs_applied.analog_out_raw))
+            ? fmt::format("{:5.2f} V",
+                          profiles::cdn127::raw_to_volts(v.outputs_applied.analog_out_raw))
             : "-",
         node ? node->counters().polls : 0, node ? node->counters().errors : 0);
   }

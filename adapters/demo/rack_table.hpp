@@ -7,6 +7,7 @@
 
 namespace dnbridge::demo {
 
-std::string render_rack(sim::SimRack& rack, TimePoint started, const std::deque<std::string>& events);
+std::string render_rack(sim::SimRack& rack, TimePoint started,
+                        const std::deque<std::string>& events);
 
 }  // namespace dnbridge::demo

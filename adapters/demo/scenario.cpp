@@ -53,18 +53,19 @@ std::vector<ScenarioStep> make_scenario(const std::vector<unsigned>& macs) {
                    [b](sim::SimRack& r, TimePoint now) {
                      r.device(mac(b)).device().pump().set_alarm(true, now);
                    }});
-  steps.push_back({seconds(26), fmt::format("pump {}: power cycled", c),
-                   [c](sim::SimRack& r, TimePoint now) { r.device(mac(c)).device().power_cycle(now); }});
-  steps.push_back({seconds(32), fmt::format("pump {}: N2 flow back", a),
-                   [a](sim::SimRack& r, TimePoint) {
-                     r.device(mac(a)).device().pump().set_n2_flow_ok(true);
-                   }});
-  steps.push_back({seconds(34), fmt::format("pump {}: alarm cleared", b),
-                   [b](sim::SimRack& r, TimePoint now) {
-                     r.device(mac(b)).device().pump().set_alarm(false, now);
-                   }});
-  steps.push_back({seconds(38), fmt::format("pump {}: its supervisor goes away (idle)", a),
-                   [a](sim::SimRack& r, TimePoint now) { (void)r.pumps().release_command(mac(a), now); }});
+  steps.push_back(
+      {seconds(26), fmt::format("pump {}: power cycled", c),
+       [c](sim::SimRack& r, TimePoint now) { r.device(mac(c)).device().power_cycle(now); }});
+  steps.push_back(
+      {seconds(32), fmt::format("pump {}: N2 flow back", a),
+       [a](sim::SimRack& r, TimePoint) { r.device(mac(a)).device().pump().set_n2_flow_ok(true); }});
+  steps.push_back(
+      {seconds(34), fmt::format("pump {}: alarm cleared", b), [b](sim::SimRack& r, TimePoint now) {
+         r.device(mac(b)).device().pump().set_alarm(false, now);
+       }});
+  steps.push_back(
+      {seconds(38), fmt::format("pump {}: its supervisor goes away (idle)", a),
+       [a](sim::SimRack& r, TimePoint now) { (void)r.pumps().release_command(mac(a), now); }});
   // Everything off at the end of the cycle, then it starts over.
   for (unsigned m : macs) {
     steps.push_back({seconds(50), fmt::format("supervisor stops pump {}", m),

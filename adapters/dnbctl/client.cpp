@@ -97,7 +97,9 @@ void Client::refresh(
     if (!samples || samples->empty()) break;
     absorb(
         *samples, pumps_,
-        [](const dnbridge_PumpState& s) { return node_key(dds::view(s.rack), dds::view(s.port), s.mac); },
+        [](const dnbridge_PumpState& s) {
+          return node_key(dds::view(s.rack), dds::view(s.port), s.mac);
+        },
         [&](const NodeKey& key, const Known<dnbridge_PumpState>& k) {
           if (on_pump) on_pump(key, k);
         });
@@ -117,7 +119,9 @@ void Client::refresh(
     if (!samples || samples->empty()) break;
     absorb(
         *samples, nodes_,
-        [](const dnbridge_NodeStatus& s) { return node_key(dds::view(s.rack), dds::view(s.port), s.mac); },
+        [](const dnbridge_NodeStatus& s) {
+          return node_key(dds::view(s.rack), dds::view(s.port), s.mac);
+        },
         [](const NodeKey&, const Known<dnbridge_NodeStatus>&) {});
   }
   for (;;) {

@@ -42,7 +42,8 @@ struct Known {
   // False once the bridge that wrote it is gone (no writer left): the
   // sample is its last word, not the current state.
   bool alive = true;
-  std::uint64_t samples = 0;  // valid samples received: a new one since a moment shows as an increase
+  std::uint64_t samples =
+      0;  // valid samples received: a new one since a moment shows as an increase
 };
 
 // SIGINT and SIGTERM end waits (watch, --hold-for) instead of the process.
@@ -60,7 +61,8 @@ class Client {
   // Takes what arrived into the caches; `on_pump` is called for every valid
   // PumpState sample, in arrival order (watch prints them), and when a
   // known pump's bridge leaves (alive turns false).
-  void refresh(const std::function<void(const NodeKey&, const Known<dnbridge_PumpState>&)>& on_pump = {});
+  void refresh(
+      const std::function<void(const NodeKey&, const Known<dnbridge_PumpState>&)>& on_pump = {});
 
   // Waits until something attached has data, `timeout` passes, or an
   // interrupt (then at most 100 ms late). Then refresh() is due.
@@ -71,7 +73,9 @@ class Client {
   bool wait_until(Deadline deadline, const std::function<bool()>& done);
 
   // Other readers (of replies) wake wait() too; `token` is not 0.
-  void attach(const dds::Entity& entity, dds::WaitSet::Token token) { waitset_.attach(entity, token); }
+  void attach(const dds::Entity& entity, dds::WaitSet::Token token) {
+    waitset_.attach(entity, token);
+  }
 
   const std::map<NodeKey, Known<dnbridge_PumpState>>& pumps() const noexcept { return pumps_; }
   const std::map<NodeKey, Known<dnbridge_DeviceState>>& devices() const noexcept {

@@ -64,8 +64,8 @@ Exit run_watch(const GlobalOptions& options, const WatchArgs& args);
 enum class Output { kPump, kBallast, kAnalog };
 struct OutputArgs {
   Output output = Output::kPump;
-  std::string node;   // MAC ID or name
-  std::string value;  // on|off, or the analog value
+  std::string node;    // MAC ID or name
+  std::string value;   // on|off, or the analog value
   std::string issuer;  // default "dnbctl user@host"
   std::int32_t strength = 10;
   double hold_for_seconds = 0;

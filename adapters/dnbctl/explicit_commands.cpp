@@ -41,16 +41,19 @@ CLI::App* add_explicit(CLI::App& app, ExplicitKind kind, ExplicitArgs& args) {
   CLI::App* cmd = nullptr;
   switch (kind) {
     case ExplicitKind::kGet:
-      cmd = app.add_subcommand("get", "Read an attribute (Get_Attribute_Single, 0x0E) of a node "
-                                      "through its bridge; the data in hex, and decoded with --as.");
+      cmd = app.add_subcommand("get",
+                               "Read an attribute (Get_Attribute_Single, 0x0E) of a node "
+                               "through its bridge; the data in hex, and decoded with --as.");
       break;
     case ExplicitKind::kSet:
-      cmd = app.add_subcommand("set", "Write an attribute (Set_Attribute_Single, 0x10) of a node "
-                                      "through its bridge.");
+      cmd = app.add_subcommand("set",
+                               "Write an attribute (Set_Attribute_Single, 0x10) of a node "
+                               "through its bridge.");
       break;
     case ExplicitKind::kService:
-      cmd = app.add_subcommand("service", "Send any CIP service to a node through its bridge "
-                                          "(e.g. Reset, 0x05, to class 1 instance 1).");
+      cmd = app.add_subcommand("service",
+                               "Send any CIP service to a node through its bridge "
+                               "(e.g. Reset, 0x05, to class 1 instance 1).");
       break;
   }
   cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
@@ -144,7 +147,8 @@ Exit run_explicit(const GlobalOptions& o, const ExplicitArgs& args) {
     return Exit::kFailed;
   }
   if (decoded && !decoded->ok()) {
-    std::fputs(fmt::format("dnbctl: cannot decode the data: {}\n", decoded->error()).c_str(), stderr);
+    std::fputs(fmt::format("dnbctl: cannot decode the data: {}\n", decoded->error()).c_str(),
+               stderr);
     return Exit::kFailed;
   }
   return Exit::kOk;

@@ -32,7 +32,8 @@ std::string transaction_status_text(std::uint8_t status) {
 }
 
 std::string general_status_text(std::uint8_t code) {
-  if (cip::is_known(code)) return std::string(cip::to_string(static_cast<cip::GeneralStatus>(code)));
+  if (cip::is_known(code))
+    return std::string(cip::to_string(static_cast<cip::GeneralStatus>(code)));
   if (code >= 0xD0) return fmt::format("object class specific (0x{:02X})", code);
   return fmt::format("reserved (0x{:02X})", code);
 }
@@ -598,10 +599,14 @@ std::string request_text(const ExplicitExchange& x) {
 
 std::string_view decoding_name(Decoding as) {
   switch (as) {
-    case Decoding::kString: return "string";
-    case Decoding::kUint: return "uint";
-    case Decoding::kInt: return "int";
-    case Decoding::kNone: break;
+    case Decoding::kString:
+      return "string";
+    case Decoding::kUint:
+      return "uint";
+    case Decoding::kInt:
+      return "int";
+    case Decoding::kNone:
+      break;
   }
   return "";
 }

@@ -203,7 +203,8 @@ Exit run_show(const GlobalOptions& o, const ShowArgs& args) {
   if (!ref) throw CommandError(Exit::kUsage, ref.error());
   Client client = make_client(o);
   const NodeKey key = find_node(client, o, *ref);
-  if (!client.wait_until(deadline_after(o.timeout()), [&] { return client.node(key) != nullptr; })) {
+  if (!client.wait_until(deadline_after(o.timeout()),
+                         [&] { return client.node(key) != nullptr; })) {
     throw CommandError(Exit::kNotFound,
                        fmt::format("{}: no NodeStatus within {:g} s",
                                    node_name(key.rack, key.port, key.mac), o.timeout_seconds));

@@ -26,7 +26,8 @@ enum class Exit : int {
 // than threading a status through every helper.
 class CommandError : public std::runtime_error {
  public:
-  CommandError(Exit code, const std::string& sentence) : std::runtime_error(sentence), code_(code) {}
+  CommandError(Exit code, const std::string& sentence)
+      : std::runtime_error(sentence), code_(code) {}
   Exit code() const noexcept { return code_; }
 
  private:

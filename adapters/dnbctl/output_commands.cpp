@@ -24,7 +24,6 @@
 namespace dnbridge::dnbctl {
 namespace {
 
-
 constexpr const char* kLifetimeNote =
     "A command stays in force only while a commander is live: when dnbctl exits its command "
     "writer goes away and the bridge puts the pump's outputs idle (the device's own idle state), "
@@ -36,16 +35,20 @@ constexpr const char* kLifetimeNote =
 
 std::string_view output_name(Output o) {
   switch (o) {
-    case Output::kPump: return "pump";
-    case Output::kBallast: return "ballast";
-    case Output::kAnalog: return "aout";
+    case Output::kPump:
+      return "pump";
+    case Output::kBallast:
+      return "ballast";
+    case Output::kAnalog:
+      return "aout";
   }
   return "";
 }
 
 Outputs applied_outputs(const dnbridge_PumpState& s) {
   if (s.outputs_idle) return Outputs{};  // idle: the device's idle state, not ours to keep
-  return Outputs{static_cast<bool>(s.pump_on), static_cast<bool>(s.n2_ballast_on), s.analog_output_raw};
+  return Outputs{static_cast<bool>(s.pump_on), static_cast<bool>(s.n2_ballast_on),
+                 s.analog_output_raw};
 }
 
 std::string default_issuer() { return "dnbctl " + user_at_host(); }
@@ -253,20 +256,23 @@ CLI::App* add_output(CLI::App& app, Output output, OutputArgs& args) {
   CLI::App* cmd = nullptr;
   switch (output) {
     case Output::kPump:
-      cmd = app.add_subcommand("pump", "Switch a pump on or off (PumpCommand), keeping the N2 "
-                                       "ballast and analog output as they are.");
+      cmd = app.add_subcommand("pump",
+                               "Switch a pump on or off (PumpCommand), keeping the N2 "
+                               "ballast and analog output as they are.");
       cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
       cmd->add_option("STATE", args.value, "on or off")->required();
       break;
     case Output::kBallast:
-      cmd = app.add_subcommand("ballast", "Switch a pump's N2 ballast on or off (PumpCommand), "
-                                          "keeping the pump and analog output as they are.");
+      cmd = app.add_subcommand("ballast",
+                               "Switch a pump's N2 ballast on or off (PumpCommand), "
+                               "keeping the pump and analog output as they are.");
       cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
       cmd->add_option("STATE", args.value, "on or off")->required();
       break;
     case Output::kAnalog:
-      cmd = app.add_subcommand("aout", "Set a pump interface's analog output (PumpCommand), "
-                                       "keeping the pump and N2 ballast as they are.");
+      cmd = app.add_subcommand("aout",
+                               "Set a pump interface's analog output (PumpCommand), "
+                               "keeping the pump and N2 ballast as they are.");
       cmd->add_option("NODE", args.node, "The node: its MAC ID (0..63) or its name")->required();
       cmd->add_option("VALUE", args.value,
                       "Volts with a V suffix, 0..10 (5.0V: rounded to the nearest of 4096 steps, "
@@ -310,9 +316,15 @@ Exit run_output(const GlobalOptions& o, const OutputArgs& args) {
   const std::string name = node_name(key.rack, key.port, key.mac);
   Outputs wanted = applied_outputs(*client.pump(key)->data);
   switch (args.output) {
-    case Output::kPump: wanted.pump_on = *on; break;
-    case Output::kBallast: wanted.n2_ballast_on = *on; break;
-    case Output::kAnalog: wanted.analog_output_raw = analog->raw; break;
+    case Output::kPump:
+      wanted.pump_on = *on;
+      break;
+    case Output::kBallast:
+      wanted.n2_ballast_on = *on;
+      break;
+    case Output::kAnalog:
+      wanted.analog_output_raw = analog->raw;
+      break;
   }
   const CommandTerms terms = command_terms_of(client, key, deadline_after(o.timeout()));
   Commander<dnbridge_PumpCommand> commander(client, args.strength, key.rack, terms);

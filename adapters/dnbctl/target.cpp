@@ -21,7 +21,9 @@ std::string where(const GlobalOptions& o) {
   return w;
 }
 
-std::string seconds_text(const GlobalOptions& o) { return fmt::format("{:g} s", o.timeout_seconds); }
+std::string seconds_text(const GlobalOptions& o) {
+  return fmt::format("{:g} s", o.timeout_seconds);
+}
 
 // `fn(key, name)` for every node the options allow, from both node topics
 // (a node may be known from one only, so far).

@@ -27,7 +27,8 @@ bool is_number(std::string_view s) {
 
 }  // namespace
 
-Parsed<std::uint64_t> parse_unsigned(std::string_view text, std::uint64_t max, std::string_view what) {
+Parsed<std::uint64_t> parse_unsigned(std::string_view text, std::uint64_t max,
+                                     std::string_view what) {
   const std::string_view t = trim(text);
   std::string_view digits = t;
   int base = 10;
@@ -39,12 +40,11 @@ Parsed<std::uint64_t> parse_unsigned(std::string_view text, std::uint64_t max, s
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value, base);
   if (digits.empty() || end != digits.data() + digits.size() ||
       (ec != std::errc{} && ec != std::errc::result_out_of_range)) {
-    return Parsed<std::uint64_t>::failure(fmt::format(
-        "{} \"{}\" is not a number (decimal, or hex with 0x)", what, text));
+    return Parsed<std::uint64_t>::failure(
+        fmt::format("{} \"{}\" is not a number (decimal, or hex with 0x)", what, text));
   }
   if (ec == std::errc::result_out_of_range || value > max) {
-    return Parsed<std::uint64_t>::failure(
-        fmt::format("{} {} is out of range 0..{}", what, t, max));
+    return Parsed<std::uint64_t>::failure(fmt::format("{} {} is out of range 0..{}", what, t, max));
   }
   return value;
 }
@@ -92,17 +92,17 @@ Parsed<AnalogValue> parse_analog(std::string_view text) {
     // The profile refuses what is outside 0..10 V; the sentence is ours.
     auto raw = profiles::cdn127::volts_to_raw(volts);
     if (!raw) {
-      return Parsed<AnalogValue>::failure(fmt::format(
-          "analog value {} V is out of range 0..{} V", t, kAnalogFullScaleVolts));
+      return Parsed<AnalogValue>::failure(
+          fmt::format("analog value {} V is out of range 0..{} V", t, kAnalogFullScaleVolts));
     }
     return AnalogValue{*raw, volts};
   }
   // No suffix: a raw count. A decimal point without V is a likely slip
   // ("5.0" meant as volts): refuse it rather than guess.
   if (t.find('.') != std::string_view::npos) {
-    return Parsed<AnalogValue>::failure(fmt::format(
-        "analog value \"{}\": give volts with a V suffix (5.0V) or a raw count 0..{}", text,
-        kAnalogMaxRaw));
+    return Parsed<AnalogValue>::failure(
+        fmt::format("analog value \"{}\": give volts with a V suffix (5.0V) or a raw count 0..{}",
+                    text, kAnalogMaxRaw));
   }
   if (!t.empty() && t.front() == '-') {
     return Parsed<AnalogValue>::failure(
@@ -150,7 +150,8 @@ Parsed<Decoding> parse_decoding(std::string_view text) {
 
 Parsed<std::string> decode_data(std::span<const std::uint8_t> data, Decoding as) {
   switch (as) {
-    case Decoding::kNone: return std::string{};
+    case Decoding::kNone:
+      return std::string{};
     case Decoding::kString: {
       auto s = cip::decode_short_string(data);
       if (!s) {

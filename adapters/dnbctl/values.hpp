@@ -38,7 +38,8 @@ class Parsed {
 
 // An unsigned number, decimal ("14") or hex with 0x ("0x0E"), 0..max.
 // `what` names the value in the message ("class", "MAC ID").
-Parsed<std::uint64_t> parse_unsigned(std::string_view text, std::uint64_t max, std::string_view what);
+Parsed<std::uint64_t> parse_unsigned(std::string_view text, std::uint64_t max,
+                                     std::string_view what);
 
 // A DeviceNet MAC ID, 0..63.
 Parsed<std::uint8_t> parse_mac(std::string_view text);

@@ -81,8 +81,8 @@ Exit run_watch(const GlobalOptions& o, const WatchArgs& args) {
         rows.push_back(p.data.get());  // a gone bridge's pumps drop out
     }
     // Home, clear screen, then the table.
-    print(fmt::format("\x1b[H\x1b[2Jdnbctl watch: DDS domain {}, {} (Ctrl-C to stop)\n\n{}", o.domain,
-                      clock_text(), pumps_table(rows)));
+    print(fmt::format("\x1b[H\x1b[2Jdnbctl watch: DDS domain {}, {} (Ctrl-C to stop)\n\n{}",
+                      o.domain, clock_text(), pumps_table(rows)));
     dirty = false;
     last_draw = std::chrono::steady_clock::now();
   };

@@ -50,13 +50,13 @@ struct ProcessCounters {
   struct Queue {
     std::string name;  // "replies"
     std::uint64_t written = 0;
-    std::uint64_t refused = 0;   // not queued: the queue was full
-    std::uint64_t depth = 0;     // waiting now
+    std::uint64_t refused = 0;  // not queued: the queue was full
+    std::uint64_t depth = 0;    // waiting now
   };
   std::vector<Queue> queues;
-  std::uint64_t commands_taken = 0;  // PumpCommand samples
-  std::uint64_t requests_taken = 0;  // ExplicitRequest samples
-  std::uint64_t command_holdoffs = 0;  // DdsInput::command_holdoffs
+  std::uint64_t commands_taken = 0;        // PumpCommand samples
+  std::uint64_t requests_taken = 0;        // ExplicitRequest samples
+  std::uint64_t command_holdoffs = 0;      // DdsInput::command_holdoffs
   std::uint64_t state_write_failures = 0;  // DdsPublisher::state_write_failures
 };
 

@@ -40,9 +40,9 @@ struct PortLoopConfig {
   std::vector<rack::PublishPolicy> publish;  // per pump, same order
   std::vector<rack::DeviceConfig> devices;   // the scan list: devices described by their EDS
   std::vector<rack::PublishPolicy> device_publish;  // per device, same order
-  rack::ExplicitPolicy explicit_policy;      // the rack's [explicit_policy]
-  Duration status_period = seconds(1);       // NodeStatus/PortStatus at least this often
-  Duration shutdown_timeout = seconds(3);    // for idling and releasing every node
+  rack::ExplicitPolicy explicit_policy;             // the rack's [explicit_policy]
+  Duration status_period = seconds(1);              // NodeStatus/PortStatus at least this often
+  Duration shutdown_timeout = seconds(3);           // for idling and releasing every node
 };
 
 // What a configuration read again changed on a port (PortLoop::reconfigure).
@@ -217,8 +217,8 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // What was published of a node, and when its state is next due.
   struct Published {
     std::unique_ptr<rack::StateGate> gate;  // its profile's (ProfileNodes::state_gate)
-    std::uint64_t checked = ~0ull;  // the view's changes when the gate was last asked
-    std::uint64_t changes = ~0ull;  // the view's status_changes at the last NodeStatus
+    std::uint64_t checked = ~0ull;          // the view's changes when the gate was last asked
+    std::uint64_t changes = ~0ull;          // the view's status_changes at the last NodeStatus
     TimePoint status_time{};
     bool status_once = false;
     std::uint64_t polls = 0;  // the node's polls at the last metrics update
@@ -234,7 +234,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // again one starts afresh; a removed one goes.
   void carry_published(const rack::ScanListChange& sc,
                        std::vector<devicenet::MacId>& policy_changed);
-  TimePoint started_{};              // when run() began
+  TimePoint started_{};  // when run() began
   bool master_started_ = false;
   bool port_dirty_ = true;
   TimePoint port_status_time_{};

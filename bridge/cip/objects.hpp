@@ -76,7 +76,7 @@ inline constexpr std::uint8_t kMacId = 1, kBaudRate = 2, kBusOffInterrupt = 3, k
 namespace connection_instance {
 inline constexpr std::uint16_t kExplicit = 1, kPoll = 2, kBitStrobe = 3;
 inline constexpr std::uint16_t kChangeOfState = 4;  // change of state or cyclic
-}
+}  // namespace connection_instance
 namespace connection_attr {
 inline constexpr std::uint8_t kState = 1, kInstanceType = 2, kTransportClassTrigger = 3,
                               kProducedConnectionId = 4, kConsumedConnectionId = 5,

@@ -258,7 +258,7 @@ class NodeRack : public ProfileNodes {
   devicenet::Scanner* scanner() { return scanner_; }
 
   // A refusal: counted, its reason kept in the view.
-  Status refuse(View& view, Status why, std::string text) {
+  Status refuse(View& view, Status why, std::string&& text) {
     ++view.commands_refused;
     view.last_command_refused = std::move(text);
     ++view.changes;
@@ -316,7 +316,7 @@ class NodeRack : public ProfileNodes {
     ResumePolicy resume = ResumePolicy::kFreshCommand;
     // The last commander went away while the policy held its outputs.
     bool held_without_commander = false;
-    TimePoint last_command{};  // when the command in force was last taken
+    TimePoint last_command{};     // when the command in force was last taken
     TimePoint lapse_at = kNever;  // when it lapses unless written again
   };
   static Entry entry_of(const Config& c) {

@@ -121,7 +121,7 @@ ScanListChange RackPort::reconfigure(const devicenet::ScannerConfig& port, const
   devicenet::ScannerConfig next = scan_list(port, nodes);
   next.master_mac = scanner_->config().master_mac;
   devicenet::Scanner::check(next);
-  const ScanListChange change = compare(scanner_->config(), in_force_, next, nodes);
+  ScanListChange change = compare(scanner_->config(), in_force_, next, nodes);
   const auto node_of = [&](MacId mac) {
     return *std::find_if(next.nodes.begin(), next.nodes.end(),
                          [&](const devicenet::NodeConfig& n) { return n.mac == mac; });
@@ -138,7 +138,7 @@ ScanListChange RackPort::reconfigure(const devicenet::ScannerConfig& port, const
     if (is.pump) {
       devices_.remove(mac);
       pumps_.replace(*is.pump);
-    } else {
+    } else if (is.device) {
       pumps_.remove(mac);
       devices_.replace(*is.device);
     }

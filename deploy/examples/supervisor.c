@@ -93,8 +93,8 @@ typedef enum { ANY, ONLINE, COMMANDED, IDLE } Wanted;
 
 /* Takes PumpState samples of (rack, port, mac) until one shows what is
  * wanted, for at most `ms`; prints each. Returns 1 if it came. */
-static int wait_state(dds_entity_t waitset, dds_entity_t reader, const char* rack,
-                      const char* port, uint8_t mac, Wanted wanted, int ms) {
+static int wait_state(dds_entity_t waitset, dds_entity_t reader, const char* rack, const char* port,
+                      uint8_t mac, Wanted wanted, int ms) {
   const dds_time_t deadline = dds_time() + DDS_MSECS(ms);
   while (dds_time() < deadline) {
     dds_waitset_wait_until(waitset, NULL, 0, deadline);
@@ -108,9 +108,11 @@ static int wait_state(dds_entity_t waitset, dds_entity_t reader, const char* rac
           s->mac != mac) {
         continue;
       }
-      printf("  %s/%s/%u %s online=%d running=%d alarm=%d interlock_ok=%d pump_on=%d idle=%d by \"%s\"\n",
-             s->rack, s->port, s->mac, s->name, s->online, s->pump_running, s->alarm_active,
-             s->interlock_ok, s->pump_on, s->outputs_idle, s->commanded_by);
+      printf(
+          "  %s/%s/%u %s online=%d running=%d alarm=%d interlock_ok=%d pump_on=%d idle=%d by "
+          "\"%s\"\n",
+          s->rack, s->port, s->mac, s->name, s->online, s->pump_running, s->alarm_active,
+          s->interlock_ok, s->pump_on, s->outputs_idle, s->commanded_by);
       done = done || wanted == ANY || (wanted == ONLINE && s->online) ||
              (wanted == COMMANDED && s->online && !s->outputs_idle && s->pump_on) ||
              (wanted == IDLE && s->outputs_idle);

@@ -709,9 +709,7 @@ class Bridge {
   }
 
   std::vector<PortWire::OutputFrame> output_frames() { return gather(&PortWire::output_frames); }
-  std::vector<PortWire::WrittenFrame> written_frames() {
-    return gather(&PortWire::written_frames);
-  }
+  std::vector<PortWire::WrittenFrame> written_frames() { return gather(&PortWire::written_frames); }
   // Every poll response handed to a port's thread: its key and analog
   // value, from its receive time to the thread having it (ns), and whether
   // that was the thread's wake-up for it (PortWire::HandedResponse::slept).
@@ -1113,9 +1111,10 @@ int run_bench(const Options& o) {
   if (awake >= 0) {
     fmt::print("CPU idle: /dev/cpu_dma_latency held at 0 us for the whole run (no CPU halts)\n");
   } else {
-    fmt::print("CPU idle: {}\n", o.hold_awake ? "/dev/cpu_dma_latency could not be held (not root?): "
-                                               "CPUs halt when idle"
-                                             : "CPUs halt when idle (--allow-idle)");
+    fmt::print("CPU idle: {}\n", o.hold_awake
+                                     ? "/dev/cpu_dma_latency could not be held (not root?): "
+                                       "CPUs halt when idle"
+                                     : "CPUs halt when idle (--allow-idle)");
   }
 
   // The measured process on one CPU, its peer on another, for the bridge as
@@ -1153,8 +1152,7 @@ int run_bench(const Options& o) {
       window_p99_lo = std::min(window_p99_lo, w.p99);
       window_p99_hi = std::max(window_p99_hi, w.p99);
     }
-    fmt::print("(0) Cyclone DDS, beside it: ddsperf {}(and ddsperf pong waitset)\n",
-               cyc.command);
+    fmt::print("(0) Cyclone DDS, beside it: ddsperf {}(and ddsperf pong waitset)\n", cyc.command);
     fmt::print(
         "    one-way = round trip / 2 (as ddsperf prints it), {:.0f} round trips in {} one-second\n"
         "    windows (the first left out):  p50 {}  p99 {}  max {}\n"
@@ -1371,9 +1369,8 @@ int run_bench(const Options& o) {
     fmt::print("(2) PumpCommand written -> poll frame with the new outputs\n");
     fmt::print("    commands written {}, their poll frames found {}\n", out.commands.size(),
                cmd.count);
-    fmt::print(
-        "    to the frame written to the CAN interface:  p50 {}  p99 {}  max {}  min {}\n",
-        us(cmd_write.p50), us(cmd_write.p99), us(cmd_write.max), us(cmd_write.min));
+    fmt::print("    to the frame written to the CAN interface:  p50 {}  p99 {}  max {}  min {}\n",
+               us(cmd_write.p50), us(cmd_write.p99), us(cmd_write.max), us(cmd_write.min));
     fmt::print(
         "    {} of them ({:.1f} %) came while the node's previous poll was unanswered and\n"
         "    went out with its response (one poll at a time on a poll connection); the "

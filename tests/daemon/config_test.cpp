@@ -1101,27 +1101,28 @@ TEST(ConfigSafeState, DefaultIsEveryOutputOffOnFaultAndIdleDownloaded) {
 }
 
 TEST(ConfigSafeState, WordsAndVoltsFromDefaultsAndNodes) {
-  const DaemonConfig c = parse_config("rack = \"r\"\n"
-                                      "[defaults]\n"
-                                      "pump_on_idle = \"hold\"\n"
-                                      "analog_output_on_fault = 2.5\n"
-                                      "[[port]]\n"
-                                      "name = \"A\"\n"
-                                      "interface = \"simulated\"\n"
-                                      "bitrate = 500000\n"
-                                      "[[port.node]]\n"
-                                      "mac = 1\n"
-                                      "name = \"p\"\n"
-                                      "pump_on_fault = \"off\"\n"
-                                      "n2_ballast_on_fault = \"on\"\n"
-                                      "n2_ballast_on_idle = \"hold\"\n"
-                                      "analog_output_on_idle = \"hold\"\n"
-                                      "[[port.node]]\n"
-                                      "mac = 2\n"
-                                      "name = \"q\"\n"
-                                      "pump_on_idle = \"off\"\n"
-                                      "analog_output_on_fault = 10\n",
-                                      "t.toml");
+  const DaemonConfig c = parse_config(
+      "rack = \"r\"\n"
+      "[defaults]\n"
+      "pump_on_idle = \"hold\"\n"
+      "analog_output_on_fault = 2.5\n"
+      "[[port]]\n"
+      "name = \"A\"\n"
+      "interface = \"simulated\"\n"
+      "bitrate = 500000\n"
+      "[[port.node]]\n"
+      "mac = 1\n"
+      "name = \"p\"\n"
+      "pump_on_fault = \"off\"\n"
+      "n2_ballast_on_fault = \"on\"\n"
+      "n2_ballast_on_idle = \"hold\"\n"
+      "analog_output_on_idle = \"hold\"\n"
+      "[[port.node]]\n"
+      "mac = 2\n"
+      "name = \"q\"\n"
+      "pump_on_idle = \"off\"\n"
+      "analog_output_on_fault = 10\n",
+      "t.toml");
   const auto& p = c.ports.at(0).nodes.at(0).pump.safe_state.values;
   EXPECT_EQ(p.pump_fault, cdn127::DiscreteAction::kOff);
   EXPECT_EQ(p.pump_idle, cdn127::DiscreteAction::kHold);  // from [defaults]
@@ -1163,16 +1164,15 @@ TEST(ConfigSafeState, OptInsAreReadAndWarnedOf) {
 }
 
 TEST(ConfigSafeState, MistakesAreErrorsWithTheirPosition) {
-  EXPECT_EQ(problems(ONE_PORT
-                     "[[port.node]]\n"
-                     "mac = 1\n"
-                     "name = \"p\"\n"
-                     "pump_on_fault = \"stop\"\n"
-                     "pump_on_idle = true\n"
-                     "analog_output_on_fault = 10.5\n"
-                     "analog_output_on_idle = \"zero\"\n"
-                     "safe_state = \"factory\"\n"
-                     "resume = \"always\"\n"),
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "pump_on_fault = \"stop\"\n"
+                              "pump_on_idle = true\n"
+                              "analog_output_on_fault = 10.5\n"
+                              "analog_output_on_idle = \"zero\"\n"
+                              "safe_state = \"factory\"\n"
+                              "resume = \"always\"\n"),
             "t.toml:9:17: pump_on_fault = \"stop\" is not an output action: use \"off\", \"on\" "
             "or \"hold\"\n"
             "t.toml:10:16: pump_on_idle must be a string, not a boolean\n"
@@ -1184,12 +1184,11 @@ TEST(ConfigSafeState, MistakesAreErrorsWithTheirPosition) {
             "t.toml:14:10: resume = \"always\" is not a policy: use \"new-command\" (the default) "
             "or \"last-command\"");
   // Values of a node that keeps the device's own: contradictory.
-  EXPECT_EQ(problems(ONE_PORT
-                     "[[port.node]]\n"
-                     "mac = 1\n"
-                     "name = \"p\"\n"
-                     "safe_state = \"device\"\n"
-                     "pump_on_idle = \"off\"\n"),
+  EXPECT_EQ(problems(ONE_PORT "[[port.node]]\n"
+                              "mac = 1\n"
+                              "name = \"p\"\n"
+                              "safe_state = \"device\"\n"
+                              "pump_on_idle = \"off\"\n"),
             "t.toml:10:16: pump_on_idle has no effect with safe_state = \"device\": the device's "
             "own fault and idle actions are kept");
 }

@@ -293,7 +293,7 @@ TEST_F(DdsTest, TakeBufferIsReusedAcrossTakes) {
   TakeBuffer<dnbridge_ExplicitRequest> buffer(2);
 
   const std::vector<std::string> ports{"a-rather-long-port-name-of-a-rack", "b", "", "port-d",
-                                       "another-long-port-name-again", "f", "g"};
+                                       "another-long-port-name-again",      "f", "g"};
   auto data_of = [](std::size_t i) {
     return std::vector<std::uint8_t>((i * 37) % 200, static_cast<std::uint8_t>(i + 1));
   };

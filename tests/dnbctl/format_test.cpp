@@ -198,9 +198,10 @@ TEST(Names, StatusesHaveTheirNames) {
 
 TEST(PumpLine, ShowsInputsAndAppliedOutputs) {
   auto s = pump(3);
-  EXPECT_EQ(pump_line(*s, "12:00:00.000"),
-            "12:00:00.000 sim-rack/A/3 pump-3 online | running warning=no alarm=no n2_flow=ok "
-            "interlock=ok ai1=2.501V | pump=on ballast=off aout=2048 (5.001V) by \"dnbctl op@host\"");
+  EXPECT_EQ(
+      pump_line(*s, "12:00:00.000"),
+      "12:00:00.000 sim-rack/A/3 pump-3 online | running warning=no alarm=no n2_flow=ok "
+      "interlock=ok ai1=2.501V | pump=on ballast=off aout=2048 (5.001V) by \"dnbctl op@host\"");
   s->outputs_idle = true;
   EXPECT_NE(pump_line(*s, "t").find("| outputs idle"), std::string::npos);
   s->online = false;
@@ -255,8 +256,9 @@ TEST(List, TablesAndJsonNestNodesUnderPorts) {
             "sim-rack  A     live    running  error-active  2.7%  176       1/2 online  "
             "simulated 500k master 0  scanning\n");
   const std::string table = nodes_table(nodes);
-  EXPECT_NE(table.find("sim-rack  A     2    pump-2  absent  no      CDN127   no answer to allocation"),
-            std::string::npos)
+  EXPECT_NE(
+      table.find("sim-rack  A     2    pump-2  absent  no      CDN127   no answer to allocation"),
+      std::string::npos)
       << table;
   EXPECT_NE(table.find("sim-rack  A     1    pump-1  online  yes     CDN127   polled every 100 ms"),
             std::string::npos)
@@ -265,7 +267,8 @@ TEST(List, TablesAndJsonNestNodesUnderPorts) {
   JsonWriter out(false);
   list_json(out, ports, nodes);
   const std::string& j = out.str();
-  EXPECT_EQ(j.rfind(R"({"racks":[{"rack":"sim-rack","bridge_alive":true,"ports":[{"port":"A",)", 0), 0u)
+  EXPECT_EQ(j.rfind(R"({"racks":[{"rack":"sim-rack","bridge_alive":true,"ports":[{"port":"A",)", 0),
+            0u)
       << j;
   // Nodes sorted by MAC inside their port.
   const auto first = j.find(R"({"mac":1,"name":"pump-1","state":"online")");
@@ -295,17 +298,14 @@ TEST(Show, IdentityStateAndCounters) {
   auto n = node(3);
   auto s = pump(3);
   const std::string text = node_details(*n, s.get(), true);
-  for (const char* line : {"node                      sim-rack/A/3 (pump-3)\n",
-                           "state                     online\n",
-                           "product name              CDN127\n",
-                           "vendor                    59 (0x003B)\n",
-                           "product type              27 (0x001B)\n",
-                           "product code              1888 (0x0760)\n",
-                           "revision                  1.5\n",
-                           "serial number             3 (0x00000003)\n",
-                           "device state              3 (operating)\n",
-                           "last refused command      from x: analog output 5000 is out of range 0..4095\n",
-                           "  commands refused        2\n"}) {
+  for (const char* line :
+       {"node                      sim-rack/A/3 (pump-3)\n", "state                     online\n",
+        "product name              CDN127\n", "vendor                    59 (0x003B)\n",
+        "product type              27 (0x001B)\n", "product code              1888 (0x0760)\n",
+        "revision                  1.5\n", "serial number             3 (0x00000003)\n",
+        "device state              3 (operating)\n",
+        "last refused command      from x: analog output 5000 is out of range 0..4095\n",
+        "  commands refused        2\n"}) {
     EXPECT_NE(text.find(line), std::string::npos) << line << "\nin:\n" << text;
   }
   JsonWriter out(false);
@@ -344,11 +344,12 @@ TEST(Explicit, SuccessWithDecodedString) {
             "as string: \"CDN127\"\n");
   JsonWriter out(false);
   explicit_json(out, x, Decoding::kString, decoded);
-  EXPECT_NE(out.str().find(R"("status":1,"status_text":"transaction completed","general_status":0,)"
-                           R"("general_status_text":"success","additional_status":255,"message":"",)"
-                           R"("data":"06 43 44 4E 31 32 37","succeeded":true,)"
-                           R"("decoded":{"as":"string","value":"CDN127"}})"),
-            std::string::npos)
+  EXPECT_NE(
+      out.str().find(R"("status":1,"status_text":"transaction completed","general_status":0,)"
+                     R"("general_status_text":"success","additional_status":255,"message":"",)"
+                     R"("data":"06 43 44 4E 31 32 37","succeeded":true,)"
+                     R"("decoded":{"as":"string","value":"CDN127"}})"),
+      std::string::npos)
       << out.str();
 }
 
@@ -386,9 +387,10 @@ TEST(Explicit, BridgeStatusWithoutDeviceAnswer) {
   EXPECT_NE(text.find("message: MAC 40 is not in the scan list of port A\n"), std::string::npos);
   JsonWriter out(false);
   explicit_json(out, x, Decoding::kNone, std::nullopt);
-  EXPECT_NE(out.str().find(R"("status":3,"status_text":"slave not in scan list","general_status":null,)"
-                           R"("general_status_text":null,"additional_status":null,)"),
-            std::string::npos)
+  EXPECT_NE(
+      out.str().find(R"("status":3,"status_text":"slave not in scan list","general_status":null,)"
+                     R"("general_status_text":null,"additional_status":null,)"),
+      std::string::npos)
       << out.str();
 }
 

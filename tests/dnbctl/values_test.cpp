@@ -78,10 +78,10 @@ TEST(ParseAnalog, VoltsRoundToTheNearestStep) {
   EXPECT_DOUBLE_EQ(*v->volts, 5.0);
   EXPECT_EQ(parse_analog("0V")->raw, 0);
   EXPECT_EQ(parse_analog("10V")->raw, 4095);
-  EXPECT_EQ(parse_analog("2.5 v")->raw, 1024);   // 1023.75
-  EXPECT_EQ(parse_analog("0.001V")->raw, 0);     // 0.41 steps
-  EXPECT_EQ(parse_analog("0.002V")->raw, 1);     // 0.82 steps
-  EXPECT_EQ(parse_analog("9.9995V")->raw, 4095); // 4094.8
+  EXPECT_EQ(parse_analog("2.5 v")->raw, 1024);    // 1023.75
+  EXPECT_EQ(parse_analog("0.001V")->raw, 0);      // 0.41 steps
+  EXPECT_EQ(parse_analog("0.002V")->raw, 1);      // 0.82 steps
+  EXPECT_EQ(parse_analog("9.9995V")->raw, 4095);  // 4094.8
 }
 
 TEST(ParseAnalog, RawCountsAreTakenAsTheyAre) {

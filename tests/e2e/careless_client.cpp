@@ -75,13 +75,13 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
-#include <mutex>
-#include <thread>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <mutex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "adapters/dds/fields.hpp"
@@ -173,10 +173,9 @@ int commander(dds_domainid_t domain, unsigned mac, std::int32_t strength, Durati
   dds::Topic<dnbridge_PumpCommand> topic(participant);
   dds::Writer<dnbridge_PumpCommand> writer(
       participant, topic,
-      dds::command_writer_qos(e2e::sim_rack_partitions(), strength,
-                              lease == Duration::zero() ? dds::kInfinite : lease,
-                              deadline == Duration::zero() ? std::nullopt
-                                                           : std::optional<Duration>(deadline)));
+      dds::command_writer_qos(
+          e2e::sim_rack_partitions(), strength, lease == Duration::zero() ? dds::kInfinite : lease,
+          deadline == Duration::zero() ? std::nullopt : std::optional<Duration>(deadline)));
   if (!writer.set_status_mask(DDS_PUBLICATION_MATCHED_STATUS |
                               DDS_OFFERED_INCOMPATIBLE_QOS_STATUS)) {
     fail("status mask of the PumpCommand writer");

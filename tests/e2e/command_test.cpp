@@ -4,8 +4,8 @@
 // reported.
 #include <memory>
 
-#include "bridge_fixture.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
+#include "bridge_fixture.hpp"
 
 namespace dnbridge::e2e {
 namespace {
@@ -32,10 +32,11 @@ using profiles::cdn127::PumpOutputs;
 class CommandTest : public BridgeTest {
  protected:
   // The echo: the outputs the device applied with its last answered poll.
-  bool echoes(unsigned mac, bool pump_on, bool n2, std::uint16_t analog, std::string_view by) const {
+  bool echoes(unsigned mac, bool pump_on, bool n2, std::uint16_t analog,
+              std::string_view by) const {
     const auto* s = pumps_.latest(pump_mac(mac));
-    return s && s->online && !s->outputs_idle && s->pump_on == pump_on &&
-           s->n2_ballast_on == n2 && s->analog_output_raw == analog && dds::view(s->commanded_by) == by;
+    return s && s->online && !s->outputs_idle && s->pump_on == pump_on && s->n2_ballast_on == n2 &&
+           s->analog_output_raw == analog && dds::view(s->commanded_by) == by;
   }
   PumpOutputs device_outputs(unsigned mac) {
     return on_port([mac](sim::SimBackend& b) { return slave(b, mac).device().outputs(); });

@@ -20,14 +20,15 @@ namespace dnbridge::e2e {
 namespace {
 
 namespace cdn127 = profiles::cdn127;
-using devicenet::Group2Message;
 using devicenet::group2_id;
+using devicenet::Group2Message;
 
 constexpr std::uint8_t kSuccess = 1, kInProgress = 2, kNotInScanList = 3, kSlaveOffline = 4,
                        kPortOffline = 5, kTxidUnknown = 6, kInvalidCommand = 8, kOutOfBuffers = 9,
                        kOtherTransaction = 10, kCouldNotConnect = 11, kInvalidPort = 13,
                        kInvalidSize = 14, kConnectionBusy = 15;
-static_assert(kSuccess == dnbridge_STATUS_SUCCESS && kConnectionBusy == dnbridge_STATUS_CONNECTION_BUSY);
+static_assert(kSuccess == dnbridge_STATUS_SUCCESS &&
+              kConnectionBusy == dnbridge_STATUS_CONNECTION_BUSY);
 
 devicenet::MacId mac_id(unsigned mac) { return *devicenet::MacId::from(mac); }
 
@@ -66,7 +67,8 @@ TEST_F(ExplicitTest, GetsIdentityAndFragmentedDeviceSupervisorStringsThroughDds)
   });
 
   const auto sent = SteadyClock::now();
-  ASSERT_NO_FATAL_FAILURE(send(get(1, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kProductName)));
+  ASSERT_NO_FATAL_FAILURE(
+      send(get(1, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kProductName)));
   const auto name = reply(1);
   ASSERT_TRUE(name);
   report("explicit Get through DDS: request written -> reply", ms_since(sent));
@@ -77,8 +79,8 @@ TEST_F(ExplicitTest, GetsIdentityAndFragmentedDeviceSupervisorStringsThroughDds)
   // [header][service][len] "CDN127": 9 bytes, more than one frame carries.
   EXPECT_GE(fragments_of_name, 2u);
 
-  ASSERT_NO_FATAL_FAILURE(send(get(2, 1, cdn127::class_id::kDeviceSupervisor,
-                                   cdn127::supervisor_attr::kManufacturerName)));
+  ASSERT_NO_FATAL_FAILURE(send(
+      get(2, 1, cdn127::class_id::kDeviceSupervisor, cdn127::supervisor_attr::kManufacturerName)));
   const auto maker = reply(2);
   ASSERT_TRUE(maker);
   EXPECT_EQ(maker->status, kSuccess) << maker->message;
@@ -171,7 +173,8 @@ TEST_F(ExplicitTest, RepeatedRequestGetsTheSameReplyAndIsNotExecutedTwice) {
     });
   });
 
-  const Request serial = get(7, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kSerialNumber);
+  const Request serial =
+      get(7, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kSerialNumber);
   ASSERT_NO_FATAL_FAILURE(send(serial));
   const auto first = reply(7);
   ASSERT_TRUE(first);
@@ -311,14 +314,15 @@ TEST_F(ExplicitTest, InProgressBusyAndOutOfBuffersUnderLoad) {
   constexpr Duration kLate = milliseconds(400);
   on_port([kLate](sim::SimBackend& b) {
     for (unsigned mac = 1; mac <= 7; ++mac) {
-      b.world().bus().faults().add(
-          sim::FaultRule::delay_by(group2_id(mac_id(mac), Group2Message::kSlaveExplicitResponse), kLate));
+      b.world().bus().faults().add(sim::FaultRule::delay_by(
+          group2_id(mac_id(mac), Group2Message::kSlaveExplicitResponse), kLate));
     }
   });
 
   // Node 1: more requests than its explicit connection queues.
   for (std::uint32_t txid = 100; txid < 108; ++txid) {
-    ASSERT_NO_FATAL_FAILURE(send(get(txid, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kVendor)));
+    ASSERT_NO_FATAL_FAILURE(
+        send(get(txid, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kVendor)));
   }
   // 2: asked while the first is still waiting for the device.
   Request status = get(100, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kVendor);

@@ -37,7 +37,8 @@ TEST_F(BridgeTest, DnbridgeProcessServesTheSupervisorAndStopsInOrderOnSigterm) {
   report("dnbridge process: writer discovered -> every pump's PumpState", ms_since(discovered));
   ASSERT_TRUE(pumps_.until([&] { return all_online(); }, seconds(10)));
   report("dnbridge process spawned -> every pump online", ms_since(spawned));
-  EXPECT_EQ(writer_participant_name(supervisor_, pumps_.reader()), std::string("dnbridge ") + kRack);
+  EXPECT_EQ(writer_participant_name(supervisor_, pumps_.reader()),
+            std::string("dnbridge ") + kRack);
 
   ASSERT_TRUE(bridge.signal(SIGTERM));
   auto unregistered = [&] {

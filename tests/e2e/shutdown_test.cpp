@@ -12,7 +12,8 @@ namespace {
 // The instance state after the last sample of each instance `key` tells
 // apart, and the last sample with data of each.
 template <class T, class Key>
-void expect_unregistered(const Subscription<T>& s, Key key, std::size_t instances, const char* topic) {
+void expect_unregistered(const Subscription<T>& s, Key key, std::size_t instances,
+                         const char* topic) {
   std::map<decltype(key(std::declval<const T&>())), dds::InstanceState> last_state;
   for (const auto& r : s.history()) {
     EXPECT_NE(r.sample.info().instance_state(), dds::InstanceState::kNotAliveDisposed)
@@ -58,8 +59,8 @@ TEST_F(BridgeTest, OrderlyStopLeavesLastSamplesThenUnregisters) {
   const auto by_mac = [](const auto& s) { return static_cast<unsigned>(s.mac); };
   expect_unregistered(pumps_, by_mac, kPumps, "PumpState");
   expect_unregistered(nodes_, by_mac, kPumps, "NodeStatus");
-  expect_unregistered(ports_, [](const auto& s) { return std::string(dds::view(s.port)); }, 1,
-                      "PortStatus");
+  expect_unregistered(
+      ports_, [](const auto& s) { return std::string(dds::view(s.port)); }, 1, "PortStatus");
 
   // The last data: offline, stopped, outputs idle.
   for (unsigned mac = 1; mac <= kPumps; ++mac) {

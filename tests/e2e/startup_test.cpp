@@ -96,7 +96,8 @@ TEST_F(BridgeTest, SourceTimestampsAreReceiveTimesOnTheWallClockAndIncrease) {
   }
   for (const auto& r : nodes_.history()) {
     if (!r.sample.valid_data()) continue;
-    EXPECT_GE(r.sample.info().source_timestamp(), created_wall_) << "NodeStatus " << int(r.sample->mac);
+    EXPECT_GE(r.sample.info().source_timestamp(), created_wall_)
+        << "NodeStatus " << int(r.sample->mac);
     EXPECT_LE(r.sample.info().source_timestamp(), r.at);
   }
   for (const auto& r : ports_.history()) {
@@ -108,7 +109,8 @@ TEST_F(BridgeTest, SourceTimestampsAreReceiveTimesOnTheWallClockAndIncrease) {
 
 TEST_F(BridgeTest, ParticipantIsNamedAfterTheRack) {
   ASSERT_NO_FATAL_FAILURE(make_bridge());
-  EXPECT_EQ(writer_participant_name(supervisor_, pumps_.reader()), std::string("dnbridge ") + kRack);
+  EXPECT_EQ(writer_participant_name(supervisor_, pumps_.reader()),
+            std::string("dnbridge ") + kRack);
 }
 
 TEST_F(BridgeTest, PortStatusShowsMeasuredScanCycleAndALateJoinerGetsTheCurrentStateAtOnce) {
@@ -152,7 +154,8 @@ TEST_F(BridgeTest, PortStatusShowsMeasuredScanCycleAndALateJoinerGetsTheCurrentS
     return true;
   };
   ASSERT_TRUE(late_pumps.until(all));
-  ASSERT_TRUE(late_ports.until([&] { return late_ports.latest([](const auto&) { return true; }); }));
+  ASSERT_TRUE(
+      late_ports.until([&] { return late_ports.latest([](const auto&) { return true; }); }));
   report("late joiner: every pump's state and the port's after creating the readers",
          ms_since(joined));
   // The first sample of each instance is the one the bridge had already

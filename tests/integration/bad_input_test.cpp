@@ -20,7 +20,10 @@ using devicenet::Group2Message;
 class RogueNode final : public sim::SimEndpoint {
  public:
   RogueNode(sim::SimWorld& world, std::vector<unsigned> victims, TimePoint start)
-      : world_(world), handle_(world.bus().attach(*this)), victims_(std::move(victims)), next_(start) {
+      : world_(world),
+        handle_(world.bus().attach(*this)),
+        victims_(std::move(victims)),
+        next_(start) {
     world.add(*this);
   }
   ~RogueNode() override { world_.remove(*this); }
@@ -105,7 +108,8 @@ TEST(BadInput, GarbageOnTheBusIsCountedAndTheScanGoesOn) {
     EXPECT_EQ(node.state(), NodeState::kOnline) << m << ": " << node.reason();
     EXPECT_EQ(node.counters().reconnects, 0u) << m;
     poll_errors += node.counters().errors;
-    explicit_bad += node.explicit_counters().malformed_frames + node.explicit_counters().unexpected_frames;
+    explicit_bad +=
+        node.explicit_counters().malformed_frames + node.explicit_counters().unexpected_frames;
   }
   const auto& port = rack.scanner().counters();
   EXPECT_GT(port.invalid_identifiers, 400u);
@@ -120,7 +124,8 @@ TEST(BadInput, GarbageOnTheBusIsCountedAndTheScanGoesOn) {
   profiles::cdn127::PumpOutputs out;
   out.pump_on = true;
   out.analog_out_raw = 777;
-  for (unsigned m : {1u, 2u, 3u, 4u}) ASSERT_TRUE(rack.pumps().command(mac(m), out, rack.now()).ok());
+  for (unsigned m : {1u, 2u, 3u, 4u})
+    ASSERT_TRUE(rack.pumps().command(mac(m), out, rack.now()).ok());
   rack.world().run_for(milliseconds(300));
   for (unsigned m : {1u, 2u, 3u, 4u}) {
     EXPECT_EQ(rack.device(mac(m)).device().outputs(), out) << m;

@@ -40,8 +40,8 @@ ByteVec bytes_of(const can::CanFrame& f) { return ByteVec(f.data.begin(), f.data
 
 SlaveOptions default_options() {
   SlaveOptions o;
-  o.mac_switch = 3;    // valid: MAC 3 from the switch
-  o.baud_switch = 2;   // valid: 500k
+  o.mac_switch = 3;   // valid: MAC 3 from the switch
+  o.baud_switch = 2;  // valid: 500k
   o.serial_number = 0x1234;
   o.pump.spin_up = seconds(3);
   o.pump.spin_down = seconds(5);
@@ -101,7 +101,8 @@ class Cdn127SlaveTest : public ::testing::Test {
       while (off < message.size()) {
         const std::size_t n = std::min<std::size_t>(6, message.size() - off);
         const std::uint8_t type = off == 0 ? 0 : (off + n == message.size() ? 2 : 1);
-        ByteVec p{static_cast<std::uint8_t>(0x80 | kMaster), static_cast<std::uint8_t>((type << 6) | count)};
+        ByteVec p{static_cast<std::uint8_t>(0x80 | kMaster),
+                  static_cast<std::uint8_t>((type << 6) | count)};
         p.insert(p.end(), message.begin() + static_cast<std::ptrdiff_t>(off),
                  message.begin() + static_cast<std::ptrdiff_t>(off + n));
         slave_->on_frame(make(kRequestId, p), now_);
@@ -162,8 +163,9 @@ class Cdn127SlaveTest : public ::testing::Test {
   // Allocate, set the poll EPR and return the actual value.
   void establish_poll(std::uint16_t epr_ms = 100) {
     allocate();
-    const ByteVec r = set(0x05, 0x02, 0x09, {static_cast<std::uint8_t>(epr_ms & 0xFF),
-                                             static_cast<std::uint8_t>(epr_ms >> 8)});
+    const ByteVec r =
+        set(0x05, 0x02, 0x09,
+            {static_cast<std::uint8_t>(epr_ms & 0xFF), static_cast<std::uint8_t>(epr_ms >> 8)});
     ASSERT_EQ(r.size(), 3u);
     ASSERT_EQ(r[0], 0x90);
     ASSERT_EQ(slave_->poll_state(), ConnectionState::kEstablished);
@@ -258,7 +260,8 @@ TEST_F(Cdn127SlaveTest, AllocateExplicitAndPoll) {
   boot();
   // [M=10][Allocate][class 3][instance 1][choice explicit|poll][allocator 10]
   // -> [M=10][Allocate response][body format 0 = 8/8]
-  EXPECT_EQ(single(kUnconnectedId, {0x0A, 0x4B, 0x03, 0x01, 0x03, 0x0A}), (ByteVec{0x0A, 0xCB, 0x00}));
+  EXPECT_EQ(single(kUnconnectedId, {0x0A, 0x4B, 0x03, 0x01, 0x03, 0x0A}),
+            (ByteVec{0x0A, 0xCB, 0x00}));
   EXPECT_EQ(slave_->owner(), kMaster);
   EXPECT_EQ(slave_->explicit_state(), ConnectionState::kEstablished);
   EXPECT_EQ(slave_->poll_state(), ConnectionState::kConfiguring);
@@ -270,20 +273,26 @@ TEST_F(Cdn127SlaveTest, AllocateExplicitAndPoll) {
 TEST_F(Cdn127SlaveTest, AllocateErrors) {
   boot();
   // choice 0: invalid attribute value / invalid choice
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x00, kMaster}), (ByteVec{kMaster, 0x94, 0x09, 0x02}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x00, kMaster}),
+            (ByteVec{kMaster, 0x94, 0x09, 0x02}));
   // bit strobe: resource unavailable / invalid choice
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x05, kMaster}), (ByteVec{kMaster, 0x94, 0x02, 0x02}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x05, kMaster}),
+            (ByteVec{kMaster, 0x94, 0x02, 0x02}));
   // COS, cyclic, ack suppression likewise
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x51, kMaster}), (ByteVec{kMaster, 0x94, 0x02, 0x02}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x51, kMaster}),
+            (ByteVec{kMaster, 0x94, 0x02, 0x02}));
   // poll alone with no explicit connection
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x02, kMaster}), (ByteVec{kMaster, 0x94, 0x09, 0x02}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x02, kMaster}),
+            (ByteVec{kMaster, 0x94, 0x09, 0x02}));
   EXPECT_EQ(slave_->owner(), 255);
 
   allocate(0x01);
   // explicit again: already allocated
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x01, kMaster}), (ByteVec{kMaster, 0x94, 0x0B, 0x02}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x01, kMaster}),
+            (ByteVec{kMaster, 0x94, 0x0B, 0x02}));
   // another master (11): owned, allocation conflict
-  EXPECT_EQ(single(kUnconnectedId, {0x0B, 0x4B, 0x03, 0x01, 0x03, 0x0B}), (ByteVec{0x0B, 0x94, 0x0C, 0x01}));
+  EXPECT_EQ(single(kUnconnectedId, {0x0B, 0x4B, 0x03, 0x01, 0x03, 0x0B}),
+            (ByteVec{0x0B, 0x94, 0x0C, 0x01}));
   // poll added by the owner, here through the explicit connection
   EXPECT_EQ(request({0x4B, 0x03, 0x01, 0x02, kMaster}), (ByteVec{0xCB, 0x00}));
   EXPECT_EQ(slave_->poll_state(), ConnectionState::kConfiguring);
@@ -293,29 +302,35 @@ TEST_F(Cdn127SlaveTest, AllocateErrors) {
 TEST_F(Cdn127SlaveTest, UnconnectedPortAcceptsOnlyAllocateAndRelease) {
   boot();
   // Get_Attribute_Single on the Group 2 only unconnected port: 0x02/0x03.
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x0E, 0x01, 0x01, 0x01}), (ByteVec{kMaster, 0x94, 0x02, 0x03}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x0E, 0x01, 0x01, 0x01}),
+            (ByteVec{kMaster, 0x94, 0x02, 0x03}));
   // Allocate to the wrong object
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x01, 0x01, 0x03, kMaster}), (ByteVec{kMaster, 0x94, 0x02, 0x03}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x01, 0x01, 0x03, kMaster}),
+            (ByteVec{kMaster, 0x94, 0x02, 0x03}));
   // Allocate without its allocator byte
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x03}), (ByteVec{kMaster, 0x94, 0x13, 0xFF}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4B, 0x03, 0x01, 0x03}),
+            (ByteVec{kMaster, 0x94, 0x13, 0xFF}));
 }
 
 TEST_F(Cdn127SlaveTest, ReleaseLeavesTheSlaveUnowned) {
   boot();
   allocate();
   // Release from another master is refused.
-  EXPECT_EQ(single(kUnconnectedId, {0x0B, 0x4C, 0x03, 0x01, 0x03}), (ByteVec{0x0B, 0x94, 0x0C, 0x01}));
+  EXPECT_EQ(single(kUnconnectedId, {0x0B, 0x4C, 0x03, 0x01, 0x03}),
+            (ByteVec{0x0B, 0x94, 0x0C, 0x01}));
   EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4C, 0x03, 0x01, 0x02}), (ByteVec{kMaster, 0xCC}));
   EXPECT_EQ(slave_->poll_state(), ConnectionState::kNonExistent);
   EXPECT_EQ(slave_->owner(), kMaster);
   // releasing what is not allocated
-  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4C, 0x03, 0x01, 0x02}), (ByteVec{kMaster, 0x94, 0x0B, 0x02}));
+  EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4C, 0x03, 0x01, 0x02}),
+            (ByteVec{kMaster, 0x94, 0x0B, 0x02}));
   EXPECT_EQ(single(kUnconnectedId, {kMaster, 0x4C, 0x03, 0x01, 0x01}), (ByteVec{kMaster, 0xCC}));
   EXPECT_EQ(slave_->owner(), 255);
   EXPECT_EQ(slave_->explicit_state(), ConnectionState::kNonExistent);
   // Explicit requests are no longer served; another master may allocate.
   EXPECT_TRUE(exchange(kRequestId, {kMaster, 0x0E, 0x01, 0x01, 0x01}).empty());
-  EXPECT_EQ(single(kUnconnectedId, {0x0B, 0x4B, 0x03, 0x01, 0x01, 0x0B}), (ByteVec{0x0B, 0xCB, 0x00}));
+  EXPECT_EQ(single(kUnconnectedId, {0x0B, 0x4B, 0x03, 0x01, 0x01, 0x0B}),
+            (ByteVec{0x0B, 0xCB, 0x00}));
 }
 
 // ---------------------------------------------------------------------------
@@ -587,8 +602,8 @@ TEST_F(Cdn127SlaveTest, ShortPollIsIdleAndAppliesIdleActions) {
   // 0-byte poll: idle. Still answered.
   const ByteVec r = poll({});
   EXPECT_EQ(r.size(), 6u);
-  EXPECT_FALSE(slave_->outputs().pump_on);      // idle value 0
-  EXPECT_TRUE(slave_->outputs().n2_ballast_on); // held
+  EXPECT_FALSE(slave_->outputs().pump_on);       // idle value 0
+  EXPECT_TRUE(slave_->outputs().n2_ballast_on);  // held
   EXPECT_EQ(slave_->outputs().analog_out_raw, 1000);
   EXPECT_TRUE(slave_->pump().last_change_was_idle());
   EXPECT_EQ(slave_->counters().polls_idle, 1u);
@@ -735,7 +750,7 @@ TEST_F(Cdn127SlaveTest, ConfigurationChangeRefusedWhilePolling) {
   allocate();
   // Before the poll connection is established: accepted, sizes follow.
   EXPECT_EQ(set(0x40, 0x01, 0x04, {0x01}), (ByteVec{0x90}));
-  EXPECT_EQ(get(0x40, 0x01, 0x10), (ByteVec{0x8E, 0x04}));        // DSUP DIN AIN
+  EXPECT_EQ(get(0x40, 0x01, 0x10), (ByteVec{0x8E, 0x04}));  // DSUP DIN AIN
   EXPECT_EQ(get(0x05, 0x02, 0x07), (ByteVec{0x8E, 0x04, 0x00}));
   EXPECT_EQ(set(0x05, 0x02, 0x09, {0x64, 0x00}), (ByteVec{0x90, 0x64, 0x00}));
   // Established: object state conflict, for Set and Reset alike.
@@ -796,8 +811,7 @@ TEST_F(Cdn127SlaveTest, ExceptionStatusFollowsThePumpAndTheEnables) {
   slave_->pump().set_warning(true);
   // Device Specific Error (bit 1) and Warning (bit 5), expanded mode bit 7
   EXPECT_EQ(get(0x32, 0x01, 0x0C), (ByteVec{0x8E, 0xA2}));
-  EXPECT_EQ(get(0x32, 0x01, 0x0D),
-            (ByteVec{0x8E, 2, 0, 0, 8, 8, 0, 8, 0, 2, 0, 1, 0, 1, 0x02}));
+  EXPECT_EQ(get(0x32, 0x01, 0x0D), (ByteVec{0x8E, 2, 0, 0, 8, 8, 0, 8, 0, 2, 0, 1, 0, 1, 0x02}));
   EXPECT_EQ(get(0x32, 0x01, 0x0E), (ByteVec{0x8E, 2, 0, 0, 0, 1, 0x01}));
   // Clearing the alarm enable clears the alarm bits
   EXPECT_EQ(set(0x32, 0x01, 0x0F, {0x00}), (ByteVec{0x90}));
@@ -818,7 +832,8 @@ TEST_F(Cdn127SlaveTest, DeviceSupervisorStrings) {
   allocate();
   EXPECT_EQ(get(0x32, 0x01, 0x03), (ByteVec{0x8E, 9, 'A', 'N', 'A', 'L', 'O', 'G', ' ', 'I', 'O'}));
   EXPECT_EQ(get(0x32, 0x01, 0x04), (ByteVec{0x8E, 8, 'E', '0', '0', '-', '0', '0', '0', '0'}));
-  EXPECT_EQ(get(0x32, 0x01, 0x05), (ByteVec{0x8E, 11, 'D', '.', 'I', '.', 'P', '.', ' ', 'I', 'n', 'c', '.'}));
+  EXPECT_EQ(get(0x32, 0x01, 0x05),
+            (ByteVec{0x8E, 11, 'D', '.', 'I', '.', 'P', '.', ' ', 'I', 'n', 'c', '.'}));
   EXPECT_EQ(get(0x32, 0x01, 0x06), (ByteVec{0x8E, 6, 'C', 'D', 'N', '1', '2', '7'}));
   EXPECT_EQ(get(0x32, 0x01, 0x07), (ByteVec{0x8E, 6, '0', '1', '.', '0', '0', '5'}));
   EXPECT_EQ(get(0x32, 0x01, 0x08), (ByteVec{0x8E, 6, '0', '1', '.', '0', '0', '0'}));
@@ -871,7 +886,8 @@ TEST_F(Cdn127SlaveTest, SwitchAttributesNotSupportedInProgramPosition) {
   EXPECT_EQ(slave_->owner(), 255);
   // Baud: kept for the next power-up.
   advance(milliseconds(2001));
-  EXPECT_EQ(single(0x43E, {kMaster, 0x4B, 0x03, 0x01, 0x01, kMaster}, 0x43B), (ByteVec{kMaster, 0xCB, 0x00}));
+  EXPECT_EQ(single(0x43E, {kMaster, 0x4B, 0x03, 0x01, 0x01, kMaster}, 0x43B),
+            (ByteVec{kMaster, 0xCB, 0x00}));
 }
 
 // ---------------------------------------------------------------------------
@@ -882,19 +898,19 @@ TEST_F(Cdn127SlaveTest, UnlistedServicesAndAttributesGiveTheirErrors) {
   allocate();
   EXPECT_EQ(set(0x01, 0x01, 0x01, {0x01, 0x00}), error(0x08));  // Identity has no Set
   EXPECT_EQ(get(0x01, 0x01, 0x09), error(0x14));
-  EXPECT_EQ(get(0x01, 0x02, 0x01), error(0x16));                // one instance
-  EXPECT_EQ(get(0x07, 0x01, 0x01), error(0x16));                // no such class
+  EXPECT_EQ(get(0x01, 0x02, 0x01), error(0x16));  // one instance
+  EXPECT_EQ(get(0x07, 0x01, 0x01), error(0x16));  // no such class
   EXPECT_EQ(request({0x4B, 0x01, 0x01, 0x03, kMaster}), error(0x08));
-  EXPECT_EQ(request({0x32, 0x01, 0x01}), error(0x08));          // unknown service code
-  EXPECT_EQ(get(0x02, 0x00, 0x02), error(0x14));                // Router class: 1, 6, 7
+  EXPECT_EQ(request({0x32, 0x01, 0x01}), error(0x08));  // unknown service code
+  EXPECT_EQ(get(0x02, 0x00, 0x02), error(0x14));        // Router class: 1, 6, 7
   EXPECT_EQ(get(0x02, 0x00, 0x07), (ByteVec{0x8E, 0x02, 0x00}));
   EXPECT_EQ(get(0x02, 0x01, 0x02), (ByteVec{0x8E, 0x02, 0x00}));
-  EXPECT_EQ(set(0x08, 0x01, 0x03, {0x01}), error(0x08));        // DIP: Get only
-  EXPECT_EQ(get(0x08, 0x08, 0x03), error(0x16));                // DIP 1..7
+  EXPECT_EQ(set(0x08, 0x01, 0x03, {0x01}), error(0x08));  // DIP: Get only
+  EXPECT_EQ(get(0x08, 0x08, 0x03), error(0x16));          // DIP 1..7
   EXPECT_EQ(get(0x08, 0x07, 0x04), (ByteVec{0x8E, 0x00}));
-  EXPECT_EQ(get(0x09, 0x03, 0x03), error(0x16));                // DOP: 2 of max 8
+  EXPECT_EQ(get(0x09, 0x03, 0x03), error(0x16));  // DOP: 2 of max 8
   EXPECT_EQ(get(0x09, 0x00, 0x02), (ByteVec{0x8E, 0x08, 0x00}));
-  EXPECT_EQ(set(0x09, 0x01, 0x04, {0x00}), error(0x0E));        // DOP status
+  EXPECT_EQ(set(0x09, 0x01, 0x04, {0x00}), error(0x0E));  // DOP status
   EXPECT_EQ(set(0x09, 0x01, 0x05, {0x02}), error(0x09));
   EXPECT_EQ(set(0x09, 0x01, 0x05, {}), error(0x13));
   EXPECT_EQ(set(0x09, 0x01, 0x05, {0x01, 0x00}), error(0x15));
@@ -905,12 +921,12 @@ TEST_F(Cdn127SlaveTest, UnlistedServicesAndAttributesGiveTheirErrors) {
   EXPECT_EQ(set(0x0B, 0x01, 0x0B, {0xFF, 0x0F}), (ByteVec{0x90}));
   EXPECT_EQ(set(0x0B, 0x01, 0x09, {0x04}), error(0x09));
   EXPECT_EQ(get(0x0B, 0x01, 0x04), error(0x14));
-  EXPECT_EQ(set(0x04, 0x01, 0x03, {0x00}), error(0x0E));        // produced assembly
+  EXPECT_EQ(set(0x04, 0x01, 0x03, {0x00}), error(0x0E));  // produced assembly
   EXPECT_EQ(set(0x04, 0x05, 0x03, {}), error(0x13));
   EXPECT_EQ(set(0x04, 0x05, 0x03, {0x01, 0x00}), error(0x15));
   EXPECT_EQ(get(0x04, 0x04, 0x03), error(0x16));
   EXPECT_EQ(get(0x04, 0x00, 0x02), (ByteVec{0x8E, 0x64, 0x00}));
-  EXPECT_EQ(request({0x0E, 0x01, 0x01}), error(0x13));          // no attribute byte
+  EXPECT_EQ(request({0x0E, 0x01, 0x01}), error(0x13));  // no attribute byte
   EXPECT_EQ(request({0x0E, 0x01, 0x01, 0x01, 0x00}), error(0x15));
   EXPECT_EQ(set(0x01, 0x00, 0x01, {0x01, 0x00}), error(0x08));  // class-level Set
 }
@@ -1661,7 +1677,8 @@ TEST(PumpModel, RunningFollowsPumpOnAfterSpinUpAndSpinDown) {
   c.spin_down = seconds(5);
   PumpModel pump(c);
   TimePoint t{};
-  pump.set_outputs({.pump_on = true, .n2_ballast_on = false, .analog_out_raw = 0}, OutputCause::kPoll, t);
+  pump.set_outputs({.pump_on = true, .n2_ballast_on = false, .analog_out_raw = 0},
+                   OutputCause::kPoll, t);
   EXPECT_EQ(pump.next_deadline(), t + seconds(3));
   pump.advance(t + milliseconds(2999));
   EXPECT_FALSE(pump.running());
@@ -1679,7 +1696,8 @@ TEST(PumpModel, RunningFollowsPumpOnAfterSpinUpAndSpinDown) {
 TEST(PumpModel, SwitchedOffBeforeSpeedNeverRuns) {
   PumpModel pump;
   TimePoint t{};
-  pump.set_outputs({.pump_on = true, .n2_ballast_on = false, .analog_out_raw = 0}, OutputCause::kPoll, t);
+  pump.set_outputs({.pump_on = true, .n2_ballast_on = false, .analog_out_raw = 0},
+                   OutputCause::kPoll, t);
   pump.set_outputs({}, OutputCause::kPoll, t + seconds(1));
   pump.advance(t + seconds(10));
   EXPECT_FALSE(pump.running());
@@ -1692,7 +1710,8 @@ TEST(PumpModel, InterlockAndAlarmStopThePump) {
   PumpModel pump(c);
   TimePoint t{};
   pump.set_interlock_ok(false, t);
-  pump.set_outputs({.pump_on = true, .n2_ballast_on = false, .analog_out_raw = 0}, OutputCause::kPoll, t);
+  pump.set_outputs({.pump_on = true, .n2_ballast_on = false, .analog_out_raw = 0},
+                   OutputCause::kPoll, t);
   EXPECT_FALSE(pump.running());
   pump.set_interlock_ok(true, t);
   EXPECT_TRUE(pump.running());

@@ -40,8 +40,8 @@ class GatewayHarness final : public devicenet::ScannerObserver {
     return nullptr;
   }
   std::size_t count(std::uint32_t txid) const {
-    return static_cast<std::size_t>(
-        std::count_if(replies.begin(), replies.end(), [&](const auto& r) { return r.txid == txid; }));
+    return static_cast<std::size_t>(std::count_if(replies.begin(), replies.end(),
+                                                  [&](const auto& r) { return r.txid == txid; }));
   }
 
   ExplicitGateway* gateway = nullptr;
@@ -76,10 +76,12 @@ class Gateway : public ::testing::Test {
   }
   void start() {
     rack_->start();
-    rack_->world().run_until([&] { return rack_->pumps().pump(mac(1))->online &&
-                                          rack_->pumps().pump(mac(2))->online &&
-                                          rack_->pumps().pump(mac(3))->state == NodeState::kWrongDevice; },
-                             seconds(30));
+    rack_->world().run_until(
+        [&] {
+          return rack_->pumps().pump(mac(1))->online && rack_->pumps().pump(mac(2))->online &&
+                 rack_->pumps().pump(mac(3))->state == NodeState::kWrongDevice;
+        },
+        seconds(30));
   }
   void run(Duration d = seconds(3)) { rack_->world().run_for(d); }
   TimePoint now() { return rack_->now(); }
@@ -95,7 +97,8 @@ class Gateway : public ::testing::Test {
 
 TEST_F(Gateway, ExecuteReturnsTheDevicesDataAndCipStatus) {
   start();
-  harness_.request(get_call(1, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kProductName), now());
+  harness_.request(get_call(1, 1, cdn127::class_id::kIdentity, cdn127::identity_attr::kProductName),
+                   now());
   harness_.request(get_call(2, 1, cdn127::class_id::kIdentity, 99), now());
   EXPECT_EQ(gateway_->in_progress(), 2u);
   run();
@@ -295,7 +298,8 @@ TEST_F(Gateway, CompletedTransactionsAreRetainedWithinTheLimit) {
   limits_.retained = 4;
   SetUp();
   start();
-  for (std::uint32_t t = 1; t <= 10; ++t) harness_.request(get_call(t, 2, 1, 1), now()), run(milliseconds(50));
+  for (std::uint32_t t = 1; t <= 10; ++t)
+    harness_.request(get_call(t, 2, 1, 1), now()), run(milliseconds(50));
   run();
   EXPECT_EQ(gateway_->retained(), 4u);
   // The oldest six are forgotten, the newest four kept.

@@ -110,7 +110,7 @@ TEST_F(MasterSlave, LifeCycleGoesThroughEveryStepWithReasons) {
   EXPECT_EQ(std::vector<PortState>(events_.port_states.begin(), events_.port_states.end()),
             (std::vector<PortState>{PortState::kCheckingMac, PortState::kRunning}));
   // The master checked its own MAC for 2 s before it allocated anything.
-  EXPECT_GE(events_.of(mac(12)).at(1).at - TimePoint{} , seconds(3) - milliseconds(1));
+  EXPECT_GE(events_.of(mac(12)).at(1).at - TimePoint{}, seconds(3) - milliseconds(1));
 }
 
 TEST_F(MasterSlave, OutputsAndInputsRoundTrip) {
@@ -290,8 +290,8 @@ TEST_F(MasterSlave, WrongIdentityIsAFaultAndNeverPolled) {
   config.pumps[0].identity = devicenet::ExpectedIdentity{59, 27, 1777};
   build(config);
   rack().start();
-  rack().world().run_until([&] { return view(21).online && view(20).state == NodeState::kWrongDevice; },
-                           seconds(20));
+  rack().world().run_until(
+      [&] { return view(21).online && view(20).state == NodeState::kWrongDevice; }, seconds(20));
   EXPECT_EQ(view(20).state, NodeState::kWrongDevice);
   EXPECT_NE(view(20).reason.find("product code 1777"), std::string::npos) << view(20).reason;
   EXPECT_NE(view(20).reason.find("product code 1888"), std::string::npos) << view(20).reason;
@@ -332,7 +332,8 @@ TEST_F(MasterSlave, DeviceConfigurationIsMadeToMatchTheScanList) {
   build(config);
   rack().start();
   ASSERT_TRUE(run_until_online());
-  EXPECT_EQ(device(15).device().configuration(), cdn127::preset(cdn127::ConfigurationPreset::kCdn118));
+  EXPECT_EQ(device(15).device().configuration(),
+            cdn127::preset(cdn127::ConfigurationPreset::kCdn118));
   EXPECT_EQ(node(15).config().profile.produced_size, 2u);
   EXPECT_EQ(node(15).config().profile.consumed_size, 3u);
   cdn127::PumpOutputs out;
@@ -420,7 +421,8 @@ TEST_F(MasterSlave, DeviceSupervisorStringsAreReadThroughFragmentation) {
                             Expected{cdn127::supervisor_attr::kSemiRevisionLevel, "E00-0000"},
                             Expected{cdn127::supervisor_attr::kManufacturerName, "D.I.P. Inc."},
                             Expected{cdn127::supervisor_attr::kManufacturerModel, "CDN127"}}) {
-    const auto* done = explicit_request(8, get(cdn127::class_id::kDeviceSupervisor, 1, e.attribute));
+    const auto* done =
+        explicit_request(8, get(cdn127::class_id::kDeviceSupervisor, 1, e.attribute));
     ASSERT_NE(done, nullptr);
     ASSERT_TRUE(done->result.ok()) << done->result.error.message();
     auto text = cip::decode_short_string(done->result.data.view());

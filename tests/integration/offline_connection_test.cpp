@@ -17,10 +17,10 @@
 namespace dnbridge::sim {
 namespace {
 
-using test::ByteVec;
-using test::hex;
 using devicenet::CommFaultedLayout;
 using devicenet::OwnershipIdentity;
+using test::ByteVec;
+using test::hex;
 using State = Cdn127Slave::NetworkState;
 
 constexpr std::uint32_t kCommFaultedResponse = 0x7EC;
@@ -109,7 +109,8 @@ TEST_F(OfflineConnectionTest, FaultedNodeIsRecoveredToANewMacAndComesOnlineThere
 
   // Online, the offline set is ignored.
   EXPECT_TRUE(exchange(kCommFaultedRequest, {0x3F, 0x4B}).empty());
-  EXPECT_TRUE(exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
 }
 
 TEST_F(OfflineConnectionTest, RecoveryAtTheSameMacRerunsTheDuplicateCheck) {
@@ -129,12 +130,15 @@ TEST_F(OfflineConnectionTest, NodesNotInCommunicationFaultIgnoreTheSet) {
   slave_->power_on(now_);
   sink_.take();
   EXPECT_TRUE(exchange(kCommFaultedRequest, {0x3F, 0x4B}).empty());
-  EXPECT_TRUE(exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
   advance(milliseconds(2001));
   ASSERT_EQ(slave_->network_state(), State::kOnline);
   sink_.take();
-  EXPECT_TRUE(exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
-  EXPECT_TRUE(exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
   EXPECT_EQ(slave_->mac().value(), 3);
   EXPECT_FALSE(slave_->offline_owner().has_value());
 }
@@ -146,16 +150,20 @@ TEST_F(OfflineConnectionTest, IdentifyAnswersOnlyWhenTheRequestMatches) {
   // match 1, value 3: this node.
   EXPECT_EQ(exchange(kCommFaultedRequest, {0x43, 0x4B}), Frames{"7EC: 03 CB 3B 00 34 12 00 00"});
   // The ICP DAS form with a time delay byte offset: answered (at once).
-  EXPECT_EQ(exchange(kCommFaultedRequest, {0x3F, 0x4B, 0x02}), Frames{"7EC: 03 CB 3B 00 34 12 00 00"});
+  EXPECT_EQ(exchange(kCommFaultedRequest, {0x3F, 0x4B, 0x02}),
+            Frames{"7EC: 03 CB 3B 00 34 12 00 00"});
   // Long form: by vendor + serial.
   EXPECT_EQ(exchange(kCommFaultedRequest, {0x00, 0x4B, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}),
             Frames{"7EC: 03 CB 3B 00 34 12 00 00"});
-  EXPECT_TRUE(exchange(kCommFaultedRequest, {0x00, 0x4B, 0x3B, 0x00, 0x35, 0x12, 0x00, 0x00}).empty());
-  EXPECT_TRUE(exchange(kCommFaultedRequest, {0x00, 0x4B, 0x3C, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kCommFaultedRequest, {0x00, 0x4B, 0x3B, 0x00, 0x35, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kCommFaultedRequest, {0x00, 0x4B, 0x3C, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
   // Other services, responses, malformed lengths: silence.
   EXPECT_TRUE(exchange(kCommFaultedRequest, {0x3F, 0x0E}).empty());
   EXPECT_TRUE(exchange(kCommFaultedRequest, {0x3F, 0xCB}).empty());
-  EXPECT_TRUE(exchange(kCommFaultedResponse, {0x03, 0xCB, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kCommFaultedResponse, {0x03, 0xCB, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
   EXPECT_TRUE(exchange(kCommFaultedRequest, {0x3F, 0x4B, 0x00, 0x00}).empty());
   EXPECT_TRUE(exchange(kCommFaultedRequest, {0x3F}).empty());
   EXPECT_TRUE(exchange(0x7C0, {0x3F, 0x4B}).empty());
@@ -174,26 +182,31 @@ TEST_F(OfflineConnectionTest, IdentifyResponseInTheVendorManualLayout) {
 TEST_F(OfflineConnectionTest, SetMacNeedsOwnershipAndMustNameTheNode) {
   fault_by_duplicate();
   // No ownership yet: refused, silently.
-  EXPECT_TRUE(exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
   EXPECT_EQ(slave_->counters().requests_refused, 1u);
   // Ownership naming another node (kTarget): not for us.
-  EXPECT_TRUE(exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x99, 0x00, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x99, 0x00, 0x00, 0x00}).empty());
   EXPECT_FALSE(slave_->offline_owner().has_value());
   take_ownership();
   // Another client cannot take it over.
-  EXPECT_TRUE(exchange(kOwnershipRequest, {0x0B, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kOwnershipRequest, {0x0B, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
   EXPECT_EQ(slave_->offline_owner()->value(), 10);
   // The owner asks again: answered.
   EXPECT_EQ(exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}),
             Frames{"7EE: 0A 81 3B 00 34 12 00 00"});
   // Set MAC naming another serial: not for us.
-  EXPECT_TRUE(exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x35, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x35, 0x12, 0x00, 0x00}).empty());
   EXPECT_EQ(slave_->mac().value(), 3);
   // Release (allocate 0), then the MAC change is refused again.
   EXPECT_EQ(exchange(kOwnershipRequest, {0x0A, 0x00, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}),
             Frames{"7EE: 0A 80 3B 00 34 12 00 00"});
   EXPECT_FALSE(slave_->offline_owner().has_value());
-  EXPECT_TRUE(exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
   EXPECT_EQ(slave_->network_state(), State::kCommunicationFault);
 }
 
@@ -203,7 +216,8 @@ TEST_F(OfflineConnectionTest, MacFromTheSwitchCannotBeChangedOffline) {
   create(o);
   fault_by_duplicate();
   take_ownership();
-  EXPECT_TRUE(exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kCommFaultedRequest, {0x07, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
   EXPECT_EQ(slave_->network_state(), State::kCommunicationFault);
   EXPECT_EQ(slave_->mac().value(), 3);
 }
@@ -217,7 +231,8 @@ TEST_F(OfflineConnectionTest, ClientIdentityOwnershipIsAnsweredByAnyFaultedNode)
   EXPECT_EQ(exchange(kOwnershipRequest, {0x0A, 0x01, 0x01, 0x00, 0x01, 0x00, 0x00, 0xDB}),
             Frames{"7EE: 0A 81 01 00 01 00 00 DB"});
   // The same MAC with another identity is another client.
-  EXPECT_TRUE(exchange(kOwnershipRequest, {0x0A, 0x01, 0x01, 0x00, 0x02, 0x00, 0x00, 0xDB}).empty());
+  EXPECT_TRUE(
+      exchange(kOwnershipRequest, {0x0A, 0x01, 0x01, 0x00, 0x02, 0x00, 0x00, 0xDB}).empty());
   EXPECT_EQ(exchange(kCommFaultedRequest, {0x09, 0x10, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}),
             (Frames{"7EC: 09 90 3B 00 34 12 00 00", "44F: 00 3B 00 34 12 00 00"}));
 }
@@ -228,7 +243,8 @@ TEST_F(OfflineConnectionTest, UnsupportedSetIsIgnored) {
   create(o);
   fault_by_duplicate();
   EXPECT_TRUE(exchange(kCommFaultedRequest, {0x3F, 0x4B}).empty());
-  EXPECT_TRUE(exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
+  EXPECT_TRUE(
+      exchange(kOwnershipRequest, {0x0A, 0x01, 0x3B, 0x00, 0x34, 0x12, 0x00, 0x00}).empty());
 }
 
 TEST_F(OfflineConnectionTest, PowerCycleDropsOwnership) {

@@ -27,19 +27,23 @@ TEST(PumpRack, RefusedCommandsAreCountedWithTheirReasonAndNothingIsApplied) {
 
   cdn127::PumpOutputs bad = good;
   bad.analog_out_raw = 5000;
-  EXPECT_EQ(rack.pumps().command(mac(1), bad, "supervisor-b", rack.now()).error(), Errc::kOutOfRange);
+  EXPECT_EQ(rack.pumps().command(mac(1), bad, "supervisor-b", rack.now()).error(),
+            Errc::kOutOfRange);
   rack.world().run_for(milliseconds(200));
   const auto& v1 = *rack.pumps().pump(mac(1));
   EXPECT_EQ(v1.commands_accepted, 1u);
   EXPECT_EQ(v1.commands_refused, 1u);
-  EXPECT_NE(v1.last_command_refused.find("supervisor-b"), std::string::npos) << v1.last_command_refused;
+  EXPECT_NE(v1.last_command_refused.find("supervisor-b"), std::string::npos)
+      << v1.last_command_refused;
   EXPECT_NE(v1.last_command_refused.find("5000"), std::string::npos) << v1.last_command_refused;
   // The refused command changed nothing: the accepted one stays in force.
   EXPECT_EQ(rack.device(mac(1)).device().outputs(), good);
   EXPECT_EQ(v1.commanded_by, "supervisor-a");
 
-  EXPECT_EQ(rack.pumps().command(mac(2), good, "supervisor-a", rack.now()).error(), Errc::kUnsupported);
-  EXPECT_NE(rack.pumps().pump(mac(2))->last_command_refused.find("no analog output"), std::string::npos);
+  EXPECT_EQ(rack.pumps().command(mac(2), good, "supervisor-a", rack.now()).error(),
+            Errc::kUnsupported);
+  EXPECT_NE(rack.pumps().pump(mac(2))->last_command_refused.find("no analog output"),
+            std::string::npos);
   EXPECT_FALSE(rack.device(mac(2)).device().outputs().pump_on);  // not applied half
 
   EXPECT_EQ(rack.pumps().command(mac(40), good, "x", rack.now()).error(), Errc::kOutOfRange);

@@ -36,7 +36,8 @@ class EventRecorder final : public devicenet::ScannerObserver {
     port_states.push_back(s);
     port_reason = r;
   }
-  void on_node_state(MacId m, NodeState f, NodeState t, const std::string& r, TimePoint at) override {
+  void on_node_state(MacId m, NodeState f, NodeState t, const std::string& r,
+                     TimePoint at) override {
     transitions.push_back({m, f, t, r, at});
   }
   void on_explicit_result(std::uint32_t id, MacId m, const devicenet::ExplicitResult& r,

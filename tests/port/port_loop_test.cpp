@@ -227,7 +227,8 @@ TEST(PortLoop, RunsARackOnItsOwnThread) {
   EXPECT_EQ(publisher.replies[0].status, rack::TransactionStatus::kSuccess);
   EXPECT_EQ(publisher.replies[0].data.size(), 7u);
 
-  ASSERT_TRUE(publisher.wait_for([&] { return publisher.port && publisher.port->nodes_online == 3; }));
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.port && publisher.port->nodes_online == 3; }));
   {
     // Polled every 20 ms: the measured cycle says so.
     ASSERT_TRUE(publisher.wait_for([&] { return publisher.port->scan_cycle_ms > 0; }));
@@ -391,7 +392,8 @@ TEST(PortLoop, BadCommandsAreRefusedAndReported) {
                 std::make_unique<sim::SimBackend>(can::kBitrate500k, std::vector<MacId>{mac(4)}),
                 publisher, null_log_sink());
   loop.start();
-  ASSERT_TRUE(publisher.wait_for([&] { return publisher.pumps.count(4) && publisher.pumps[4].online; }));
+  ASSERT_TRUE(
+      publisher.wait_for([&] { return publisher.pumps.count(4) && publisher.pumps[4].online; }));
   profiles::cdn127::PumpOutputs out;
   out.analog_out_raw = 9999;
   loop.command(mac(4), rack::NodeCommand(out), "careless");

@@ -135,7 +135,8 @@ class SecureBridgeTest : public ::testing::Test {
     auto c = daemon::embedded_default_config();
     c.domain_id = kDomain;
     for (auto& port : c.ports) {
-      for (auto& node : port.nodes) node.pump.no_commander = daemon::NoCommanderPolicy::kHoldLastOutputs;
+      for (auto& node : port.nodes)
+        node.pump.no_commander = daemon::NoCommanderPolicy::kHoldLastOutputs;
     }
     c.security = settings_of("rack");
     return c;

@@ -247,8 +247,8 @@ double guest_slowdown() {
 
 std::chrono::milliseconds patience(std::chrono::milliseconds base) {
   static const double factor = guest_slowdown();
-  return std::chrono::milliseconds(
-      static_cast<std::chrono::milliseconds::rep>(std::ceil(static_cast<double>(base.count()) * factor)));
+  return std::chrono::milliseconds(static_cast<std::chrono::milliseconds::rep>(
+      std::ceil(static_cast<double>(base.count()) * factor)));
 }
 
 fs::path work_dir() {

@@ -603,7 +603,8 @@ TEST_F(SystemTest, PowerCycledDeviceComesBack) {
   start_bridge({{"A", "vcan0", {5, 6}}});
   ASSERT_TRUE(wait_online("A", {5, 6}));
   ASSERT_TRUE(supervisor().command("A", 6, true));
-  ASSERT_TRUE(wait_sim(sim, 2, [](const SimStatus& s) { return s.at(6).pump_on; }, 10s))
+  ASSERT_TRUE(wait_sim(
+      sim, 2, [](const SimStatus& s) { return s.at(6).pump_on; }, 10s))
       << "pump 6 did not come on";
 
   sim.send("power-cycle 6");
@@ -625,7 +626,8 @@ TEST_F(SystemTest, PowerCycledDeviceComesBack) {
   }
   // A command written after the return: applied.
   ASSERT_TRUE(supervisor().command("A", 6, true));
-  ASSERT_TRUE(wait_sim(sim, 2, [](const SimStatus& s) { return s.at(6).pump_on; }, 10s))
+  ASSERT_TRUE(wait_sim(
+      sim, 2, [](const SimStatus& s) { return s.at(6).pump_on; }, 10s))
       << "pump 6 did not come on after a new command";
 
   sim.send("power-off 5");

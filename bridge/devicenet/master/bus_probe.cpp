@@ -79,7 +79,7 @@ class BusProbe::Slot final : private ExplicitClient::Listener {
     }
   }
 
-  void end(ScanOutcome outcome, std::string detail) {
+  void end(ScanOutcome outcome, const std::string& detail) {
     if (done_) return;
     finding_.outcome = outcome;
     // An identity only whole: what was read of one refused in part is not

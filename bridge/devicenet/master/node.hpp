@@ -61,9 +61,9 @@ class Node final : private ExplicitClient::Listener {
   // (the bus was lost; the master checks its MAC again first).
   void suspend(std::string_view reason, TimePoint now);
 
-  void on_explicit_frame(Bytes payload, TimePoint now);  // Group 2 message 3
-  void on_poll_response(Bytes payload, TimePoint now);   // Group 1 message 15
-  void on_cos_message(Bytes payload, TimePoint now);     // Group 1 message 13
+  void on_explicit_frame(Bytes payload, TimePoint now);   // Group 2 message 3
+  void on_poll_response(Bytes payload, TimePoint now);    // Group 1 message 15
+  void on_cos_message(Bytes payload, TimePoint now);      // Group 1 message 13
   void on_strobe_response(Bytes payload, TimePoint now);  // Group 1 message 14
   // The node sent a duplicate MAC check request: it is powering up.
   void on_duplicate_mac_request(TimePoint now);
@@ -187,16 +187,16 @@ class Node final : private ExplicitClient::Listener {
   };
   // One row of the start-up table.
   struct StepRow {
-    Step step;
-    NodeState phase;  // the state reported while it runs
-    Verb verb;
+    Step step{};
+    NodeState phase{};  // the state reported while it runs
+    Verb verb{};
     cip::AttributeRef target;  // Get/Set: the attribute; a profile's from the profile
-    std::uint8_t choice;       // Allocate/Release: allocation choice bits
-    OnRefusal on_refusal;
-    Step next;  // after a good answer, unless the handler chooses
+    std::uint8_t choice = 0;   // Allocate/Release: allocation choice bits
+    OnRefusal on_refusal{};
+    Step next{};  // after a good answer, unless the handler chooses
     // Checks a good answer (and, with kHandler, a refusal); returns the next
     // step, or kNone when it has moved the node itself (a fault, a wait).
-    Step (Node::*handler)(const ExplicitResult&, TimePoint);
+    Step (Node::*handler)(const ExplicitResult&, TimePoint) = nullptr;
   };
   static const StepRow kStartup[];
   static const StepRow& row(Step step);
@@ -352,8 +352,8 @@ class Node final : private ExplicitClient::Listener {
   // A Release refused whole (0x0B): the connections still to release one
   // at a time (the one in hand included); 0 otherwise.
   std::uint8_t releases_left_ = 0;
-  InlineBytes<16> setting_found_;    // what the device had before the Set
-  unsigned step_timeouts_ = 0;       // consecutive timeouts of the current life-cycle step
+  InlineBytes<16> setting_found_;  // what the device had before the Set
+  unsigned step_timeouts_ = 0;     // consecutive timeouts of the current life-cycle step
   Step last_step_ = Step::kNone;
   RequestMessage last_request_;
   InlineBytes<64> last_request_data_;

@@ -1021,6 +1021,7 @@ Node::Step Node::cos_step_after(Step step) const {
     }
   };
   const auto* at = std::find(std::begin(kOrder), std::end(kOrder), step);
+  if (at == std::end(kOrder)) return Step::kExplicitEpr;  // not a step of the input connection
   for (++at; at != std::end(kOrder); ++at) {
     if (applies(*at)) return *at;
   }

@@ -23,6 +23,7 @@ class MacId {
   }
 
   constexpr std::uint8_t value() const noexcept { return v_; }
+  // NOLINTNEXTLINE(modernize-use-nullptr): misread in a defaulted <=> (llvm-project#53961)
   friend constexpr auto operator<=>(MacId, MacId) noexcept = default;
 
  private:

@@ -41,12 +41,16 @@ Result<IdentityStatus> decode_identity_status(Bytes value) noexcept {
 Result<SerialNumber> decode_serial_number(Bytes value) noexcept {
   ByteReader r{value};
   switch (value.size()) {
-    case 2: return SerialNumber{.value = r.u16le(), .width = 2};
-    case 4: return SerialNumber{.value = r.u32le(), .width = 4};
+    case 2:
+      return SerialNumber{.value = r.u16le(), .width = 2};
+    case 4:
+      return SerialNumber{.value = r.u32le(), .width = 4};
     case 0:
     case 1:
-    case 3: return Errc::kTruncated;
-    default: return Errc::kMalformed;
+    case 3:
+      return Errc::kTruncated;
+    default:
+      return Errc::kMalformed;
   }
 }
 
@@ -69,12 +73,18 @@ Result<IdentityState> decode_identity_state(Bytes value) noexcept {
 
 std::string_view to_string(IdentityState state) noexcept {
   switch (state) {
-    case IdentityState::kNonExistent: return "non-existent";
-    case IdentityState::kSelfTest: return "self test";
-    case IdentityState::kStandby: return "standby";
-    case IdentityState::kOperating: return "operating";
-    case IdentityState::kMajorRecoverableFault: return "major recoverable fault";
-    case IdentityState::kMajorUnrecoverableFault: return "major unrecoverable fault";
+    case IdentityState::kNonExistent:
+      return "non-existent";
+    case IdentityState::kSelfTest:
+      return "self test";
+    case IdentityState::kStandby:
+      return "standby";
+    case IdentityState::kOperating:
+      return "operating";
+    case IdentityState::kMajorRecoverableFault:
+      return "major recoverable fault";
+    case IdentityState::kMajorUnrecoverableFault:
+      return "major unrecoverable fault";
   }
   return "reserved";
 }
@@ -86,13 +96,20 @@ Result<SupervisorDeviceStatus> decode_supervisor_device_status(Bytes value) noex
 
 std::string_view to_string(SupervisorDeviceStatus status) noexcept {
   switch (status) {
-    case SupervisorDeviceStatus::kUndefined: return "undefined";
-    case SupervisorDeviceStatus::kSelfTesting: return "self testing";
-    case SupervisorDeviceStatus::kIdle: return "idle";
-    case SupervisorDeviceStatus::kSelfTestException: return "self-test exception";
-    case SupervisorDeviceStatus::kExecuting: return "executing";
-    case SupervisorDeviceStatus::kAbort: return "abort";
-    case SupervisorDeviceStatus::kCriticalFault: return "critical fault";
+    case SupervisorDeviceStatus::kUndefined:
+      return "undefined";
+    case SupervisorDeviceStatus::kSelfTesting:
+      return "self testing";
+    case SupervisorDeviceStatus::kIdle:
+      return "idle";
+    case SupervisorDeviceStatus::kSelfTestException:
+      return "self-test exception";
+    case SupervisorDeviceStatus::kExecuting:
+      return "executing";
+    case SupervisorDeviceStatus::kAbort:
+      return "abort";
+    case SupervisorDeviceStatus::kCriticalFault:
+      return "critical fault";
   }
   // Manual: "7-50 Reserved", "51-99 Device Specific", "100-255 Vendor Specific".
   const auto v = static_cast<std::uint8_t>(status);

@@ -113,7 +113,7 @@ Result<ExceptionStatus> decode_exception_status(Bytes value) noexcept;
 // device detail: a USINT count of status bits, then (count + 7) / 8 bytes.
 struct PointStatus {
   static constexpr std::size_t kMaxBytes = (255 + 7) / 8;
-  std::uint8_t count = 0;                   // status bits (number of points)
+  std::uint8_t count = 0;                      // status bits (number of points)
   std::array<std::uint8_t, kMaxBytes> bits{};  // (count + 7) / 8 bytes are used
   // Status bit of point `index` (0-based: instance index + 1); false past count.
   bool fault(std::size_t index) const noexcept {

@@ -2,6 +2,8 @@
 // their meaning, analog scaling, and the poll request's outputs.
 #include "bridge/profiles/cdn127/io_data.hpp"
 
+#include <cmath>
+
 namespace dnbridge::profiles::cdn127 {
 
 // CDN127 manual, AIP "Value - Attribute 3": "integers in the range 0..4095
@@ -16,7 +18,7 @@ Result<std::uint16_t> volts_to_raw(double volts) noexcept {
   // Written so that NaN fails too.
   if (!(volts >= 0.0 && volts <= kAnalogFullScaleVolts)) return Errc::kOutOfRange;
   const double steps = volts * static_cast<double>(kAnalogMaxRaw) / kAnalogFullScaleVolts;
-  return static_cast<std::uint16_t>(steps + 0.5);  // non-negative: +0.5 rounds to nearest
+  return static_cast<std::uint16_t>(std::lround(steps));
 }
 
 namespace {
@@ -87,9 +89,9 @@ PumpInputs PumpInputs::decode(std::uint8_t bits, std::uint8_t no_nc_mask) noexce
 }
 
 std::uint8_t PumpInputs::encode(std::uint8_t no_nc_mask) const noexcept {
-  const auto normal = static_cast<std::uint8_t>(set_if(pump_running, 0) | set_if(!warning_active, 1) |
-                                                set_if(n2_flow_ok, 2) | set_if(!alarm_active, 3) |
-                                                set_if(interlock_ok, 4));
+  const auto normal = static_cast<std::uint8_t>(set_if(pump_running, 0) |
+                                                set_if(!warning_active, 1) | set_if(n2_flow_ok, 2) |
+                                                set_if(!alarm_active, 3) | set_if(interlock_ok, 4));
   return static_cast<std::uint8_t>((normal ^ no_nc_mask) & kPumpInputMask);
 }
 

@@ -21,13 +21,13 @@ Result<std::uint16_t> volts_to_raw(double volts) noexcept;
 // Device Supervisor exception status byte (manual, Assembly note (1) and
 // Device Supervisor attribute 12).
 struct ExceptionStatus {
-  bool alarm_device_common = false;        // bit 0
-  bool alarm_device_specific = false;      // bit 1: N2 flow, pump alarm or pump fail
-  bool alarm_manufacturer_specific = false;  // bit 2
-  bool warning_device_common = false;      // bit 4
-  bool warning_device_specific = false;    // bit 5: pump warning
+  bool alarm_device_common = false;            // bit 0
+  bool alarm_device_specific = false;          // bit 1: N2 flow, pump alarm or pump fail
+  bool alarm_manufacturer_specific = false;    // bit 2
+  bool warning_device_common = false;          // bit 4
+  bool warning_device_specific = false;        // bit 5: pump warning
   bool warning_manufacturer_specific = false;  // bit 6
-  bool expanded_mode = false;              // bit 7
+  bool expanded_mode = false;                  // bit 7
 
   static ExceptionStatus decode(std::uint8_t byte) noexcept;
   std::uint8_t encode() const noexcept;
@@ -111,8 +111,8 @@ Result<std::size_t> encode_poll_request(const PollRequestLayout& layout, const P
 Result<PumpOutputs> decode_poll_request(const PollRequestLayout& layout, Bytes payload) noexcept;
 // The slave's side: encodes a poll response (kOutOfRange for an analog value
 // over 4095 in a channel the layout carries; kBufferTooSmall). Pad bytes are 0.
-Result<std::size_t> encode_poll_response(const PollResponseLayout& layout, std::uint8_t exception_status,
-                                         std::uint8_t input_bits,
+Result<std::size_t> encode_poll_response(const PollResponseLayout& layout,
+                                         std::uint8_t exception_status, std::uint8_t input_bits,
                                          const std::array<std::uint16_t, 2>& analog_inputs_raw,
                                          MutableBytes out) noexcept;
 

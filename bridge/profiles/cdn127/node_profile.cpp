@@ -36,8 +36,8 @@ Result<devicenet::NodeProfile> make_node_profile(const IoConfiguration& config,
   p.identity = {kVendorId, kProductType, kProductCode};
   // Mode first: it decides how the counts that follow are laid out, and the
   // device may check the combination.
-  p.settings.push_back(configuration_setting(configuration_attr::kMode, config.mode,
-                                             "Configuration.Mode"));
+  p.settings.push_back(
+      configuration_setting(configuration_attr::kMode, config.mode, "Configuration.Mode"));
   p.settings.push_back(configuration_setting(configuration_attr::kNumDigitalInput,
                                              config.num_digital_inputs,
                                              "Configuration.NumDigitalInput"));

@@ -43,11 +43,10 @@ inline constexpr std::uint8_t kValue = 3, kRange = 7, kDataType = 8, kFaultState
                               kIdleState = 10, kFaultValue = 11, kIdleValue = 12;
 }
 namespace supervisor_attr {
-inline constexpr std::uint8_t kManufacturerType = 3, kSemiRevisionLevel = 4,
-                              kManufacturerName = 5, kManufacturerModel = 6,
-                              kSoftwareRevision = 7, kHardwareRevision = 8, kDeviceStatus = 11,
-                              kExceptionStatus = 12, kExceptionDetail = 13, kWarningDetail = 14,
-                              kAlarmEnable = 15, kWarningEnable = 16;
+inline constexpr std::uint8_t kManufacturerType = 3, kSemiRevisionLevel = 4, kManufacturerName = 5,
+                              kManufacturerModel = 6, kSoftwareRevision = 7, kHardwareRevision = 8,
+                              kDeviceStatus = 11, kExceptionStatus = 12, kExceptionDetail = 13,
+                              kWarningDetail = 14, kAlarmEnable = 15, kWarningEnable = 16;
 }
 namespace configuration_attr {
 inline constexpr std::uint8_t kMode = 1, kNumDigitalInput = 2, kNumDigitalOutput = 3,

@@ -98,17 +98,23 @@ Result<PollFormat> poll_format(const IoConfiguration& config) noexcept {
 Result<PollResponseLayout> produced_assembly_layout(std::uint8_t instance,
                                                     const IoConfiguration& config) noexcept {
   switch (instance) {
-    case 1: return response_layout(true, 0, 0, 0, 0);
-    case 2: return response_layout(true, 1, kFixedChannels, 0, 0);
-    case 3: return response_layout(false, 1, kFixedChannels, 0, 0);
-    case 101: return response_layout(true, 1, kFixedChannels, 0, kFixedAnalogInputs);
-    case 102: return response_layout(false, 1, kFixedChannels, 1, kFixedAnalogInputs);
+    case 1:
+      return response_layout(true, 0, 0, 0, 0);
+    case 2:
+      return response_layout(true, 1, kFixedChannels, 0, 0);
+    case 3:
+      return response_layout(false, 1, kFixedChannels, 0, 0);
+    case 101:
+      return response_layout(true, 1, kFixedChannels, 0, kFixedAnalogInputs);
+    case 102:
+      return response_layout(false, 1, kFixedChannels, 1, kFixedAnalogInputs);
     case 103: {
       Result<PollFormat> f = poll_format(config);
       if (!f) return f.error();
       return f->response;
     }
-    default: return Errc::kOutOfRange;
+    default:
+      return Errc::kOutOfRange;
   }
 }
 
@@ -118,14 +124,17 @@ Result<PollResponseLayout> produced_assembly_layout(std::uint8_t instance,
 Result<PollRequestLayout> consumed_assembly_layout(std::uint8_t instance,
                                                    const IoConfiguration& config) noexcept {
   switch (instance) {
-    case 5: return request_layout(1, 0, 0);
-    case 100: return request_layout(1, 0, 1);
+    case 5:
+      return request_layout(1, 0, 0);
+    case 100:
+      return request_layout(1, 0, 1);
     case 104: {
       Result<PollFormat> f = poll_format(config);
       if (!f) return f.error();
       return f->request;
     }
-    default: return Errc::kOutOfRange;
+    default:
+      return Errc::kOutOfRange;
   }
 }
 

@@ -53,7 +53,7 @@ struct PollRequestLayout {
   std::size_t dout_offset = 0, dout_size = 0;
   std::size_t pad_size = 0;
   std::size_t aout_offset = 0, aout_count = 0;  // count of 2-byte words
-  std::size_t size = 0;                          // the poll connection's consumed size
+  std::size_t size = 0;                         // the poll connection's consumed size
 
   // CDN127 manual, "Poll Packet Sizes": "If the Num Digital Output and Num
   // Analog Output are both 0 then the CONSUMED SIZE for the POLL connection
@@ -73,7 +73,7 @@ struct PollResponseLayout {
   std::size_t din_channels = 0;
   std::size_t pad_size = 0;
   std::size_t ain_offset = 0, ain_count = 0;  // count of 2-byte words
-  std::size_t size = 0;                        // the poll connection's produced size
+  std::size_t size = 0;                       // the poll connection's produced size
 
   friend bool operator==(const PollResponseLayout&, const PollResponseLayout&) = default;
 };

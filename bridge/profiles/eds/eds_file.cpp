@@ -416,7 +416,7 @@ class Reader {
     d.number = number;
     d.line = e.line;
     auto size = integer(e, 0, "size in bytes", 0, 0xFFFF);
-    auto bits = integer(e, 1, "bits used", 0, 0xFFFF * 8);
+    auto bits = integer(e, 1, "bits used", 0, std::int64_t{0xFFFF} * 8);
     auto carried = kinds(e, 2, "the connections that carry it");
     d.name = string(e, 3);
     auto path_size = integer(e, 4, "path size", 0, 0xFF);
@@ -562,7 +562,7 @@ class Reader {
       a.path.attribute = 3;
     }
     if (given(e, 2) != nullptr) {
-      auto bits = integer(e, 2, "size in bits", 0, 0xFFFF * 8);
+      auto bits = integer(e, 2, "size in bits", 0, std::int64_t{0xFFFF} * 8);
       if (!bits) return std::nullopt;
       a.bits = static_cast<std::uint32_t>(*bits);
     }
@@ -580,10 +580,8 @@ class Reader {
       Member m;
       m.bits = static_cast<std::uint16_t>(*bits);
       const Field* ref = given(e, i + 1);
-      if (ref == nullptr) {
-        m.kind = Member::Kind::kPadding;
-      } else if (ref->quoted && ref->text.empty()) {
-        m.kind = Member::Kind::kPadding;  // "" is an empty path
+      if (ref == nullptr || (ref->quoted && ref->text.empty())) {
+        m.kind = Member::Kind::kPadding;  // no reference, or "": an empty path
       } else if (ref->quoted) {
         auto p = path(e, i + 1, "member path");
         if (!p) return std::nullopt;
@@ -601,7 +599,7 @@ class Reader {
         return std::nullopt;
       }
       total += m.bits;
-      a.members.push_back(std::move(m));
+      a.members.push_back(m);
     }
     if (a.bits && !a.members.empty() && total != *a.bits) {
       error(e.line, fmt::format("{} ({}): its members take {} bits, its size is {}", e.keyword,

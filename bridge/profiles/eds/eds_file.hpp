@@ -185,8 +185,8 @@ struct Parsed {
   std::optional<EdsFile> file;  // absent when there is an error
                                 // At most kMaxProblems, errors before warnings, in line order.
   std::vector<Problem> problems;
-  std::size_t errors = 0;         // all of them, shown or not
-  std::size_t not_shown = 0;      // problems past kMaxProblems
+  std::size_t errors = 0;     // all of them, shown or not
+  std::size_t not_shown = 0;  // problems past kMaxProblems
 };
 
 // Reads `text` (the whole file).

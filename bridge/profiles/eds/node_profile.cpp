@@ -237,7 +237,7 @@ Result<NodeIo> node_io(const EdsFile& file, ConnectionKind connection, std::stri
   return layouts_of(file, *e);
 }
 
-Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> shared,
+Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const EdsFile>& shared,
                                                  const EdsNode& node, std::string* why) {
   const EdsFile& file = *shared;
   auto entries = io_entries(file, node.connection, why);

@@ -87,7 +87,7 @@ Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
 // assembly, the profile checks the device's member list (Assembly attribute
 // 2, shared/seeds/003) against it at start-up (member_check.hpp): a device
 // that reports other members is a configuration fault saying which.
-Result<devicenet::NodeProfile> make_node_profile(std::shared_ptr<const EdsFile> file,
+Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const EdsFile>& file,
                                                  const EdsNode& node, std::string* why = nullptr);
 
 // The writable, linked parameters whose names speak of a fault or an idle

@@ -55,9 +55,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::size_t before = r.consumed();
     std::string_view text;
     switch (kind % 3) {
-      case 0: text = read_short_string(r); break;
-      case 1: text = read_string(r); break;
-      default: text = read_fixed_string(r, kind / 3U); break;
+      case 0:
+        text = read_short_string(r);
+        break;
+      case 1:
+        text = read_string(r);
+        break;
+      default:
+        text = read_fixed_string(r, kind / 3U);
+        break;
     }
     FUZZ_CHECK(inside(text, input));
     FUZZ_CHECK(r.consumed() >= before);

@@ -4,10 +4,11 @@
 // Properties: fixed-size values decode only at their size; a SHORT_STRING
 // decodes only when its length byte covers the rest exactly; the supervisor
 // detail accounts for every byte it was given; names exist for every value.
+#include "bridge/profiles/cdn127/device_info.hpp"
+
 #include <cstddef>
 #include <cstdint>
 
-#include "bridge/profiles/cdn127/device_info.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;
@@ -44,10 +45,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(rev.ok() == (value.size() == 2));
   auto status = decode_identity_status(value);
   FUZZ_CHECK(status.ok() == (value.size() == 2));
-  if (status) FUZZ_CHECK(status->any_fault() == (status->minor_recoverable_fault() ||
-                                                  status->minor_unrecoverable_fault() ||
-                                                  status->major_recoverable_fault() ||
-                                                  status->major_unrecoverable_fault()));
+  if (status)
+    FUZZ_CHECK(status->any_fault() ==
+               (status->minor_recoverable_fault() || status->minor_unrecoverable_fault() ||
+                status->major_recoverable_fault() || status->major_unrecoverable_fault()));
   auto serial = decode_serial_number(value);
   FUZZ_CHECK(serial.ok() == (value.size() == 2 || value.size() == 4));
   if (serial) FUZZ_CHECK(serial->width == value.size());

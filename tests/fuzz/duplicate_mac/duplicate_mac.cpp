@@ -27,7 +27,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(frame.ok());
   FUZZ_CHECK(frame->id == group2_id(mac, Group2Message::kDuplicateMacCheck));
   FUZZ_CHECK(frame->len == kDuplicateMacMessageSize);
-  for (std::size_t i = 0; i < kDuplicateMacMessageSize; ++i) FUZZ_CHECK(frame->data[i] == payload[i]);
+  for (std::size_t i = 0; i < kDuplicateMacMessageSize; ++i)
+    FUZZ_CHECK(frame->data[i] == payload[i]);
   auto again = decode_duplicate_mac(frame->payload());
   FUZZ_CHECK(again.ok() && *again == *m);
 

@@ -2,11 +2,12 @@
 // Properties: a path that decodes encodes (in every minimum format) to
 // encoded_size() bytes that decode to the same path; the smallest encoding is
 // never longer than the input; an encoder refuses a buffer one byte short.
+#include "bridge/cip/epath.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
 
-#include "bridge/cip/epath.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;
@@ -16,7 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   auto path = decode_epath(Bytes(data, size));
   if (!path) return 0;
   FUZZ_CHECK(path->empty() == (size == 0));
-  for (const LogicalFormat f : {LogicalFormat::k8Bit, LogicalFormat::k16Bit, LogicalFormat::k32Bit}) {
+  for (const LogicalFormat f :
+       {LogicalFormat::k8Bit, LogicalFormat::k16Bit, LogicalFormat::k32Bit}) {
     std::array<std::uint8_t, 32> buf{};
     const std::size_t need = encoded_size(*path, f);
     FUZZ_CHECK(need <= buf.size());

@@ -26,8 +26,8 @@ bool same(Bytes a, Bytes b) {
 }
 
 bool inside(Bytes part, Bytes whole) {
-  return part.empty() || (part.data() >= whole.data() &&
-                          part.data() + part.size() <= whole.data() + whole.size());
+  return part.empty() ||
+         (part.data() >= whole.data() && part.data() + part.size() <= whole.data() + whole.size());
 }
 
 void check_request(Bytes message, BodyFormat format) {
@@ -62,7 +62,8 @@ void check_response(Bytes message) {
   if (resp->is_error()) {
     FUZZ_CHECK(resp->general_status != cip::GeneralStatus::kSuccess);
     FUZZ_CHECK(resp->data.empty());
-    auto n = encode_error_response(resp->general_status, resp->additional_status, MutableBytes(buf));
+    auto n =
+        encode_error_response(resp->general_status, resp->additional_status, MutableBytes(buf));
     FUZZ_CHECK(n.ok());
     // The additional code may be missing (read as 0xFF) and bytes after it
     // are ignored: the encoding matches the input up to what was read.
@@ -74,7 +75,8 @@ void check_response(Bytes message) {
   } else {
     FUZZ_CHECK(resp->general_status == cip::GeneralStatus::kSuccess);
     if (message.size() > buf.size()) return;
-    auto n = encode_success_response(resp->service, resp->data, MutableBytes(buf.data(), message.size()));
+    auto n = encode_success_response(resp->service, resp->data,
+                                     MutableBytes(buf.data(), message.size()));
     FUZZ_CHECK(n.ok() && *n == message.size());
     FUZZ_CHECK(same(Bytes(buf.data(), *n), message));
     auto small = encode_success_response(resp->service, resp->data,

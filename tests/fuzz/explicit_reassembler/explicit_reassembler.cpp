@@ -89,7 +89,8 @@ void transfer(std::size_t max_size, std::uint8_t mode, Bytes message) {
       FUZZ_CHECK(!sender.active());
       FUZZ_CHECK(complete);
       FUZZ_CHECK(receiver.message().size() == message.size());
-      for (std::size_t i = 0; i < message.size(); ++i) FUZZ_CHECK(receiver.message()[i] == message[i]);
+      for (std::size_t i = 0; i < message.size(); ++i)
+        FUZZ_CHECK(receiver.message()[i] == message[i]);
     }
     if (s == ExplicitFragmentSender::Step::kFailed) FUZZ_CHECK(!sender.active());
   }

@@ -18,7 +18,8 @@ using namespace dnbridge::devicenet;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::uint32_t can_id = 0;
-  for (std::size_t i = 0; i < size && i < 4; ++i) can_id |= static_cast<std::uint32_t>(data[i]) << (8 * i);
+  for (std::size_t i = 0; i < size && i < 4; ++i)
+    can_id |= static_cast<std::uint32_t>(data[i]) << (8 * i);
 
   for (const std::uint32_t id : {can_id, can_id & can::kMaxStandardId}) {
     auto decoded = decode_identifier(id);

@@ -12,12 +12,13 @@
 // refuse any payload but one of exactly the layout's size; what decodes
 // re-encodes to a message that decodes to the same values, byte for byte
 // except the pad byte (and reserved output bits).
+#include "bridge/profiles/cdn127/poll_format.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
 
 #include "bridge/profiles/cdn127/io_data.hpp"
-#include "bridge/profiles/cdn127/poll_format.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;
@@ -64,11 +65,14 @@ void check_response(const PollResponseLayout& layout, std::uint8_t mask, Bytes p
     FUZZ_CHECK(pad ? buf[i] == 0 : buf[i] == payload[i]);
   }
   if (layout.size > 0) {
-    FUZZ_CHECK(!encode_poll_response(layout, dsup, bits, analog, MutableBytes(buf.data(), layout.size - 1)).ok());
+    FUZZ_CHECK(
+        !encode_poll_response(layout, dsup, bits, analog, MutableBytes(buf.data(), layout.size - 1))
+             .ok());
   }
   auto again = decode_poll_response(layout, mask, Bytes(buf.data(), *n));
   FUZZ_CHECK(again.ok() && same(*again, *in));
-  if (in->exception_status) FUZZ_CHECK(ExceptionStatus::decode(in->exception_status->encode()) == *in->exception_status);
+  if (in->exception_status)
+    FUZZ_CHECK(ExceptionStatus::decode(in->exception_status->encode()) == *in->exception_status);
   if (in->pump) FUZZ_CHECK(PumpInputs::decode(in->pump->encode(mask), mask) == *in->pump);
 }
 
@@ -80,12 +84,14 @@ void check_request(const PollRequestLayout& layout, Bytes payload) {
   std::array<std::uint8_t, 16> buf{};
   auto n = encode_poll_request(layout, *out, MutableBytes(buf));
   FUZZ_CHECK(n.ok() && *n == layout.size);
-  if (layout.dout_size != 0) FUZZ_CHECK(buf[0] == (payload[0] & (kOutputPumpOnBit | kOutputN2BallastBit)));
+  if (layout.dout_size != 0)
+    FUZZ_CHECK(buf[0] == (payload[0] & (kOutputPumpOnBit | kOutputN2BallastBit)));
   if (layout.aout_count != 0) {
     FUZZ_CHECK(buf[layout.aout_offset] == payload[layout.aout_offset]);
     FUZZ_CHECK(buf[layout.aout_offset + 1] == payload[layout.aout_offset + 1]);
   }
-  if (layout.size > 0) FUZZ_CHECK(!encode_poll_request(layout, *out, MutableBytes(buf.data(), layout.size - 1)).ok());
+  if (layout.size > 0)
+    FUZZ_CHECK(!encode_poll_request(layout, *out, MutableBytes(buf.data(), layout.size - 1)).ok());
   auto again = decode_poll_request(layout, Bytes(buf.data(), *n));
   FUZZ_CHECK(again.ok() && *again == *out);
 }

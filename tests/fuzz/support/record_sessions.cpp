@@ -93,7 +93,8 @@ void run(const Scenario& s, const std::string& scanner_dir, const std::string& s
   for (std::size_t i = 0; i < s.devices.size(); ++i) {
     if (!s.devices[i]) continue;
     slave_sinks.push_back(std::make_unique<QueueSink>(queue));
-    sim::SlaveOptions o = sim::default_slave_options(devicenet::MacId::from(static_cast<unsigned>(i + 1)).value());
+    sim::SlaveOptions o =
+        sim::default_slave_options(devicenet::MacId::from(static_cast<unsigned>(i + 1)).value());
     if (i == 0) o = fuzz::fuzz_slave_options();
     slaves.push_back(std::make_unique<sim::Cdn127Slave>(*slave_sinks.back(), o));
   }

@@ -78,7 +78,8 @@ inline void append_record(std::vector<std::uint8_t>& out, Op op, Duration step, 
     out.push_back(0xFF);
     units -= kMaxStepUnits;
   }
-  out.push_back(static_cast<std::uint8_t>((static_cast<unsigned>(op) << 4) | (data.size() & 0x0FU)));
+  out.push_back(
+      static_cast<std::uint8_t>((static_cast<unsigned>(op) << 4) | (data.size() & 0x0FU)));
   out.push_back(static_cast<std::uint8_t>(units & 0xFFU));
   out.push_back(static_cast<std::uint8_t>(units >> 8));
   if (op == Op::kFrame) {

@@ -15,7 +15,8 @@ TEST(GeneralStatusTest, EveryCodeOfTheTableIsNamed) {
   EXPECT_FALSE(is_known(0x2D));
   EXPECT_FALSE(is_known(0xFF));
   EXPECT_EQ(to_string(GeneralStatus::kObjectStateConflict), "object state conflict");
-  EXPECT_EQ(to_string(GeneralStatus::kGroup2OnlyServerFailure), "Group 2 only server general failure");
+  EXPECT_EQ(to_string(GeneralStatus::kGroup2OnlyServerFailure),
+            "Group 2 only server general failure");
 }
 
 }  // namespace

@@ -64,7 +64,10 @@ class RecordingListener : public ExplicitClient::Listener {
 };
 
 RequestMessage get_single(std::uint16_t class_id, std::uint16_t instance, std::uint8_t attribute) {
-  return {.service = 0x0E, .class_id = class_id, .instance_id = instance, .attribute = attribute,
+  return {.service = 0x0E,
+          .class_id = class_id,
+          .instance_id = instance,
+          .attribute = attribute,
           .data = {}};
 }
 
@@ -97,8 +100,11 @@ class ExplicitClientTest : public ::testing::Test {
 TEST_F(ExplicitClientTest, AllocateGoldenExchange) {
   EXPECT_EQ(client.deadline(), kNever);
   const ByteVec choice_and_allocator = {0x03, 0x0A};
-  const RequestMessage allocate{.service = 0x4B, .class_id = 0x03, .instance_id = 0x01,
-                                .attribute = std::nullopt, .data = choice_and_allocator};
+  const RequestMessage allocate{.service = 0x4B,
+                                .class_id = 0x03,
+                                .instance_id = 0x01,
+                                .attribute = std::nullopt,
+                                .data = choice_and_allocator};
   ASSERT_TRUE(client.submit(1, allocate, /*unconnected=*/true, now).ok());
 
   // 41E: G2 message 6 to slave 3 | 4A header: Frag 0, XID 1 (the first
@@ -176,7 +182,7 @@ TEST_F(ExplicitClientTest, XidTogglesWithEveryTransaction) {
   answer({0x4A, 0x8E, 0x11});
   ASSERT_EQ(sink.frames.size(), 2u);
   EXPECT_EQ(sink.last(), "41C: 0A 0E 01 01 07");  // XID 0
-  answer({0x4A, 0x8E, 0x11});  // the first answer repeated: old XID
+  answer({0x4A, 0x8E, 0x11});                     // the first answer repeated: old XID
   EXPECT_EQ(client.counters().unexpected_frames, 1u);
   answer({0x0A, 0x8E, 0x22});
   ASSERT_EQ(sink.frames.size(), 3u);
@@ -556,9 +562,9 @@ TEST_F(ExplicitClientTest, RepeatedResponseFragmentIsReAckedNotAppended) {
   answer({0xCA, 0x41, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0A});
   answer({0xCA, 0x41, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0A});  // and again
   answer({0xCA, 0x82, 0x0B});
-  EXPECT_EQ(sink.hex_from(1), (std::vector<std::string>{"41C: CA C0 00", "41C: CA C0 00",
-                                                         "41C: CA C1 00", "41C: CA C1 00",
-                                                         "41C: CA C2 00"}));
+  EXPECT_EQ(sink.hex_from(1),
+            (std::vector<std::string>{"41C: CA C0 00", "41C: CA C0 00", "41C: CA C1 00",
+                                      "41C: CA C1 00", "41C: CA C2 00"}));
   ASSERT_EQ(listener.results.size(), 1u);
   EXPECT_EQ(listener.results[0].data, "0A 01 02 03 04 05 06 07 08 09 0A 0B");
   EXPECT_EQ(client.counters().malformed_frames, 0u);
@@ -636,7 +642,7 @@ TEST_F(ExplicitClientTest, OversizedResponseIsRefusedWithErrorAck) {
     fragment = {0xCA, static_cast<std::uint8_t>(0x40 | (i & 0x3F)), 1, 2, 3, 4, 5, 6};
     answer(fragment);
   }
-  ASSERT_EQ(sink.frames.size(), 86u);  // request + 85 acks
+  ASSERT_EQ(sink.frames.size(), 86u);                     // request + 85 acks
   EXPECT_EQ(sink.hex_from(64).front(), "41C: CA FF 00");  // count 63
   EXPECT_EQ(sink.hex_from(65).front(), "41C: CA C0 00");  // count 0 after the wrap
   EXPECT_TRUE(listener.results.empty());
@@ -697,8 +703,8 @@ TEST_F(ExplicitClientTest, RandomFramesNeverBreakTheClient) {
   for (int i = 0; i < 20000; ++i) {
     if (client.queued() < 3) {
       const bool long_one = (i % 3) == 0;
-      const Status s = long_one ? client.submit(next_tag, set_twelve(), false, now)
-                                : submit_get(next_tag);
+      const Status s =
+          long_one ? client.submit(next_tag, set_twelve(), false, now) : submit_get(next_tag);
       ASSERT_TRUE(s.ok());
       ++next_tag;
       ++submitted;

@@ -49,9 +49,10 @@ class ScriptedSlave {
         std::vector<std::uint8_t> body = answer(*request);
         std::vector<std::uint8_t> frame{payload[0]};
         frame.insert(frame.end(), body.begin(), body.end());
-        out.push_back(can::CanFrame::make(group2_id(mac(kSlave), Group2Message::kSlaveExplicitResponse),
-                                          Bytes(frame))
-                          .value());
+        out.push_back(
+            can::CanFrame::make(group2_id(mac(kSlave), Group2Message::kSlaveExplicitResponse),
+                                Bytes(frame))
+                .value());
         break;
       }
       case Group2Message::kMasterIoPoll:
@@ -79,16 +80,26 @@ class ScriptedSlave {
     const auto key = (r.class_id << 16) | (r.instance_id << 8) | r.attribute.value_or(0);
     if (r.service == 0x0E) {
       switch (key) {
-        case 0x010101: return ok({1, 0});        // vendor 1
-        case 0x010102: return ok({12, 0});       // product type 12
-        case 0x010103: return ok({34, 0});       // product code 34
-        case 0x010104: return ok({2, 1});        // revision 2.1
-        case 0x010106: return ok({4, 3, 2, 1});  // serial 0x01020304
-        case 0x010107: return ok({2, 'I', 'O'});
-        case 0x010108: return ok({3});
-        case 0x050207: return ok({10, 0});       // produced size
-        case 0x050208: return ok({12, 0});       // consumed size
-        default: break;
+        case 0x010101:
+          return ok({1, 0});  // vendor 1
+        case 0x010102:
+          return ok({12, 0});  // product type 12
+        case 0x010103:
+          return ok({34, 0});  // product code 34
+        case 0x010104:
+          return ok({2, 1});  // revision 2.1
+        case 0x010106:
+          return ok({4, 3, 2, 1});  // serial 0x01020304
+        case 0x010107:
+          return ok({2, 'I', 'O'});
+        case 0x010108:
+          return ok({3});
+        case 0x050207:
+          return ok({10, 0});  // produced size
+        case 0x050208:
+          return ok({12, 0});  // consumed size
+        default:
+          break;
       }
     }
     if (r.service == 0x10 && r.attribute == 9) return ok({r.data.begin(), r.data.end()});
@@ -114,7 +125,8 @@ class ScriptedSlave {
     for (std::size_t i = 0; i < io_fragment_count(produced.size()); ++i) {
       can::CanFrame r;
       r.id = 0x3C0 + kSlave;
-      r.len = static_cast<std::uint8_t>(io_fragment(Bytes(produced), i, MutableBytes(r.data)).value());
+      r.len =
+          static_cast<std::uint8_t>(io_fragment(Bytes(produced), i, MutableBytes(r.data)).value());
       out.push_back(r);
     }
     if (scramble_next_response) {
@@ -152,7 +164,8 @@ class IoFragmentationTest : public ::testing::Test {
         if (f.id == 0x3C0 + kSlave) ++poll_response_frames_;
         if (f.id == group2_id(mac(kSlave), Group2Message::kMasterIoPoll)) ++poll_frames_;
         for (const auto& reply : slave_.on_frame(f)) wire_.send(reply, now_);
-        if (f.id == 0x3C0 + kSlave || f.id == group2_id(mac(kSlave), Group2Message::kSlaveExplicitResponse)) {
+        if (f.id == 0x3C0 + kSlave ||
+            f.id == group2_id(mac(kSlave), Group2Message::kSlaveExplicitResponse)) {
           scanner_->on_frame(f, now_);
         }
       }

@@ -115,9 +115,10 @@ TEST(CommFaulted, ReservedBitIsIgnoredOnDecode) {
 TEST(CommFaulted, OutOfRangeFieldsAreRefused) {
   EXPECT_EQ(encode_comm_faulted({.value = 64}).error(), Errc::kOutOfRange);
   EXPECT_EQ(encode_comm_faulted({.service = 0x80}).error(), Errc::kOutOfRange);
-  EXPECT_EQ(encode_comm_faulted({.layout = CommFaultedLayout::kPortVendorSerial, .physical_port = 0x80})
-                .error(),
-            Errc::kOutOfRange);
+  EXPECT_EQ(
+      encode_comm_faulted({.layout = CommFaultedLayout::kPortVendorSerial, .physical_port = 0x80})
+          .error(),
+      Errc::kOutOfRange);
 }
 
 TEST(CommFaulted, LengthsWithoutALayoutFail) {

@@ -126,8 +126,12 @@ TEST(ShortStringTest, EmptyAndLongestStrings) {
 }
 
 TEST(IdentityStateTest, NamedAndReservedStates) {
-  const char* names[] = {"non-existent", "self test", "standby", "operating",
-                         "major recoverable fault", "major unrecoverable fault"};
+  const char* names[] = {"non-existent",
+                         "self test",
+                         "standby",
+                         "operating",
+                         "major recoverable fault",
+                         "major unrecoverable fault"};
   for (std::uint8_t v = 0; v <= 5; ++v) {
     const auto s = decode_identity_state(ByteVec{v});
     ASSERT_TRUE(s.ok());
@@ -144,8 +148,8 @@ TEST(IdentityStateTest, NamedAndReservedStates) {
 // --- Device Supervisor ------------------------------------------------------
 
 TEST(SupervisorDeviceStatusTest, NamedAndRangedValues) {
-  const char* names[] = {"undefined", "self testing", "idle", "self-test exception",
-                         "executing", "abort", "critical fault"};
+  const char* names[] = {"undefined", "self testing", "idle",          "self-test exception",
+                         "executing", "abort",        "critical fault"};
   for (std::uint8_t v = 0; v <= 6; ++v) {
     EXPECT_EQ(to_string(decode_supervisor_device_status(ByteVec{v}).value()), names[v]);
   }
@@ -271,7 +275,8 @@ TEST(SupervisorDetailTest, PointStructureOverrunningItsDeviceDetailIsMalformed) 
 }
 
 // A test-side encoder for the round trip.
-ByteVec encode_detail(const ByteVec& common, const std::vector<std::pair<std::uint8_t, ByteVec>>& points,
+ByteVec encode_detail(const ByteVec& common,
+                      const std::vector<std::pair<std::uint8_t, ByteVec>>& points,
                       const ByteVec& manufacturer) {
   ByteVec device;
   for (const auto& [count, bits] : points) {

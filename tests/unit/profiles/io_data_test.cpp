@@ -72,9 +72,9 @@ TEST(Analog, VoltsToRawRoundsToNearestStep) {
 }
 
 TEST(Analog, VoltsOutsideTheRangeAreRefusedNotClipped) {
-  for (double v : {-0.0001, -1.0, 10.0001, 11.0, std::numeric_limits<double>::quiet_NaN(),
-                   std::numeric_limits<double>::infinity(),
-                   -std::numeric_limits<double>::infinity()}) {
+  for (double v :
+       {-0.0001, -1.0, 10.0001, 11.0, std::numeric_limits<double>::quiet_NaN(),
+        std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}) {
     EXPECT_EQ(volts_to_raw(v).error(), Errc::kOutOfRange) << v;
   }
 }
@@ -107,13 +107,19 @@ TEST(ExceptionStatusTest, RoundTripsAndSummarises) {
 TEST(PumpInputsTest, HealthyRunningPumpWithDefaultPolarity) {
   // 0x1F: bit 0 running, 1 "1 if NO warning", 2 N2 flow OK, 3 "1 if NO
   // alarm", 4 interlock OK.
-  const PumpInputs healthy{.pump_running = true, .warning_active = false, .n2_flow_ok = true,
-                           .alarm_active = false, .interlock_ok = true};
+  const PumpInputs healthy{.pump_running = true,
+                           .warning_active = false,
+                           .n2_flow_ok = true,
+                           .alarm_active = false,
+                           .interlock_ok = true};
   EXPECT_EQ(PumpInputs::decode(0x1F, 0x00), healthy);
   EXPECT_EQ(healthy.encode(0x00), 0x1F);
   // Everything bad: stopped, warning, no N2, alarm, interlock failed.
-  const PumpInputs bad{.pump_running = false, .warning_active = true, .n2_flow_ok = false,
-                       .alarm_active = true, .interlock_ok = false};
+  const PumpInputs bad{.pump_running = false,
+                       .warning_active = true,
+                       .n2_flow_ok = false,
+                       .alarm_active = true,
+                       .interlock_ok = false};
   EXPECT_EQ(PumpInputs::decode(0x00, 0x00), bad);
   // Reserved bits 5..7 mean nothing.
   EXPECT_EQ(PumpInputs::decode(0xFF, 0x00), healthy);
@@ -128,8 +134,11 @@ struct PolarityGolden {
 };
 
 TEST(PumpInputsTest, NoNcMaskInvertsExactlyItsOwnBit) {
-  const PumpInputs healthy{.pump_running = true, .warning_active = false, .n2_flow_ok = true,
-                           .alarm_active = false, .interlock_ok = true};
+  const PumpInputs healthy{.pump_running = true,
+                           .warning_active = false,
+                           .n2_flow_ok = true,
+                           .alarm_active = false,
+                           .interlock_ok = true};
   auto with = [&](auto field, bool value) {
     PumpInputs p = healthy;
     p.*field = value;
@@ -166,8 +175,10 @@ TEST(PumpInputsTest, NoNcMaskInvertsExactlyItsOwnBit) {
 
 TEST(PumpInputsTest, RoundTripsForEveryStateAndMask) {
   for (unsigned state = 0; state < 32; ++state) {
-    const PumpInputs p{.pump_running = (state & 1) != 0, .warning_active = (state & 2) != 0,
-                       .n2_flow_ok = (state & 4) != 0, .alarm_active = (state & 8) != 0,
+    const PumpInputs p{.pump_running = (state & 1) != 0,
+                       .warning_active = (state & 2) != 0,
+                       .n2_flow_ok = (state & 4) != 0,
+                       .alarm_active = (state & 8) != 0,
                        .interlock_ok = (state & 16) != 0};
     for (unsigned m = 0; m <= 0xFF; ++m) {
       const auto mask = static_cast<std::uint8_t>(m);
@@ -191,8 +202,11 @@ TEST(PollResponse, Cdn127PresetGolden) {
   ASSERT_TRUE(in.ok());
   EXPECT_EQ(in->exception_status, ExceptionStatus{.warning_device_specific = true});
   EXPECT_EQ(in->input_bits, 0x1D);
-  EXPECT_EQ(in->pump, (PumpInputs{.pump_running = true, .warning_active = true, .n2_flow_ok = true,
-                                  .alarm_active = false, .interlock_ok = true}));
+  EXPECT_EQ(in->pump, (PumpInputs{.pump_running = true,
+                                  .warning_active = true,
+                                  .n2_flow_ok = true,
+                                  .alarm_active = false,
+                                  .interlock_ok = true}));
   EXPECT_EQ(in->analog_inputs_raw[0], 4095);
   EXPECT_EQ(in->analog_inputs_raw[1], 2048);
 
@@ -327,9 +341,9 @@ TEST(PollResponse, RoundTripsTruncationAndOverlengthForEveryLayout) {
       longer.push_back(0);
       EXPECT_EQ(decode_poll_response(l, mask, longer).error(), Errc::kMalformed);
       if (l.size) {
-        EXPECT_EQ(encode_poll_response(l, dsup, din, ain, MutableBytes(buf.data(), l.size - 1))
-                      .error(),
-                  Errc::kBufferTooSmall);
+        EXPECT_EQ(
+            encode_poll_response(l, dsup, din, ain, MutableBytes(buf.data(), l.size - 1)).error(),
+            Errc::kBufferTooSmall);
       }
     }
     ++layouts;
@@ -433,7 +447,8 @@ TEST(PollRequest, RoundTripsTruncationAndOverlengthForEveryLayout) {
     const PollRequestLayout& l = f.request;
     SCOPED_TRACE(describe(l));
     for (int trial = 0; trial < 4; ++trial) {
-      const PumpOutputs o{.pump_on = bit(rng) != 0, .n2_ballast_on = bit(rng) != 0,
+      const PumpOutputs o{.pump_on = bit(rng) != 0,
+                          .n2_ballast_on = bit(rng) != 0,
                           .analog_out_raw = static_cast<std::uint16_t>(analog(rng))};
       std::array<std::uint8_t, 8> buf{};
       buf.fill(0xEE);
@@ -448,10 +463,10 @@ TEST(PollRequest, RoundTripsTruncationAndOverlengthForEveryLayout) {
       const Bytes wire(buf.data(), l.size);
       const auto back = decode_poll_request(l, wire);
       ASSERT_TRUE(back.ok());
-      const PumpOutputs expected{.pump_on = l.dout_size ? o.pump_on : false,
-                                 .n2_ballast_on = l.dout_size ? o.n2_ballast_on : false,
-                                 .analog_out_raw = l.aout_count ? o.analog_out_raw
-                                                                : std::uint16_t{0}};
+      const PumpOutputs expected{
+          .pump_on = l.dout_size ? o.pump_on : false,
+          .n2_ballast_on = l.dout_size ? o.n2_ballast_on : false,
+          .analog_out_raw = l.aout_count ? o.analog_out_raw : std::uint16_t{0}};
       EXPECT_EQ(*back, expected);
       for (std::size_t k = 0; k < l.size; ++k) {
         ASSERT_EQ(decode_poll_request(l, wire.first(k)).error(), Errc::kTruncated) << k;

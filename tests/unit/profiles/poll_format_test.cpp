@@ -59,16 +59,15 @@ TEST(PollFormat, EveryValidConfigurationMatchesTheModel) {
   // them must change nothing.
   for (unsigned bits = 0; bits < 8; ++bits) {
     for (std::uint8_t reserved : {std::uint8_t{0x00}, std::uint8_t{0x7A}}) {
-      const auto mode_byte = static_cast<std::uint8_t>(((bits & 4) ? 0x80 : 0) |
-                                                       ((bits & 2) ? 0x04 : 0) |
-                                                       ((bits & 1) ? 0x01 : 0) | reserved);
+      const auto mode_byte = static_cast<std::uint8_t>(
+          ((bits & 4) ? 0x80 : 0) | ((bits & 2) ? 0x04 : 0) | ((bits & 1) ? 0x01 : 0) | reserved);
       for (std::uint8_t di = 0; di <= 8; ++di) {
         for (std::uint8_t dout = 0; dout <= 8; ++dout) {
           for (std::uint8_t ai = 0; ai <= 2; ++ai) {
             for (std::uint8_t ao = 0; ao <= 1; ++ao) {
-              SCOPED_TRACE(testing::Message() << "mode " << int{mode_byte} << " DI " << int{di}
-                                              << " DO " << int{dout} << " AI " << int{ai}
-                                              << " AO " << int{ao});
+              SCOPED_TRACE(testing::Message()
+                           << "mode " << int{mode_byte} << " DI " << int{di} << " DO " << int{dout}
+                           << " AI " << int{ai} << " AO " << int{ao});
               const IoConfiguration c = config(mode_byte, di, dout, ai, ao);
               ASSERT_TRUE(validate(c).ok());
               const Result<PollFormat> f = poll_format(c);
@@ -80,8 +79,7 @@ TEST(PollFormat, EveryValidConfigurationMatchesTheModel) {
               EXPECT_EQ(f->request.dout_size, rq.count("DOUT"));
               EXPECT_EQ(f->request.pad_size, rq.count("PAD"));
               EXPECT_EQ(f->request.aout_count * 2, rq.count("AOUT"));
-              EXPECT_EQ(f->request.aout_offset,
-                        ao ? rq.first("AOUT") : rq.bytes.size());
+              EXPECT_EQ(f->request.aout_offset, ao ? rq.first("AOUT") : rq.bytes.size());
               EXPECT_EQ(f->request.has_idle_condition(), dout > 0 || ao > 0);
 
               const Model rs = model_response(mode_byte, di, ai);
@@ -121,12 +119,21 @@ TEST(PollFormat, Cdn127PresetIsFourByteRequestSixByteResponse) {
   EXPECT_EQ(c, config(0x86, 8, 8, 2, 1));
   const PollFormat f = poll_format(c).value();
   // Request: byte 0 DOUT, byte 1 PAD, bytes 2-3 AOUT.
-  EXPECT_EQ(f.request, (PollRequestLayout{.dout_offset = 0, .dout_size = 1, .pad_size = 1,
-                                          .aout_offset = 2, .aout_count = 1, .size = 4}));
+  EXPECT_EQ(f.request, (PollRequestLayout{.dout_offset = 0,
+                                          .dout_size = 1,
+                                          .pad_size = 1,
+                                          .aout_offset = 2,
+                                          .aout_count = 1,
+                                          .size = 4}));
   // Response: byte 0 DSUP, byte 1 DIN, bytes 2-5 AIN[2]; DSUP+DIN is even: no pad.
-  EXPECT_EQ(f.response, (PollResponseLayout{.has_dsup = true, .din_offset = 1, .din_size = 1,
-                                            .din_channels = 8, .pad_size = 0, .ain_offset = 2,
-                                            .ain_count = 2, .size = 6}));
+  EXPECT_EQ(f.response, (PollResponseLayout{.has_dsup = true,
+                                            .din_offset = 1,
+                                            .din_size = 1,
+                                            .din_channels = 8,
+                                            .pad_size = 0,
+                                            .ain_offset = 2,
+                                            .ain_count = 2,
+                                            .size = 6}));
   EXPECT_EQ(describe(f), "request 4 B [DOUT PAD AOUT]; response 6 B [DSUP DIN AIN AIN]");
 }
 
@@ -135,12 +142,21 @@ TEST(PollFormat, Cdn118PresetFollowsNoEvenByte) {
   EXPECT_EQ(c, config(0x81, 8, 8, 0, 1));
   const PollFormat f = poll_format(c).value();
   // Request: byte 0 DOUT, bytes 1-2 AOUT (NoEvenByte set: no pad).
-  EXPECT_EQ(f.request, (PollRequestLayout{.dout_offset = 0, .dout_size = 1, .pad_size = 0,
-                                          .aout_offset = 1, .aout_count = 1, .size = 3}));
+  EXPECT_EQ(f.request, (PollRequestLayout{.dout_offset = 0,
+                                          .dout_size = 1,
+                                          .pad_size = 0,
+                                          .aout_offset = 1,
+                                          .aout_count = 1,
+                                          .size = 3}));
   // Response: byte 0 DSUP, byte 1 DIN.
-  EXPECT_EQ(f.response, (PollResponseLayout{.has_dsup = true, .din_offset = 1, .din_size = 1,
-                                            .din_channels = 8, .pad_size = 0, .ain_offset = 2,
-                                            .ain_count = 0, .size = 2}));
+  EXPECT_EQ(f.response, (PollResponseLayout{.has_dsup = true,
+                                            .din_offset = 1,
+                                            .din_size = 1,
+                                            .din_channels = 8,
+                                            .pad_size = 0,
+                                            .ain_offset = 2,
+                                            .ain_count = 0,
+                                            .size = 2}));
   EXPECT_EQ(describe(f), "request 3 B [DOUT AOUT]; response 2 B [DSUP DIN]");
 }
 
@@ -155,20 +171,55 @@ TEST(PollFormat, FixedProducedAssemblies) {
   const IoConfiguration odd = config(0x01, 0, 0, 0, 0);
   const IoConfiguration bad = config(0x00, 9, 9, 3, 2);
   const ProducedGolden golden[] = {
-      {1, {.has_dsup = true, .din_offset = 1, .din_size = 0, .din_channels = 0, .pad_size = 0,
-           .ain_offset = 1, .ain_count = 0, .size = 1},
+      {1,
+       {.has_dsup = true,
+        .din_offset = 1,
+        .din_size = 0,
+        .din_channels = 0,
+        .pad_size = 0,
+        .ain_offset = 1,
+        .ain_count = 0,
+        .size = 1},
        "response 1 B [DSUP]"},
-      {2, {.has_dsup = true, .din_offset = 1, .din_size = 1, .din_channels = 8, .pad_size = 0,
-           .ain_offset = 2, .ain_count = 0, .size = 2},
+      {2,
+       {.has_dsup = true,
+        .din_offset = 1,
+        .din_size = 1,
+        .din_channels = 8,
+        .pad_size = 0,
+        .ain_offset = 2,
+        .ain_count = 0,
+        .size = 2},
        "response 2 B [DSUP DIN]"},
-      {3, {.has_dsup = false, .din_offset = 0, .din_size = 1, .din_channels = 8, .pad_size = 0,
-           .ain_offset = 1, .ain_count = 0, .size = 1},
+      {3,
+       {.has_dsup = false,
+        .din_offset = 0,
+        .din_size = 1,
+        .din_channels = 8,
+        .pad_size = 0,
+        .ain_offset = 1,
+        .ain_count = 0,
+        .size = 1},
        "response 1 B [DIN]"},
-      {101, {.has_dsup = true, .din_offset = 1, .din_size = 1, .din_channels = 8, .pad_size = 0,
-             .ain_offset = 2, .ain_count = 2, .size = 6},
+      {101,
+       {.has_dsup = true,
+        .din_offset = 1,
+        .din_size = 1,
+        .din_channels = 8,
+        .pad_size = 0,
+        .ain_offset = 2,
+        .ain_count = 2,
+        .size = 6},
        "response 6 B [DSUP DIN AIN AIN]"},
-      {102, {.has_dsup = false, .din_offset = 0, .din_size = 1, .din_channels = 8, .pad_size = 1,
-             .ain_offset = 2, .ain_count = 2, .size = 6},
+      {102,
+       {.has_dsup = false,
+        .din_offset = 0,
+        .din_size = 1,
+        .din_channels = 8,
+        .pad_size = 1,
+        .ain_offset = 2,
+        .ain_count = 2,
+        .size = 6},
        "response 6 B [DIN PAD AIN AIN]"},
   };
   for (const auto& g : golden) {
@@ -186,13 +237,19 @@ TEST(PollFormat, FixedConsumedAssemblies) {
   const IoConfiguration bad = config(0x00, 9, 9, 3, 2);
   for (const IoConfiguration& c : {preset(ConfigurationPreset::kCdn127), bad}) {
     // 5: byte 0 outputs.
-    EXPECT_EQ(consumed_assembly_layout(5, c).value(),
-              (PollRequestLayout{.dout_offset = 0, .dout_size = 1, .pad_size = 0,
-                                 .aout_offset = 1, .aout_count = 0, .size = 1}));
+    EXPECT_EQ(consumed_assembly_layout(5, c).value(), (PollRequestLayout{.dout_offset = 0,
+                                                                         .dout_size = 1,
+                                                                         .pad_size = 0,
+                                                                         .aout_offset = 1,
+                                                                         .aout_count = 0,
+                                                                         .size = 1}));
     // 100: byte 0 outputs, bytes 1-2 analog output, no pad.
-    EXPECT_EQ(consumed_assembly_layout(100, c).value(),
-              (PollRequestLayout{.dout_offset = 0, .dout_size = 1, .pad_size = 0,
-                                 .aout_offset = 1, .aout_count = 1, .size = 3}));
+    EXPECT_EQ(consumed_assembly_layout(100, c).value(), (PollRequestLayout{.dout_offset = 0,
+                                                                           .dout_size = 1,
+                                                                           .pad_size = 0,
+                                                                           .aout_offset = 1,
+                                                                           .aout_count = 1,
+                                                                           .size = 3}));
   }
   EXPECT_EQ(describe(consumed_assembly_layout(100, bad).value()), "request 3 B [DOUT AOUT]");
 }
