@@ -31,13 +31,6 @@ constexpr Duration kClockSkewReported = seconds(1);
 // one that comes alone is taken at once, on Cyclone's thread.
 constexpr Duration kCommandHoldoff = milliseconds(1);
 
-// The filter of a node's own command readers (DdsInput::node_readers_).
-template <class Command, class Key>
-bool commands_node(const Command& c, const void* key) {
-  const auto& k = *static_cast<const Key*>(key);
-  return c.mac == k.mac && dds::view(c.port) == k.port && dds::view(c.rack) == k.rack;
-}
-
 // Samples taken at a time.
 constexpr std::size_t kBatch = 32;
 
@@ -89,73 +82,6 @@ void take_all(dds::Reader<T>& reader, Logger& log, const char* what, Fn fn) {
 
 }  // namespace
 
-// One reader of a command topic, with what it takes samples into.
-class DdsInput::CommandReader {
- public:
-  virtual ~CommandReader() = default;
-  // Takes every sample waiting and hands each to the input (on_command).
-  virtual void take(DdsInput& input, const CommandClass& from) = 0;
-  virtual const dds::Entity& entity() const = 0;
-};
-
-// A command topic the input reads: the profile it commands, and its readers.
-class DdsInput::CommandTopic {
- public:
-  virtual ~CommandTopic() = default;
-  virtual std::string_view profile() const = 0;
-  virtual std::string_view name() const = 0;
-  // Its readers are needed to run: a failure to make one is not only a
-  // topic that DDS Security does not grant (the publisher's own topic).
-  virtual bool required() const = 0;
-  // A reader for a class of nodes (`node` null) or for one node, its own
-  // topic entity filtered to it (`node` must outlive the reader). Throws
-  // dds::Error.
-  virtual std::unique_ptr<CommandReader> reader(const dds::Participant& participant,
-                                                const dds::Qos& qos, const dds_listener_t* listener,
-                                                const NodeKey* node) const = 0;
-};
-
-template <class Command>
-class DdsInput::TypedCommandTopic final : public CommandTopic {
- public:
-  // On `shared`, the participant's topic of it (the publisher's), or on one of its own.
-  explicit TypedCommandTopic(const dds::Topic<Command>* shared) : shared_(shared) {}
-  explicit TypedCommandTopic(dds::Topic<Command>&& own) : own_(std::move(own)), shared_(&*own_) {}
-
-  std::string_view profile() const override { return kProfileCommanded<Command>; }
-  std::string_view name() const override { return dds::TopicTraits<Command>::kName; }
-  bool required() const override { return !own_; }
-
-  std::unique_ptr<CommandReader> reader(const dds::Participant& participant, const dds::Qos& qos,
-                                        const dds_listener_t* listener,
-                                        const NodeKey* node) const override {
-    auto made = std::make_unique<Reader>();
-    const dds::Topic<Command>* topic = shared_;
-    if (node) {
-      made->filtered.emplace(participant);
-      made->filtered->filter(&commands_node<Command, NodeKey>, node);
-      topic = &*made->filtered;
-    }
-    made->reader.emplace(participant, *topic, qos, listener);
-    return made;
-  }
-
- private:
-  struct Reader final : CommandReader {
-    std::optional<dds::Topic<Command>> filtered;  // before the reader: it outlives it
-    std::optional<dds::Reader<Command>> reader;
-    dds::TakeBuffer<Command> buffer{kBatch};
-    void take(DdsInput& input, const CommandClass& from) override {
-      take_batches([&] { return reader->take(buffer); }, buffer.capacity(), 0, input.command_log_,
-                   dds::TopicTraits<Command>::kName,
-                   [&](std::size_t i) { input.on_command(buffer.data(i), buffer.info(i), from); });
-    }
-    const dds::Entity& entity() const override { return *reader; }
-  };
-  std::optional<dds::Topic<Command>> own_;
-  const dds::Topic<Command>* shared_;
-};
-
 void HandoffLogSink::write_structured(LogLevel level, std::string_view component,
                                       std::string_view message, std::span<const LogField> fields) {
   {
@@ -204,7 +130,8 @@ void DrainFirstLogSink::write_structured(LogLevel level, std::string_view compon
 
 DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
                    std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log,
-                   std::function<void(ReloadCall)> reload, Duration max_commander_lease)
+                   std::function<void(ReloadCall)> reload, Duration max_commander_lease,
+                   std::span<const ProfileTopics> profiles)
     : rack_(std::move(rack)),
       publisher_(publisher),
       ports_(std::move(ports)),
@@ -225,19 +152,22 @@ DdsInput::DdsInput(const dds::Participant& participant, DdsPublisher& publisher,
       command_log_(log_.to(command_sink_)),
       own_sink_(log_.sink(), [this] { drain_command_log(); }) {
   log_ = log_.to(own_sink_);
-  command_topics_.push_back(
-      std::make_unique<TypedCommandTopic<dnbridge_PumpCommand>>(&publisher.command_topic()));
-  if (auto devices = unless_denied(log_, "the devices' commands (dnbridge/DeviceCommand)", [&] {
-        return dds::Topic<dnbridge_DeviceCommand>(participant);
-      })) {
-    command_topics_.push_back(
-        std::make_unique<TypedCommandTopic<dnbridge_DeviceCommand>>(std::move(*devices)));
+  for (const ProfileTopics& profile : profiles) {
+    const auto make = [&] { return profile.make_command(participant); };
+    if (profile.required) {
+      command_topics_.push_back(make());
+    } else if (auto topic = unless_denied(log_,
+                                          fmt::format("the commands of profile \"{}\" ({})",
+                                                      profile.profile, profile.command_topic),
+                                          make)) {
+      command_topics_.push_back(std::move(*topic));
+    }
   }
   {
     std::lock_guard lock(command_take_mutex_);
     ensure_command_classes();
     if (command_classes_.empty() || command_classes_.front()->refresh_ms != 0) {
-      throw std::runtime_error("creating the reader of the pumps' commands failed (logged)");
+      throw std::runtime_error("creating the readers of the commands failed (logged)");
     }
   }
   // Readers of the services that DDS Security grants (the publisher has
@@ -543,20 +473,19 @@ void DdsInput::take_commands() {
 }
 
 void DdsInput::take_commands(const CommandClass& from) {
-  for (const auto& reader : from.readers) reader->take(*this, from);
+  for (const auto& reader : from.readers) {
+    reader->take(command_log_, [&](const CommandSample& c) { on_command(c, from); });
+  }
 }
 
-template <class Command>
-port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info,
-                                   const CommandClass& from) {
-  constexpr std::string_view kProfile = kProfileCommanded<Command>;
-  port::PortLoop* loop = port_of(dds::view(c.port));
+port::PortLoop* DdsInput::loop_for(const CommandSample& c, const CommandClass& from) {
+  port::PortLoop* loop = port_of(c.port);
   const auto mac = devicenet::MacId::from(c.mac);
   const std::string_view profile = loop && mac ? loop->profile_of(*mac) : std::string_view{};
   // Every class's readers have every instance: a node's commands are its
   // own readers' when it has them, else its class's, and a refusal is said
   // once, by the class without refresh.
-  if (profile == kProfile && !profile.empty()) {
+  if (profile == c.profile && !profile.empty()) {
     const std::uint32_t refresh = loop->command_refresh_ms(*mac);
     if (refresh != from.refresh_ms) return nullptr;
     if (from.node) {
@@ -571,21 +500,19 @@ port::PortLoop* DdsInput::loop_for(const Command& c, const dds::SampleInfo& info
   }
   if (from.refresh_ms != 0 || from.node) return nullptr;
   command_warn_limit_.warn(
-      command_log_, port::steady_now(), "{} sample{} for port \"{}\" MAC {} refused: {}",
-      dds::TopicTraits<Command>::kName,
-      info.valid_data() ? fmt::format(" from {}", dds::view(c.issuer)) : "", dds::view(c.port),
-      c.mac,
+      command_log_, port::steady_now(), "{} sample{} for port \"{}\" MAC {} refused: {}", c.topic,
+      c.info.valid_data() ? fmt::format(" from {}", c.issuer) : "", c.port, c.mac,
       profile.empty() ? std::string("not in this rack's configuration")
                       : fmt::format("the node's profile is \"{}\"; {} commands the nodes of "
                                     "profile \"{}\"",
-                                    profile, dds::TopicTraits<Command>::kName, kProfile));
+                                    profile, c.topic, c.profile));
   return nullptr;
 }
 
-template <class Command>
-void DdsInput::on_command(const Command& c, const dds::SampleInfo& info, const CommandClass& from) {
-  if (dds::view(c.rack) != rack_) return;  // another bridge's node
-  port::PortLoop* loop = loop_for(c, info, from);
+void DdsInput::on_command(const CommandSample& c, const CommandClass& from) {
+  if (c.rack != rack_) return;  // another bridge's node
+  const dds::SampleInfo& info = c.info;
+  port::PortLoop* loop = loop_for(c, from);
   if (!loop) return;
   if (info.valid_data()) commands_taken_.fetch_add(1, std::memory_order_relaxed);
   const auto mac = devicenet::MacId::from(c.mac);
@@ -598,12 +525,12 @@ void DdsInput::on_command(const Command& c, const dds::SampleInfo& info, const C
     return;
   }
   if (!info.valid_data()) return;
-  note_clock_skew(c, info);
-  loop->command(*mac, command_of(c), std::string(dds::view(c.issuer)));
+  note_clock_skew(c);
+  loop->command(*mac, c.outputs(), std::string(c.issuer));
 }
 
-template <class Command>
-void DdsInput::note_clock_skew(const Command& c, const dds::SampleInfo& info) {
+void DdsInput::note_clock_skew(const CommandSample& c) {
+  const dds::SampleInfo& info = c.info;
   // Commands are applied in the order they arrive, whatever their stamps
   // (dds::command_reader_qos): a commander's clock cannot hold a pump. A
   // stamp far ahead still says that a commander's clock is wrong, and other
@@ -616,7 +543,7 @@ void DdsInput::note_clock_skew(const Command& c, const dds::SampleInfo& info) {
       "command from \"{}\" for port \"{}\" MAC {} is stamped {:.1f} s ahead of this host's "
       "clock ({} such commands so far): applied in the order received; check the commander's "
       "clock synchronisation",
-      dds::view(c.issuer), dds::view(c.port), c.mac, std::chrono::duration<double>(ahead).count(),
+      c.issuer, c.port, c.mac, std::chrono::duration<double>(ahead).count(),
       commands_stamped_ahead_);
 }
 

@@ -3,9 +3,10 @@
 // requests and reload requests for this rack, each handed to its port's
 // loop through the loop's inbox; nothing here touches master state. Every
 // command topic (one per profile: PumpCommand commands the CDN127s,
-// DeviceCommand the devices described by their EDS) takes one path: a
-// CommandTopic makes its readers, a sample becomes a rack::NodeCommand
-// (samples.hpp, command_of) for the node's port loop.
+// DeviceCommand the devices described by their EDS) takes one path: the
+// profile's CommandTopic (profile_topics.hpp) makes its readers, and a
+// sample becomes a CommandSample, whose outputs are a rack::NodeCommand for
+// the node's port loop.
 // Commands are taken by a listener, on the Cyclone thread that delivers
 // them, and handed over at once (take, push, wake: nothing that waits);
 // under a flood, at most once per hold-off, the rest by the input's own
@@ -30,6 +31,7 @@
 #include <vector>
 
 #include "adapters/daemon/dds_publisher.hpp"
+#include "adapters/daemon/profile_topics.hpp"
 #include "adapters/dds/listener.hpp"
 #include "adapters/dds/reader.hpp"
 #include "adapters/dds/waitset.hpp"
@@ -103,7 +105,8 @@ class DdsInput {
   DdsInput(const dds::Participant& participant, DdsPublisher& publisher, std::string rack,
            std::map<std::string, port::PortLoop*, std::less<>> ports, Logger log,
            std::function<void(ReloadCall)> reload = {},
-           Duration max_commander_lease = dds::kDefaultMaxCommanderLease);
+           Duration max_commander_lease = dds::kDefaultMaxCommanderLease,
+           std::span<const ProfileTopics> profiles = bridge_profiles());
   ~DdsInput();
   DdsInput(const DdsInput&) = delete;
   DdsInput& operator=(const DdsInput&) = delete;
@@ -140,11 +143,6 @@ class DdsInput {
   // or of one node (node_readers_): one per command topic (of the node's
   // profile, for a node's own).
   struct CommandClass;
-  // A command topic and its readers; one reader of it (dds_input.cpp).
-  class CommandTopic;
-  class CommandReader;
-  template <class Command>
-  class TypedCommandTopic;
   // Every command reader's commands; one class's.
   void take_commands();
   void take_commands(const CommandClass& from);
@@ -153,14 +151,12 @@ class DdsInput {
   void on_scan_request(const dds::Sample<dnbridge_BusScanRequest>& sample);
   void take_reload_requests();
   // A command sample taken by a reader of `from`, of any command topic.
-  template <class Command>
-  void on_command(const Command& c, const dds::SampleInfo& info, const CommandClass& from);
+  void on_command(const CommandSample& c, const CommandClass& from);
   // The port loop a command sample is for, when the MAC is a node of that
   // loop of the profile the topic commands and of the reader's command
   // refresh; else null, and a refusal (a node not in the rack, or of
   // another profile) is logged (rate-limited).
-  template <class Command>
-  port::PortLoop* loop_for(const Command& c, const dds::SampleInfo& info, const CommandClass& from);
+  port::PortLoop* loop_for(const CommandSample& c, const CommandClass& from);
   // A class of command readers for every command refresh the ports' nodes
   // have now (none is deleted before stop). Under command_take_mutex_.
   void ensure_command_classes();
@@ -182,10 +178,7 @@ class DdsInput {
   // makes it stale: from then on its class takes the node's commands
   // (loop_for), and the input drops it when the port loop wakes it. Under
   // command_take_mutex_.
-  struct NodeKey {
-    std::string rack, port;
-    std::uint8_t mac;
-  };
+  using NodeKey = CommandedNode;
   // A node by port and MAC, found without a copy of its port's name.
   struct NodeRef {
     std::string_view port;
@@ -210,8 +203,7 @@ class DdsInput {
   bool classes_closed_ = false;  // stop(): no class is made after it (under the mutex)
   std::uint64_t refresh_generations() const;
   void on_request(const dnbridge_ExplicitRequest& r, std::span<const unsigned char> serialized);
-  template <class Command>
-  void note_clock_skew(const Command& c, const dds::SampleInfo& info);
+  void note_clock_skew(const CommandSample& c);
   port::PortLoop* port_of(std::string_view name);
 
   std::string rack_;

@@ -23,107 +23,16 @@ dds::Timestamp WallClock::to_wall(TimePoint monotonic) const {
   return dds::Timestamp(monotonic.time_since_epoch() + offset_);
 }
 
-namespace {
-
-// A node's instance of a state topic.
-template <class T>
-dds::Owned<T> key_of(const std::string& rack, const std::string& port, std::uint8_t mac) {
-  dds::Owned<T> key;
-  dds::set_string(key->rack, rack);
-  dds::set_string(key->port, port);
-  key->mac = mac;
-  return key;
-}
-
-}  // namespace
-
-class DdsPublisher::StateTopic {
- public:
-  virtual ~StateTopic() = default;
-  virtual std::string_view profile() const = 0;
-  virtual const char* name() const = 0;
-  // The node's state sample (no writer, when DDS Security does not grant
-  // the topic: nothing, OK).
-  virtual Status write(const std::string& rack, const std::string& port, const rack::NodeView& node,
-                       dds::Timestamp at) = 0;
-  // The node's NodeStatus, its profile's part included.
-  virtual void fill_status(dnbridge_NodeStatus& out, const std::string& rack,
-                           const std::string& port, const rack::NodeView& node,
-                           const port::NodeStatusView& status) const = 0;
-  virtual Status dispose(const std::string& rack, const std::string& port, std::uint8_t mac,
-                         dds::Timestamp at) = 0;
-  virtual Status unregister(const std::string& rack, const std::string& port, std::uint8_t mac,
-                            dds::Timestamp at) = 0;
-  virtual void wait_for_acks(Duration timeout) = 0;
-};
-
-// A profile's state topic of type State, whose nodes' views are View.
-template <class State, class View>
-class DdsPublisher::TypedStateTopic final : public StateTopic {
- public:
-  using Fill = void (*)(State&, std::string_view, std::string_view, const View&);
-  // `required`: a writer DDS Security does not grant is an error (thrown),
-  // not a topic left out.
-  TypedStateTopic(const dds::Participant& participant, const dds::Qos& qos, Logger& log,
-                  std::string_view profile, Fill fill, bool required)
-      : profile_(profile), fill_(fill) {
-    const auto make = [&] { return Out(participant, qos); };
-    if (required) {
-      out_.emplace(participant, qos);
-    } else {
-      out_ = unless_denied(log, fmt::format("the state of profile \"{}\" ({})", profile, name()),
-                           make);
-    }
-  }
-  std::string_view profile() const override { return profile_; }
-  const char* name() const override { return dds::TopicTraits<State>::kName; }
-  Status write(const std::string& rack, const std::string& port, const rack::NodeView& node,
-               dds::Timestamp at) override {
-    if (!out_) return {};
-    dds::Owned<State> sample;
-    fill_(*sample, rack, port, static_cast<const View&>(node));
-    return out_->writer.write(*sample, at);
-  }
-  void fill_status(dnbridge_NodeStatus& out, const std::string& rack, const std::string& port,
-                   const rack::NodeView& node, const port::NodeStatusView& status) const override {
-    fill_node_status(out, rack, port, static_cast<const View&>(node), status);
-  }
-  Status dispose(const std::string& rack, const std::string& port, std::uint8_t mac,
-                 dds::Timestamp at) override {
-    if (!out_) return {};
-    return out_->writer.dispose(*key_of<State>(rack, port, mac), at);
-  }
-  Status unregister(const std::string& rack, const std::string& port, std::uint8_t mac,
-                    dds::Timestamp at) override {
-    if (!out_) return {};
-    return out_->writer.unregister_instance(*key_of<State>(rack, port, mac), at);
-  }
-  void wait_for_acks(Duration timeout) override {
-    if (out_) (void)out_->writer.wait_for_acks(timeout);
-  }
-
- private:
-  struct Out {
-    Out(const dds::Participant& participant, const dds::Qos& qos)
-        : topic(participant), writer(participant, topic, qos) {}
-    dds::Topic<State> topic;
-    dds::Writer<State> writer;
-  };
-  std::string_view profile_;
-  Fill fill_;
-  std::optional<Out> out_;
-};
-
 DdsPublisher::~DdsPublisher() = default;
 
 DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack,
-                           Duration state_deadline, Logger log)
+                           Duration state_deadline, Logger log,
+                           std::span<const ProfileTopics> profiles)
     : rack_(std::move(rack)),
       log_(std::move(log)),
       partition_{dds::rack_partition(rack_)},
       node_topic_(participant),
       port_topic_(participant),
-      command_topic_(participant),
       request_topic_(participant),
       reply_topic_(participant),
       node_writer_(participant, node_topic_, dds::state_writer_qos(state_deadline)),
@@ -141,13 +50,12 @@ DdsPublisher::DdsPublisher(const dds::Participant& participant, std::string rack
                             })),
       reply_out_("dds reply out", kReplyBacklog) {
   const dds::Qos qos = dds::state_writer_qos(state_deadline);
-  state_topics_.push_back(std::make_unique<TypedStateTopic<dnbridge_PumpState, rack::PumpView>>(
-      participant, qos, log_, rack::PumpProfile::kName, &fill_pump_state, true));
-  state_topics_.push_back(std::make_unique<TypedStateTopic<dnbridge_DeviceState, rack::DeviceView>>(
-      participant, qos, log_, rack::DeviceProfile::kName, &fill_device_state, false));
+  for (const ProfileTopics& profile : profiles) {
+    state_topics_.push_back(profile.make_state(participant, qos, log_));
+  }
 }
 
-DdsPublisher::StateTopic* DdsPublisher::state_topic(std::string_view profile) const {
+StateTopic* DdsPublisher::state_topic(std::string_view profile) const {
   for (const auto& t : state_topics_) {
     if (t->profile() == profile) return t.get();
   }

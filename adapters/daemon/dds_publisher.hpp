@@ -27,7 +27,9 @@
 #include <vector>
 
 #include "adapters/daemon/outbox.hpp"
+#include "adapters/daemon/profile_topics.hpp"
 #include "adapters/daemon/reload.hpp"
+#include "adapters/daemon/unless_denied.hpp"
 #include "adapters/dds/participant.hpp"
 #include "adapters/dds/sample.hpp"
 #include "adapters/dds/time.hpp"
@@ -60,30 +62,13 @@ struct Service {
   dds::Writer<Reply> writer;
 };
 
-// Makes `make()`'s entity, or nothing when DDS Security does not grant it
-// (permissions signed before the service came): the bridge then runs
-// without it, and says so once, naming `what`. Any other failure throws.
-template <class Make>
-auto unless_denied(Logger& log, std::string_view what, Make make)
-    -> std::optional<decltype(make())> {
-  try {
-    return make();
-  } catch (const dds::Error& e) {
-    if (e.code() != DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) throw;
-    log.warn(
-        "{}: not in this bridge's DDS Security permissions, so not offered (the site's "
-        "make-site-pki.sh, run again, grants it): {}",
-        what, e.what());
-    return std::nullopt;
-  }
-}
-
 class DdsPublisher final : public port::PortPublisher {
  public:
   // `state_deadline`: the deadline offered on the state topics (each
   // instance is written at least that often while its port runs).
+  // `profiles`: the state topic of each (profile_topics.hpp).
   DdsPublisher(const dds::Participant& participant, std::string rack, Duration state_deadline,
-               Logger log);
+               Logger log, std::span<const ProfileTopics> profiles = bridge_profiles());
   ~DdsPublisher() override;
 
   void node_state(const std::string& port, const rack::NodeView& node,
@@ -123,7 +108,6 @@ class DdsPublisher final : public port::PortPublisher {
   // Replies handed over at most this many at a time; more are undelivered.
   static constexpr std::size_t kReplyBacklog = 1024;
 
-  const dds::Topic<dnbridge_PumpCommand>& command_topic() const { return command_topic_; }
   const dds::Topic<dnbridge_ExplicitRequest>& request_topic() const { return request_topic_; }
   // Null when DDS Security does not grant the service (unless_denied).
   const dds::Topic<dnbridge_BusScanRequest>* scan_request_topic() const {
@@ -138,12 +122,6 @@ class DdsPublisher final : public port::PortPublisher {
   bool check(Status s, const char* what);
   // The same for a state topic's write, disposal or unregistration, counted.
   void check_state(Status s, const char* what);
-  // A profile's state topic (PumpState for "cdn127", DeviceState for
-  // "eds"): its writer, and how its sample and its part of NodeStatus are
-  // filled (samples.hpp). One per profile (dds_publisher.cpp).
-  class StateTopic;
-  template <class State, class View>
-  class TypedStateTopic;
   // The state topic of `profile`; null for a profile it does not know.
   StateTopic* state_topic(std::string_view profile) const;
   // The state topic a node's samples were written on, besides NodeStatus.
@@ -162,10 +140,9 @@ class DdsPublisher final : public port::PortPublisher {
   WallClock clock_;
   dds::Topic<dnbridge_NodeStatus> node_topic_;
   dds::Topic<dnbridge_PortStatus> port_topic_;
-  dds::Topic<dnbridge_PumpCommand> command_topic_;
   dds::Topic<dnbridge_ExplicitRequest> request_topic_;
   dds::Topic<dnbridge_ExplicitReply> reply_topic_;
-  std::vector<std::unique_ptr<StateTopic>> state_topics_;
+  std::vector<std::unique_ptr<StateTopic>> state_topics_;  // one per profile
   dds::Writer<dnbridge_NodeStatus> node_writer_;
   dds::Writer<dnbridge_PortStatus> port_writer_;
   dds::Writer<dnbridge_ExplicitReply> reply_writer_;

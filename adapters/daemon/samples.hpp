@@ -38,15 +38,6 @@ void fill_reload_reply(dnbridge_ReloadReply& out, std::string_view rack, const R
 rack::NodeCommand command_of(const dnbridge_PumpCommand& command);
 rack::NodeCommand command_of(const dnbridge_DeviceCommand& command);
 
-// The profile whose nodes a command topic commands.
-template <class Command>
-inline constexpr std::string_view kProfileCommanded = {};
-template <>
-inline constexpr std::string_view kProfileCommanded<dnbridge_PumpCommand> =
-    rack::PumpProfile::kName;
-template <>
-inline constexpr std::string_view kProfileCommanded<dnbridge_DeviceCommand> =
-    rack::DeviceProfile::kName;
 // A request sample as the explicit gateway takes it.
 rack::ExplicitCall call_of(const dnbridge_ExplicitRequest& request);
 

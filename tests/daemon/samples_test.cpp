@@ -6,10 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "adapters/daemon/profile_topics.hpp"
 #include "adapters/dds/topics.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
+#include "bridge/rack/rack_port.hpp"
 
 namespace dnbridge::daemon {
 namespace {
@@ -80,6 +83,32 @@ TEST(Samples, ADevicesProductNameIsPublishedAsUtf8) {
   fill_node_status(*status, "r", "A", *view, node);
   EXPECT_STREQ(status->product_name, "\xC2\xB5Pump \xC3\xA4");
   EXPECT_STREQ(status->name, "Pumpe \xC3\xA4tz");
+}
+
+// Every profile a port's rack has is registered with its DDS topics, once:
+// a profile left out would have nodes that are neither published nor
+// commanded.
+TEST(ProfileTopics, EveryProfileOfARackPortHasItsTopicsOnce) {
+  NullSink sink;
+  rack::RackPort port({}, rack::PortNodes{}, sink, Logger());
+  const auto registered = bridge_profiles();
+  ASSERT_EQ(registered.size(), port.profiles().size());
+  for (const rack::ProfileNodes* nodes : port.profiles()) {
+    SCOPED_TRACE(std::string(nodes->profile()));
+    EXPECT_EQ(std::count_if(registered.begin(), registered.end(),
+                            [&](const ProfileTopics& t) { return t.profile == nodes->profile(); }),
+              1);
+  }
+  // The CDN127's are required (the bridge does not run without them); the
+  // topics are the IDL's.
+  EXPECT_EQ(registered[0].profile, rack::PumpProfile::kName);
+  EXPECT_TRUE(registered[0].required);
+  EXPECT_EQ(registered[0].state_topic, dds::TopicTraits<dnbridge_PumpState>::kName);
+  EXPECT_EQ(registered[0].command_topic, dds::TopicTraits<dnbridge_PumpCommand>::kName);
+  EXPECT_EQ(registered[1].profile, rack::DeviceProfile::kName);
+  EXPECT_FALSE(registered[1].required);
+  EXPECT_EQ(registered[1].state_topic, dds::TopicTraits<dnbridge_DeviceState>::kName);
+  EXPECT_EQ(registered[1].command_topic, dds::TopicTraits<dnbridge_DeviceCommand>::kName);
 }
 
 }  // namespace
