@@ -1,6 +1,8 @@
 // A node described by its EDS as the master takes it: identity, the poll
 // connection's paths and sizes, the parameters and then the safe state as
 // settings at their link paths, and each refusal said with the parameter.
+#include "bridge/profiles/eds/node_profile.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -8,7 +10,6 @@
 #include <vector>
 
 #include "bridge/cip/assembly.hpp"
-#include "bridge/profiles/eds/node_profile.hpp"
 #include "tests/support/example_eds.hpp"
 
 namespace dnbridge::eds {

@@ -2,13 +2,14 @@
 // members: the example I/O block's input and output, nested assemblies,
 // path members and padding, signed and REAL values, scaling, and commands
 // encoded field by field with every refusal said.
+#include "bridge/profiles/eds/io_layout.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "bridge/profiles/eds/io_layout.hpp"
 #include "tests/support/example_eds.hpp"
 
 namespace dnbridge::eds {

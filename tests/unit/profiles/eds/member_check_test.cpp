@@ -1,9 +1,10 @@
 // A device's assembly member list against its EDS: agreement, and each kind
 // of difference said with the member, both sides and the assembly.
+#include "bridge/profiles/eds/member_check.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "bridge/profiles/eds/member_check.hpp"
 #include "tests/support/example_eds.hpp"
 
 namespace dnbridge::eds {
