@@ -707,8 +707,21 @@ void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems&
   if (parameters) {
     if (auto v = read_parameter_values(*parameters, "parameters", r)) s.eds_node.parameters = *v;
   }
+  // The parameters that set the outputs' fault and idle actions, or
+  // "device": the device's own, fixed by its maker.
   const toml::node* safe = nt.get("safe_state");
-  if (safe) {
+  if (safe && safe->is_string()) {
+    if (auto v = read_string(*safe, "safe_state", r); v && *v == "device") {
+      s.eds_node.safe_state_of_device = true;
+    } else if (v) {
+      r.error(safe->source(),
+              fmt::format("safe_state = \"{}\" is not a choice for profile = \"eds\": give the "
+                          "parameters that set the outputs' fault and idle actions "
+                          "([{{ name = \"...\", value = ... }}]), or \"device\" where the "
+                          "device's maker fixes them",
+                          *v));
+    }
+  } else if (safe) {
     if (auto v = read_parameter_values(*safe, "safe_state", r)) s.eds_node.safe_state = *v;
   }
   const toml::node* key = nt.require("eds");
@@ -724,7 +737,18 @@ void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems&
   s.eds_digest = e.digest;
   // Outputs whose safe state the node leaves as the device has it.
   const auto& io = eds::node_io(*e.file, s.eds_node.connection);
-  if (io && io->consumed.size > 0) {
+  if (io && io->consumed.size > 0 && s.eds_node.safe_state_of_device) {
+    std::string read;
+    for (const eds::Param* p : eds::safe_state_left_to_device(*e.file, s.eds_node)) {
+      if (eds::kept_setting(*p)) read += fmt::format(", Param{} \"{}\"", p->number, p->name);
+    }
+    r.warning(safe->source(),
+              fmt::format("node {}: its outputs' fault and idle behaviour is the device's own "
+                          "(safe_state = \"device\"): {}, never written",
+                          s.pump.node.mac.value(),
+                          read.empty() ? std::string("its EDS names no parameter to read")
+                                       : "read at start-up: " + read.substr(2)));
+  } else if (io && io->consumed.size > 0) {
     for (const eds::Param* p : eds::safe_state_left_to_device(*e.file, s.eds_node)) {
       r.warning(key->source(),
                 fmt::format("node {}: Param{} \"{}\" is set neither in safe_state nor in "

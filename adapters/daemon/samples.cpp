@@ -212,11 +212,13 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
 void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
                       const rack::DeviceView& v, const port::NodeStatusView& node) {
   fill_node_common(out, rack, port, v, node);
-  // Its safe state is the EDS parameters the configuration gives: no
-  // CDN127 action to name, the values read back in words.
+  // Its safe state is the EDS parameters the configuration gives, or the
+  // device's own (safe_state = "device"): no CDN127 action to name, the
+  // values read back in words.
   const auto unknown = dnbridge_SAFE_ACTION_UNKNOWN;
   out.safe_state_known = !v.safe_state_text.empty();
-  out.safe_state_source = dnbridge_SAFE_STATE_CONFIGURED;
+  out.safe_state_source =
+      v.safe_state_of_device ? dnbridge_SAFE_STATE_DEVICE : dnbridge_SAFE_STATE_CONFIGURED;
   out.pump_on_fault = out.pump_on_idle = out.n2_ballast_on_fault = out.n2_ballast_on_idle =
       out.analog_output_on_fault = out.analog_output_on_idle = unknown;
   out.analog_output_fault_raw = out.analog_output_idle_raw = 0;

@@ -57,24 +57,41 @@ DeviceView DeviceProfile::view_of(const DeviceConfig& d, const Slot& slot) {
   v.reason = "not started";
   v.product = eds_of(d).device.product_name;
   v.io = slot.io;
+  v.safe_state_of_device = slot.settings.safe_state_of_device;
   return v;
 }
 
 void DeviceProfile::carry_over(const DeviceView&, DeviceView&) {}
 
 void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::Node& node) {
-  // The safe state's settings follow the parameters' (eds::make_node_profile).
+  // The safe state's settings follow the parameters' (eds::make_node_profile):
+  // the safe_state parameters, or with safe_state = "device" the ones the
+  // EDS names for it, read and kept.
+  std::vector<const eds::Param*> params;
+  if (slot.settings.safe_state_of_device) {
+    for (const eds::Param* p : eds::safe_state_left_to_device(*slot.eds, slot.settings)) {
+      if (eds::kept_setting(*p)) params.push_back(p);
+    }
+  } else {
+    for (const auto& given : slot.settings.safe_state)
+      params.push_back(slot.eds->param(given.name));
+  }
   const auto& in_force = node.settings_in_force();
   const std::size_t first = slot.settings.parameters.size();
   std::string text;
-  for (std::size_t i = 0; i < slot.settings.safe_state.size(); ++i) {
-    const eds::Param* p = slot.eds->param(slot.settings.safe_state[i].name);
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const eds::Param* p = params[i];
     if (p == nullptr || first + i >= in_force.size()) continue;
     const auto& bytes = in_force[first + i];
     const std::uint64_t raw = little_endian(bytes);
     const auto bits = static_cast<std::uint16_t>(std::min<std::size_t>(bytes.size() * 8, 64));
     text += fmt::format("{}Param{} {} = {}{}", text.empty() ? "" : "; ", p->number, p->name,
                         eds::from_raw(p->type, bits, raw), p->units.empty() ? "" : " " + p->units);
+  }
+  if (slot.settings.safe_state_of_device) {
+    text = text.empty() ? "the device's own (safe_state = \"device\"): its EDS names no "
+                          "parameter for it"
+                        : "the device's own (safe_state = \"device\"): " + text;
   }
   v.safe_state_text = std::move(text);
 }

@@ -51,8 +51,10 @@ struct DeviceView : NodeView {
 
   // The safe state the device had when the node last came online: each
   // safe_state parameter as read back after the download, in words
-  // ("Param6 Output fault action = 0; ..."); empty until then.
+  // ("Param6 Output fault action = 0; ..."), or with safe_state = "device"
+  // the device's own as read; empty until then.
   std::string safe_state_text;
+  bool safe_state_of_device = false;  // safe_state = "device"
 };
 
 struct DeviceProfile {

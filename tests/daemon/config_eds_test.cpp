@@ -96,6 +96,40 @@ TEST(ConfigEds, SafeStateParametersLeftToTheDeviceAreWarnedOf) {
   EXPECT_TRUE(parse(ONE_PORT IO_BLOCK).warnings.empty());
 }
 
+// A device whose outputs' fault and idle behaviour its maker fixes is
+// configured by saying so: read where its EDS names it, never written,
+// warned of at every start (the load's warnings are logged).
+TEST(ConfigEds, SafeStateDeviceLeavesTheSafeStateToTheDeviceAndIsWarnedOf) {
+  const DaemonConfig c = parse(ONE_PORT
+                               "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                               "eds = \"dnbridge-example-io-block.eds\"\n"
+                               "safe_state = \"device\"\n");
+  const NodeSettings& n = c.ports.at(0).nodes.at(0);
+  EXPECT_TRUE(n.eds_node.safe_state_of_device);
+  EXPECT_TRUE(n.eds_node.safe_state.empty());
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_THAT(c.warnings[0],
+              HasSubstr("t.toml:11:14: node 20: its outputs' fault and idle behaviour is the "
+                        "device's own (safe_state = \"device\"): read at start-up: Param6 "
+                        "\"Output fault action\", Param7 \"Output fault value\", Param8 "
+                        "\"Output idle action\", Param9 \"Output idle value\", never written"));
+  const auto list =
+      rack::RackPort::scan_list(to_scanner_config(c.ports[0], "host"), to_port_nodes(c.ports[0]));
+  ASSERT_EQ(list.nodes.size(), 1u);
+  ASSERT_EQ(list.nodes[0].profile.settings.size(), 4u);
+  for (const auto& setting : list.nodes[0].profile.settings) {
+    EXPECT_TRUE(setting.keep_device_value) << setting.name;
+  }
+  // Another word is not a choice for this profile.
+  EXPECT_THAT(
+      problems(ONE_PORT "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                        "eds = \"dnbridge-example-io-block.eds\"\nsafe_state = \"configured\"\n"),
+      HasSubstr("t.toml:11:14: safe_state = \"configured\" is not a choice for profile = "
+                "\"eds\": give the parameters that set the outputs' fault and idle "
+                "actions ([{ name = \"...\", value = ... }]), or \"device\" where the "
+                "device's maker fixes them"));
+}
+
 TEST(ConfigEds, TheShippedExampleLoads) {
   const DaemonConfig c =
       load_config_file(std::string(DNBRIDGE_SOURCE_DIR) + "/deploy/config/eds-rack-example.toml");

@@ -13,6 +13,7 @@
 #include "adapters/dds/topics.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
 #include "bridge/rack/rack_port.hpp"
+#include "support/example_eds.hpp"
 
 namespace dnbridge::daemon {
 namespace {
@@ -83,6 +84,31 @@ TEST(Samples, ADevicesProductNameIsPublishedAsUtf8) {
   fill_node_status(*status, "r", "A", *view, node);
   EXPECT_STREQ(status->product_name, "\xC2\xB5Pump \xC3\xA4");
   EXPECT_STREQ(status->name, "Pumpe \xC3\xA4tz");
+}
+
+// A device's NodeStatus says where its safe state comes from: the
+// configuration's parameters, or the device's own (safe_state = "device").
+TEST(Samples, ADevicesSafeStateSourceIsPublished) {
+  rack::DeviceConfig d;
+  d.node.mac = devicenet::MacId::from(20).value();
+  d.node.name = "io-20";
+  d.eds = std::make_shared<const eds::EdsFile>(test::example_eds(test::kIoBlockEds));
+  d.settings.safe_state_of_device = true;
+  rack::DeviceRack rack({d});
+  NullSink sink;
+  devicenet::Scanner scanner(rack::DeviceRack::scanner_config({}, {d}), sink, rack, Logger());
+  const rack::DeviceView* view = rack.device(d.node.mac);
+  ASSERT_NE(view, nullptr);
+  dds::Owned<dnbridge_NodeStatus> status;
+  fill_node_status(*status, "r", "A", *view, port::NodeStatusView::of(*scanner.node(d.node.mac)));
+  EXPECT_EQ(status->safe_state_source, dnbridge_SAFE_STATE_DEVICE);
+  EXPECT_FALSE(status->safe_state_known);  // not read yet: the node is not online
+  d.settings.safe_state_of_device = false;
+  d.settings.safe_state = {{"Output idle action", 0}};
+  rack::DeviceRack configured({d});
+  fill_node_status(*status, "r", "A", *configured.device(d.node.mac),
+                   port::NodeStatusView::of(*scanner.node(d.node.mac)));
+  EXPECT_EQ(status->safe_state_source, dnbridge_SAFE_STATE_CONFIGURED);
 }
 
 // Every profile a port's rack has is registered with its DDS topics, once:

@@ -89,6 +89,27 @@ TEST_F(DeviceRackTest, TheStartUpDownloadsParametersAndSafeStateAndReadsTheInput
   EXPECT_EQ(view().input_values[2].value, -1000);
 }
 
+// safe_state = "device": the device's maker fixes its outputs' fault and
+// idle behaviour; the master reads what the EDS names for it, shows it and
+// writes none of it.
+TEST_F(DeviceRackTest, ADeviceWithItsOwnSafeStateIsReadAndShownNeverWritten) {
+  rack::DeviceConfig d = io_block();
+  d.settings.safe_state.clear();
+  d.settings.safe_state_of_device = true;
+  start({d});
+  ASSERT_TRUE(device().objects().set_param_value(7, Bytes(ByteVec{0x3C})));
+  ASSERT_TRUE(device().objects().set_param_value(9, Bytes(ByteVec{0x0F})));
+  ASSERT_TRUE(run_until_online()) << view().reason;
+  EXPECT_EQ(param(1), 5);  // the node's parameters are still downloaded
+  EXPECT_EQ(param(7), 0x3C);
+  EXPECT_EQ(param(9), 0x0F);
+  EXPECT_TRUE(view().safe_state_of_device);
+  EXPECT_EQ(view().safe_state_text,
+            "the device's own (safe_state = \"device\"): Param6 Output fault action = 0; Param7 "
+            "Output fault value = 60; Param8 Output idle action = 0; Param9 Output idle value = "
+            "15");
+}
+
 TEST_F(DeviceRackTest, ACommandByFieldsOrBytesReachesTheOutputsAfterItsChecks) {
   start();
   ASSERT_TRUE(run_until_online()) << view().reason;

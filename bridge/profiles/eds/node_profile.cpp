@@ -251,11 +251,16 @@ Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const Eds
                                "carries at most {}",
                                io.produced.size, devicenet::kMaxStrobeResponse));
   }
-  if (io.consumed.size > 0 && node.safe_state.empty()) {
+  if (node.safe_state_of_device && !node.safe_state.empty()) {
+    return explain(why, Errc::kMalformed,
+                   "safe_state: the device's own (\"device\") and parameters at once");
+  }
+  if (io.consumed.size > 0 && node.safe_state.empty() && !node.safe_state_of_device) {
     return explain(
         why, Errc::kMalformed,
         fmt::format("the node has outputs ({}) and no safe state: give the parameters that set "
-                    "their fault and idle actions (safe_state)",
+                    "their fault and idle actions (safe_state), or safe_state = \"device\" "
+                    "where the device's maker fixes them",
                     describe_data(io.consumed, "output")));
   }
 
@@ -278,6 +283,11 @@ Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const Eds
   };
   if (auto s = add(node.parameters, "parameters"); !s) return s.error();
   if (auto s = add(node.safe_state, "safe_state"); !s) return s.error();
+  if (node.safe_state_of_device) {
+    for (const Param* param : safe_state_left_to_device(file, node)) {
+      if (auto s = kept_setting(*param)) p.settings.push_back(std::move(*s));
+    }
+  }
 
   // On change of state, cyclic or bit-strobe the poll response carries the
   // same data as the input connection's messages.
@@ -324,6 +334,24 @@ std::vector<const Param*> safe_state_left_to_device(const EdsFile& file, const E
     if (!set(p)) left.push_back(&p);
   }
   return left;
+}
+
+std::optional<devicenet::AttributeSetting> kept_setting(const Param& p) {
+  const cip::EPath& link = p.link;
+  if (!link.class_id || !link.instance_id || !link.attribute || link.connection_point ||
+      *link.class_id > 0xFFFF || *link.instance_id > 0xFFFF || *link.attribute > 0xFF ||
+      (p.size != 1 && p.size != 2 && p.size != 4)) {
+    return std::nullopt;  // kept values are read as 1, 2 or 4 byte integers
+  }
+  devicenet::AttributeSetting s;
+  s.class_id = static_cast<std::uint16_t>(*link.class_id);
+  s.instance_id = static_cast<std::uint16_t>(*link.instance_id);
+  s.attribute = static_cast<std::uint8_t>(*link.attribute);
+  s.value.assign(p.size, 0);
+  s.name = fmt::format("Param{} {}", p.number, p.name);
+  s.keep_device_value = true;
+  s.device_value_max = p.size == 4 ? 0xFFFFFFFFu : (1u << (8 * p.size)) - 1;
+  return s;
 }
 
 }  // namespace dnbridge::eds

@@ -36,6 +36,11 @@ struct EdsNode {
   ConnectionKind connection = ConnectionKind::kPoll;
   std::vector<ParameterValue> parameters;  // set in this order
   std::vector<ParameterValue> safe_state;  // then these
+  // safe_state = "device": the outputs' fault and idle behaviour is the
+  // device's own, fixed by its maker; none is written. The parameters the
+  // EDS names for it (safe_state_left_to_device) are read and kept
+  // (devicenet::AttributeSetting::keep_device_value).
+  bool safe_state_of_device = false;
   // Change of state or cyclic: the connection's EPR (the heartbeat, or the
   // cycle), its production inhibit time (change of state; none leaves the
   // device's), and whether its messages are acknowledged.
@@ -81,7 +86,8 @@ Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
 // an output or produces more than one frame (the master sends no strobe
 // outputs), an unknown parameter (with the nearest name), one given twice, one
 // read only, one without a link path or of a string type, a value outside
-// its type or the EDS's limits, and outputs without a safe state.
+// its type or the EDS's limits, and outputs without a safe state (neither
+// safe_state parameters nor safe_state_of_device).
 //
 // Where the EDS lists the members of the connection's input or output
 // assembly, the profile checks the device's member list (Assembly attribute
@@ -94,7 +100,12 @@ Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const Eds
 // state ("fault", "idle", any case) that the node sets in neither list:
 // values the device keeps as they are, which may be its factory's. No
 // standard names a device's safe-state parameters: for a warning, not a
-// refusal.
+// refusal. With safe_state_of_device, the ones the master reads and keeps.
 std::vector<const Param*> safe_state_left_to_device(const EdsFile& file, const EdsNode& node);
+
+// The setting that reads the parameter `p` and keeps the device's value
+// (keep_device_value: any value of its size); nothing when it has no link
+// path to an attribute or is not of 1, 2 or 4 bytes.
+std::optional<devicenet::AttributeSetting> kept_setting(const Param& p);
 
 }  // namespace dnbridge::eds

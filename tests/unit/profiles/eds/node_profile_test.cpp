@@ -111,7 +111,36 @@ TEST(EdsNodeProfile, OutputsWithoutASafeStateAreRefused) {
   EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kMalformed));
   EXPECT_EQ(why,
             "the node has outputs (output 2 B \"Outputs\" = Assem150 (Outputs)) and no safe "
-            "state: give the parameters that set their fault and idle actions (safe_state)");
+            "state: give the parameters that set their fault and idle actions (safe_state), or "
+            "safe_state = \"device\" where the device's maker fixes them");
+}
+
+// safe_state = "device": nothing of the safe state is written; the
+// parameters the EDS names for it are read and kept, after the node's own.
+TEST(EdsNodeProfile, TheDevicesOwnSafeStateIsReadAndKeptNeverWritten) {
+  const EdsFile f = test::example_eds(test::kIoBlockEds);
+  EdsNode n;
+  n.parameters = {{"Input filter", 5}};
+  n.safe_state_of_device = true;
+  std::string why;
+  auto p = profile_of(f, n, &why);
+  ASSERT_TRUE(p.ok()) << why;
+  ASSERT_EQ(p->settings.size(), 5u);
+  EXPECT_FALSE(p->settings[0].keep_device_value);  // the parameter, set
+  std::vector<std::string> kept;
+  for (std::size_t i = 1; i < p->settings.size(); ++i) {
+    const auto& s = p->settings[i];
+    EXPECT_TRUE(s.keep_device_value) << s.name;
+    EXPECT_EQ(s.device_value_max + 1, 1ull << (8 * s.value.size())) << s.name;
+    kept.push_back(s.name);
+  }
+  EXPECT_EQ(kept,
+            (std::vector<std::string>{"Param6 Output fault action", "Param7 Output fault value",
+                                      "Param8 Output idle action", "Param9 Output idle value"}));
+  // The device's own and parameters at once is no safe state.
+  n.safe_state = {{"Output idle action", 0}};
+  EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kMalformed));
+  EXPECT_EQ(why, "safe_state: the device's own (\"device\") and parameters at once");
 }
 
 struct Refusal {
