@@ -738,16 +738,32 @@ void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems&
   // Outputs whose safe state the node leaves as the device has it.
   const auto& io = eds::node_io(*e.file, s.eds_node.connection);
   if (io && io->consumed.size > 0 && s.eds_node.safe_state_of_device) {
-    std::string read;
-    for (const eds::Param* p : eds::safe_state_left_to_device(*e.file, s.eds_node)) {
-      if (eds::kept_setting(*p)) read += fmt::format(", Param{} \"{}\"", p->number, p->name);
-    }
+    const auto names = [](const std::vector<const eds::Param*>& params) {
+      std::string text;
+      for (const eds::Param* p : params) {
+        text += fmt::format("{}Param{} \"{}\"", text.empty() ? "" : ", ", p->number, p->name);
+      }
+      return text;
+    };
+    const eds::DeviceSafeState d = eds::device_safe_state(*e.file, s.eds_node);
     r.warning(safe->source(),
               fmt::format("node {}: its outputs' fault and idle behaviour is the device's own "
                           "(safe_state = \"device\"): {}, never written",
                           s.pump.node.mac.value(),
-                          read.empty() ? std::string("its EDS names no parameter to read")
-                                       : "read at start-up: " + read.substr(2)));
+                          d.read.empty() ? std::string("its EDS names no parameter to read")
+                                         : "read at start-up: " + names(d.read)));
+    if (!d.unread.empty()) {
+      r.warning(safe->source(),
+                fmt::format("node {}: {} not read (no link path to an attribute, or not of 1, 2 "
+                            "or 4 bytes): not shown",
+                            s.pump.node.mac.value(), names(d.unread)));
+    }
+    if (!d.written.empty()) {
+      r.warning(safe->source(),
+                fmt::format("node {}: {} set in parameters although safe_state = \"device\": "
+                            "written all the same",
+                            s.pump.node.mac.value(), names(d.written)));
+    }
   } else if (io && io->consumed.size > 0) {
     for (const eds::Param* p : eds::safe_state_left_to_device(*e.file, s.eds_node)) {
       r.warning(key->source(),

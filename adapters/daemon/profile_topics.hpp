@@ -68,7 +68,9 @@ class StateTopic {
   virtual void wait_for_acks(Duration timeout) = 0;
 };
 
-// A command sample of any command topic, as the input takes it.
+// A command sample of any command topic, as the input takes it: valid only
+// during the call it is handed to (its views and its outputs' source are the
+// reader's take buffer); never kept.
 struct CommandSample {
   std::string_view topic;    // "dnbridge/PumpCommand"
   std::string_view profile;  // the profile whose nodes the topic commands

@@ -216,14 +216,14 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   // device's own (safe_state = "device"): no CDN127 action to name, the
   // values read back in words.
   const auto unknown = dnbridge_SAFE_ACTION_UNKNOWN;
-  out.safe_state_known = !v.safe_state_text.empty();
+  out.safe_state_known = v.safe_state_read;
   out.safe_state_source =
       v.safe_state_of_device ? dnbridge_SAFE_STATE_DEVICE : dnbridge_SAFE_STATE_CONFIGURED;
   out.pump_on_fault = out.pump_on_idle = out.n2_ballast_on_fault = out.n2_ballast_on_idle =
       out.analog_output_on_fault = out.analog_output_on_idle = unknown;
   out.analog_output_fault_raw = out.analog_output_idle_raw = 0;
-  set_string(out.safe_state_text, out.safe_state_known ? std::string_view(v.safe_state_text)
-                                                       : std::string_view{"not read yet"});
+  set_string(out.safe_state_text, v.safe_state_text.empty() ? std::string_view{"not read yet"}
+                                                            : std::string_view(v.safe_state_text));
   set_string(out.idle_reason, v.idle_reason());
 }
 

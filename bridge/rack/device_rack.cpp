@@ -69,9 +69,7 @@ void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::
   // EDS names for it, read and kept.
   std::vector<const eds::Param*> params;
   if (slot.settings.safe_state_of_device) {
-    for (const eds::Param* p : eds::safe_state_left_to_device(*slot.eds, slot.settings)) {
-      if (eds::kept_setting(*p)) params.push_back(p);
-    }
+    params = eds::device_safe_state(*slot.eds, slot.settings).read;
   } else {
     for (const auto& given : slot.settings.safe_state)
       params.push_back(slot.eds->param(given.name));
@@ -79,9 +77,11 @@ void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::
   const auto& in_force = node.settings_in_force();
   const std::size_t first = slot.settings.parameters.size();
   std::string text;
+  bool read = false;
   for (std::size_t i = 0; i < params.size(); ++i) {
     const eds::Param* p = params[i];
     if (p == nullptr || first + i >= in_force.size()) continue;
+    read = true;
     const auto& bytes = in_force[first + i];
     const std::uint64_t raw = little_endian(bytes);
     const auto bits = static_cast<std::uint16_t>(std::min<std::size_t>(bytes.size() * 8, 64));
@@ -94,6 +94,7 @@ void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::
                         : "the device's own (safe_state = \"device\"): " + text;
   }
   v.safe_state_text = std::move(text);
+  v.safe_state_read = read;
 }
 
 bool DeviceProfile::take_inputs(DeviceView& v, const Slot& slot, Bytes data) {

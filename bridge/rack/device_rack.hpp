@@ -54,6 +54,7 @@ struct DeviceView : NodeView {
   // ("Param6 Output fault action = 0; ..."), or with safe_state = "device"
   // the device's own as read; empty until then.
   std::string safe_state_text;
+  bool safe_state_read = false;       // a parameter of it was read (the text has values)
   bool safe_state_of_device = false;  // safe_state = "device"
 };
 

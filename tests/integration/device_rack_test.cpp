@@ -104,6 +104,7 @@ TEST_F(DeviceRackTest, ADeviceWithItsOwnSafeStateIsReadAndShownNeverWritten) {
   EXPECT_EQ(param(7), 0x3C);
   EXPECT_EQ(param(9), 0x0F);
   EXPECT_TRUE(view().safe_state_of_device);
+  EXPECT_TRUE(view().safe_state_read);
   EXPECT_EQ(view().safe_state_text,
             "the device's own (safe_state = \"device\"): Param6 Output fault action = 0; Param7 "
             "Output fault value = 60; Param8 Output idle action = 0; Param9 Output idle value = "

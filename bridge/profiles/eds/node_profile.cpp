@@ -284,8 +284,8 @@ Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const Eds
   if (auto s = add(node.parameters, "parameters"); !s) return s.error();
   if (auto s = add(node.safe_state, "safe_state"); !s) return s.error();
   if (node.safe_state_of_device) {
-    for (const Param* param : safe_state_left_to_device(file, node)) {
-      if (auto s = kept_setting(*param)) p.settings.push_back(std::move(*s));
+    for (const Param* param : device_safe_state(file, node).read) {
+      p.settings.push_back(*kept_setting(*param));
     }
   }
 
@@ -315,10 +315,18 @@ Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const Eds
   return p;
 }
 
+namespace {
+
+// A parameter whose name speaks of a fault or an idle state ("fault",
+// "idle", any case).
+bool of_safe_state(const Param& p) {
+  const std::string name = to_lower(p.name);
+  return name.find("fault") != std::string::npos || name.find("idle") != std::string::npos;
+}
+
+}  // namespace
+
 std::vector<const Param*> safe_state_left_to_device(const EdsFile& file, const EdsNode& node) {
-  const auto speaks_of = [](std::string_view name, std::string_view word) {
-    return to_lower(name).find(word) != std::string::npos;
-  };
   const auto set = [&](const Param& p) {
     for (const auto* list : {&node.parameters, &node.safe_state}) {
       for (const ParameterValue& v : *list) {
@@ -330,10 +338,25 @@ std::vector<const Param*> safe_state_left_to_device(const EdsFile& file, const E
   std::vector<const Param*> left;
   for (const Param& p : file.params) {
     if (p.read_only() || p.link.empty() || p.type.size == 0) continue;
-    if (!speaks_of(p.name, "fault") && !speaks_of(p.name, "idle")) continue;
-    if (!set(p)) left.push_back(&p);
+    if (of_safe_state(p) && !set(p)) left.push_back(&p);
   }
   return left;
+}
+
+DeviceSafeState device_safe_state(const EdsFile& file, const EdsNode& node) {
+  DeviceSafeState d;
+  for (const Param& p : file.params) {
+    if (!of_safe_state(p)) continue;
+    const bool given =
+        std::any_of(node.parameters.begin(), node.parameters.end(),
+                    [&](const ParameterValue& v) { return file.param(v.name) == &p; });
+    if (given) {
+      d.written.push_back(&p);
+    } else {
+      (kept_setting(p) ? d.read : d.unread).push_back(&p);
+    }
+  }
+  return d;
 }
 
 std::optional<devicenet::AttributeSetting> kept_setting(const Param& p) {

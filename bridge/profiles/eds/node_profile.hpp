@@ -38,7 +38,7 @@ struct EdsNode {
   std::vector<ParameterValue> safe_state;  // then these
   // safe_state = "device": the outputs' fault and idle behaviour is the
   // device's own, fixed by its maker; none is written. The parameters the
-  // EDS names for it (safe_state_left_to_device) are read and kept
+  // EDS names for it (device_safe_state) are read and kept
   // (devicenet::AttributeSetting::keep_device_value).
   bool safe_state_of_device = false;
   // Change of state or cyclic: the connection's EPR (the heartbeat, or the
@@ -100,8 +100,18 @@ Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const Eds
 // state ("fault", "idle", any case) that the node sets in neither list:
 // values the device keeps as they are, which may be its factory's. No
 // standard names a device's safe-state parameters: for a warning, not a
-// refusal. With safe_state_of_device, the ones the master reads and keeps.
+// refusal.
 std::vector<const Param*> safe_state_left_to_device(const EdsFile& file, const EdsNode& node);
+
+// With safe_state = "device", the parameters whose names speak of a fault
+// or an idle state, writable or read only, in the EDS's order: `read`, the
+// ones the master reads and keeps at start-up (a link path to an attribute,
+// 1, 2 or 4 bytes), after the node's parameters; `unread`, the others;
+// `written`, those the node sets in `parameters` all the same.
+struct DeviceSafeState {
+  std::vector<const Param*> read, unread, written;
+};
+DeviceSafeState device_safe_state(const EdsFile& file, const EdsNode& node);
 
 // The setting that reads the parameter `p` and keeps the device's value
 // (keep_device_value: any value of its size); nothing when it has no link

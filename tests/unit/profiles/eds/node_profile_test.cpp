@@ -131,7 +131,7 @@ TEST(EdsNodeProfile, TheDevicesOwnSafeStateIsReadAndKeptNeverWritten) {
   for (std::size_t i = 1; i < p->settings.size(); ++i) {
     const auto& s = p->settings[i];
     EXPECT_TRUE(s.keep_device_value) << s.name;
-    EXPECT_EQ(s.device_value_max + 1, 1ull << (8 * s.value.size())) << s.name;
+    EXPECT_EQ(std::uint64_t{s.device_value_max} + 1, 1ull << (8 * s.value.size())) << s.name;
     kept.push_back(s.name);
   }
   EXPECT_EQ(kept,
