@@ -1291,19 +1291,19 @@ rack::DeviceConfig NodeSettings::device() const {
 }
 
 rack::PortNodes to_port_nodes(const PortConfig& port) {
-  rack::PortNodes out;
+  rack::PortNodes out(std::vector<rack::PumpConfig>{}, std::vector<rack::DeviceConfig>{});
   for (const auto& n : port.nodes) {
     if (n.is_eds()) {
-      out.devices.push_back(n.device());
+      out.of<rack::DeviceConfig>().push_back(n.device());
     } else {
-      out.pumps.push_back(n.pump);
+      out.of<rack::PumpConfig>().push_back(n.pump);
     }
   }
   return out;
 }
 
 std::vector<rack::PumpConfig> to_pump_configs(const PortConfig& port) {
-  return to_port_nodes(port).pumps;
+  return to_port_nodes(port).of<rack::PumpConfig>();
 }
 
 devicenet::ScannerConfig to_scanner_config(const PortConfig& port, std::string_view host_id) {

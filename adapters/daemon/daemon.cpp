@@ -30,10 +30,8 @@ port::PortLoopConfig loop_config(const DaemonConfig& rack, const PortConfig& p,
   c.port = p.name;
   c.explicit_policy = rack.explicit_policy;
   c.scanner = to_scanner_config(p, host_id);
-  rack::PortNodes nodes = to_port_nodes(p);
-  c.pumps = std::move(nodes.pumps);
-  c.devices = std::move(nodes.devices);
-  for (const auto& n : p.nodes) (n.is_eds() ? c.device_publish : c.publish).push_back(n.publish);
+  c.nodes = to_port_nodes(p);
+  for (const auto& n : p.nodes) c.publish[n.pump.node.mac] = n.publish;
   return c;
 }
 
@@ -317,8 +315,7 @@ ReloadReport Daemon::reload() {
       try {
         loops.push_back(loop_config(plan.in_force, p, host_id_));
         const auto& loop = loops.back();
-        devicenet::Scanner::check(
-            rack::RackPort::scan_list(loop.scanner, rack::PortNodes{loop.pumps, loop.devices}));
+        devicenet::Scanner::check(rack::RackPort::scan_list(loop.scanner, loop.nodes));
       } catch (const std::exception& e) {
         r.status = ReloadStatus::kRefused;
         r.problems.push_back(fmt::format("port {}: {}", p.name, e.what()));
@@ -333,12 +330,12 @@ ReloadReport Daemon::reload() {
   // before a port applies it: a node's commands never go unread meanwhile.
   std::vector<std::uint32_t> refreshes;
   for (const auto& c : loops) {
-    const auto add = [&](Duration d) {
-      refreshes.push_back(
-          static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(d).count()));
-    };
-    for (const auto& p : c.pumps) add(p.command_refresh);
-    for (const auto& d : c.devices) add(d.command_refresh);
+    for (const auto& list : c.nodes.lists()) {
+      for (std::size_t i = 0; i < list->size(); ++i) {
+        refreshes.push_back(static_cast<std::uint32_t>(
+            std::chrono::duration_cast<milliseconds>(list->command_refresh(i)).count()));
+      }
+    }
   }
   if (input_) input_->prepare_command_refreshes(refreshes);
   std::vector<std::pair<std::string, std::future<port::PortChange>>> pending;

@@ -18,8 +18,7 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
       publisher_(publisher),
       log_(Logger(log, fmt::format("port {}", config_.port)).with("PORT", config_.port)) {
   // The master's events reach the rack model first, then this loop.
-  port_.emplace(config_.scanner, rack::PortNodes{config_.pumps, config_.devices}, backend_->sink(),
-                log_);
+  port_.emplace(config_.scanner, config_.nodes, backend_->sink(), log_);
   port_->observe(static_cast<devicenet::ScannerObserver&>(*this));
   for (const rack::ProfileNodes* nodes : port_->profiles()) {
     profile_names_.push_back(nodes->profile());
@@ -145,8 +144,7 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
   std::array<std::string_view, MacId::kMax + 1> profile_before{};
   for (unsigned m = 0; m <= MacId::kMax; ++m) profile_before[m] = profile_of(*MacId::from(m));
   try {
-    change.scan_list =
-        port_->reconfigure(next.scanner, rack::PortNodes{next.pumps, next.devices}, now);
+    change.scan_list = port_->reconfigure(next.scanner, next.nodes, now);
   } catch (const std::exception& e) {
     change.refused = e.what();
     log_.error("configuration not applied: {}", change.refused);
@@ -154,10 +152,8 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
     return;
   }
   const auto& sc = change.scan_list;
-  config_.pumps = std::move(next.pumps);
+  config_.nodes = std::move(next.nodes);
   config_.publish = std::move(next.publish);
-  config_.devices = std::move(next.devices);
-  config_.device_publish = std::move(next.device_publish);
   carry_published(sc, change.publish_changed);
   for (MacId mac : sc.removed) publisher_.node_removed(config_.port, mac);
   for (MacId mac : sc.reconfigured) {
@@ -194,14 +190,8 @@ void PortLoop::apply(const Reconfigure& r, TimePoint now) {
 }
 
 rack::PublishPolicy PortLoop::policy_of(MacId mac) const {
-  const auto in = [&](const auto& configs, const std::vector<rack::PublishPolicy>& policies) {
-    for (std::size_t i = 0; i < configs.size() && i < policies.size(); ++i) {
-      if (configs[i].node.mac == mac) return std::optional(policies[i]);
-    }
-    return std::optional<rack::PublishPolicy>();
-  };
-  return in(config_.pumps, config_.publish)
-      .value_or(in(config_.devices, config_.device_publish).value_or(rack::PublishPolicy{}));
+  const auto it = config_.publish.find(mac);
+  return it == config_.publish.end() ? rack::PublishPolicy{} : it->second;
 }
 
 void PortLoop::carry_published(const rack::ScanListChange& sc, std::vector<MacId>& policy_changed) {

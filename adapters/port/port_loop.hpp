@@ -12,6 +12,7 @@
 #include <deque>
 #include <functional>
 #include <future>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -25,24 +26,21 @@
 #include "adapters/port/port_publisher.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/master/scanner.hpp"
-#include "bridge/rack/device_rack.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
 #include "bridge/rack/publish_gate.hpp"
-#include "bridge/rack/pump_rack.hpp"
 #include "bridge/rack/rack_port.hpp"
 
 namespace dnbridge::port {
 
 struct PortLoopConfig {
-  std::string port;                          // the port's name
-  devicenet::ScannerConfig scanner;          // master MAC and timings; nodes from the lists below
-  std::vector<rack::PumpConfig> pumps;       // the scan list: CDN127s
-  std::vector<rack::PublishPolicy> publish;  // per pump, same order
-  std::vector<rack::DeviceConfig> devices;   // the scan list: devices described by their EDS
-  std::vector<rack::PublishPolicy> device_publish;  // per device, same order
-  rack::ExplicitPolicy explicit_policy;             // the rack's [explicit_policy]
-  Duration status_period = seconds(1);              // NodeStatus/PortStatus at least this often
-  Duration shutdown_timeout = seconds(3);           // for idling and releasing every node
+  std::string port;                  // the port's name
+  devicenet::ScannerConfig scanner;  // master MAC and timings; nodes from `nodes`
+  rack::PortNodes nodes;             // the scan list, by profile
+  // Per node; PublishPolicy{} for a node not named.
+  std::map<devicenet::MacId, rack::PublishPolicy> publish;
+  rack::ExplicitPolicy explicit_policy;    // the rack's [explicit_policy]
+  Duration status_period = seconds(1);     // NodeStatus/PortStatus at least this often
+  Duration shutdown_timeout = seconds(3);  // for idling and releasing every node
 };
 
 // What a configuration read again changed on a port (PortLoop::reconfigure).

@@ -23,21 +23,28 @@ const eds::EdsFile& eds_of(const DeviceConfig& d) {
 
 }  // namespace
 
+devicenet::NodeConfig DeviceRack::scan_entry(const DeviceConfig& d) {
+  std::string why;
+  (void)eds_of(d);  // throws without a file
+  auto profile = eds::make_node_profile(d.eds, d.settings, &why);
+  if (!profile) {
+    throw std::invalid_argument(
+        fmt::format("node {} ({}): {}: {}", d.node.mac.value(), d.node.name, d.eds_path, why));
+  }
+  devicenet::NodeConfig node = d.node;
+  node.profile = std::move(*profile);
+  return node;
+}
+
 devicenet::ScannerConfig DeviceRack::scanner_config(devicenet::ScannerConfig port,
                                                     const std::vector<DeviceConfig>& devices) {
-  for (const auto& d : devices) {
-    std::string why;
-    (void)eds_of(d);  // throws without a file
-    auto profile = eds::make_node_profile(d.eds, d.settings, &why);
-    if (!profile) {
-      throw std::invalid_argument(
-          fmt::format("node {} ({}): {}: {}", d.node.mac.value(), d.node.name, d.eds_path, why));
-    }
-    devicenet::NodeConfig node = d.node;
-    node.profile = std::move(*profile);
-    port.nodes.push_back(std::move(node));
-  }
+  for (const auto& d : devices) port.nodes.push_back(scan_entry(d));
   return port;
+}
+
+bool DeviceRack::same_device_settings(const DeviceConfig& a, const DeviceConfig& b) {
+  return same_scan_entry(a.node, b.node) && a.eds_digest == b.eds_digest &&
+         a.settings == b.settings;
 }
 
 DeviceProfile::Slot DeviceProfile::slot_of(const DeviceConfig& d) {

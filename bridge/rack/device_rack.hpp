@@ -19,7 +19,10 @@
 
 namespace dnbridge::rack {
 
+class DeviceRack;
+
 struct DeviceConfig {
+  using Rack = DeviceRack;
   devicenet::NodeConfig node;  // its profile is made from the EDS (scanner_config)
   NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
   ResumePolicy resume = ResumePolicy::kFreshCommand;
@@ -85,11 +88,16 @@ struct MalformedCommand {
 
 class DeviceRack final : public NodeRack<DeviceProfile> {
  public:
-  // Adds the devices' nodes to the scan list, each profile made from its
-  // EDS. Throws std::invalid_argument, naming the node and what is wrong,
-  // for one the EDS does not allow.
+  // The master's scan-list entry, its node profile made from the EDS.
+  // Throws std::invalid_argument, naming the node and what is wrong, for one
+  // the EDS does not allow.
+  static devicenet::NodeConfig scan_entry(const DeviceConfig& device);
+  // Adds the devices' nodes to the scan list.
   static devicenet::ScannerConfig scanner_config(devicenet::ScannerConfig port,
                                                  const std::vector<DeviceConfig>& devices);
+  // The settings the master brings to the device: its EDS, connection,
+  // parameters and safe state, and the scan-list entry but for the name.
+  static bool same_device_settings(const DeviceConfig& a, const DeviceConfig& b);
 
   using NodeRack::NodeRack;
 

@@ -54,7 +54,14 @@ class NodeRack : public ProfileNodes {
   }
 
   // Attach after the scanner is built (the scanner reports to this rack).
-  void attach(devicenet::Scanner& scanner) { scanner_ = &scanner; }
+  void attach(devicenet::Scanner& scanner) override { scanner_ = &scanner; }
+
+  // What the bridge itself does with the node is the same: its name, its
+  // no-commander and resume policies, its command refresh.
+  static bool same_handling(const Config& a, const Config& b) {
+    return a.node.name == b.node.name && a.no_commander == b.no_commander && a.resume == b.resume &&
+           a.command_refresh == b.command_refresh;
+  }
 
   std::string_view profile() const noexcept override { return Profile::kName; }
 
@@ -99,7 +106,7 @@ class NodeRack : public ProfileNodes {
     views_.back().profile = Profile::kName;
     views_.back().command_refresh = c.command_refresh;
   }
-  void remove(devicenet::MacId mac) {
+  void remove(devicenet::MacId mac) override {
     const int i = index_[mac.value()];
     if (i < 0) return;
     views_.erase(views_.begin() + i);
@@ -248,6 +255,13 @@ class NodeRack : public ProfileNodes {
   }
 
  protected:
+  // Two scan-list entries as configured, but for the node's name.
+  static bool same_scan_entry(devicenet::NodeConfig a, devicenet::NodeConfig b) {
+    a.name.clear();
+    b.name.clear();
+    return a == b;
+  }
+
   View* find(devicenet::MacId mac) {
     const int i = index_[mac.value()];
     return i < 0 ? nullptr : &views_[static_cast<std::size_t>(i)];

@@ -20,6 +20,10 @@
 #include "bridge/devicenet/master/scanner_events.hpp"
 #include "bridge/rack/node_view.hpp"
 
+namespace dnbridge::devicenet {
+class Scanner;
+}  // namespace dnbridge::devicenet
+
 namespace dnbridge::rack {
 
 // A command's outputs in one of the forms a profile takes (a CDN127's
@@ -46,6 +50,11 @@ class ProfileNodes : public devicenet::ScannerObserver {
  public:
   // The profile's name as the rack file gives it ("cdn127", "eds").
   virtual std::string_view profile() const noexcept = 0;
+
+  // The master these nodes are on, once it is built (it reports to them).
+  virtual void attach(devicenet::Scanner& scanner) = 0;
+  // The node at `mac` leaves the scan list (nothing when not one of these).
+  virtual void remove(devicenet::MacId mac) = 0;
 
   // The node at `mac` when it is one of these; null otherwise.
   virtual const NodeView* node(devicenet::MacId mac) const = 0;

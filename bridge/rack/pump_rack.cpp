@@ -12,22 +12,29 @@ namespace dnbridge::rack {
 using devicenet::MacId;
 namespace cdn127 = profiles::cdn127;
 
+devicenet::NodeConfig PumpRack::scan_entry(const PumpConfig& p) {
+  auto profile = cdn127::make_node_profile(p.io, p.safe_state);
+  if (!profile) {
+    throw std::invalid_argument(fmt::format("node {} ({}): invalid I/O configuration: {}",
+                                            p.node.mac.value(), p.node.name,
+                                            profile.error().message()));
+  }
+  devicenet::NodeConfig node = p.node;
+  node.profile = std::move(*profile);
+  if (p.identity) node.profile.identity = *p.identity;
+  return node;
+}
+
 devicenet::ScannerConfig PumpRack::scanner_config(devicenet::ScannerConfig port,
                                                   const std::vector<PumpConfig>& pumps) {
   port.nodes.clear();
-  for (const auto& p : pumps) {
-    auto profile = cdn127::make_node_profile(p.io, p.safe_state);
-    if (!profile) {
-      throw std::invalid_argument(fmt::format("node {} ({}): invalid I/O configuration: {}",
-                                              p.node.mac.value(), p.node.name,
-                                              profile.error().message()));
-    }
-    devicenet::NodeConfig node = p.node;
-    node.profile = std::move(*profile);
-    if (p.identity) node.profile.identity = *p.identity;
-    port.nodes.push_back(std::move(node));
-  }
+  for (const auto& p : pumps) port.nodes.push_back(scan_entry(p));
   return port;
+}
+
+bool PumpRack::same_device_settings(const PumpConfig& a, const PumpConfig& b) {
+  return same_scan_entry(a.node, b.node) && a.io == b.io && a.safe_state == b.safe_state &&
+         a.identity == b.identity;
 }
 
 PumpProfile::Slot PumpProfile::slot_of(const PumpConfig& p) {

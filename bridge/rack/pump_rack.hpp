@@ -20,9 +20,12 @@
 
 namespace dnbridge::rack {
 
+class PumpRack;
+
 // One pump's configuration in the rack: the scan-list entry and the CDN127
 // I/O configuration its poll data is decoded with.
 struct PumpConfig {
+  using Rack = PumpRack;
   devicenet::NodeConfig node;
   NoCommanderPolicy no_commander = NoCommanderPolicy::kIdle;
   ResumePolicy resume = ResumePolicy::kFreshCommand;
@@ -83,10 +86,15 @@ struct PumpProfile {
 
 class PumpRack final : public NodeRack<PumpProfile> {
  public:
-  // Builds the scan list's node profiles from the pumps' I/O configurations.
-  // Throws std::invalid_argument for an invalid configuration.
+  // The master's scan-list entry, its node profile made from the pump's I/O
+  // configuration. Throws std::invalid_argument for an invalid one.
+  static devicenet::NodeConfig scan_entry(const PumpConfig& pump);
+  // The port's scan list of `pumps` alone (the nodes `port` had replaced).
   static devicenet::ScannerConfig scanner_config(devicenet::ScannerConfig port,
                                                  const std::vector<PumpConfig>& pumps);
+  // The settings the master brings to the device (all but the name and the
+  // bridge's own handling).
+  static bool same_device_settings(const PumpConfig& a, const PumpConfig& b);
 
   using NodeRack::NodeRack;
 

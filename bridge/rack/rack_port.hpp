@@ -1,21 +1,26 @@
 #pragma once
 // One port of a rack, composed the one way it is everywhere (the daemon's
 // port loop, dnbridge-sim, the benchmark, the simulated rack of the tests):
-// the master (devicenet::Scanner) built from the scan list of the pumps
-// (CDN127s) and the devices described by their EDS files, the rack models
-// (PumpRack, then DeviceRack) hearing the master's events first, then the
-// observers added, in the order added.
-#include <array>
+// the master (devicenet::Scanner) built from the scan list of the nodes of
+// every profile (port_nodes.hpp), one model of the nodes per profile (its
+// rack: PumpRack, DeviceRack, ...) hearing the master's events first, in
+// the order of the profiles, then the observers added, in the order added.
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
+#include <string>
+#include <typeindex>
+#include <typeinfo>
+#include <utility>
 #include <vector>
 
 #include "bridge/can/frame_sink.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/master/scanner.hpp"
-#include "bridge/rack/device_rack.hpp"
-#include "bridge/rack/pump_rack.hpp"
+#include "bridge/rack/port_nodes.hpp"
+#include "bridge/rack/profile_nodes.hpp"
 
 namespace dnbridge::rack {
 
@@ -41,12 +46,6 @@ struct ScanListChange {
   }
 };
 
-// The nodes of a port's scan list, by profile.
-struct PortNodes {
-  std::vector<PumpConfig> pumps;
-  std::vector<DeviceConfig> devices;
-};
-
 ScanListChange compare(const devicenet::ScannerConfig& port_before, const PortNodes& before,
                        const devicenet::ScannerConfig& port_after, const PortNodes& after);
 
@@ -58,15 +57,10 @@ class RackPort {
   // list the master refuses.
   RackPort(devicenet::ScannerConfig port, const PortNodes& nodes, can::FrameSink& sink, Logger log,
            const std::function<void(devicenet::ScannerConfig&)>& adjust = {});
-  // Pumps only.
-  RackPort(devicenet::ScannerConfig port, const std::vector<PumpConfig>& pumps,
-           can::FrameSink& sink, Logger log,
-           const std::function<void(devicenet::ScannerConfig&)>& adjust = {})
-      : RackPort(std::move(port), PortNodes{pumps, {}}, sink, std::move(log), adjust) {}
   RackPort(const RackPort&) = delete;
   RackPort& operator=(const RackPort&) = delete;
 
-  // Hears the master's events after the rack model; add before the master
+  // Hears the master's events after the nodes' racks; add before the master
   // starts.
   void observe(devicenet::ScannerObserver& observer) { observers_.add(observer); }
 
@@ -77,11 +71,6 @@ class RackPort {
   // for a scan list the master refuses.
   ScanListChange reconfigure(const devicenet::ScannerConfig& port, const PortNodes& nodes,
                              TimePoint now);
-  // Pumps only.
-  ScanListChange reconfigure(const devicenet::ScannerConfig& port,
-                             const std::vector<PumpConfig>& pumps, TimePoint now) {
-    return reconfigure(port, PortNodes{pumps, {}}, now);
-  }
 
   // The master's scan list for `nodes` (the port's MAC and timings from
   // `port`). Throws std::invalid_argument for a node its profile refuses.
@@ -89,21 +78,37 @@ class RackPort {
 
   devicenet::Scanner& scanner() { return *scanner_; }
   const devicenet::Scanner& scanner() const { return *scanner_; }
-  PumpRack& pumps() { return pumps_; }
-  const PumpRack& pumps() const { return pumps_; }
-  DeviceRack& devices() { return devices_; }
-  const DeviceRack& devices() const { return devices_; }
+
+  // The port's nodes of the profile whose rack is `Rack` (PumpRack,
+  // DeviceRack, ...). Throws std::logic_error when the port has never had
+  // a list of that profile.
+  template <class Rack>
+  Rack& nodes() {
+    return const_cast<Rack&>(std::as_const(*this).nodes<Rack>());
+  }
+  template <class Rack>
+  const Rack& nodes() const {
+    for (ProfileNodes* p : profiles_) {
+      if (const auto* r = dynamic_cast<const Rack*>(p)) return *r;
+    }
+    throw std::logic_error("the port has no nodes of the profile of " +
+                           std::string(typeid(Rack).name()));
+  }
   // Every profile's nodes, in the order they hear the master's events.
   std::span<ProfileNodes* const> profiles() const { return profiles_; }
   // The nodes of the profile the node at `mac` has; null when no node has it.
   ProfileNodes* nodes_of(devicenet::MacId mac) const;
 
  private:
+  // The rack of `list`'s profile, made (empty, and attached) when the port
+  // has none yet.
+  ProfileNodes& rack_of(const NodeList& list);
+
   PortNodes in_force_;
-  PumpRack pumps_;
-  DeviceRack devices_;
-  std::array<ProfileNodes*, 2> profiles_{&pumps_, &devices_};
-  devicenet::ObserverFanout observers_;
+  std::vector<std::unique_ptr<ProfileNodes>> racks_;
+  std::vector<std::type_index> rack_lists_;  // the configuration type of each rack's nodes
+  std::vector<ProfileNodes*> profiles_;      // racks_, as the layer above sees them
+  devicenet::ObserverFanout observers_;      // the racks, then the observers added
   std::optional<devicenet::Scanner> scanner_;
 };
 

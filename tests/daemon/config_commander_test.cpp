@@ -54,7 +54,8 @@ TEST(ConfigCommanders, ARefreshIsTheNodesOwnElseItsPortsElseTheDefaults) {
   EXPECT_EQ(refresh_of(c, 0, 2), Duration::zero());
   EXPECT_EQ(refresh_of(c, 1, 0), milliseconds(2000));
   // The rack model gets it, for either profile.
-  EXPECT_EQ(to_port_nodes(c.ports.at(0)).pumps.at(1).command_refresh, milliseconds(1000));
+  EXPECT_EQ(to_port_nodes(c.ports.at(0)).of<rack::PumpConfig>().at(1).command_refresh,
+            milliseconds(1000));
 }
 
 TEST(ConfigCommanders, OutOfRangeValuesAreErrors) {

@@ -67,9 +67,9 @@ TEST(ConfigEds, ANodeDescribedByItsEdsLoadsWithItsParametersAndSafeState) {
   EXPECT_EQ(n.eds_node.safe_state.size(), 4u);
 
   const rack::PortNodes nodes = to_port_nodes(c.ports[0]);
-  EXPECT_TRUE(nodes.pumps.empty());
-  ASSERT_EQ(nodes.devices.size(), 1u);
-  const rack::DeviceConfig& d = nodes.devices[0];
+  EXPECT_TRUE(nodes.of<rack::PumpConfig>().empty());
+  ASSERT_EQ(nodes.of<rack::DeviceConfig>().size(), 1u);
+  const rack::DeviceConfig& d = nodes.of<rack::DeviceConfig>()[0];
   EXPECT_EQ(d.node.mac.value(), 20);
   EXPECT_EQ(d.node.name, "io-1");
   EXPECT_EQ(d.node.poll_period, milliseconds(20));
@@ -135,21 +135,24 @@ TEST(ConfigEds, TheShippedExampleLoads) {
       load_config_file(std::string(DNBRIDGE_SOURCE_DIR) + "/deploy/config/eds-rack-example.toml");
   EXPECT_TRUE(c.warnings.empty());
   const rack::PortNodes nodes = to_port_nodes(c.ports.at(0));
-  ASSERT_EQ(nodes.pumps.size(), 1u);
-  ASSERT_EQ(nodes.devices.size(), 3u);
-  EXPECT_EQ(nodes.devices[0].eds->device.product_name, "Example IO block 8DI/8DO/1AI");
-  EXPECT_EQ(nodes.devices[0].settings.connection, eds::ConnectionKind::kPoll);
-  EXPECT_EQ(nodes.devices[1].settings.connection, eds::ConnectionKind::kChangeOfState);
-  EXPECT_EQ(nodes.devices[1].settings.heartbeat, milliseconds(500));
-  EXPECT_EQ(nodes.devices[2].eds->device.product_name, "Example valve manifold 16");
-  EXPECT_EQ(nodes.devices[2].settings.connection, eds::ConnectionKind::kStrobe);
+  ASSERT_EQ(nodes.of<rack::PumpConfig>().size(), 1u);
+  ASSERT_EQ(nodes.of<rack::DeviceConfig>().size(), 3u);
+  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[0].eds->device.product_name,
+            "Example IO block 8DI/8DO/1AI");
+  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[0].settings.connection, eds::ConnectionKind::kPoll);
+  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[1].settings.connection,
+            eds::ConnectionKind::kChangeOfState);
+  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[1].settings.heartbeat, milliseconds(500));
+  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[2].eds->device.product_name,
+            "Example valve manifold 16");
+  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[2].settings.connection, eds::ConnectionKind::kStrobe);
 }
 
 TEST(ConfigEds, APumpAndADeviceShareAPort) {
   const DaemonConfig c = parse(ONE_PORT "[[port.node]]\nmac = 1\nname = \"pump-1\"\n" IO_BLOCK);
   const rack::PortNodes nodes = to_port_nodes(c.ports.at(0));
-  ASSERT_EQ(nodes.pumps.size(), 1u);
-  ASSERT_EQ(nodes.devices.size(), 1u);
+  ASSERT_EQ(nodes.of<rack::PumpConfig>().size(), 1u);
+  ASSERT_EQ(nodes.of<rack::DeviceConfig>().size(), 1u);
   EXPECT_EQ(to_pump_configs(c.ports[0]).size(), 1u);
 }
 

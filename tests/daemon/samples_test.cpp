@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "adapters/daemon/config.hpp"
 #include "adapters/daemon/profile_topics.hpp"
 #include "adapters/dds/topics.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"
@@ -111,12 +112,12 @@ TEST(Samples, ADevicesSafeStateSourceIsPublished) {
   EXPECT_EQ(status->safe_state_source, dnbridge_SAFE_STATE_CONFIGURED);
 }
 
-// Every profile a port's rack has is registered with its DDS topics, once:
-// a profile left out would have nodes that are neither published nor
-// commanded.
+// Every profile a port of the rack file has is registered with its DDS
+// topics, once: a profile left out would have nodes that are neither
+// published nor commanded.
 TEST(ProfileTopics, EveryProfileOfARackPortHasItsTopicsOnce) {
   NullSink sink;
-  rack::RackPort port({}, rack::PortNodes{}, sink, Logger());
+  rack::RackPort port({}, to_port_nodes(PortConfig{}), sink, Logger());
   const auto registered = bridge_profiles();
   ASSERT_EQ(registered.size(), port.profiles().size());
   for (const rack::ProfileNodes* nodes : port.profiles()) {

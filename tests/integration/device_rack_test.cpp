@@ -256,7 +256,7 @@ TEST_F(DeviceRackTest, APumpAndADeviceShareAPortAndAReloadMovesANodeBetweenThem)
   // at 1 as the EDS expects, so it is a wrong device there.
   auto port = rack_->scanner().config();
   rack::PortNodes next;
-  next.devices = {io_block(1)};
+  next.of<rack::DeviceConfig>() = {io_block(1)};
   const auto change = rack_->port().reconfigure(port, next, now());
   EXPECT_EQ(change.reconfigured, (std::vector<devicenet::MacId>{mac(1)}));
   EXPECT_EQ(change.removed, (std::vector<devicenet::MacId>{mac(kIo)}));

@@ -82,7 +82,7 @@ class LiveReconfigureTest : public ::testing::Test {
   sim::SimRack& rack() { return *rack_; }
   TimePoint now() { return rack_->now(); }
   rack::ScanListChange reconfigure(const std::vector<rack::PumpConfig>& pumps) {
-    return rack_->port().reconfigure(port_, pumps, now());
+    return rack_->port().reconfigure(port_, rack::PortNodes(pumps), now());
   }
   std::vector<rack::PumpConfig> without(unsigned m) const {
     std::vector<rack::PumpConfig> out;

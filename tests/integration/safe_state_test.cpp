@@ -519,8 +519,8 @@ TEST_F(SafeStateRack, ANodeTakenOutDuringABusLossIsPolledIdleBeforeItsRelease) {
   command_all_on();
 
   silence_master();
-  (void)rack_->port().reconfigure(rack_->scanner().config(), std::vector<rack::PumpConfig>{},
-                                  now());
+  (void)rack_->port().reconfigure(rack_->scanner().config(),
+                                  rack::PortNodes(std::vector<rack::PumpConfig>{}), now());
   ASSERT_EQ(rack_->scanner().nodes_leaving(), 1u);
   world().run_for(milliseconds(300));
   unsilence_master();

@@ -163,7 +163,8 @@ TEST_F(StrobeRackTest, ANodeAddedWithAShorterPeriodIsStrobedAtItsPeriodAtOnce) {
   fast.node.expected_packet_rate = milliseconds(80);
   const auto eds = std::make_shared<const eds::EdsFile>(example_eds(kValveManifoldEds));
   rack_->add_eds_device(*eds, sim::default_eds_slave_options(mac(kValves2)), now());
-  rack_->port().reconfigure(rack_->scanner().config(), rack::PortNodes{{}, {slow, fast}}, now());
+  rack_->port().reconfigure(rack_->scanner().config(),
+                            rack::PortNodes(std::vector<rack::DeviceConfig>{slow, fast}), now());
   ASSERT_TRUE(world().run_until(
       [&] { return node(kValves2).state() == devicenet::NodeState::kOnline; }, seconds(5)))
       << node(kValves2).reason();
@@ -185,8 +186,9 @@ TEST_F(StrobeRackTest, ANodeThatStillAnswersTheStrobesAfterItsReleaseWasLostIsRe
   const std::uint32_t unconnected =
       devicenet::group2_id(mac(kValves2), Group2Message::kUnconnectedExplicitRequest);
   const auto lost = world().bus().faults().add(sim::FaultRule::drop(unconnected));
-  rack_->port().reconfigure(rack_->scanner().config(),
-                            rack::PortNodes{{}, {strobed_manifold(kValves)}}, now());
+  rack_->port().reconfigure(
+      rack_->scanner().config(),
+      rack::PortNodes(std::vector<rack::DeviceConfig>{strobed_manifold(kValves)}), now());
   ASSERT_TRUE(world().run_until([&] { return rack_->scanner().nodes_leaving() == 0; }, seconds(5)));
   world().bus().faults().remove(lost);
   ASSERT_EQ(device(kValves2).strobe_state(), sim::ConnectionState::kEstablished);

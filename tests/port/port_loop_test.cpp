@@ -182,8 +182,8 @@ PortLoopConfig config_for(const std::vector<unsigned>& macs) {
     p.node.poll_period = milliseconds(20);
     p.node.expected_packet_rate = milliseconds(100);
     p.io = profiles::cdn127::preset(profiles::cdn127::ConfigurationPreset::kCdn127);
-    c.pumps.push_back(p);
-    c.publish.push_back({milliseconds(500), 0.05});
+    c.nodes.of<rack::PumpConfig>().push_back(p);
+    c.publish[mac(m)] = {milliseconds(500), 0.05};
   }
   return c;
 }
@@ -753,7 +753,7 @@ TEST(PortLoop, AReconfigurationIsAppliedOnThePortsThread) {
   EXPECT_FALSE(loop.has_node(mac(3)));
 
   PortLoopConfig next = config_for({1, 3});
-  next.publish[0].max_period = milliseconds(300);
+  next.publish[mac(1)].max_period = milliseconds(300);
   next.explicit_policy.allow_output_writes = true;
   auto done = loop.reconfigure(next);
   ASSERT_EQ(done.wait_for(std::chrono::seconds(10)), std::future_status::ready);
@@ -809,17 +809,17 @@ namespace {
 TEST(PortLoop, APumpKeepsItsPublishStateThroughReloadsWhateverTheOrder) {
   RecordingPublisher publisher;
   PortLoopConfig first = config_for({1, 3});
-  first.publish[0].max_period = milliseconds(500);
-  first.publish[1].max_period = milliseconds(400);
+  first.publish[mac(1)].max_period = milliseconds(500);
+  first.publish[mac(3)].max_period = milliseconds(400);
   PortLoop loop(first,
                 std::make_unique<sim::SimBackend>(can::kBitrate500k,
                                                   std::vector<MacId>{mac(1), mac(2), mac(3)}),
                 publisher, null_log_sink());
   loop.start();
   PortLoopConfig second = config_for({1, 2, 3});
-  second.publish[0].max_period = milliseconds(500);
-  second.publish[1].max_period = milliseconds(600);
-  second.publish[2].max_period = milliseconds(400);
+  second.publish[mac(1)].max_period = milliseconds(500);
+  second.publish[mac(2)].max_period = milliseconds(600);
+  second.publish[mac(3)].max_period = milliseconds(400);
   const auto apply = [&](const PortLoopConfig& c) {
     auto done = loop.reconfigure(c);
     EXPECT_EQ(done.wait_for(std::chrono::seconds(10)), std::future_status::ready);
@@ -832,7 +832,7 @@ TEST(PortLoop, APumpKeepsItsPublishStateThroughReloadsWhateverTheOrder) {
   const PortChange again = apply(second);
   EXPECT_FALSE(again.any()) << again.publish_changed.size();
   // One pump's policy: that pump's only.
-  second.publish[2].max_period = milliseconds(300);
+  second.publish[mac(3)].max_period = milliseconds(300);
   const PortChange one = apply(second);
   EXPECT_EQ(one.publish_changed, std::vector<MacId>{mac(3)});
   loop.stop();

@@ -85,10 +85,13 @@ void SimRack::start() {
 }
 
 bool SimRack::all_online() const {
-  const auto online = [](const auto& views) {
-    return std::all_of(views.begin(), views.end(), [](const auto& v) { return v.online; });
-  };
-  return online(port_->pumps().pumps()) && online(port_->devices().devices());
+  return std::all_of(port_->profiles().begin(), port_->profiles().end(),
+                     [](const rack::ProfileNodes* nodes) {
+                       for (std::size_t i = 0; i < nodes->size(); ++i) {
+                         if (!nodes->view(i).online) return false;
+                       }
+                       return true;
+                     });
 }
 
 }  // namespace dnbridge::sim

@@ -12,6 +12,7 @@
 #include "adapters/sim/world/sim_master.hpp"
 #include "adapters/sim/world/sim_slave.hpp"
 #include "adapters/sim/world/sim_world.hpp"
+#include "bridge/rack/device_rack.hpp"
 #include "bridge/rack/pump_rack.hpp"
 #include "bridge/rack/rack_port.hpp"
 
@@ -44,8 +45,8 @@ class SimRack {
   TimePoint now() const { return world_.now(); }
   devicenet::Scanner& scanner() { return port_->scanner(); }
   SimMaster& master() { return *master_; }
-  rack::PumpRack& pumps() { return port_->pumps(); }
-  rack::DeviceRack& devices() { return port_->devices(); }
+  rack::PumpRack& pumps() { return port_->nodes<rack::PumpRack>(); }
+  rack::DeviceRack& devices() { return port_->nodes<rack::DeviceRack>(); }
   // The master and the rack model together (a live reconfiguration).
   rack::RackPort& port() { return *port_; }
   // Extra observers (tests record events); add before start().

@@ -2,6 +2,7 @@
 // What the master tells the layer above. Called from inside the scanner's
 // event handling (on the port's own thread): implementations copy what they
 // need and return; they must not call back into the scanner.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -101,6 +102,10 @@ namespace dnbridge::devicenet {
 class ObserverFanout final : public ScannerObserver {
  public:
   void add(ScannerObserver& o) { observers_.push_back(&o); }
+  // Hears the events before the observers from `position` on.
+  void insert(std::size_t position, ScannerObserver& o) {
+    observers_.insert(observers_.begin() + static_cast<std::ptrdiff_t>(position), &o);
+  }
 
   void on_port_state(PortState s, const std::string& r, TimePoint at) override {
     for (auto* o : observers_) o->on_port_state(s, r, at);
