@@ -1,11 +1,17 @@
 #pragma once
 // The ODVA objects, by number and by name: the class codes of the common
-// objects (one table, class_name), the attribute numbers of the objects every
-// DeviceNet device has (Identity, DeviceNet, Connection with its two
-// predefined Group 2 instances), and the attributes the master addresses by
-// name (AttributeRef). What a profile defines itself (its vendor classes,
-// the attribute numbers its manual gives for its I/O points) is its
+// objects (class_id, with their names in one table, kClasses), the
+// attribute numbers of the objects every DeviceNet device has (Identity,
+// DeviceNet, Connection with its predefined Group 2 instances), and the
+// attributes the master addresses by name (AttributeRef).
+//
+// One scheme for every object: `<object>_attr::` holds its attribute
+// numbers, `<object>_instance::` its instance numbers where it has more than
+// one, and `<object>::` (`devicenet_object::` for the DeviceNet object, whose
+// name is the namespace of the master) its class code and the AttributeRefs. What a profile defines
+// itself (its vendor classes, the attribute numbers its manual gives for its I/O points) is its
 // profile's (profiles/cdn127/objects.hpp).
+#include <array>
 #include <cstdint>
 #include <string_view>
 
@@ -37,30 +43,33 @@ inline constexpr std::uint16_t kParameter = 0x0F;
 inline constexpr std::uint16_t kAcknowledgeHandler = 0x2B;
 }  // namespace class_id
 
-// "Identity", "Discrete Output Point", ...; empty for a class not above.
+// A class and its name as the CIP specification gives it.
+struct CipClass {
+  std::uint16_t id = 0;
+  std::string_view name;
+};
+
+// Every class of class_id, in its order.
+inline constexpr std::array<CipClass, 11> kClasses{{
+    {class_id::kIdentity, "Identity"},
+    {class_id::kMessageRouter, "Message Router"},
+    {class_id::kDeviceNet, "DeviceNet"},
+    {class_id::kAssembly, "Assembly"},
+    {class_id::kConnection, "Connection"},
+    {class_id::kDiscreteInputPoint, "Discrete Input Point"},
+    {class_id::kDiscreteOutputPoint, "Discrete Output Point"},
+    {class_id::kAnalogInputPoint, "Analog Input Point"},
+    {class_id::kAnalogOutputPoint, "Analog Output Point"},
+    {class_id::kParameter, "Parameter"},
+    {class_id::kAcknowledgeHandler, "Acknowledge Handler"},
+}};
+
+// "Identity", "Discrete Output Point", ...; empty for a class not in kClasses.
 constexpr std::string_view class_name(std::uint16_t class_id) noexcept {
-  switch (class_id) {
-    case class_id::kIdentity:
-      return "Identity";
-    case class_id::kMessageRouter:
-      return "Message Router";
-    case class_id::kDeviceNet:
-      return "DeviceNet";
-    case class_id::kAssembly:
-      return "Assembly";
-    case class_id::kConnection:
-      return "Connection";
-    case class_id::kDiscreteInputPoint:
-      return "Discrete Input Point";
-    case class_id::kDiscreteOutputPoint:
-      return "Discrete Output Point";
-    case class_id::kAnalogInputPoint:
-      return "Analog Input Point";
-    case class_id::kAnalogOutputPoint:
-      return "Analog Output Point";
-    default:
-      return {};
+  for (const CipClass& c : kClasses) {
+    if (c.id == class_id) return c.name;
   }
+  return {};
 }
 
 // Attribute numbers of the objects every device has.
@@ -84,6 +93,9 @@ inline constexpr std::uint8_t kState = 1, kInstanceType = 2, kTransportClassTrig
                               kExpectedPacketRate = 9, kWatchdogTimeoutAction = 12,
                               kProducedPathLength = 13, kProducedPath = 14,
                               kConsumedPathLength = 15, kConsumedPath = 16, kInhibitTime = 17;
+}
+namespace acknowledge_handler_attr {
+inline constexpr std::uint8_t kAcknowledgeTimer = 1, kRetryLimit = 2, kProducingInstance = 3;
 }
 // Class attributes (instance 0) common to the objects.
 namespace class_attr {
@@ -121,54 +133,51 @@ inline constexpr AttributeRef kAllocationInformation{kClass, 1, devicenet_attr::
 
 namespace connection {
 inline constexpr std::uint16_t kClass = class_id::kConnection;
-inline constexpr std::uint16_t kExplicitInstance = connection_instance::kExplicit;
-inline constexpr std::uint16_t kPollInstance = connection_instance::kPoll;
 
 inline constexpr AttributeRef kExplicitExpectedPacketRate{
-    kClass, kExplicitInstance, connection_attr::kExpectedPacketRate,
+    kClass, connection_instance::kExplicit, connection_attr::kExpectedPacketRate,
     "Connection 1 (explicit).ExpectedPacketRate"};
-inline constexpr AttributeRef kPollProducedSize{kClass, kPollInstance,
+inline constexpr AttributeRef kPollProducedSize{kClass, connection_instance::kPoll,
                                                 connection_attr::kProducedSize,
                                                 "Connection 2 (poll).ProducedConnectionSize"};
-inline constexpr AttributeRef kPollConsumedSize{kClass, kPollInstance,
+inline constexpr AttributeRef kPollConsumedSize{kClass, connection_instance::kPoll,
                                                 connection_attr::kConsumedSize,
                                                 "Connection 2 (poll).ConsumedConnectionSize"};
-inline constexpr AttributeRef kPollExpectedPacketRate{kClass, kPollInstance,
+inline constexpr AttributeRef kPollExpectedPacketRate{kClass, connection_instance::kPoll,
                                                       connection_attr::kExpectedPacketRate,
                                                       "Connection 2 (poll).ExpectedPacketRate"};
 // The CDN127 manual labels attribute 16 "Production Path" too; it is the
 // consumed path (the ODVA Connection object's attribute 16).
-inline constexpr AttributeRef kPollProducedPath{kClass, kPollInstance,
+inline constexpr AttributeRef kPollProducedPath{kClass, connection_instance::kPoll,
                                                 connection_attr::kProducedPath,
                                                 "Connection 2 (poll).ProducedConnectionPath"};
-inline constexpr AttributeRef kPollConsumedPath{kClass, kPollInstance,
+inline constexpr AttributeRef kPollConsumedPath{kClass, connection_instance::kPoll,
                                                 connection_attr::kConsumedPath,
                                                 "Connection 2 (poll).ConsumedConnectionPath"};
 
 // Instance 4: change of state or cyclic, as allocated.
-inline constexpr std::uint16_t kCosInstance = connection_instance::kChangeOfState;
 inline constexpr AttributeRef kCosProducedSize{
-    kClass, kCosInstance, connection_attr::kProducedSize,
+    kClass, connection_instance::kChangeOfState, connection_attr::kProducedSize,
     "Connection 4 (change of state).ProducedConnectionSize"};
 inline constexpr AttributeRef kCosExpectedPacketRate{
-    kClass, kCosInstance, connection_attr::kExpectedPacketRate,
+    kClass, connection_instance::kChangeOfState, connection_attr::kExpectedPacketRate,
     "Connection 4 (change of state).ExpectedPacketRate"};
 inline constexpr AttributeRef kCosProducedPath{
-    kClass, kCosInstance, connection_attr::kProducedPath,
+    kClass, connection_instance::kChangeOfState, connection_attr::kProducedPath,
     "Connection 4 (change of state).ProducedConnectionPath"};
-inline constexpr AttributeRef kCosInhibitTime{kClass, kCosInstance, connection_attr::kInhibitTime,
+inline constexpr AttributeRef kCosInhibitTime{kClass, connection_instance::kChangeOfState,
+                                              connection_attr::kInhibitTime,
                                               "Connection 4 (change of state).InhibitTime"};
 
 // Instance 3: bit-strobe.
-inline constexpr std::uint16_t kStrobeInstance = connection_instance::kBitStrobe;
 inline constexpr AttributeRef kStrobeProducedSize{
-    kClass, kStrobeInstance, connection_attr::kProducedSize,
+    kClass, connection_instance::kBitStrobe, connection_attr::kProducedSize,
     "Connection 3 (bit-strobe).ProducedConnectionSize"};
 inline constexpr AttributeRef kStrobeExpectedPacketRate{
-    kClass, kStrobeInstance, connection_attr::kExpectedPacketRate,
+    kClass, connection_instance::kBitStrobe, connection_attr::kExpectedPacketRate,
     "Connection 3 (bit-strobe).ExpectedPacketRate"};
 inline constexpr AttributeRef kStrobeProducedPath{
-    kClass, kStrobeInstance, connection_attr::kProducedPath,
+    kClass, connection_instance::kBitStrobe, connection_attr::kProducedPath,
     "Connection 3 (bit-strobe).ProducedConnectionPath"};
 }  // namespace connection
 
@@ -177,9 +186,12 @@ inline constexpr AttributeRef kStrobeProducedPath{
 // again (UINT ms), and how often it does (USINT).
 namespace acknowledge_handler {
 inline constexpr std::uint16_t kClass = class_id::kAcknowledgeHandler;
-inline constexpr AttributeRef kAckTimer{kClass, 1, 1, "Acknowledge Handler.AcknowledgeTimer"};
-inline constexpr AttributeRef kRetryLimit{kClass, 1, 2, "Acknowledge Handler.RetryLimit"};
-inline constexpr AttributeRef kProducingInstance{kClass, 1, 3,
+inline constexpr AttributeRef kAckTimer{kClass, 1, acknowledge_handler_attr::kAcknowledgeTimer,
+                                        "Acknowledge Handler.AcknowledgeTimer"};
+inline constexpr AttributeRef kRetryLimit{kClass, 1, acknowledge_handler_attr::kRetryLimit,
+                                          "Acknowledge Handler.RetryLimit"};
+inline constexpr AttributeRef kProducingInstance{kClass, 1,
+                                                 acknowledge_handler_attr::kProducingInstance,
                                                  "Acknowledge Handler.ProducingConnectionInstance"};
 }  // namespace acknowledge_handler
 
