@@ -18,13 +18,18 @@ namespace {
 
 // Each input in a buffer of its own exact size, as libFuzzer gives it, so
 // that a read past its end is caught.
-void run_one(const std::filesystem::path& file) {
+bool run_one(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    std::fprintf(stderr, "%s: does not read\n", file.c_str());
+    return false;
+  }
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
                                 std::istreambuf_iterator<char>());
   const auto data = std::make_unique<std::uint8_t[]>(bytes.size());
   std::copy(bytes.begin(), bytes.end(), data.get());
   (void)LLVMFuzzerTestOneInput(data.get(), bytes.size());
+  return true;
 }
 
 }  // namespace
@@ -33,6 +38,10 @@ int main(int argc, char** argv) {
   std::size_t runs = 0;
   for (int i = 1; i < argc; ++i) {
     const std::filesystem::path given(argv[i]);
+    if (!std::filesystem::exists(given)) {
+      std::fprintf(stderr, "%s: no such file or directory\n", argv[i]);
+      return 1;
+    }
     std::vector<std::filesystem::path> files;
     if (std::filesystem::is_directory(given)) {
       for (const auto& entry : std::filesystem::directory_iterator(given)) {
@@ -43,7 +52,7 @@ int main(int argc, char** argv) {
       files.push_back(given);
     }
     for (const auto& file : files) {
-      run_one(file);
+      if (!run_one(file)) return 1;
       ++runs;
     }
   }
