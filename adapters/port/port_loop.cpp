@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 
 #include "adapters/port/thread_name.hpp"
 
@@ -20,9 +21,6 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
   // The master's events reach the rack model first, then this loop.
   port_.emplace(config_.scanner, config_.nodes, backend_->sink(), log_);
   port_->observe(static_cast<devicenet::ScannerObserver&>(*this));
-  for (const rack::ProfileNodes* nodes : port_->profiles()) {
-    profile_names_.push_back(nodes->profile());
-  }
   gateway_.emplace(scanner(), rack::ExplicitGateway::Limits{}, config_.explicit_policy, log_);
   rack::ScanListChange all;
   for (const rack::ProfileNodes* nodes : port_->profiles()) {
@@ -37,24 +35,35 @@ void PortLoop::note_scan_list() {
   std::uint64_t macs = 0;
   std::array<std::uint8_t, MacId::kMax + 1> profile{};
   std::array<std::uint32_t, MacId::kMax + 1> refresh{};
-  const auto profiles = port_->profiles();
-  for (std::size_t p = 0; p < profiles.size(); ++p) {
-    for (std::size_t i = 0; i < profiles[p]->size(); ++i) {
-      const rack::NodeView& v = profiles[p]->view(i);
+  for (const rack::ProfileNodes* nodes : port_->profiles()) {
+    const std::uint8_t p = profile_index(nodes->profile());
+    for (std::size_t i = 0; i < nodes->size(); ++i) {
+      const rack::NodeView& v = nodes->view(i);
       macs |= std::uint64_t{1} << v.mac.value();
-      profile[v.mac.value()] = static_cast<std::uint8_t>(p + 1);
+      profile[v.mac.value()] = p;
       refresh[v.mac.value()] = static_cast<std::uint32_t>(
           std::chrono::duration_cast<milliseconds>(v.command_refresh).count());
     }
   }
   for (std::size_t m = 0; m <= MacId::kMax; ++m) {
-    profile_of_[m].store(profile[m], std::memory_order_relaxed);
+    profile_of_[m].store(profile[m], std::memory_order_release);
     refresh_ms_[m].store(refresh[m], std::memory_order_relaxed);
   }
   scan_list_.store(macs, std::memory_order_relaxed);
   refresh_generation_.fetch_add(1, std::memory_order_release);
   std::lock_guard lock(command_watch_mutex_);
   if (command_watch_) command_watch_();
+}
+
+std::uint8_t PortLoop::profile_index(std::string_view name) {
+  for (std::size_t p = 0; p < profile_count_; ++p) {
+    if (profile_names_[p] == name) return static_cast<std::uint8_t>(p + 1);
+  }
+  if (profile_count_ == kMaxProfiles) {
+    throw std::logic_error(fmt::format("more than {} node profiles on one port", kMaxProfiles));
+  }
+  profile_names_[profile_count_] = name;
+  return static_cast<std::uint8_t>(++profile_count_);
 }
 
 void PortLoop::watch_command_state(std::function<void()> watch) {

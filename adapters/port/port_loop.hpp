@@ -111,7 +111,7 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
     return (scan_list_.load(std::memory_order_relaxed) >> mac.value()) & 1u;
   }
   std::string_view profile_of(devicenet::MacId mac) const {
-    const std::uint8_t p = profile_of_[mac.value()].load(std::memory_order_relaxed);
+    const std::uint8_t p = profile_of_[mac.value()].load(std::memory_order_acquire);
     return p == 0 ? std::string_view{} : profile_names_[p - 1];
   }
   // The node's command_refresh_ms, 0 when off or not a node (any thread).
@@ -255,9 +255,15 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   Duration longest_pass_{};
 
   std::atomic<std::uint64_t> scan_list_{0};  // bit per MAC; set on the port's thread
-  // Per MAC, 1 + the index of its profile in profile_names_; 0: none.
+  // Per MAC, 1 + the index of its profile in profile_names_; 0: none. A
+  // profile's name is appended (on the port's thread, when a rack of it first
+  // comes) before any MAC's release store names it, and never changes: a
+  // reader on another thread that sees the index sees the name.
   std::array<std::atomic<std::uint8_t>, devicenet::MacId::kMax + 1> profile_of_{};
-  std::vector<std::string_view> profile_names_;  // the rack port's profiles; fixed
+  static constexpr std::size_t kMaxProfiles = 16;
+  std::array<std::string_view, kMaxProfiles> profile_names_{};
+  std::size_t profile_count_ = 0;  // port's thread only
+  std::uint8_t profile_index(std::string_view name);
   std::array<std::atomic<std::uint32_t>, devicenet::MacId::kMax + 1> refresh_ms_{};
   std::atomic<std::uint64_t> refresh_generation_{0};
   // Commands not written again within their node's command refresh: idle.

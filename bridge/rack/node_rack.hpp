@@ -54,7 +54,13 @@ class NodeRack : public ProfileNodes {
   }
 
   // Attach after the scanner is built (the scanner reports to this rack).
-  void attach(devicenet::Scanner& scanner) override { scanner_ = &scanner; }
+  // A rack that comes after the master started (a reload's new profile)
+  // takes the port's state as it is.
+  void attach(devicenet::Scanner& scanner) override {
+    scanner_ = &scanner;
+    port_state_ = scanner.state();
+    port_reason_ = scanner.reason();
+  }
 
   // What the bridge itself does with the node is the same: its name, its
   // no-commander and resume policies, its command refresh.

@@ -48,7 +48,8 @@ class StateGate;
 
 class ProfileNodes : public devicenet::ScannerObserver {
  public:
-  // The profile's name as the rack file gives it ("cdn127", "eds").
+  // The profile's name as the rack file gives it ("cdn127", "eds"), in
+  // static storage: readers keep the view for the life of the program.
   virtual std::string_view profile() const noexcept = 0;
 
   // The master these nodes are on, once it is built (it reports to them).
