@@ -112,8 +112,6 @@ void fill_safe_state(dnbridge_NodeStatus& out, const rack::PumpView& v) {
 
 }  // namespace
 
-namespace {
-
 // What NodeStatus says of any node, whatever its profile.
 void fill_node_common(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
                       const rack::NodeView& v, const port::NodeStatusView& node) {
@@ -189,8 +187,6 @@ void fill_node_common(dnbridge_NodeStatus& out, std::string_view rack, std::stri
   out.counters.commands_accepted = v.commands_accepted;
   out.counters.commands_refused = v.commands_refused;
 }
-
-}  // namespace
 
 void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
                       const rack::PumpView& v, const port::NodeStatusView& node) {

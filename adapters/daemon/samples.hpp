@@ -15,6 +15,12 @@
 
 namespace dnbridge::daemon {
 
+// The part of NodeStatus every node has, whatever its profile (identity,
+// state, timings, errors, counters): a profile's NodeStatus filler calls it
+// first, then fills its own part (safe state, idle reason).
+void fill_node_common(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
+                      const rack::NodeView& v, const port::NodeStatusView& node);
+
 void fill_pump_state(dnbridge_PumpState& out, std::string_view rack, std::string_view port,
                      const rack::PumpView& pump);
 void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::string_view port,
