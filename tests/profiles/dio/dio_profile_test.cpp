@@ -76,7 +76,7 @@ class LastSample {
   std::optional<dds::Sample<T>> last_;
 };
 
-port::PortLoopConfig port_config() {
+DioConfig io_block() {
   DioConfig io;
   io.node.mac = kNode;
   io.node.name = "io block";
@@ -84,11 +84,16 @@ port::PortLoopConfig port_config() {
   io.node.expected_packet_rate = milliseconds(100);
   io.fault_outputs = 0x01;
   io.idle_outputs = 0x80;
+  return io;
+}
+
+// The port, with the I/O block in its scan list or none.
+port::PortLoopConfig port_config(bool with_io_block) {
   port::PortLoopConfig c;
   c.port = kPort;
   c.scanner.master_mac = *MacId::from(0);
   c.status_period = milliseconds(200);
-  c.nodes.of<DioConfig>().push_back(io);
+  if (with_io_block) c.nodes.of<DioConfig>().push_back(io_block());
   return c;
 }
 
@@ -97,12 +102,18 @@ class DioProfileTest : public ::testing::Test {
   DioProfileTest()
       : rack_(::testing::UnitTest::GetInstance()->current_test_info()->name()),
         bridge_(test_domain(), rack_),
-        publisher_(bridge_, rack_, seconds(1), Logger(), dio_profiles()) {
+        publisher_(bridge_, rack_, seconds(1), Logger(), dio_profiles()) {}
+  ~DioProfileTest() override {
+    if (input_) input_->stop();
+    if (loop_) loop_->stop();
+  }
+
+  void start(bool with_io_block) {
     auto backend = std::make_unique<sim::SimBackend>(
         can::kBitrate500k, std::vector<MacId>{}, nullptr,
         std::vector<sim::EdsDeviceSpec>{
             {kNode, std::make_shared<const eds::EdsFile>(example_eds(kIoBlockEds))}});
-    loop_.emplace(port_config(), std::move(backend), publisher_, null_log_sink());
+    loop_.emplace(port_config(with_io_block), std::move(backend), publisher_, null_log_sink());
     input_.emplace(bridge_, publisher_, rack_,
                    std::map<std::string, port::PortLoop*, std::less<>>{{kPort, &*loop_}}, Logger(),
                    std::function<void(daemon::ReloadCall)>{}, dds::kDefaultMaxCommanderLease,
@@ -110,28 +121,55 @@ class DioProfileTest : public ::testing::Test {
     loop_->start();
     input_->start();
   }
-  ~DioProfileTest() override {
-    input_->stop();
-    loop_->stop();
+
+  // Runs `fn` on the simulated I/O block, on the port's thread; false when
+  // the port did not run it in time.
+  bool on_device(std::function<void(sim::EdsSlave&)> fn) {
+    // Shared with the posted function, which may run after a timeout here.
+    auto done = std::make_shared<std::promise<void>>();
+    auto future = done->get_future();
+    loop_->post([done, fn = std::move(fn)](port::CanBackend& backend) {
+      fn(static_cast<sim::SimBackend&>(backend).eds_device(kNode).device());
+      done->set_value();
+    });
+    return future.wait_for(kEventTimeout) == std::future_status::ready;
+  }
+  // The device's Parameter `n`; -1 when it cannot be read.
+  double param(unsigned n) {
+    auto value = std::make_shared<double>(-1);
+    EXPECT_TRUE(on_device([value, n](sim::EdsSlave& device) {
+      *value = device.objects().param_number(n).value_or(-1);
+    }));
+    return *value;
+  }
+  bool set_param(unsigned n, std::uint8_t v) {
+    auto set = std::make_shared<bool>(false);
+    const bool ran = on_device([set, n, v](sim::EdsSlave& device) {
+      const std::vector<std::uint8_t> bytes{v};
+      *set = device.objects().set_param_value(n, Bytes(bytes));
+    });
+    return ran && *set;
   }
 
-  // The simulated device's Parameter `n`, read on the port's thread.
-  double param(unsigned n) {
-    std::promise<double> value;
-    loop_->post([&](port::CanBackend& backend) {
-      auto& device = static_cast<sim::SimBackend&>(backend).eds_device(kNode).device();
-      value.set_value(device.objects().param_number(n).value_or(-1));
-    });
-    return value.get_future().get();
-  }
-  void set_param(unsigned n, std::uint8_t v) {
-    std::promise<bool> done;
-    loop_->post([&](port::CanBackend& backend) {
-      auto& device = static_cast<sim::SimBackend&>(backend).eds_device(kNode).device();
-      const std::vector<std::uint8_t> bytes{v};
-      done.set_value(device.objects().set_param_value(n, Bytes(bytes)));
-    });
-    ASSERT_TRUE(done.get_future().get());
+  // A supervisor's command of the I/O block's outputs, written until the
+  // writer is dropped.
+  struct Commander {
+    Commander(const dds::Participant& participant, const std::string& rack)
+        : topic(participant),
+          writer(participant, topic,
+                 dds::command_writer_qos(dds::rack_partitions(rack), 10, seconds(1))) {}
+    dds::Topic<dnbridge_test_DioCommand> topic;
+    dds::Writer<dnbridge_test_DioCommand> writer;
+  };
+  bool command(Commander& commander, std::uint8_t outputs) {
+    if (!dds::testing::until_matched(supervisor_, commander.writer)) return false;
+    dds::Owned<dnbridge_test_DioCommand> c;
+    dds::set_string(c->rack, rack_);
+    dds::set_string(c->port, kPort);
+    c->mac = kMac;
+    c->outputs = outputs;
+    dds::set_string(c->issuer, "dio-supervisor");
+    return commander.writer.write(*c).ok();
   }
 
   std::string rack_;
@@ -145,6 +183,7 @@ class DioProfileTest : public ::testing::Test {
 };
 
 TEST_F(DioProfileTest, ItsNodeIsPublishedOnItsOwnTopicAndCommandedThroughTheSharedPaths) {
+  start(true);
   // Online, its safe state downloaded and read back.
   ASSERT_TRUE(states_.until([](const auto& s) { return s.online && s.inputs_valid; }));
   EXPECT_EQ(param(7), 0x01);
@@ -155,23 +194,14 @@ TEST_F(DioProfileTest, ItsNodeIsPublishedOnItsOwnTopicAndCommandedThroughTheShar
   EXPECT_TRUE(states_.last().outputs_idle);
 
   // Inputs from the device reach the topic.
-  set_param(3, 0xA5);
+  ASSERT_TRUE(set_param(3, 0xA5));
   ASSERT_TRUE(states_.until([](const auto& s) { return s.inputs == 0xA5; }))
       << "inputs 0x" << std::hex << int{states_.last().inputs};
 
   // A supervisor commands the outputs through the profile's command topic.
   {
-    dds::Topic<dnbridge_test_DioCommand> topic(supervisor_);
-    dds::Writer<dnbridge_test_DioCommand> writer(
-        supervisor_, topic, dds::command_writer_qos(dds::rack_partitions(rack_), 10, seconds(1)));
-    ASSERT_TRUE(dds::testing::until_matched(supervisor_, writer));
-    dds::Owned<dnbridge_test_DioCommand> c;
-    dds::set_string(c->rack, rack_);
-    dds::set_string(c->port, kPort);
-    c->mac = kMac;
-    c->outputs = 0x81;
-    dds::set_string(c->issuer, "dio-supervisor");
-    ASSERT_TRUE(writer.write(*c).ok());
+    Commander commander(supervisor_, rack_);
+    ASSERT_TRUE(command(commander, 0x81));
     ASSERT_TRUE(states_.until([](const auto& s) { return !s.outputs_idle && s.outputs == 0x81; }))
         << states_.last().idle_reason;
     EXPECT_STREQ(states_.last().commanded_by, "dio-supervisor");
@@ -182,6 +212,26 @@ TEST_F(DioProfileTest, ItsNodeIsPublishedOnItsOwnTopicAndCommandedThroughTheShar
   ASSERT_TRUE(states_.until([](const auto& s) { return s.outputs_idle; }));
   EXPECT_STREQ(states_.last().commanded_by, "");
   EXPECT_EQ(param(4), 0x80);
+}
+
+// A port that had no node of the profile gets one by a reload: its rack is
+// made then, and the DDS input, on Cyclone's threads, finds the node's
+// profile and hands it its commands.
+TEST_F(DioProfileTest, AReloadBringsTheProfileToAPortThatHadNone) {
+  start(false);
+  auto change = loop_->reconfigure(port_config(true));
+  ASSERT_EQ(change.wait_for(kEventTimeout), std::future_status::ready);
+  const port::PortChange applied = change.get();
+  ASSERT_TRUE(applied.refused.empty()) << applied.refused;
+  ASSERT_EQ(applied.scan_list.added, std::vector<MacId>{kNode});
+  EXPECT_EQ(loop_->profile_of(kNode), DioProfile::kName);
+
+  ASSERT_TRUE(states_.until([](const auto& s) { return s.online && s.inputs_valid; }));
+  Commander commander(supervisor_, rack_);
+  ASSERT_TRUE(command(commander, 0x42));
+  ASSERT_TRUE(states_.until([](const auto& s) { return !s.outputs_idle && s.outputs == 0x42; }))
+      << states_.last().idle_reason;
+  EXPECT_EQ(param(4), 0x42);
 }
 
 }  // namespace

@@ -82,17 +82,17 @@ void DioProfile::take_applied(DioView& v, const Slot&, Bytes outputs) {
   if (!outputs.empty()) v.outputs_applied = outputs[0];
 }
 
-Status DioRack::command(MacId mac, std::uint8_t outputs, std::string_view issuer, TimePoint now) {
+Status DioRack::command(MacId mac, DioOutputs outputs, std::string_view issuer, TimePoint now) {
   DioView* v = find(mac);
   if (!v || !scanner()) return Errc::kOutOfRange;
   if (auto s = refuse_unless_online(*v, issuer); !s) return s;
-  const std::array<std::uint8_t, 2> data{outputs, 0};
+  const std::array<std::uint8_t, 2> data{outputs.bits, 0};
   return apply_command(*v, Bytes(data), outputs, issuer, now);
 }
 
 Status DioRack::command(MacId mac, const rack::NodeCommand& command, std::string_view issuer,
                         TimePoint now) {
-  if (const auto* outputs = command.as<std::uint8_t>()) {
+  if (const auto* outputs = command.as<DioOutputs>()) {
     return this->command(mac, *outputs, issuer, now);
   }
   return refuse_other_form(mac, issuer);

@@ -33,12 +33,19 @@ struct DioConfig {
   std::uint8_t idle_outputs = 0;
 };
 
+// A command's outputs, one bit per digital output (a type of its own, so
+// that no other profile's rack takes it for its own form).
+struct DioOutputs {
+  std::uint8_t bits = 0;
+  friend bool operator==(const DioOutputs&, const DioOutputs&) = default;
+};
+
 struct DioView : rack::NodeView {
   std::uint8_t inputs = 0;  // from the last poll response (valid once has_inputs)
   std::uint8_t module_status = 0;
   std::int16_t analog_input_mv = 0;
   std::uint8_t outputs_applied = 0;  // with the last answered poll (when not outputs_idle)
-  std::optional<std::uint8_t> outputs_requested;
+  std::optional<DioOutputs> outputs_requested;
   std::string idle_reason() const { return idle_text(outputs_requested.has_value()); }
   // The safe state as read back when the node last came online.
   std::optional<std::uint8_t> fault_outputs_read, idle_outputs_read;
@@ -48,7 +55,7 @@ struct DioProfile {
   static constexpr std::string_view kName = "dio";
   using Config = DioConfig;
   using View = DioView;
-  using Outputs = std::uint8_t;
+  using Outputs = DioOutputs;
   struct Slot {};
   static Slot slot_of(const DioConfig&) { return {}; }
   static DioView view_of(const DioConfig& c, const Slot&);
@@ -65,9 +72,8 @@ class DioRack final : public rack::NodeRack<DioProfile> {
 
   using NodeRack::NodeRack;
 
-  // New outputs, one bit per digital output.
-  Status command(devicenet::MacId mac, std::uint8_t outputs, std::string_view issuer,
-                 TimePoint now);
+  // New outputs, refused unless the node is online.
+  Status command(devicenet::MacId mac, DioOutputs outputs, std::string_view issuer, TimePoint now);
   Status command(devicenet::MacId mac, const rack::NodeCommand& command, std::string_view issuer,
                  TimePoint now) override;
   std::unique_ptr<rack::StateGate> state_gate(const rack::PublishPolicy& policy) const override;

@@ -46,7 +46,7 @@ void fill_dio_status(dnbridge_NodeStatus& out, std::string_view rack, std::strin
 }
 
 rack::NodeCommand command_of(const dnbridge_test_DioCommand& c) {
-  return rack::NodeCommand(std::uint8_t{c.outputs});
+  return rack::NodeCommand(DioOutputs{c.outputs});
 }
 
 std::span<const daemon::ProfileTopics> dio_profiles() {
