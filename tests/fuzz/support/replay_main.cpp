@@ -26,6 +26,10 @@ bool run_one(const std::filesystem::path& file) {
   }
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
                                 std::istreambuf_iterator<char>());
+  if (in.bad()) {
+    std::fprintf(stderr, "%s: read failed\n", file.c_str());
+    return false;
+  }
   const auto data = std::make_unique<std::uint8_t[]>(bytes.size());
   std::copy(bytes.begin(), bytes.end(), data.get());
   (void)LLVMFuzzerTestOneInput(data.get(), bytes.size());
