@@ -6,6 +6,7 @@
 #include <optional>
 #include <set>
 #include <string_view>
+#include <utility>
 
 #include "bridge/cip/assembly.hpp"
 #include "bridge/cip/epath.hpp"
@@ -104,6 +105,27 @@ Result<const Param*> find_param(const EdsFile& file, std::string_view name, std:
   return p;
 }
 
+namespace {
+
+// The attribute the parameter's link path names, as a setting without its
+// value; nothing when the link path is not a class, instance and attribute
+// within their ranges (none, a connection point).
+std::optional<devicenet::AttributeSetting> linked_attribute(const Param& p) {
+  const cip::EPath& link = p.link;
+  if (!link.class_id || !link.instance_id || !link.attribute || link.connection_point ||
+      *link.class_id > 0xFFFF || *link.instance_id > 0xFFFF || *link.attribute > 0xFF) {
+    return std::nullopt;
+  }
+  devicenet::AttributeSetting s;
+  s.class_id = static_cast<std::uint16_t>(*link.class_id);
+  s.instance_id = static_cast<std::uint16_t>(*link.instance_id);
+  s.attribute = static_cast<std::uint8_t>(*link.attribute);
+  s.name = fmt::format("Param{} {}", p.number, p.name);
+  return s;
+}
+
+}  // namespace
+
 Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
                                                       const ParameterValue& given,
                                                       std::string_view list, std::string* why) {
@@ -114,12 +136,11 @@ Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
   if (p->read_only()) {
     return explain(why, Errc::kMalformed, fmt::format("{} is read only", label));
   }
-  const cip::EPath& link = p->link;
-  if (!link.class_id || !link.instance_id || !link.attribute || link.connection_point ||
-      *link.class_id > 0xFFFF || *link.instance_id > 0xFFFF || *link.attribute > 0xFF) {
+  auto linked = linked_attribute(*p);
+  if (!linked) {
     return explain(why, Errc::kUnsupported,
                    fmt::format("{} has no link path to an attribute (its link path: {})", label,
-                               link.empty() ? "none" : "not class/instance/attribute"));
+                               p->link.empty() ? "none" : "not class/instance/attribute"));
   }
   if (p->type.size == 0) {
     return explain(why, Errc::kUnsupported,
@@ -143,15 +164,10 @@ Result<devicenet::AttributeSetting> parameter_setting(const EdsFile& file,
                    fmt::format("{}: {} is outside the EDS's limits {}", label, given.value,
                                limits_text(p->minimum, p->maximum)));
   }
-  devicenet::AttributeSetting s;
-  s.class_id = static_cast<std::uint16_t>(*link.class_id);
-  s.instance_id = static_cast<std::uint16_t>(*link.instance_id);
-  s.attribute = static_cast<std::uint8_t>(*link.attribute);
   for (unsigned i = 0; i < p->size; ++i) {
-    s.value.push_back(static_cast<std::uint8_t>(*raw >> (8 * i)));
+    linked->value.push_back(static_cast<std::uint8_t>(*raw >> (8 * i)));
   }
-  s.name = fmt::format("Param{} {}", p->number, p->name);
-  return s;
+  return std::move(*linked);
 }
 
 namespace {
@@ -360,20 +376,13 @@ DeviceSafeState device_safe_state(const EdsFile& file, const EdsNode& node) {
 }
 
 std::optional<devicenet::AttributeSetting> kept_setting(const Param& p) {
-  const cip::EPath& link = p.link;
-  if (!link.class_id || !link.instance_id || !link.attribute || link.connection_point ||
-      *link.class_id > 0xFFFF || *link.instance_id > 0xFFFF || *link.attribute > 0xFF ||
-      (p.size != 1 && p.size != 2 && p.size != 4)) {
+  auto s = linked_attribute(p);
+  if (!s || (p.size != 1 && p.size != 2 && p.size != 4)) {
     return std::nullopt;  // kept values are read as 1, 2 or 4 byte integers
   }
-  devicenet::AttributeSetting s;
-  s.class_id = static_cast<std::uint16_t>(*link.class_id);
-  s.instance_id = static_cast<std::uint16_t>(*link.instance_id);
-  s.attribute = static_cast<std::uint8_t>(*link.attribute);
-  s.value.assign(p.size, 0);
-  s.name = fmt::format("Param{} {}", p.number, p.name);
-  s.keep_device_value = true;
-  s.device_value_max = p.size == 4 ? 0xFFFFFFFFu : (1u << (8 * p.size)) - 1;
+  s->value.assign(p.size, 0);
+  s->keep_device_value = true;
+  s->device_value_max = p.size == 4 ? 0xFFFFFFFFu : (1u << (8 * p.size)) - 1;
   return s;
 }
 
