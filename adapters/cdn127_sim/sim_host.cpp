@@ -313,14 +313,14 @@ std::string SimHost::eds_status_line(SocketDevice& d) {
   const auto& strobe = s.strobe_counters();
   return fmt::format(
       "mac {} power {} network {} owner {} poll {} cos {} | eds \"{}\" | inputs {} outputs {} | "
-      "cos produced {} acks {} retries {} given-up {} | strobe {} commands {} responses {}",
+      "cos produced {} acks {} retries {} given-up {} late {} | strobe {} commands {} responses {}",
       d.mac().value(), on_off(d.powered()), sim::to_string(s.network_state()),
       s.owner() == 255 ? std::string("none") : std::to_string(s.owner()),
       established(s.poll_state()), established(s.cos_state()),
       s.objects().file().device.product_name,
       data(s.connections().poll_connection().produced_assembly), data(s.poll_output_assembly()),
-      cos.produced, cos.acks_received, cos.retries, cos.given_up, established(s.strobe_state()),
-      strobe.commands, strobe.responses);
+      cos.produced, cos.acks_received, cos.retries, cos.given_up, cos.late_acks,
+      established(s.strobe_state()), strobe.commands, strobe.responses);
 }
 
 std::string SimHost::execute(const ControlCommand& c, TimePoint now) {

@@ -119,6 +119,26 @@ TEST(CosAcknowledged, AWithheldAckIsRetriedAtTheAckTimerUpToTheLimitAndCounted) 
   EXPECT_EQ(link.consumer().counters().repeats, 2u);
 }
 
+// An acknowledgment that comes after the device gave its message up is too
+// late: counted as such, not as one received; the next message's counts as
+// ever.
+TEST(CosAcknowledged, AnAcknowledgmentAfterTheRetriesIsCountedLate) {
+  CosLink link(production(), consumption());
+  link.drop_acks = true;
+  link.run_until(t0 + milliseconds(20));
+  link.set_data({7, 0});
+  link.run_until(t0 + milliseconds(100));
+  ASSERT_EQ(link.producer().counters().given_up, 1u);
+  link.producer().on_ack();
+  link.producer().on_ack();  // a second, for the same message: nothing
+  EXPECT_EQ(link.producer().counters().late_acks, 1u);
+  EXPECT_EQ(link.producer().counters().acks_received, 0u);
+  link.drop_acks = false;
+  link.set_data({8, 0});
+  EXPECT_EQ(link.producer().counters().acks_received, 1u);
+  EXPECT_EQ(link.producer().counters().late_acks, 1u);
+}
+
 TEST(CosAcknowledged, WithAcknowledgmentSuppressedNothingIsRetried) {
   sim::CosProduction p = production();
   p.ack_suppressed = true;

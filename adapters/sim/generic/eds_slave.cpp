@@ -175,21 +175,13 @@ bool EdsSlave::on_strobe(const can::CanFrame& frame, TimePoint now) noexcept {
 
 CosProducerCounters EdsSlave::cos_counters() const noexcept {
   CosProducerCounters c = cos_ended_;
-  if (cos_) {
-    c.produced += cos_->counters().produced;
-    c.retries += cos_->counters().retries;
-    c.acks_received += cos_->counters().acks_received;
-    c.given_up += cos_->counters().given_up;
-  }
+  if (cos_) c += cos_->counters();
   return c;
 }
 
 void EdsSlave::end_cos() noexcept {
   if (!cos_) return;
-  cos_ended_.produced += cos_->counters().produced;
-  cos_ended_.retries += cos_->counters().retries;
-  cos_ended_.acks_received += cos_->counters().acks_received;
-  cos_ended_.given_up += cos_->counters().given_up;
+  cos_ended_ += cos_->counters();
   cos_.reset();
 }
 
