@@ -1,9 +1,9 @@
 // cdn127-sim's control language.
-#include "adapters/cdn127_sim/control.hpp"
+#include "adapters/sim/host/control.hpp"
 
 #include <gtest/gtest.h>
 
-namespace dnbridge::cdn127_sim {
+namespace dnbridge::sim::host {
 namespace {
 
 ControlCommand ok(std::string_view line) {
@@ -115,4 +115,4 @@ TEST(Control, ErrorsSayWhatIsWrong) {
 }
 
 }  // namespace
-}  // namespace dnbridge::cdn127_sim
+}  // namespace dnbridge::sim::host

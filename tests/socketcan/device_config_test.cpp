@@ -1,7 +1,7 @@
 // cdn127-sim's device configuration (--device-config, --reading): what each
 // key sets, how the layers combine, and every problem reported with its
 // position.
-#include "adapters/cdn127_sim/device_config.hpp"
+#include "adapters/sim/host/device_config.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace dnbridge::cdn127_sim {
+namespace dnbridge::sim::host {
 namespace {
 
 using devicenet::MacId;
@@ -288,4 +288,4 @@ TEST(DeviceConfig, MissingFileIsAProblemNotACrash) {
 }
 
 }  // namespace
-}  // namespace dnbridge::cdn127_sim
+}  // namespace dnbridge::sim::host

@@ -1,4 +1,6 @@
-// Node: its state, its timers and frames, losing it, faults and shutdown.
+// Node: its state, its timers and frames, its keep-alive and health, going
+// online, losing it, faults and shutdown, and the explicit requests it
+// carries for others.
 #include "bridge/devicenet/master/node.hpp"
 
 #include <fmt/format.h>
@@ -6,6 +8,7 @@
 #include <algorithm>
 #include <array>
 
+#include "bridge/cip/identity_health.hpp"
 #include "bridge/devicenet/master/node_internal.hpp"
 
 namespace dnbridge::devicenet {
@@ -13,6 +16,8 @@ namespace dnbridge::devicenet {
 using namespace node_detail;
 
 namespace {
+
+namespace ident = cip::identity;
 
 // The node's explicit messaging: the port's, with the node's own response
 // timeout for a slow device.
@@ -303,6 +308,142 @@ TimePoint Node::deadline() const {
     if (cos_) t = std::min(t, cos_->watchdog_deadline());
   }
   return t;
+}
+
+// --- keep-alive, health, going online ---------------------------------------
+
+void Node::on_keepalive_result(const ExplicitResult& r, TimePoint now) {
+  if (r.ok() || r.error == Errc::kDeviceError) {
+    if (r.ok() && !keepalive_reads_status_ && r.data.size() == 1) {
+      identity_.state = r.data[0];
+      if (device_state_ != r.data[0]) {
+        device_state_ = r.data[0];
+        observer_.on_device_state(config_.mac, r.data[0], now);
+      }
+    }
+    if (r.ok() && keepalive_reads_status_ && r.data.size() == 2) {
+      const auto status = static_cast<std::uint16_t>(*read_uint(r.data.view()));
+      if (identity_.status != status) {
+        identity_.status = status;
+        note_minor_faults();
+        observer_.on_node_identity(config_.mac, identity_, now);
+      }
+    }
+    if (r.ok() && !check_health(now)) return;
+    return;
+  }
+  // The device drops the explicit connection after 4 x EPR without a
+  // request; single lost frames must not be taken for that. Try again at
+  // once, and give up only when nothing has come back for that long.
+  if (now - last_explicit_answer_ >= 4 * explicit_epr_) {
+    lose(fmt::format("explicit connection lost: no answer for {} ms (4 x EPR; {})",
+                     std::chrono::duration_cast<milliseconds>(now - last_explicit_answer_).count(),
+                     status_text(r)),
+         now);
+    return;
+  }
+  keepalive_at_ = now;
+}
+
+void Node::note_minor_faults() {
+  std::string minor = ident::minor_faults(identity_.status.value_or(0));
+  if (minor == minor_faults_) return;
+  if (!minor.empty()) log_.warn("the device reports a {}", minor);
+  if (minor.empty()) log_.info("the device's minor faults cleared");
+  minor_faults_ = std::move(minor);
+}
+
+bool Node::check_health(TimePoint now) {
+  const auto major = ident::major_fault(identity_.status, identity_.state);
+  if (!major) return true;
+  device_fault(fmt::format("the device reports a {}; re-checked every {} ms", *major,
+                           std::chrono::duration_cast<milliseconds>(port_.fault_recheck).count()),
+               now);
+  return false;
+}
+
+void Node::idle_poll_before_release(TimePoint now) {
+  // Frames written to the port leave in the order written: the Release
+  // that follows reaches the device after this poll.
+  stray_poll_responses_ = poll_outstanding_ ? 2 : 1;
+  const bool idle = idle_;
+  idle_ = true;
+  send_poll(now);
+  idle_ = idle;
+  // Its answer is a stray, counted above: no poll of the node's own waits.
+  poll_outstanding_ = false;
+  poll_deadline_ = kNever;
+}
+
+void Node::device_fault(std::string reason, TimePoint now) {
+  enter_fault(NodeState::kDeviceFault, std::move(reason), now);
+}
+
+void Node::lose_and_release(std::string reason, TimePoint now) {
+  // The poll connection lives: the outputs go to the device's idle state at
+  // once rather than after its own watchdog, and what the device holds is
+  // released (the node is allocated afresh after the back-off).
+  if (state_ == NodeState::kOnline) idle_poll_before_release(now);
+  const std::uint8_t held = held_connections();
+  lose(std::move(reason), now);
+  if (held != 0) release(Step::kReleaseFault, held, now);
+}
+
+void Node::go_online(TimePoint now) {
+  retry_delay_ = port_.allocate_retry_min;
+  stray_poll_responses_ = 0;
+  cos_consecutive_errors_ = 0;
+  poll_outstanding_ = false;
+  poll_unanswered_ = false;
+  consecutive_errors_ = 0;
+  last_response_ = now;
+  last_explicit_answer_ = now;
+  next_poll_ = next_poll_slot(now);
+  keepalive_at_ = now + explicit_epr_;
+  io_reassembler_.reset();
+  std::string reason =
+      fmt::format("polled every {} ms; EPR {} ms (explicit {} ms); {} B out, {} B in",
+                  std::chrono::duration_cast<milliseconds>(config_.poll_period).count(),
+                  std::chrono::duration_cast<milliseconds>(poll_epr_).count(),
+                  std::chrono::duration_cast<milliseconds>(explicit_epr_).count(),
+                  config_.profile.consumed_size, config_.profile.produced_size);
+  if (produced_from_fallback_ || consumed_from_fallback_) {
+    // Worth knowing about a device: it refused Connection 2 attributes 7/8.
+    reason +=
+        fmt::format(" (sizes read from {} and {})", size_attribute(true, produced_from_fallback_),
+                    size_attribute(false, consumed_from_fallback_));
+  }
+  if (cos_) {
+    const CosSettings& c = cos_->settings();
+    const InputKind kind = config_.profile.input_connection->kind;
+    reason += fmt::format(
+        "; inputs {} (EPR {} ms, {})",
+        kind == InputKind::kCyclic          ? "cyclic"
+        : kind == InputKind::kChangeOfState ? "on change of state"
+                                            : "bit-strobed",
+        to_ms(c.expected_packet_rate),
+        kind == InputKind::kBitStrobe ? std::string("strobed with the port's other nodes")
+        : c.ack_suppressed
+            ? std::string("acknowledgment suppressed")
+            : fmt::format("acknowledged: the device retries after {} ms, {} time(s){}",
+                          to_ms(c.ack_timer), unsigned{c.retry_limit},
+                          ack_handler_unread_ ? " (defaults: its Acknowledge "
+                                                "Handler not read)"
+                                              : ""));
+  }
+  if (!identity_state_supported_) reason += "; Identity.State not supported: state unknown";
+  set_state(NodeState::kOnline, std::move(reason), now);
+  // Outputs set before the node came online go out with the first poll.
+  send_poll(now);
+}
+
+Status Node::request_explicit(std::uint32_t request_id, const RequestMessage& request,
+                              TimePoint now) {
+  if ((request_id & kInternalTag) != 0) return Errc::kOutOfRange;
+  if (!connected_ || shutting_down_) return Errc::kNotConnected;
+  // Two places stay free for the life cycle and the keep-alive.
+  if (client_.queued() + 2 > ExplicitClient::kQueueCapacity) return Errc::kBusy;
+  return client_.submit(request_id, request, false, now);
 }
 
 }  // namespace dnbridge::devicenet

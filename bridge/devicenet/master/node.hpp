@@ -209,7 +209,9 @@ class Node final : private ExplicitClient::Listener {
   // The attribute a step addresses (a profile's from the profile).
   cip::AttributeRef target_of(Step step) const;
 
-  // The handlers of the start-up table (node_lifecycle.cpp).
+  // The handlers of the start-up table (kStartup, node_lifecycle.cpp): from
+  // the allocation to the configuration in node_identify.cpp, the I/O
+  // connections' in node_connections.cpp.
   Step after_allocate_explicit(const ExplicitResult& r, TimePoint now);
   Step after_allocation_info(const ExplicitResult& r, TimePoint now);
   Step after_identity_match(const ExplicitResult& r, TimePoint now);

@@ -13,7 +13,7 @@
 #include <string>
 #include <string_view>
 
-#include "adapters/cdn127_sim/device_config.hpp"
+#include "adapters/sim/host/device_config.hpp"
 #include "adapters/daemon/config.hpp"
 #include "adapters/security/toml_settings.hpp"
 #include "bridge/devicenet/master/scanner.hpp"
@@ -67,17 +67,17 @@ void rack_configuration(std::string_view text) {
 }
 
 void devices(std::string_view text) {
-  cdn127_sim::DeviceConfig config;
+  sim::host::DeviceConfig config;
   try {
-    config = cdn127_sim::parse_device_config(text, "devices.toml");
-  } catch (const cdn127_sim::DeviceConfigError& e) {
+    config = sim::host::parse_device_config(text, "devices.toml");
+  } catch (const sim::host::DeviceConfigError& e) {
     FUZZ_CHECK(!e.problems().empty());
     for (const auto& p : e.problems()) FUZZ_CHECK(placed(p, "devices.toml"));
     return;
   }
-  const auto options = cdn127_sim::device_options({}, config, cdn127_sim::Reading::kLenient);
+  const auto options = sim::host::device_options({}, config, sim::host::Reading::kLenient);
   FUZZ_CHECK(options.size() == config.devices.size());
-  for (const auto& o : options) (void)cdn127_sim::describe_readings(o.cdn127);
+  for (const auto& o : options) (void)sim::host::describe_readings(o.cdn127);
 }
 
 void security_table(std::string_view text) {

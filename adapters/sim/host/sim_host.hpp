@@ -12,15 +12,15 @@
 #include <string>
 #include <vector>
 
-#include "adapters/cdn127_sim/control.hpp"
-#include "adapters/cdn127_sim/device_config.hpp"
+#include "adapters/sim/host/control.hpp"
+#include "adapters/sim/host/device_config.hpp"
 #include "adapters/sim/cdn127/cdn127_slave.hpp"
 #include "adapters/sim/generic/eds_slave.hpp"
 #include "adapters/socketcan/can_socket.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/wire/mac_id.hpp"
 
-namespace dnbridge::cdn127_sim {
+namespace dnbridge::sim::host {
 
 // One device: its socket, its slave and its power.
 class SocketDevice final : public can::FrameSink {
@@ -105,4 +105,4 @@ class SimHost {
   TimePoint reopen_at_ = kNever;
 };
 
-}  // namespace dnbridge::cdn127_sim
+}  // namespace dnbridge::sim::host

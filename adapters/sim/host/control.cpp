@@ -1,4 +1,4 @@
-#include "adapters/cdn127_sim/control.hpp"
+#include "adapters/sim/host/control.hpp"
 
 #include <fmt/format.h>
 
@@ -9,7 +9,7 @@
 
 #include "bridge/profiles/cdn127/io_data.hpp"
 
-namespace dnbridge::cdn127_sim {
+namespace dnbridge::sim::host {
 namespace {
 
 std::vector<std::string_view> words(std::string_view line) {
@@ -199,4 +199,4 @@ Each command is answered with one line: "ok ..." or "error: ...".
 )";
 }
 
-}  // namespace dnbridge::cdn127_sim
+}  // namespace dnbridge::sim::host

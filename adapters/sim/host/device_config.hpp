@@ -56,7 +56,7 @@
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/wire/mac_id.hpp"
 
-namespace dnbridge::cdn127_sim {
+namespace dnbridge::sim::host {
 
 // What one table sets; what it leaves unset stays as the layer below has it.
 struct DeviceSettings {
@@ -137,4 +137,4 @@ std::vector<DeviceSpec> device_options(const std::vector<devicenet::MacId>& macs
 // explicit responses 300 ms late, ...").
 std::string describe_readings(const sim::SlaveOptions& options);
 
-}  // namespace dnbridge::cdn127_sim
+}  // namespace dnbridge::sim::host

@@ -12,9 +12,9 @@
 #include <exception>
 #include <mutex>
 
-#include "adapters/cdn127_sim/control.hpp"
-#include "adapters/cdn127_sim/device_config.hpp"
-#include "adapters/cdn127_sim/sim_host.hpp"
+#include "adapters/sim/host/control.hpp"
+#include "adapters/sim/host/device_config.hpp"
+#include "adapters/sim/host/sim_host.hpp"
 #include "adapters/version/version.hpp"
 
 namespace {
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
       "      # Identity Reset type 1): DOP fault/idle actions 1 (no change), AOP fault/idle\n"
       "      # states 0 (hold): the pump stays on when the master goes idle or away. false\n"
       "      # (default): each DOP goes Off (action 0, value 0), the AOP holds (state 0).\n\n" +
-      std::string(cdn127_sim::control_help())};
+      std::string(sim::host::control_help())};
   std::string interface;
   std::vector<unsigned> macs;
   std::string control = "-";
@@ -107,16 +107,16 @@ int main(int argc, char** argv) {
                        "Print the version and source revision, and exit");
   CLI11_PARSE(app, argc, argv);
 
-  std::vector<cdn127_sim::DeviceSpec> devices;
+  std::vector<sim::host::DeviceSpec> devices;
   try {
-    cdn127_sim::DeviceConfig config;
-    if (!device_config_file.empty()) config = cdn127_sim::load_device_config(device_config_file);
+    sim::host::DeviceConfig config;
+    if (!device_config_file.empty()) config = sim::host::load_device_config(device_config_file);
     std::vector<devicenet::MacId> ids;
     ids.reserve(macs.size());
     for (auto m : macs) ids.push_back(devicenet::MacId::from_bits(m));
     const auto reading =
-        reading_name == "field" ? cdn127_sim::Reading::kField : cdn127_sim::Reading::kLenient;
-    devices = cdn127_sim::device_options(ids, config, reading);
+        reading_name == "field" ? sim::host::Reading::kField : sim::host::Reading::kLenient;
+    devices = sim::host::device_options(ids, config, reading);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kBadConfiguration;
@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    cdn127_sim::SimHost host(interface, std::move(devices), log);
+    sim::host::SimHost host(interface, std::move(devices), log);
     std::printf("ready\n");
     std::fflush(stdout);
     host.run(control_fd, quit_at_end, stdout);

@@ -1,4 +1,4 @@
-#include "adapters/cdn127_sim/device_config.hpp"
+#include "adapters/sim/host/device_config.hpp"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -15,7 +15,7 @@
 #include "adapters/toml/reader.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
-namespace dnbridge::cdn127_sim {
+namespace dnbridge::sim::host {
 namespace {
 
 using devicenet::MacId;
@@ -295,4 +295,4 @@ std::string describe_readings(const sim::SlaveOptions& o) {
   return out;
 }
 
-}  // namespace dnbridge::cdn127_sim
+}  // namespace dnbridge::sim::host

@@ -1,4 +1,4 @@
-#include "adapters/cdn127_sim/sim_host.hpp"
+#include "adapters/sim/host/sim_host.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -14,12 +14,12 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "adapters/cdn127_sim/device_config.hpp"
+#include "adapters/sim/host/device_config.hpp"
 #include "adapters/port/steady_time.hpp"
 #include "adapters/sim/world/sim_rack.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 
-namespace dnbridge::cdn127_sim {
+namespace dnbridge::sim::host {
 namespace {
 
 using socketcan::errno_code;
@@ -527,4 +527,4 @@ void SimHost::run(int control_fd, bool quit_at_end, std::FILE* replies) {
   }
 }
 
-}  // namespace dnbridge::cdn127_sim
+}  // namespace dnbridge::sim::host

@@ -37,7 +37,7 @@
 #include <string_view>
 #include <variant>
 
-namespace dnbridge::cdn127_sim {
+namespace dnbridge::sim::host {
 
 enum class Verb : std::uint8_t {
   kSet,
@@ -85,4 +85,4 @@ ParseResult parse_control(std::string_view line);
 // The help text, as `help` and --help print it.
 std::string_view control_help() noexcept;
 
-}  // namespace dnbridge::cdn127_sim
+}  // namespace dnbridge::sim::host
