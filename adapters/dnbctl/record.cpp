@@ -2,7 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 namespace dnbridge::dnbctl {
+
+Json::Json(double d) {
+  if (std::isfinite(d)) value_ = Digits{fmt::format("{}", d)};
+}
 
 Json Json::digits(std::string text) {
   Json j;

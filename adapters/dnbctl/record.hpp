@@ -29,8 +29,8 @@ struct Decimal {
   int places = 0;
 };
 
-// A JSON value: null, a boolean, an integer, a measured value, a string, a
-// number already in JSON's form, an object (a record), an array of objects
+// A JSON value: null, a boolean, an integer, a measured value, a real, a
+// string, a number already in JSON's form, an object (a record), an array of objects
 // or an array of values.
 class Json {
  public:
@@ -42,6 +42,9 @@ class Json {
   template <std::signed_integral T>
   Json(T n) : value_(static_cast<std::int64_t>(n)) {}
   Json(Decimal d) : value_(d) {}
+  // The shortest digits that read back as `d` (as fmt writes it for the
+  // text); null if not finite.
+  Json(double d);
   Json(std::string s) : value_(std::move(s)) {}
   Json(std::string_view s) : value_(std::string(s)) {}
   Json(const char* s) : value_(std::string(s)) {}

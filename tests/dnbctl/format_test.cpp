@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <initializer_list>
 #include <limits>
 
@@ -315,6 +317,34 @@ TEST(Show, IdentityStateAndCounters) {
                            R"("product_name":"CDN127"})"),
             std::string::npos)
       << out.str();
+}
+
+// A device's fields: their values as JSON numbers, as the text shows them.
+TEST(Show, ADevicesFieldsAreNumbersInJson) {
+  auto n = node(21);
+  char name[] = "Analog input 1", type[] = "INT", units[] = "mV", empty[] = "";
+  char bits_name[] = "Digital inputs", bits_type[] = "BYTE";
+  std::array<dnbridge_DeviceField, 3> fields{};
+  fields[0] = {name, 4, type, units, 8, 16, -1000.0, -2.5};
+  fields[1] = {bits_name, 3, bits_type, empty, 0, 8, 165.0, 165.0};
+  fields[2] = {bits_name, 3, bits_type, empty, 0, 8, 0.0, std::nan("")};
+  dnbridge_DeviceState d{};
+  char product[] = "Example IO block";
+  d.product = product;
+  d.inputs_valid = true;
+  d.input_fields._buffer = fields.data();
+  d.input_fields._length = d.input_fields._maximum = fields.size();
+  d.outputs_idle = true;
+  JsonWriter out(false);
+  node_json(out, *n, nullptr, true, &d);
+  EXPECT_NE(out.str().find(R"("name":"Analog input 1","type":"INT","units":"mV","bit_offset":8,)"
+                           R"("bits":16,"value":-1000,"shown":-2.5})"),
+            std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find(R"("bits":8,"value":165,"shown":165})"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find(R"("value":0,"shown":null})"), std::string::npos) << out.str();
+  EXPECT_NE(node_details(*n, nullptr, true, &d).find("Analog input 1 = -2.5 mV"),
+            std::string::npos);
 }
 
 ExplicitExchange get_name() {
