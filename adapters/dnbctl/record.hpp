@@ -30,8 +30,8 @@ struct Decimal {
 };
 
 // A JSON value: null, a boolean, an integer, a measured value, a real, a
-// string, a number already in JSON's form, an object (a record), an array of objects
-// or an array of values.
+// string, a number already in JSON's form, an object (a record), an array of
+// objects or an array of values.
 class Json {
  public:
   Json() = default;

@@ -10,7 +10,6 @@ CosProducer::CosProducer(CosProduction settings, Bytes data, TimePoint establish
 std::vector<std::uint8_t> CosProducer::produce(TimePoint now) {
   last_production_ = now;
   change_pending_ = false;
-  gave_up_ = false;
   ++counters_.produced;
   if (!settings_.ack_suppressed) {
     awaiting_ack_ = true;  // a message still waiting is superseded
@@ -42,13 +41,12 @@ std::optional<std::vector<std::uint8_t>> CosProducer::set_data(Bytes data, TimeP
 }
 
 void CosProducer::on_ack() {
-  if (gave_up_) {
-    // Too late for the device, which has gone on; counted, not taken.
-    gave_up_ = false;
+  if (!awaiting_ack_) {
+    // Nothing waiting: too late for a message given up, or again for one
+    // acknowledged. Counted, not taken.
     ++counters_.late_acks;
     return;
   }
-  if (!awaiting_ack_) return;
   awaiting_ack_ = false;
   ++counters_.acks_received;
 }
@@ -66,7 +64,6 @@ std::optional<std::vector<std::uint8_t>> CosProducer::on_timer(TimePoint now) {
   if (awaiting_ack_ && now >= ack_deadline_) {
     if (retries_left_ == 0) {
       awaiting_ack_ = false;
-      gave_up_ = true;
       ++counters_.given_up;
       return std::nullopt;
     }

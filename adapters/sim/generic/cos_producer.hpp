@@ -42,7 +42,7 @@ struct CosProducerCounters {
   std::uint64_t retries = 0;        // sent again for want of an acknowledgment
   std::uint64_t acks_received = 0;  // acknowledgments of a waiting message
   std::uint64_t given_up = 0;       // messages still unacknowledged after the retry limit
-  std::uint64_t late_acks = 0;      // an acknowledgment of a message given up, before the next
+  std::uint64_t late_acks = 0;      // acknowledgments with no message waiting (after a give-up)
 
   CosProducerCounters& operator+=(const CosProducerCounters& o) noexcept {
     produced += o.produced;
@@ -85,7 +85,6 @@ class CosProducer {
   TimePoint last_production_;
   bool change_pending_ = false;  // a change held back by the inhibit time
   bool awaiting_ack_ = false;
-  bool gave_up_ = false;  // the last message given up, no acknowledgment since
   std::uint8_t retries_left_ = 0;
   TimePoint ack_deadline_{};
   CosProducerCounters counters_;

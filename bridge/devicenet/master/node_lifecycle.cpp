@@ -1,5 +1,6 @@
-// Node: its start-up as one ordered table of steps (kStartup below), and the
-// handlers that check what the device answers.
+// Node: its start-up as one ordered table of steps (kStartup below), each
+// step's request built and sent, and its answer taken to the row's handler
+// (node_identify.cpp, node_connections.cpp) or to where the row leads.
 //
 // The rule the table follows: read what the device has before writing; write
 // only what differs, and read it back; where the device refuses but what it

@@ -182,7 +182,8 @@ TEST_F(EdsSlaveChangeOfState, WithoutAckTheMessageIsRetriedUpToTheRetryLimit) {
   EXPECT_EQ(slave().cos_counters().retries, 3u);
   EXPECT_EQ(slave().cos_counters().given_up, 1u);
   EXPECT_EQ(slave().cos_counters().acks_received, 0u);
-  // A late acknowledgment of the next change stops its retries at once.
+  // An acknowledgment of the next change after 5 ms stops its retries at
+  // once.
   change_inputs(0x12);
   world_.run_for(milliseconds(5));
   tester_.send(TestNode::ack_frame());
