@@ -14,8 +14,8 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "adapters/sim/host/device_config.hpp"
 #include "adapters/port/steady_time.hpp"
+#include "adapters/sim/host/device_config.hpp"
 #include "adapters/sim/world/sim_rack.hpp"
 #include "bridge/profiles/cdn127/io_data.hpp"
 

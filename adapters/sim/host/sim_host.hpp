@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "adapters/sim/host/control.hpp"
-#include "adapters/sim/host/device_config.hpp"
 #include "adapters/sim/cdn127/cdn127_slave.hpp"
 #include "adapters/sim/generic/eds_slave.hpp"
+#include "adapters/sim/host/control.hpp"
+#include "adapters/sim/host/device_config.hpp"
 #include "adapters/socketcan/can_socket.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/wire/mac_id.hpp"

@@ -13,9 +13,9 @@
 #include <string>
 #include <string_view>
 
-#include "adapters/sim/host/device_config.hpp"
 #include "adapters/daemon/config.hpp"
 #include "adapters/security/toml_settings.hpp"
+#include "adapters/sim/host/device_config.hpp"
 #include "bridge/devicenet/master/scanner.hpp"
 #include "bridge/rack/pump_rack.hpp"
 #include "tests/fuzz/support/fuzz_check.hpp"
