@@ -258,10 +258,14 @@ void SimHost::try_reopen(TimePoint now) {
   log_.info("interface {} is back", interface_);
 }
 
-void SimHost::on_socket(std::size_t index, TimePoint now) {
+void SimHost::on_socket(std::size_t index) {
   auto& d = *devices_[index];
   for (int i = 0; i < 64 && d.socket().is_open(); ++i) {
     auto r = d.socket().read();
+    // Each frame at the time it is read: a frame that arrives while the ones
+    // before it are answered (the last fragment after the first one's
+    // acknowledgment) is late from its own arrival, not from the wake-up's.
+    const TimePoint now = this->now();
     if (!r) {
       if (is(r.error(), EAGAIN)) return;
       if (interface_gone(r.error())) {
@@ -520,7 +524,7 @@ void SimHost::run(int control_fd, bool quit_at_end, std::FILE* replies) {
           std::fflush(replies);
         }
       } else if (token < devices_.size()) {
-        on_socket(static_cast<std::size_t>(token), t);
+        on_socket(static_cast<std::size_t>(token));
       }
     }
     (void)control_open;

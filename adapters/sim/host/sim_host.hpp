@@ -90,7 +90,9 @@ class SimHost {
   std::string status_line(SocketDevice& d, TimePoint now);
   std::string eds_status_line(SocketDevice& d);
   std::string set_input(SocketDevice& d, const ControlCommand& c, TimePoint now);
-  void on_socket(std::size_t index, TimePoint now);
+  // Reads what the device's socket holds, each frame handed over at the time it
+  // is read.
+  void on_socket(std::size_t index);
   void interface_lost(const std::error_code& why, TimePoint now);
   void try_reopen(TimePoint now);
   TimePoint next_deadline() const;
