@@ -61,12 +61,21 @@ endif()
 # Man pages and the changelog, gzipped as Debian installs them.
 set(man_dir ${CMAKE_CURRENT_BINARY_DIR}/man)
 set(package_files "")
+# dnbridge.toml(5)'s key reference, generated from the rack file's key table.
+set(config_keys_roff ${man_dir}/dnbridge.toml.keys)
+add_custom_command(
+  OUTPUT ${config_keys_roff}
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${man_dir}
+  COMMAND config_keys_roff ${config_keys_roff}
+  DEPENDS config_keys_roff
+  COMMENT "dnbridge.toml(5): the key reference")
 foreach(page dnbridge.8 dnbctl.1 dnbridge.toml.5 dnbridge-sim.1 cdn127-sim.1 dnbridge-demo.1)
   set(example_args "")
   set(example_deps "")
   if(page STREQUAL "dnbridge.toml.5")
-    set(example_args -DEXAMPLE=${PROJECT_SOURCE_DIR}/deploy/config/rack-example.toml)
-    set(example_deps ${PROJECT_SOURCE_DIR}/deploy/config/rack-example.toml)
+    set(example_args -DEXAMPLE=${PROJECT_SOURCE_DIR}/deploy/config/rack-example.toml
+                     -DKEYS=${config_keys_roff})
+    set(example_deps ${PROJECT_SOURCE_DIR}/deploy/config/rack-example.toml ${config_keys_roff})
   endif()
   add_custom_command(
     OUTPUT ${man_dir}/${page} ${man_dir}/${page}.gz

@@ -29,7 +29,6 @@ namespace {
 
 using toml_config::read_bool;
 using toml_config::read_int_as;
-using toml_config::read_ms;
 using toml_config::read_name;
 using toml_config::read_string;
 using toml_config::type_name;
@@ -49,6 +48,7 @@ rack::ExplicitPolicy read_explicit_policy(const toml::node& n, Problems& r) {
     keys[i] = rack::policy_key(static_cast<rack::GuardedRequest>(i));
   }
   TableReader table(*t, "[explicit_policy]", r);
+  table.allow_only(key_names(KeyPlace::kExplicitPolicy));
   for (std::size_t i = 0; i < keys.size(); ++i) {
     if (const toml::node* v = table.get(keys[i])) {
       if (auto allowed = read_bool(*v, keys[i], r)) {
@@ -65,6 +65,7 @@ std::optional<std::string> read_metrics(const toml::node& n, Problems& r) {
   const toml::table* t = toml_config::as_table(n, "metrics", "[metrics]", r);
   if (!t) return std::nullopt;
   TableReader table(*t, "[metrics]", r);
+  table.allow_only(key_names(KeyPlace::kMetrics));
   const toml::node* listen = table.require("listen");
   if (!listen) return std::nullopt;
   auto v = read_string(*listen, "listen", r);
@@ -103,13 +104,11 @@ std::optional<LogLevel> log_level_named(std::string_view name) {
   return std::nullopt;
 }
 
-// RTPS maps domain IDs to UDP ports; with the standard port parameters the
-// highest that fits is 232.
-constexpr std::int64_t kMaxDomainId = 232;
-
 DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadContext& ctx,
                        Problems& r) {
   TableReader root(table, "the top level", r);
+  root.allow_only(key_names(KeyPlace::kTop),
+                  [](std::string_view key) { return misplaced_key(KeyPlace::kTop, false, key); });
   DaemonConfig config;
   config.source = std::string(source);
   if (const toml::node* n = root.require("rack")) {
@@ -132,8 +131,9 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadCo
     }
   }
   if (const toml::node* n = root.get("domain")) {
-    if (auto v = read_int_as<std::uint32_t>(
-            *n, "domain", {0, kMaxDomainId, {}, "a DDS domain ID is 0..232"}, r)) {
+    const KeyRange b = bounds_of(KeyPlace::kTop, "domain");
+    if (auto v = read_int_as<std::uint32_t>(*n, "domain",
+                                            {b.min, b.max, {}, "a DDS domain ID is 0..232"}, r)) {
       config.domain_id = *v;
     }
   }
@@ -141,8 +141,7 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadCo
     if (auto v = read_mac(*n, "master_mac", r)) config.master_mac = *v;
   }
   if (const toml::node* n = root.get("max_commander_lease_ms")) {
-    if (auto v =
-            read_ms(*n, "max_commander_lease_ms", kMinCommanderLeaseMs, kMaxCommanderLeaseMs, r)) {
+    if (auto v = read_key_ms(*n, KeyPlace::kTop, "max_commander_lease_ms", r)) {
       config.max_commander_lease = *v;
     }
   }
@@ -165,7 +164,7 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadCo
   }
 
   if (const toml::node* n = root.get("security")) {
-    config.security = security::read_table(*n, r);
+    config.security = security::read_table(*n, r, key_names(KeyPlace::kSecurity));
   }
 
   if (const toml::node* n = root.get("metrics")) {
@@ -176,10 +175,16 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadCo
   if (const toml::node* n = root.get("defaults")) {
     if (const toml::table* t = toml_config::as_table(*n, "defaults", "[defaults]", r)) {
       defaults.emplace(*t, "[defaults]", r);
+      defaults->allow_only(defaults_key_names(), [](std::string_view key) {
+        return misplaced_key(KeyPlace::kNode, true, key);
+      });
       // Read once on their own, so that their problems are reported even
       // when no node inherits them.
       NodeSettings ignored;
       read_node_settings(Layers{nullptr, &*defaults}, ignored, r);
+      NodeSettings ignored_eds;
+      ignored_eds.profile = kProfileEds;
+      read_eds_node(Layers{nullptr, &*defaults}, ctx, ignored_eds, r);
       // Every key [defaults] may hold is declared by now.
       defaults->finish();
     }

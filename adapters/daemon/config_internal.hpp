@@ -16,6 +16,7 @@
 #include <string_view>
 
 #include "adapters/daemon/config.hpp"
+#include "adapters/daemon/config_keys.hpp"
 #include "adapters/toml/reader.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/wire/mac_id.hpp"
@@ -43,18 +44,9 @@ std::optional<MacId> read_mac(const toml::node& n, std::string_view key, Problem
 constexpr std::string_view kProfileCdn127 = "cdn127";
 constexpr std::string_view kProfileEds = "eds";
 
-// The keys only a CDN127 node has, and only a profile = "eds" node has.
-constexpr std::array<std::string_view, 9> kCdn127OnlyKeys{"io",
-                                                          "identity",
-                                                          "pump_on_fault",
-                                                          "pump_on_idle",
-                                                          "n2_ballast_on_fault",
-                                                          "n2_ballast_on_idle",
-                                                          "analog_output_on_fault",
-                                                          "analog_output_on_idle",
-                                                          "analog_deadband_volts"};
-constexpr std::array<std::string_view, 6> kEdsOnlyKeys{
-    "eds", "connection", "parameters", "heartbeat_ms", "inhibit_ms", "acknowledged"};
+// The node keys of the profiles other than `profile` (kCdn127Nodes,
+// kEdsNodes) that the node gives, each refused with its profile.
+void refuse_other_profiles_keys(TableReader& node, std::uint8_t profile, Problems& r);
 
 enum class Level { kBuiltIn, kDefaults, kNode };
 
@@ -82,22 +74,18 @@ struct Layers {
 // Where a value another one is compared with came from, for the message.
 std::string origin(const Found& f);
 
-// DeviceNet expected packet rates are UINT milliseconds (Connection object
-// attribute 9); the poll period is bounded by the expected packet rate.
-constexpr std::int64_t kMaxPacketRateMs = 0xFFFF;
-constexpr std::int64_t kMaxPublishPeriodMs = 3'600'000;
-constexpr std::int64_t kMaxPollBatchMs = 1000;
-constexpr std::int64_t kMaxResponseTimeoutMs =
-    60'000;  // cut to a quarter of each node's poll period
 constexpr double kAnalogFullScaleVolts = 10.0;
-// A command refresh shorter than a DDS write's round trip under load would
-// idle a healthy commander's pumps; longer than ten minutes is no bound.
-constexpr std::int64_t kMinCommandRefreshMs = 50;
-constexpr std::int64_t kMaxCommandRefreshMs = 600'000;
-// A lease shorter than this would have a commander lose its pumps on any
-// hiccup of its host; longer than ten minutes is no bound.
-constexpr std::int64_t kMinCommanderLeaseMs = 100;
-constexpr std::int64_t kMaxCommanderLeaseMs = 600'000;
+
+// The integer key `key` at `place`, read within the key table's bounds
+// (config_keys.hpp): as a duration in ms, or as T.
+std::optional<Duration> read_key_ms(const toml::node& n, KeyPlace place, std::string_view key,
+                                    Problems& r);
+template <class T>
+std::optional<T> read_key_int(const toml::node& n, KeyPlace place, std::string_view key,
+                              Problems& r) {
+  const KeyRange b = bounds_of(place, key);
+  return toml_config::read_int_as<T>(n, key, {b.min, b.max}, r);
+}
 
 // command_refresh_ms: 0 (off), or how often a commander must write a
 // node's command for it to stay in force (a node's, [defaults]' or a port's).
@@ -108,6 +96,12 @@ std::optional<Duration> read_command_refresh(const toml::node& n, Problems& r);
 
 // Every setting a node and [defaults] share (config_node.cpp).
 void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r);
+
+// safe_state, the same two choices for every profile: true for "device"
+// (the device's own fault and idle actions), false for "configured" (the
+// ones the file gives: a CDN127's pump_on_fault ..., an EDS node's
+// safe_state_parameters).
+std::optional<bool> read_safe_state_source(const toml::node& n, Problems& r);
 
 // A CDN127's own keys (config_node_cdn127.cpp): io, identity, and the safe
 // state of its outputs.
@@ -127,8 +121,9 @@ struct ReadContext {
   std::map<std::string, EdsRead> eds_files;  // by resolved path
 };
 
-// A profile = "eds" node's own keys (config_node_eds.cpp).
-void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems& r);
+// A profile = "eds" node's own keys, its own else [defaults]'; [defaults]
+// alone when `layers` has no node (config_node_eds.cpp).
+void read_eds_node(const Layers& layers, ReadContext& ctx, NodeSettings& s, Problems& r);
 
 // ---------------------------------------------------------------------------
 // A [[port]] table and its [[port.node]] tables (config_port.cpp).

@@ -15,7 +15,6 @@
 namespace dnbridge::daemon::config_detail {
 
 using toml_config::read_bool;
-using toml_config::read_ms;
 using toml_config::read_number;
 using toml_config::read_string;
 
@@ -57,12 +56,12 @@ void read_poll_timing(const Layers& layers, NodeSettings& s, Problems& r) {
   const Found epr = layers.find("expected_packet_rate_ms");
   bool poll_ok = true, epr_ok = true;
   if (poll.value) {
-    auto v = read_ms(*poll.value, "poll_period_ms", 1, kMaxPacketRateMs, r);
+    auto v = read_key_ms(*poll.value, KeyPlace::kNode, "poll_period_ms", r);
     poll_ok = v.has_value();
     if (v) s.pump.node.poll_period = *v;
   }
   if (epr.value) {
-    auto v = read_ms(*epr.value, "expected_packet_rate_ms", 1, kMaxPacketRateMs, r);
+    auto v = read_key_ms(*epr.value, KeyPlace::kNode, "expected_packet_rate_ms", r);
     epr_ok = v.has_value();
     if (v) s.pump.node.expected_packet_rate = *v;
   }
@@ -82,7 +81,7 @@ void read_poll_timing(const Layers& layers, NodeSettings& s, Problems& r) {
                 at_epr ? origin(poll) : std::string()));
   }
   if (Found f = layers.find("explicit_packet_rate_ms"); f.value) {
-    if (auto v = read_ms(*f.value, "explicit_packet_rate_ms", 1, kMaxPacketRateMs, r)) {
+    if (auto v = read_key_ms(*f.value, KeyPlace::kNode, "explicit_packet_rate_ms", r)) {
       s.pump.node.explicit_packet_rate = *v;
     }
   }
@@ -91,7 +90,7 @@ void read_poll_timing(const Layers& layers, NodeSettings& s, Problems& r) {
       s.pump.node.immediate_poll_on_change = *v;
   }
   if (const Found gap = layers.find("immediate_poll_min_gap_ms"); gap.value) {
-    if (auto v = read_ms(*gap.value, "immediate_poll_min_gap_ms", 0, kMaxPacketRateMs, r)) {
+    if (auto v = read_key_ms(*gap.value, KeyPlace::kNode, "immediate_poll_min_gap_ms", r)) {
       s.pump.node.immediate_poll_min_gap = *v;
       // Longer than the poll period it would only hold back changes the
       // node's next slot carries anyway: a mistake, not a setting.
@@ -115,7 +114,7 @@ void read_poll_timing(const Layers& layers, NodeSettings& s, Problems& r) {
         std::min(s.pump.node.immediate_poll_min_gap, s.pump.node.poll_period);
   }
   if (Found f = layers.find("publish_max_period_ms"); f.value) {
-    if (auto v = read_ms(*f.value, "publish_max_period_ms", 1, kMaxPublishPeriodMs, r)) {
+    if (auto v = read_key_ms(*f.value, KeyPlace::kNode, "publish_max_period_ms", r)) {
       s.publish.max_period = *v;
       if (per_node && poll_ok && *v < s.pump.node.poll_period) {
         r.warning(
@@ -148,8 +147,9 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
     }
   }
   // A CDN127's own settings; a node of another profile refuses them
-  // (read_eds_node), [defaults] may hold them for the CDN127s.
-  const bool cdn127 = s.profile == kProfileCdn127;
+  // (read_eds_node), [defaults] may hold them for the CDN127s whatever
+  // profile it gives the others.
+  const bool cdn127 = s.profile == kProfileCdn127 || !layers.per_node();
   if (Found f = layers.find("io"); f.value && cdn127) {
     if (auto v = read_io(*f.value, r)) s.pump.io = *v;
   }
@@ -169,12 +169,12 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
     }
   }
   if (Found f = layers.find("explicit_response_timeout_ms"); f.value) {
-    if (auto v = read_ms(*f.value, "explicit_response_timeout_ms", 1, kMaxResponseTimeoutMs, r)) {
+    if (auto v = read_key_ms(*f.value, KeyPlace::kNode, "explicit_response_timeout_ms", r)) {
       s.pump.node.explicit_response_timeout = *v;
     }
   }
   if (Found f = layers.find("poll_response_timeout_ms"); f.value) {
-    if (auto v = read_ms(*f.value, "poll_response_timeout_ms", 1, kMaxResponseTimeoutMs, r)) {
+    if (auto v = read_key_ms(*f.value, KeyPlace::kNode, "poll_response_timeout_ms", r)) {
       s.pump.node.poll_response_timeout = *v;
     }
   }
@@ -195,6 +195,25 @@ void read_node_settings(const Layers& layers, NodeSettings& s, Problems& r) {
   }
   if (cdn127) read_safe_state(layers, s, r);
   read_resume(layers, s, r);
+}
+
+std::optional<bool> read_safe_state_source(const toml::node& n, Problems& r) {
+  auto v = read_string(n, "safe_state", r);
+  if (!v) return std::nullopt;
+  if (*v == "configured") return false;
+  if (*v == "device") return true;
+  r.error(n.source(),
+          fmt::format("safe_state = \"{}\" is not a choice: use \"configured\" (the default: the "
+                      "fault and idle actions this file gives are downloaded) or \"device\" "
+                      "(the device's own, fixed by its maker)",
+                      *v));
+  return std::nullopt;
+}
+
+void refuse_other_profiles_keys(TableReader& node, std::uint8_t profile, Problems& r) {
+  for (std::string_view key : keys_of_other_profiles(profile)) {
+    if (const toml::node* n = node.get(key)) r.error(n->source(), other_profile_key(profile, key));
+  }
 }
 
 }  // namespace dnbridge::daemon::config_detail

@@ -71,6 +71,7 @@ std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Problems& r)
     return std::nullopt;
   }
   TableReader table(*t, "io", r);
+  table.allow_only(key_names(KeyPlace::kIo));
   bool ok = true;
   auto io = cdn127::preset(cdn127::ConfigurationPreset::kCdn127);
   if (const toml::node* p = table.get("preset")) {
@@ -81,7 +82,8 @@ std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Problems& r)
     }
   }
   if (const toml::node* m = table.get("mode")) {
-    if (auto v = read_int_as<std::uint8_t>(*m, "io.mode", {0, 0xFF}, r)) {
+    const KeyRange b = bounds_of(KeyPlace::kIo, "mode");
+    if (auto v = read_int_as<std::uint8_t>(*m, "io.mode", {b.min, b.max}, r)) {
       io.mode = *v;
       // CDN127 manual, Configuration object, Mode: "Bits 3..5 should be set
       // to 0"; bit 6 is not described. Loaded as given, but said.
@@ -96,7 +98,8 @@ std::optional<cdn127::IoConfiguration> read_io(const toml::node& n, Problems& r)
     }
   }
   if (const toml::node* m = table.get("no_nc_mask")) {
-    if (auto v = read_int_as<std::uint8_t>(*m, "io.no_nc_mask", {0, 0xFF}, r)) {
+    const KeyRange b = bounds_of(KeyPlace::kIo, "no_nc_mask");
+    if (auto v = read_int_as<std::uint8_t>(*m, "io.no_nc_mask", {b.min, b.max}, r)) {
       io.no_nc_mask = *v;
     } else {
       ok = false;
@@ -146,12 +149,15 @@ std::optional<devicenet::ExpectedIdentity> read_identity(const toml::node& n, Pr
     return std::nullopt;
   }
   TableReader table(*t, "identity", r);
+  table.allow_only(key_names(KeyPlace::kIdentity));
   devicenet::ExpectedIdentity id;
   bool ok = true;
   auto field = [&](std::string_view key, std::uint16_t& out) {
     const toml::node* v = table.require(key);
-    auto value = v ? read_int_as<std::uint16_t>(*v, fmt::format("identity.{}", key), {0, 0xFFFF}, r)
-                   : std::nullopt;
+    const KeyRange b = bounds_of(KeyPlace::kIdentity, key);
+    auto value =
+        v ? read_int_as<std::uint16_t>(*v, fmt::format("identity.{}", key), {b.min, b.max}, r)
+          : std::nullopt;
     if (value) {
       out = *value;
     } else {
@@ -224,17 +230,9 @@ std::optional<cdn127::AnalogAction> read_analog_action(const toml::node& n, std:
 
 void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
   if (Found f = layers.find("safe_state"); f.value) {
-    if (auto v = read_string(*f.value, "safe_state", r)) {
-      if (*v == "configured") {
-        s.pump.safe_state.source = cdn127::SafeStateSource::kConfiguration;
-      } else if (*v == "device") {
-        s.pump.safe_state.source = cdn127::SafeStateSource::kDevice;
-      } else {
-        r.error(f.value->source(),
-                fmt::format("safe_state = \"{}\" is not a choice: use \"configured\" (the "
-                            "default: the keys pump_on_fault ... are downloaded) or \"device\"",
-                            *v));
-      }
+    if (auto device = read_safe_state_source(*f.value, r)) {
+      s.pump.safe_state.source =
+          *device ? cdn127::SafeStateSource::kDevice : cdn127::SafeStateSource::kConfiguration;
     }
   }
   const bool keep_device = s.pump.safe_state.source == cdn127::SafeStateSource::kDevice;

@@ -14,7 +14,6 @@
 namespace dnbridge::daemon::config_detail {
 
 using toml_config::read_bool;
-using toml_config::read_ms;
 using toml_config::read_number;
 using toml_config::read_string;
 using toml_config::type_name;
@@ -104,6 +103,7 @@ std::optional<std::vector<eds::ParameterValue>> read_parameter_values(const toml
   bool ok = true;
   for (const toml::node& element : *list) {
     TableReader t(*element.as_table(), std::string(key), r);
+    t.allow_only(key_names(KeyPlace::kParameter));
     const toml::node* name = t.require("name");
     const toml::node* value = t.require("value");
     auto name_v = name ? read_string(*name, fmt::format("{}.name", key), r) : std::nullopt;
@@ -119,9 +119,11 @@ std::optional<std::vector<eds::ParameterValue>> read_parameter_values(const toml
 }
 
 // connection, and heartbeat_ms, inhibit_ms and acknowledged for a
-// change-of-state or cyclic connection. Gives the `connection` key, if any.
-const toml::node* read_eds_connection(TableReader& nt, NodeSettings& s, Problems& r) {
-  const toml::node* connection = nt.get("connection");
+// change-of-state or cyclic connection; [defaults] read alone takes each
+// as it stands, the node it is for not known. Gives the `connection` key,
+// if any.
+const toml::node* read_eds_connection(const Layers& layers, NodeSettings& s, Problems& r) {
+  const toml::node* connection = layers.find("connection").value;
   bool connection_known = true;
   if (connection) {
     auto v = read_connection(*connection, r);
@@ -129,25 +131,26 @@ const toml::node* read_eds_connection(TableReader& nt, NodeSettings& s, Problems
     connection_known = v.has_value();
   }
   // The change-of-state or cyclic connection's own settings.
+  const bool per_node = layers.per_node();
   const bool cos = s.eds_node.connection == eds::ConnectionKind::kChangeOfState ||
                    s.eds_node.connection == eds::ConnectionKind::kCyclic;
   for (std::string_view k : {"heartbeat_ms", "inhibit_ms", "acknowledged"}) {
-    const toml::node* n = nt.get(k);
+    const toml::node* n = layers.find(k).value;
     if (n == nullptr || !connection_known) continue;
-    if (!cos) {
+    if (per_node && !cos) {
       r.error(n->source(), fmt::format("{} is for connection = \"change-of-state\" or "
                                        "\"cyclic\" (this node's is \"{}\")",
                                        k, to_string(s.eds_node.connection)));
     } else if (k == "heartbeat_ms") {
-      if (auto v = read_ms(*n, k, 1, kMaxPacketRateMs, r)) s.eds_node.heartbeat = *v;
+      if (auto v = read_key_ms(*n, KeyPlace::kNode, k, r)) s.eds_node.heartbeat = *v;
     } else if (k == "inhibit_ms") {
-      if (s.eds_node.connection == eds::ConnectionKind::kCyclic) {
+      if (per_node && s.eds_node.connection == eds::ConnectionKind::kCyclic) {
         r.error(n->source(),
                 "inhibit_ms is for connection = \"change-of-state\": a cyclic "
                 "connection produces every heartbeat_ms, changes or not");
-      } else if (auto v = read_ms(*n, k, 0, kMaxPacketRateMs, r)) {
+      } else if (auto v = read_key_ms(*n, KeyPlace::kNode, k, r)) {
         s.eds_node.inhibit = *v;
-        if (*v >= s.eds_node.heartbeat) {
+        if (per_node && *v >= s.eds_node.heartbeat) {
           r.error(
               n->source(),
               fmt::format("inhibit_ms = {} is not shorter than heartbeat_ms ({}): "
@@ -163,54 +166,60 @@ const toml::node* read_eds_connection(TableReader& nt, NodeSettings& s, Problems
   return connection;
 }
 
-}  // namespace
+// safe_state ("configured" or "device", as for every profile) and
+// safe_state_parameters, the parameters that set the outputs' fault and
+// idle actions. A node's safe_state = [ ... ] is the same as
+// safe_state_parameters = [ ... ], said in a warning. Gives the key the
+// safe state's problems are reported at, if any.
+const toml::node* read_eds_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
+  const Found source = layers.find("safe_state");
+  const Found params = layers.find("safe_state_parameters");
+  const toml::node* values = params.value;
+  Level values_level = params.level;
+  if (source.value && source.value->is_array() && source.level == Level::kNode) {
+    r.warning(source.value->source(),
+              "safe_state = [ ... ] is read as safe_state_parameters = [ ... ]: safe_state says "
+              "\"configured\" or \"device\" for every profile, the parameters go in "
+              "safe_state_parameters");
+    if (params.value && params.level == Level::kNode) {
+      r.error(params.value->source(),
+              "safe_state_parameters and safe_state = [ ... ] both give the parameters: keep "
+              "safe_state_parameters");
+      return params.value;
+    }
+    values = source.value;
+    values_level = Level::kNode;
+  } else if (source.value) {
+    if (auto device = read_safe_state_source(*source.value, r)) {
+      s.eds_node.safe_state_of_device = *device;
+    }
+  }
+  if (values == nullptr) return source.value;
+  // A node that keeps the device's values and gives values of its own says
+  // two things; [defaults] may give values other nodes use (read alone, it
+  // has them checked).
+  if (s.eds_node.safe_state_of_device && layers.per_node()) {
+    if (values_level == Level::kNode) {
+      r.error(values->source(),
+              "safe_state_parameters has no effect with safe_state = "
+              "\"device\": the device's own fault and idle actions are kept");
+    }
+    return source.value;
+  }
+  if (auto v = read_parameter_values(
+          *values, values == source.value ? "safe_state" : "safe_state_parameters", r)) {
+    s.eds_node.safe_state = *v;
+  }
+  return values;
+}
 
-// A profile = "eds" node's own keys: eds (the file, relative to the
-// configuration's directory), connection, parameters, safe_state; checked
-// against the EDS as the master will take them.
-void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems& r) {
-  for (std::string_view key : kCdn127OnlyKeys) {
-    if (const toml::node* n = nt.get(key)) {
-      r.error(n->source(),
-              fmt::format("{} is a CDN127 setting: this node has profile = \"eds\"", key));
-    }
-  }
-  const toml::node* connection = read_eds_connection(nt, s, r);
-  const toml::node* parameters = nt.get("parameters");
-  if (parameters) {
-    if (auto v = read_parameter_values(*parameters, "parameters", r)) s.eds_node.parameters = *v;
-  }
-  // The parameters that set the outputs' fault and idle actions, or
-  // "device": the device's own, fixed by its maker.
-  const toml::node* safe = nt.get("safe_state");
-  if (safe && safe->is_string()) {
-    if (auto v = read_string(*safe, "safe_state", r); v && *v == "device") {
-      s.eds_node.safe_state_of_device = true;
-    } else if (v) {
-      r.error(safe->source(),
-              fmt::format("safe_state = \"{}\" is not a choice for profile = \"eds\": give the "
-                          "parameters that set the outputs' fault and idle actions "
-                          "([{{ name = \"...\", value = ... }}]), or \"device\" where the "
-                          "device's maker fixes them",
-                          *v));
-    }
-  } else if (safe) {
-    if (auto v = read_parameter_values(*safe, "safe_state", r)) s.eds_node.safe_state = *v;
-  }
-  const toml::node* key = nt.require("eds");
-  if (!key) return;
-  auto given = read_string(*key, "eds", r);
-  if (!given) return;
-  std::filesystem::path path(*given);
-  if (path.is_relative() && !ctx.base_dir.empty()) path = ctx.base_dir / path;
-  s.eds_path = path.lexically_normal().string();
-  const EdsRead& e = read_eds_file(s.eds_path, *key, ctx, r);
-  if (!e.file) return;
-  s.eds = e.file;
-  s.eds_digest = e.digest;
-  // Outputs whose safe state the node leaves as the device has it.
+// The outputs' safe state as the node's EDS and settings leave it, in
+// warnings: the device's own, or the parameters nobody set.
+void warn_of_safe_state(const EdsRead& e, const toml::node& eds_key, const toml::node* safe,
+                        NodeSettings& s, Problems& r) {
   const auto& io = eds::node_io(*e.file, s.eds_node.connection);
-  if (io && io->consumed.size > 0 && s.eds_node.safe_state_of_device) {
+  if (!io || io->consumed.size == 0) return;
+  if (s.eds_node.safe_state_of_device) {
     const auto names = [](const std::vector<const eds::Param*>& params) {
       std::string text;
       for (const eds::Param* p : params) {
@@ -219,32 +228,66 @@ void read_eds_node(TableReader& nt, ReadContext& ctx, NodeSettings& s, Problems&
       return text;
     };
     const eds::DeviceSafeState d = eds::device_safe_state(*e.file, s.eds_node);
-    r.warning(safe->source(),
-              fmt::format("node {}: its outputs' fault and idle behaviour is the device's own "
-                          "(safe_state = \"device\"): {}, never written",
-                          s.pump.node.mac.value(),
-                          d.read.empty() ? std::string("its EDS names no parameter to read")
-                                         : "read at start-up: " + names(d.read)));
+    const toml::source_region& at = safe ? safe->source() : eds_key.source();
+    r.warning(at, fmt::format("node {}: its outputs' fault and idle behaviour is the device's own "
+                              "(safe_state = \"device\"): {}, never written",
+                              s.pump.node.mac.value(),
+                              d.read.empty() ? std::string("its EDS names no parameter to read")
+                                             : "read at start-up: " + names(d.read)));
     if (!d.unread.empty()) {
-      r.warning(safe->source(),
-                fmt::format("node {}: {} not read (no link path to an attribute, or not of 1, 2 "
-                            "or 4 bytes): not shown",
-                            s.pump.node.mac.value(), names(d.unread)));
+      r.warning(at, fmt::format("node {}: {} not read (no link path to an attribute, or not of 1, "
+                                "2 or 4 bytes): not shown",
+                                s.pump.node.mac.value(), names(d.unread)));
     }
     if (!d.written.empty()) {
-      r.warning(safe->source(),
-                fmt::format("node {}: {} set in parameters although safe_state = \"device\": "
-                            "written all the same",
-                            s.pump.node.mac.value(), names(d.written)));
+      r.warning(at, fmt::format("node {}: {} set in parameters although safe_state = \"device\": "
+                                "written all the same",
+                                s.pump.node.mac.value(), names(d.written)));
     }
-  } else if (io && io->consumed.size > 0) {
-    for (const eds::Param* p : eds::safe_state_left_to_device(*e.file, s.eds_node)) {
-      r.warning(key->source(),
-                fmt::format("node {}: Param{} \"{}\" is set neither in safe_state nor in "
-                            "parameters: the device keeps its own value",
-                            s.pump.node.mac.value(), p->number, p->name));
-    }
+    return;
   }
+  for (const eds::Param* p : eds::safe_state_left_to_device(*e.file, s.eds_node)) {
+    r.warning(eds_key.source(),
+              fmt::format("node {}: Param{} \"{}\" is set neither in safe_state_parameters nor "
+                          "in parameters: the device keeps its own value",
+                          s.pump.node.mac.value(), p->number, p->name));
+  }
+}
+
+}  // namespace
+
+// A profile = "eds" node's own keys: eds (the file, relative to the
+// configuration's directory), connection, parameters, safe_state and
+// safe_state_parameters, each the node's own, else [defaults]'; checked
+// against the EDS as the master will take them. [defaults] read alone
+// (layers.node null) has its values and its EDS file checked as they stand.
+void read_eds_node(const Layers& layers, ReadContext& ctx, NodeSettings& s, Problems& r) {
+  if (layers.per_node()) refuse_other_profiles_keys(*layers.node, kEdsNodes, r);
+  const toml::node* connection = read_eds_connection(layers, s, r);
+  const toml::node* parameters = layers.find("parameters").value;
+  if (parameters) {
+    if (auto v = read_parameter_values(*parameters, "parameters", r)) s.eds_node.parameters = *v;
+  }
+  const toml::node* safe = read_eds_safe_state(layers, s, r);
+  const toml::node* key = layers.find("eds").value;
+  if (!key) {
+    if (layers.per_node()) {
+      r.error(layers.node->table().source(),
+              "missing required key 'eds' in [[port.node]] (a profile = \"eds\" node's EDS "
+              "file, its own or [defaults]')");
+    }
+    return;
+  }
+  auto given = read_string(*key, "eds", r);
+  if (!given) return;
+  std::filesystem::path path(*given);
+  if (path.is_relative() && !ctx.base_dir.empty()) path = ctx.base_dir / path;
+  s.eds_path = path.lexically_normal().string();
+  const EdsRead& e = read_eds_file(s.eds_path, *key, ctx, r);
+  if (!e.file || !layers.per_node()) return;
+  s.eds = e.file;
+  s.eds_digest = e.digest;
+  warn_of_safe_state(e, *key, safe, s, r);
   std::string why;
   if (!eds::make_node_profile(e.file, s.eds_node, &why)) {
     // At the key the problem is about.

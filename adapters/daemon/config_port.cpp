@@ -15,9 +15,7 @@
 
 namespace dnbridge::daemon::config_detail {
 
-using toml_config::read_int_as;
 using toml_config::read_integer;
-using toml_config::read_ms;
 using toml_config::read_name;
 using toml_config::read_string;
 using toml_config::type_name;
@@ -77,6 +75,8 @@ void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
 PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableReader* defaults,
                      ReadContext& ctx, Problems& r) {
   TableReader t(table, "[[port]]", r);
+  t.allow_only(key_names(KeyPlace::kPort),
+               [](std::string_view key) { return misplaced_key(KeyPlace::kPort, false, key); });
   PortConfig port;
   port.master.master_mac = rack.master_mac;
   if (const toml::node* n = t.require("name")) {
@@ -129,19 +129,19 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
     if (auto v = read_mac(*master_mac_node, "master_mac", r)) port.master.master_mac = *v;
   }
   if (const toml::node* n = t.get("master_vendor_id")) {
-    if (auto v = read_int_as<std::uint16_t>(*n, "master_vendor_id", {0, 0xFFFF}, r)) {
+    if (auto v = read_key_int<std::uint16_t>(*n, KeyPlace::kPort, "master_vendor_id", r)) {
       port.master.vendor_id = *v;
     }
   }
   if (const toml::node* n = t.get("master_serial_number")) {
-    if (auto v = read_int_as<std::uint32_t>(*n, "master_serial_number", {0, 0xFFFF'FFFF}, r)) {
+    if (auto v = read_key_int<std::uint32_t>(*n, KeyPlace::kPort, "master_serial_number", r)) {
       port.master_serial_number = *v;
     }
   }
 
   auto timing = [&](std::string_view key, Duration& out) {
     if (const toml::node* n = t.get(key)) {
-      if (auto v = read_ms(*n, key, 1, kMaxPublishPeriodMs, r)) out = *v;
+      if (auto v = read_key_ms(*n, KeyPlace::kPort, key, r)) out = *v;
     }
   };
   devicenet::ScannerConfig& tm = port.master;
@@ -152,10 +152,10 @@ PortConfig read_port(const toml::table& table, const DaemonConfig& rack, TableRe
   timing("explicit_response_timeout_ms", tm.explicit_messaging.response_timeout);
   timing("scan_response_timeout_ms", tm.scan_response_timeout);
   if (const toml::node* n = t.get("poll_batch_ms")) {
-    if (auto v = read_ms(*n, "poll_batch_ms", 0, kMaxPollBatchMs, r)) tm.poll_batch_window = *v;
+    if (auto v = read_key_ms(*n, KeyPlace::kPort, "poll_batch_ms", r)) tm.poll_batch_window = *v;
   }
   if (const toml::node* n = t.get("max_consecutive_errors")) {
-    if (auto v = read_int_as<unsigned>(*n, "max_consecutive_errors", {1, 1000}, r)) {
+    if (auto v = read_key_int<unsigned>(*n, KeyPlace::kPort, "max_consecutive_errors", r)) {
       tm.max_consecutive_errors = *v;
     }
   }
@@ -201,6 +201,8 @@ void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
   std::map<std::string, std::uint32_t> names;
   for (const toml::node& element : *list) {
     TableReader nt(*element.as_table(), "[[port.node]]", r);
+    nt.allow_only(key_names(KeyPlace::kNode),
+                  [](std::string_view key) { return misplaced_key(KeyPlace::kNode, false, key); });
     NodeSettings s;
     bool ok = true;
     const toml::node* mac_node = nt.require("mac");
@@ -230,7 +232,7 @@ void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
       ok = false;
     }
     if (const toml::node* serial = nt.get("serial")) {
-      if (auto v = read_int_as<std::uint32_t>(*serial, "serial", {0, 0xFFFF'FFFF}, r)) {
+      if (auto v = read_key_int<std::uint32_t>(*serial, KeyPlace::kNode, "serial", r)) {
         s.pump.node.serial_number = *v;
       } else {
         ok = false;
@@ -262,13 +264,9 @@ void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
                             s.pump.node.name));
     }
     if (s.is_eds()) {
-      read_eds_node(nt, ctx, s, r);
+      read_eds_node(Layers{&nt, defaults}, ctx, s, r);
     } else {
-      for (std::string_view key : kEdsOnlyKeys) {
-        if (const toml::node* n = nt.get(key)) {
-          r.error(n->source(), fmt::format("{} is for profile = \"eds\" nodes", key));
-        }
-      }
+      refuse_other_profiles_keys(nt, kCdn127Nodes, r);
     }
     if (ok) port.nodes.push_back(std::move(s));
   }

@@ -43,10 +43,16 @@ std::string origin(const Found& f) {
   return {};
 }
 
+std::optional<Duration> read_key_ms(const toml::node& n, KeyPlace place, std::string_view key,
+                                    Problems& r) {
+  const KeyRange b = bounds_of(place, key);
+  return read_ms(n, key, b.min, b.max, r);
+}
+
 // command_refresh_ms: 0 (off), or how often a commander must write a
 // node's command for it to stay in force.
 std::optional<Duration> read_command_refresh(const toml::node& n, Problems& r) {
-  auto v = read_ms(n, "command_refresh_ms", 0, kMaxCommandRefreshMs, r);
+  auto v = read_key_ms(n, KeyPlace::kNode, "command_refresh_ms", r);
   if (v && *v > Duration::zero() && *v < milliseconds(kMinCommandRefreshMs)) {
     r.error(n.source(),
             fmt::format("command_refresh_ms = {} is too short: use 0 (off) or {}..{} ms",

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <string_view>
+#include <utility>
 
 namespace dnbridge::security {
 namespace {
@@ -37,13 +38,15 @@ std::optional<std::filesystem::path> read_path(const toml::node& n, std::string_
 
 }  // namespace
 
-std::optional<Settings> read_table(const toml::node& node, toml_config::Problems& problems) {
+std::optional<Settings> read_table(const toml::node& node, toml_config::Problems& problems,
+                                   std::vector<std::string_view> allowed) {
   const toml::table* t = node.as_table();
   if (t == nullptr) {
     problems.error(node.source(), "security must be a table ([security])");
     return std::nullopt;
   }
   toml_config::TableReader table(*t, "[security]", problems);
+  if (!allowed.empty()) table.allow_only(std::move(allowed));
   const std::size_t before = problems.error_count();
   Settings s;
   for (const FileKey& k : kRequired) {

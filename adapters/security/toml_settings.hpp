@@ -19,6 +19,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "adapters/security/settings.hpp"
@@ -28,8 +29,10 @@ namespace dnbridge::security {
 
 // Reads the value of a `security` key. Paths are kept as written:
 // Settings::resolve_relative_to takes them from the file's directory. Adds
-// what is wrong to `problems`; nullopt when anything is.
-std::optional<Settings> read_table(const toml::node& node, toml_config::Problems& problems);
+// what is wrong to `problems`; nullopt when anything is. `allowed`, when
+// given, is the table of the keys the file documents (TableReader::allow_only).
+std::optional<Settings> read_table(const toml::node& node, toml_config::Problems& problems,
+                                   std::vector<std::string_view> allowed = {});
 
 // A file whose [security] table is wrong, or absent: every problem,
 // "FILE:LINE:COLUMN: text", one per line.

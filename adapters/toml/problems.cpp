@@ -7,15 +7,16 @@
 #include "bridge/common/closest.hpp"
 
 namespace dnbridge::toml_config {
-std::vector<Problem> unknown_keys(const toml::table& table, std::string_view where,
-                                  std::span<const std::string_view> known) {
-  std::vector<Problem> out;
+std::vector<UnknownKey> unknown_keys(const toml::table& table, std::string_view where,
+                                     std::span<const std::string_view> known,
+                                     std::span<const std::string_view> hints) {
+  std::vector<UnknownKey> out;
   for (auto&& [key, value] : table) {
     const std::string_view name = key.str();
     if (std::find(known.begin(), known.end(), name) != known.end()) continue;
     std::string hint;
-    if (const auto k = closest(name, known)) hint = fmt::format(" (did you mean '{}'?)", *k);
-    out.push_back({key.source(), fmt::format("unknown key '{}' in {}{}", name, where, hint)});
+    if (const auto k = closest(name, hints)) hint = fmt::format(" (did you mean '{}'?)", *k);
+    out.push_back({name, key.source(), fmt::format("unknown key '{}' in {}{}", name, where, hint)});
   }
   return out;
 }

@@ -15,11 +15,18 @@ struct Problem {
   std::string text;
 };
 
+struct UnknownKey {
+  std::string_view key;
+  toml::source_region at;
+  std::string text;
+};
+
 // A misspelt key must not fall back silently to a default: one problem per
 // key of `table` not in `known`, "unknown key 'x' in WHERE", with the
-// closest known key as a hint when one is close.
-std::vector<Problem> unknown_keys(const toml::table& table, std::string_view where,
-                                  std::span<const std::string_view> known);
+// closest key of `hints` as a hint when one is close.
+std::vector<UnknownKey> unknown_keys(const toml::table& table, std::string_view where,
+                                     std::span<const std::string_view> known,
+                                     std::span<const std::string_view> hints);
 
 // What a value is, for "KEY must be ..., not a string": "a string",
 // "an integer", "a table", ...

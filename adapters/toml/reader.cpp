@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 namespace dnbridge::toml_config {
 
@@ -122,7 +123,16 @@ std::optional<Duration> read_ms(const toml::node& n, std::string_view key, std::
   return milliseconds(*v);
 }
 
+void TableReader::allow_only(std::vector<std::string_view> allowed, Explain explain) {
+  allowed_ = std::move(allowed);
+  explain_ = std::move(explain);
+}
+
 const toml::node* TableReader::get(std::string_view key) {
+  if (allowed_ && std::find(allowed_->begin(), allowed_->end(), key) == allowed_->end()) {
+    throw std::logic_error(fmt::format(
+        "{}: the reader asks for '{}', which the table of its keys does not list", where_, key));
+  }
   if (std::find(declared_.begin(), declared_.end(), key) == declared_.end()) {
     declared_.emplace_back(key);
   }
@@ -140,8 +150,14 @@ const toml::node* TableReader::require(std::string_view key) {
 void TableReader::finish() {
   if (finished_) return;
   finished_ = true;
-  const std::vector<std::string_view> known(declared_.begin(), declared_.end());
-  for (auto& p : unknown_keys(table_, where_, known)) problems_.error(p.at, std::move(p.text));
+  const std::vector<std::string_view> declared(declared_.begin(), declared_.end());
+  for (auto& p : unknown_keys(table_, where_, declared, allowed_ ? *allowed_ : declared)) {
+    if (explain_) {
+      const std::string why = explain_(p.key);
+      if (!why.empty()) p.text = why;
+    }
+    problems_.error(p.at, std::move(p.text));
+  }
 }
 
 const toml::table* as_table(const toml::node& node, std::string_view key, std::string_view spelling,

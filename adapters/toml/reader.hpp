@@ -5,12 +5,15 @@
 // same words everywhere, and tables whose allowed keys are the keys the code
 // reads: a TableReader declares every key it is asked for, and reports any
 // other key the table holds as unknown, with the closest declared key as a
-// hint. There is no list of keys apart from the code that reads them.
+// hint. Where a file's keys are documented in a table of their own (the rack
+// file's, adapters/daemon/config_keys.hpp), allow_only holds the reader to
+// it.
 #include <toml++/toml.h>
 
 #include <cstdint>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -108,6 +111,14 @@ class TableReader {
   TableReader(const TableReader&) = delete;
   TableReader& operator=(const TableReader&) = delete;
 
+  // Only the keys `allowed` may be asked for: another is a std::logic_error
+  // (the reader and the table of its keys disagree). A key the table holds
+  // and nobody asked for is reported as `explain` says, where it says
+  // something ("KEY stands in ..."), else as unknown, with the closest
+  // allowed key as a hint.
+  using Explain = std::function<std::string(std::string_view key)>;
+  void allow_only(std::vector<std::string_view> allowed, Explain explain = {});
+
   const toml::node* get(std::string_view key);
   // Missing: "missing required key 'KEY' in WHERE", at the table.
   const toml::node* require(std::string_view key);
@@ -122,6 +133,8 @@ class TableReader {
   std::string where_;
   Problems& problems_;
   std::vector<std::string> declared_;
+  std::optional<std::vector<std::string_view>> allowed_;
+  Explain explain_;
   bool finished_ = false;
   int unwinding_ = std::uncaught_exceptions();
 };

@@ -25,15 +25,15 @@ using ::testing::HasSubstr;
   "bitrate = 500000\n"
 
 // Lines 6..: the example I/O block at MAC 20, with its safe state.
-#define IO_BLOCK                                                    \
-  "[[port.node]]\n"                                                 \
-  "mac = 20\n"                                                      \
-  "name = \"io-1\"\n"                                               \
-  "profile = \"eds\"\n"                                             \
-  "eds = \"dnbridge-example-io-block.eds\"\n"                       \
-  "safe_state = [ { name = \"Output fault action\", value = 0 },\n" \
-  "               { name = \"Output fault value\", value = 0 },\n"  \
-  "               { name = \"Output idle action\", value = 0 },\n"  \
+#define IO_BLOCK                                                               \
+  "[[port.node]]\n"                                                            \
+  "mac = 20\n"                                                                 \
+  "name = \"io-1\"\n"                                                          \
+  "profile = \"eds\"\n"                                                        \
+  "eds = \"dnbridge-example-io-block.eds\"\n"                                  \
+  "safe_state_parameters = [ { name = \"Output fault action\", value = 0 },\n" \
+  "               { name = \"Output fault value\", value = 0 },\n"             \
+  "               { name = \"Output idle action\", value = 0 },\n"             \
   "               { name = \"Output idle value\", value = 0 } ]\n"
 
 DaemonConfig parse(std::string_view text, const std::filesystem::path& base = DNBRIDGE_EDS_DIR) {
@@ -83,14 +83,16 @@ TEST(ConfigEds, ANodeDescribedByItsEdsLoadsWithItsParametersAndSafeState) {
 }
 
 TEST(ConfigEds, SafeStateParametersLeftToTheDeviceAreWarnedOf) {
-  const DaemonConfig c = parse(ONE_PORT
-                               "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
-                               "eds = \"dnbridge-example-io-block.eds\"\n"
-                               "safe_state = [ { name = \"Output idle action\", value = 0 },\n"
-                               "               { name = \"Output idle value\", value = 0 } ]\n");
+  const DaemonConfig c =
+      parse(ONE_PORT
+            "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+            "eds = \"dnbridge-example-io-block.eds\"\n"
+            "safe_state_parameters = [ { name = \"Output idle action\", value = 0 },\n"
+            "               { name = \"Output idle value\", value = 0 } ]\n");
   ASSERT_EQ(c.warnings.size(), 2u);
   EXPECT_THAT(c.warnings[0], HasSubstr("t.toml:10:7: node 20: Param6 \"Output fault action\" is "
-                                       "set neither in safe_state nor in parameters: the device "
+                                       "set neither in safe_state_parameters nor in parameters: "
+                                       "the device "
                                        "keeps its own value"));
   EXPECT_THAT(c.warnings[1], HasSubstr("Param7 \"Output fault value\""));
   EXPECT_TRUE(parse(ONE_PORT IO_BLOCK).warnings.empty());
@@ -120,14 +122,112 @@ TEST(ConfigEds, SafeStateDeviceLeavesTheSafeStateToTheDeviceAndIsWarnedOf) {
   for (const auto& setting : list.nodes[0].profile.settings) {
     EXPECT_TRUE(setting.keep_device_value) << setting.name;
   }
-  // Another word is not a choice for this profile.
+  // "configured", as for a CDN127, takes its values from safe_state_parameters.
   EXPECT_THAT(
       problems(ONE_PORT "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
                         "eds = \"dnbridge-example-io-block.eds\"\nsafe_state = \"configured\"\n"),
-      HasSubstr("t.toml:11:14: safe_state = \"configured\" is not a choice for profile = "
-                "\"eds\": give the parameters that set the outputs' fault and idle "
-                "actions ([{ name = \"...\", value = ... }]), or \"device\" where the "
-                "device's maker fixes them"));
+      HasSubstr("t.toml:10:7: node 20 (" + std::string(DNBRIDGE_EDS_DIR) +
+                "/dnbridge-example-io-block.eds): the node has outputs (output 2 B \"Outputs\" "
+                "= Assem150 (Outputs)) and no safe state: give the parameters that set their "
+                "fault and idle actions (safe_state_parameters), or safe_state = \"device\" "
+                "where the device's maker fixes them"));
+  EXPECT_THAT(
+      problems(ONE_PORT "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                        "eds = \"dnbridge-example-io-block.eds\"\nsafe_state = \"factory\"\n"),
+      HasSubstr("t.toml:11:14: safe_state = \"factory\" is not a choice: use \"configured\""));
+}
+
+// safe_state = [ ... ] is safe_state_parameters = [ ... ], said in a
+// warning; both at once is an error.
+TEST(ConfigEds, SafeStateAsAnArrayIsReadAsItsParametersAndWarnedOf) {
+  const DaemonConfig c = parse(ONE_PORT
+                               "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                               "eds = \"dnbridge-example-io-block.eds\"\n"
+                               "safe_state = [ { name = \"Output fault action\", value = 0 },\n"
+                               "               { name = \"Output fault value\", value = 0 },\n"
+                               "               { name = \"Output idle action\", value = 0 },\n"
+                               "               { name = \"Output idle value\", value = 0 } ]\n");
+  const NodeSettings& n = c.ports.at(0).nodes.at(0);
+  EXPECT_EQ(n.eds_node.safe_state.size(), 4u);
+  EXPECT_FALSE(n.eds_node.safe_state_of_device);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_EQ(c.warnings[0],
+            "t.toml:11:14: safe_state = [ ... ] is read as safe_state_parameters = [ ... ]: "
+            "safe_state says \"configured\" or \"device\" for every profile, the parameters go "
+            "in safe_state_parameters");
+  EXPECT_THAT(problems(ONE_PORT "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                                "eds = \"dnbridge-example-io-block.eds\"\n"
+                                "safe_state = [ { name = \"Output idle action\", value = 0 } ]\n"
+                                "safe_state_parameters = [ { name = \"Output idle action\", "
+                                "value = 0 } ]\n"),
+              HasSubstr("t.toml:12:25: safe_state_parameters and safe_state = [ ... ] both give "
+                        "the parameters: keep safe_state_parameters"));
+  EXPECT_THAT(problems(ONE_PORT "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                                "eds = \"dnbridge-example-io-block.eds\"\n"
+                                "safe_state = \"device\"\n"
+                                "safe_state_parameters = [ { name = \"Output idle action\", "
+                                "value = 0 } ]\n"),
+              HasSubstr("t.toml:12:25: safe_state_parameters has no effect with safe_state = "
+                        "\"device\": the device's own fault and idle actions are kept"));
+}
+
+// [defaults] holds every node key but mac, name and serial; a key of one
+// profile there is for the nodes of that profile.
+TEST(ConfigEds, DefaultsHoldAnEdsNodesKeysForTheEdsNodes) {
+  const DaemonConfig c = parse(
+      "rack = \"r\"\n"
+      "[defaults]\n"
+      "eds = \"dnbridge-example-io-block.eds\"\n"
+      "connection = \"change-of-state\"\n"
+      "heartbeat_ms = 700\n"
+      "parameters = [ { name = \"Input filter\", value = 5 } ]\n"
+      "safe_state = \"device\"\n"
+      "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"
+      "[[port.node]]\nmac = 1\nname = \"pump-1\"\n"
+      "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+      "[[port.node]]\nmac = 21\nname = \"io-2\"\nprofile = \"eds\"\nheartbeat_ms = 900\n"
+      "safe_state = \"configured\"\n"
+      "safe_state_parameters = [ { name = \"Output fault action\", value = 0 },\n"
+      "  { name = \"Output fault value\", value = 0 },\n"
+      "  { name = \"Output idle action\", value = 0 },\n"
+      "  { name = \"Output idle value\", value = 0 } ]\n");
+  const auto& nodes = c.ports.at(0).nodes;
+  ASSERT_EQ(nodes.size(), 3u);
+  // The pump takes the shared safe_state; the EDS keys are not for it.
+  EXPECT_FALSE(nodes[0].is_eds());
+  EXPECT_EQ(nodes[0].pump.safe_state.source, profiles::cdn127::SafeStateSource::kDevice);
+  for (const NodeSettings* n : {&nodes[1], &nodes[2]}) {
+    EXPECT_TRUE(n->is_eds());
+    ASSERT_NE(n->eds, nullptr);
+    EXPECT_EQ(n->eds_node.connection, eds::ConnectionKind::kChangeOfState);
+    ASSERT_EQ(n->eds_node.parameters.size(), 1u);
+  }
+  EXPECT_EQ(nodes[1].eds_node.heartbeat, milliseconds(700));
+  EXPECT_TRUE(nodes[1].eds_node.safe_state_of_device);
+  EXPECT_EQ(nodes[2].eds_node.heartbeat, milliseconds(900));
+  EXPECT_FALSE(nodes[2].eds_node.safe_state_of_device);
+  EXPECT_EQ(nodes[2].eds_node.safe_state.size(), 4u);
+  // [defaults]' values are checked even when no node takes them, and its
+  // CDN127 keys are for the CDN127s whatever profile it gives the others.
+  EXPECT_TRUE(parse("rack = \"r\"\n"
+                    "[defaults]\n"
+                    "profile = \"eds\"\n"
+                    "pump_on_fault = \"off\"\n"
+                    "io = \"cdn118\"\n"
+                    "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n")
+                  .ports.at(0)
+                  .nodes.empty());
+  EXPECT_THAT(problems("rack = \"r\"\n"
+                       "[defaults]\n"
+                       "safe_state = \"device\"\n"
+                       "safe_state_parameters = 3\n"
+                       "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"),
+              HasSubstr("t.toml:4:25: safe_state_parameters must be an array"));
+  EXPECT_THAT(problems("rack = \"r\"\n"
+                       "[defaults]\n"
+                       "heartbeat_ms = 0\n"
+                       "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"),
+              HasSubstr("t.toml:3:16: heartbeat_ms = 0 is out of range (1..65535 ms)"));
 }
 
 TEST(ConfigEds, TheShippedExampleLoads) {
@@ -166,7 +266,7 @@ TEST(ConfigEds, ARelativePathIsTheConfigurationFilesNeighbour) {
     std::ofstream f(dir / "rack.toml");
     f << ONE_PORT
         "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\neds = \"eds/block.eds\"\n"
-        "safe_state = [ { name = \"Output idle action\", value = 0 } ]\n";
+        "safe_state_parameters = [ { name = \"Output idle action\", value = 0 } ]\n";
   }
   const DaemonConfig c = load_config_file(dir / "rack.toml");
   ASSERT_NE(c.ports.at(0).nodes.at(0).eds, nullptr);

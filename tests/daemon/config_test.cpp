@@ -398,8 +398,8 @@ TEST(ConfigErrors, MacAndNameOnlyInNodesNotInDefaults) {
                               "[defaults]\n"
                               "mac = 3\n"
                               "name = \"x\"\n"),
-            "t.toml:10:1: unknown key 'mac' in [defaults]\n"
-            "t.toml:11:1: unknown key 'name' in [defaults]");
+            "t.toml:10:1: mac stands in a [[port.node]] table only, not in [defaults]\n"
+            "t.toml:11:1: name stands in a [[port.node]] table only, not in [defaults]");
 }
 
 // A serial number belongs to one device: never in [defaults].
@@ -411,7 +411,7 @@ TEST(ConfigErrors, SerialOnlyInNodesNotInDefaults) {
                               "[defaults]\n"
                               "serial = 3\n"),
             "t.toml:9:10: serial = 4294967296 is out of range (0..4294967295)\n"
-            "t.toml:11:1: unknown key 'serial' in [defaults]");
+            "t.toml:11:1: serial stands in a [[port.node]] table only, not in [defaults]");
 }
 
 TEST(ConfigFile, SerialAndTimeoutsOfASlowDevice) {
@@ -1180,7 +1180,8 @@ TEST(ConfigSafeState, MistakesAreErrorsWithTheirPosition) {
             "t.toml:12:25: analog_output_on_idle = \"zero\" is not an analog output action: use "
             "a voltage (0..10, e.g. 0.0) or \"hold\"\n"
             "t.toml:13:14: safe_state = \"factory\" is not a choice: use \"configured\" (the "
-            "default: the keys pump_on_fault ... are downloaded) or \"device\"\n"
+            "default: the fault and idle actions this file gives are downloaded) or \"device\" "
+            "(the device's own, fixed by its maker)\n"
             "t.toml:14:10: resume = \"always\" is not a policy: use \"new-command\" (the default) "
             "or \"last-command\"");
   // Values of a node that keeps the device's own: contradictory.

@@ -1,6 +1,9 @@
 // The TOML kit every configuration is read with (adapters/toml/reader.hpp):
-// the keys a table may hold are the keys its reader asked for.
+// the keys a table may hold are the keys its reader asked for, within the
+// table of its keys where it is held to one.
 #include <gtest/gtest.h>
+
+#include <stdexcept>
 
 #include "adapters/toml/reader.hpp"
 
@@ -21,6 +24,25 @@ TEST(TomlReader, AKeyNoReaderAskedForIsUnknownWithTheClosestAskedAsAHint) {
       p.errors(),
       (std::vector<std::string>{
           "t.toml:1:1: unknown key 'pollperiod_ms' in [x] (did you mean 'poll_period_ms'?)"}));
+}
+
+TEST(TomlReader, AReaderHeldToItsKeysTableAsksForNoOtherAndExplainsWhatStandsElsewhere) {
+  Problems p("t.toml");
+  const auto root = parse("pollperiod_ms = 5\nmac = 3\nname = \"a\"\n", p);
+  ASSERT_TRUE(root.has_value());
+  {
+    TableReader t(*root, "[x]", p);
+    t.allow_only({"name", "poll_period_ms"}, [](std::string_view key) {
+      return key == "mac" ? std::string("mac stands elsewhere") : std::string();
+    });
+    ASSERT_NE(t.get("name"), nullptr);
+    EXPECT_THROW(t.get("colour"), std::logic_error);
+  }
+  // The hint comes from the allowed keys, asked for or not.
+  EXPECT_EQ(p.errors(),
+            (std::vector<std::string>{
+                "t.toml:1:1: unknown key 'pollperiod_ms' in [x] (did you mean 'poll_period_ms'?)",
+                "t.toml:2:1: mac stands elsewhere"}));
 }
 
 TEST(TomlReader, RequiredKeysAndTypedValuesSayWhatIsWrongWhere) {

@@ -44,7 +44,7 @@ class DnbctlDevices : public ::testing::Test {
         // What one dnbctl run commanded stays applied when it exits, for the
         // test to see (and for the next run to find).
         "no_commander = \"hold\"\n"
-        "safe_state = [ { name = \"Output fault action\", value = 0 },\n"
+        "safe_state_parameters = [ { name = \"Output fault action\", value = 0 },\n"
         "               { name = \"Output fault value\", value = 0 },\n"
         "               { name = \"Output idle action\", value = 0 },\n"
         "               { name = \"Output idle value\", value = 0 } ]\n",

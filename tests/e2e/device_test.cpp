@@ -53,7 +53,7 @@ class DeviceTest : public BridgeTest {
         "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
         "eds = \"dnbridge-example-io-block.eds\"\n"
         "parameters = [ { name = \"Input filter\", value = 7 } ]\n"
-        "safe_state = [ { name = \"Output fault action\", value = 0 },\n"
+        "safe_state_parameters = [ { name = \"Output fault action\", value = 0 },\n"
         "               { name = \"Output fault value\", value = 0 },\n"
         "               { name = \"Output idle action\", value = 0 },\n"
         "               { name = \"Output idle value\", value = 0x40 } ]\n",

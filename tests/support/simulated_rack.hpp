@@ -43,7 +43,7 @@ inline std::string example_io_block_node(std::string_view source_dir) {
   text +=
       "/deploy/eds/dnbridge-example-io-block.eds\"\n"
       "  connection = \"change-of-state\"\n"
-      "  safe_state = [ { name = \"Output fault action\", value = 0 },\n"
+      "  safe_state_parameters = [ { name = \"Output fault action\", value = 0 },\n"
       "                 { name = \"Output fault value\", value = 0 },\n"
       "                 { name = \"Output idle action\", value = 0 },\n"
       "                 { name = \"Output idle value\", value = 0 } ]\n";

@@ -352,7 +352,7 @@ TEST_F(SystemTest, ACdn127AndEdsDevicesOnChangeOfStateAndBitStrobeShareABus) {
   const std::string io_node = fmt::format(
       "  profile = \"eds\"\n  eds = \"{}/dnbridge-example-io-block.eds\"\n"
       "  connection = \"change-of-state\"\n  heartbeat_ms = 200\n  inhibit_ms = 10\n"
-      "  safe_state = [ {{ name = \"Output fault action\", value = 0 }},\n"
+      "  safe_state_parameters = [ {{ name = \"Output fault action\", value = 0 }},\n"
       "    {{ name = \"Output fault value\", value = 0 }},\n"
       "    {{ name = \"Output idle action\", value = 0 }},\n"
       "    {{ name = \"Output idle value\", value = 0 }} ]",
@@ -360,7 +360,7 @@ TEST_F(SystemTest, ACdn127AndEdsDevicesOnChangeOfStateAndBitStrobeShareABus) {
   const std::string valves_node = fmt::format(
       "  profile = \"eds\"\n  eds = \"{}/dnbridge-example-valve-manifold.eds\"\n"
       "  connection = \"bit-strobe\"\n"
-      "  safe_state = [ {{ name = \"Output fault action\", value = 0 }},\n"
+      "  safe_state_parameters = [ {{ name = \"Output fault action\", value = 0 }},\n"
       "    {{ name = \"Output fault value\", value = 0 }},\n"
       "    {{ name = \"Output idle action\", value = 0 }},\n"
       "    {{ name = \"Output idle value\", value = 0 }} ]",

@@ -269,14 +269,14 @@ Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const Eds
   }
   if (node.safe_state_of_device && !node.safe_state.empty()) {
     return explain(why, Errc::kMalformed,
-                   "safe_state: the device's own (\"device\") and parameters at once");
+                   "safe_state_parameters: given with safe_state = \"device\" (the device's own)");
   }
   if (io.consumed.size > 0 && node.safe_state.empty() && !node.safe_state_of_device) {
     return explain(
         why, Errc::kMalformed,
         fmt::format("the node has outputs ({}) and no safe state: give the parameters that set "
-                    "their fault and idle actions (safe_state), or safe_state = \"device\" "
-                    "where the device's maker fixes them",
+                    "their fault and idle actions (safe_state_parameters), or safe_state = "
+                    "\"device\" where the device's maker fixes them",
                     describe_data(io.consumed, "output")));
   }
 
@@ -298,7 +298,7 @@ Result<devicenet::NodeProfile> make_node_profile(const std::shared_ptr<const Eds
     return {};
   };
   if (auto s = add(node.parameters, "parameters"); !s) return s.error();
-  if (auto s = add(node.safe_state, "safe_state"); !s) return s.error();
+  if (auto s = add(node.safe_state, "safe_state_parameters"); !s) return s.error();
   if (node.safe_state_of_device) {
     for (const Param* param : device_safe_state(file, node).read) {
       p.settings.push_back(*kept_setting(*param));

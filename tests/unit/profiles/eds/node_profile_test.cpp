@@ -111,8 +111,9 @@ TEST(EdsNodeProfile, OutputsWithoutASafeStateAreRefused) {
   EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kMalformed));
   EXPECT_EQ(why,
             "the node has outputs (output 2 B \"Outputs\" = Assem150 (Outputs)) and no safe "
-            "state: give the parameters that set their fault and idle actions (safe_state), or "
-            "safe_state = \"device\" where the device's maker fixes them");
+            "state: give the parameters that set their fault and idle actions "
+            "(safe_state_parameters), or safe_state = \"device\" where the device's maker fixes "
+            "them");
 }
 
 // safe_state = "device": nothing of the safe state is written; the
@@ -140,7 +141,7 @@ TEST(EdsNodeProfile, TheDevicesOwnSafeStateIsReadAndKeptNeverWritten) {
   // The device's own and parameters at once is no safe state.
   n.safe_state = {{"Output idle action", 0}};
   EXPECT_EQ(profile_of(f, n, &why).error(), make_error_code(Errc::kMalformed));
-  EXPECT_EQ(why, "safe_state: the device's own (\"device\") and parameters at once");
+  EXPECT_EQ(why, "safe_state_parameters: given with safe_state = \"device\" (the device's own)");
 }
 
 struct Refusal {
@@ -184,7 +185,7 @@ INSTANTIATE_TEST_SUITE_P(
         Refusal{"also in the safe state",
                 {{"Output idle action", 1}},
                 Errc::kMalformed,
-                "safe_state: Param8 \"Output idle action\" is given twice"}));
+                "safe_state_parameters: Param8 \"Output idle action\" is given twice"}));
 
 TEST(EdsNodeProfile, AConnectionTheEdsDoesNotOfferIsRefused) {
   const EdsFile f = test::example_eds(test::kIoBlockEds);
