@@ -132,8 +132,8 @@ DaemonConfig read_rack(const toml::table& table, std::string_view source, ReadCo
   }
   if (const toml::node* n = root.get("domain")) {
     const KeyRange b = bounds_of(KeyPlace::kTop, "domain");
-    if (auto v = read_int_as<std::uint32_t>(*n, "domain",
-                                            {b.min, b.max, {}, "a DDS domain ID is 0..232"}, r)) {
+    const std::string note = fmt::format("a DDS domain ID is {}..{}", b.min, b.max);
+    if (auto v = read_int_as<std::uint32_t>(*n, "domain", {b.min, b.max, {}, note}, r)) {
       config.domain_id = *v;
     }
   }

@@ -49,10 +49,10 @@ struct NodeSettings {
   std::string profile = "cdn127";  // or "eds"
 
   // Profile "eds".
-  std::shared_ptr<const eds::EdsFile> eds;
-  std::string eds_path;          // as resolved (absolute, or relative to the working directory)
-  std::uint64_t eds_digest = 0;  // of its text
-  eds::EdsNode eds_node;         // connection, parameters, safe state
+  std::shared_ptr<const profiles::eds::EdsFile> eds;
+  std::string eds_path;             // as resolved (absolute, or relative to the working directory)
+  std::uint64_t eds_digest = 0;     // of its text
+  profiles::eds::EdsNode eds_node;  // connection, parameters, safe state
 
   bool is_eds() const noexcept { return profile == "eds"; }
   // Profile "eds" as the rack model takes it.

@@ -112,7 +112,7 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r);
 // What reading one configuration keeps besides its problems: where relative
 // EDS paths start, and each EDS file read, once.
 struct EdsRead {
-  std::shared_ptr<const eds::EdsFile> file;  // null: not usable
+  std::shared_ptr<const profiles::eds::EdsFile> file;  // null: not usable
   std::uint64_t digest = 0;
   std::uint32_t first_line = 0;  // of the `eds` key that read it
 };

@@ -145,7 +145,7 @@ constexpr std::array kKeys = std::to_array<ConfigKey>({
    "This node's own poll response timeout, for a slow device.", kAll, true},
   {"no_commander", P::kNode, "string", words("\"idle\" or \"hold\""), "\"idle\"", R::kApplied,
    "What the outputs do when no supervisor commands the node any more.", kAll, true},
-  {"command_refresh_ms", P::kNode, "integer, ms", {0, kMaxCommandRefreshMs, "0 is off, else at least 50"}, "the port's, else 0", R::kApplied,
+  {"command_refresh_ms", P::kNode, "integer, ms", {0, kMaxCommandRefreshMs, "0 is off, else at least 50"}, "the port's, else [defaults]', else 0", R::kApplied,
    "A commander must write the node's command at least this often, or it is no longer in force.", kAll, true},
   {"resume", P::kNode, "string", words("\"new-command\" or \"last-command\""), "\"new-command\"", R::kApplied,
    "After a loss the outputs are idle until a new command, or (unsafe, warned of) the last command drives them again.", kAll, true},
@@ -266,7 +266,8 @@ std::string_view reload_words(OnReload r) {
 }
 
 // Literal text in roff: a backslash is \e, a minus is \- (keys and values
-// copy as typed), and a line never starts with a . or '.
+// copy as typed). A text line starts with \&, which keeps a leading . or '
+// from being read as a request.
 std::string roff(std::string_view text) {
   std::string out;
   for (char c : text) {
@@ -317,34 +318,47 @@ std::vector<std::string_view> defaults_key_names() {
 }
 
 std::string misplaced_key(KeyPlace place, bool in_defaults, std::string_view key) {
+  const ConfigKey* node = config_key(P::kNode, key);
+  const ConfigKey* port = config_key(P::kPort, key);
+  // Where a node key stands: "[defaults] or a [[port.node]] table", or "a
+  // [[port.node]] table only".
+  const auto node_places = [](const ConfigKey& k) {
+    return k.in_defaults ? std::string("[defaults] or a [[port.node]] table")
+                         : std::string("a [[port.node]] table only");
+  };
   if (in_defaults) {
-    if (config_key(P::kNode, key) != nullptr) {
-      return fmt::format("{} stands in a [[port.node]] table only, not in [defaults]", key);
-    }
-  } else if (place == P::kPort) {
-    if (const ConfigKey* k = config_key(P::kNode, key)) {
-      return fmt::format("{} is a node key: it stands in {} [[port.node]] table{}", key,
-                         k->in_defaults ? "[defaults] or a" : "a", k->in_defaults ? "" : " only");
-    }
-  } else if (place == P::kNode) {
-    if (config_key(P::kPort, key) != nullptr) {
-      return fmt::format(
-          "{} is a port key: it stands in the [[port]] table, before its "
-          "[[port.node]] tables",
-          key);
-    }
+    if (node) return fmt::format("{} stands in a [[port.node]] table only, not in [defaults]", key);
+    if (port)
+      return fmt::format("{} is a port key: it stands in a [[port]] table, not in [defaults]", key);
+    return {};
   }
-  if (place == P::kTop && config_key(P::kNode, key) != nullptr) {
-    return fmt::format(
-        "{} is a node key: it stands in [defaults] or a [[port.node]] table, "
-        "not at the top level",
-        key);
+  switch (place) {
+    case P::kTop:
+      if (node && port) {
+        return fmt::format("{} stands in a [[port]] or [[port.node]] table, not at the top level",
+                           key);
+      }
+      if (node)
+        return fmt::format("{} is a node key: it stands in {}, not at the top level", key,
+                           node_places(*node));
+      if (port)
+        return fmt::format("{} is a port key: it stands in a [[port]] table, not at the top level",
+                           key);
+      return {};
+    case P::kPort:
+      if (node) return fmt::format("{} is a node key: it stands in {}", key, node_places(*node));
+      return {};
+    case P::kNode:
+      if (port) {
+        return fmt::format(
+            "{} is a port key: it stands in the [[port]] table, before its "
+            "[[port.node]] tables",
+            key);
+      }
+      return {};
+    default:
+      return {};
   }
-  if (place == P::kTop && config_key(P::kPort, key) != nullptr) {
-    return fmt::format("{} is a port key: it stands in a [[port]] table, not at the top level",
-                       key);
-  }
-  return {};
 }
 
 std::string other_profile_key(std::uint8_t profile, std::string_view key) {
@@ -390,7 +404,7 @@ std::string key_reference_roff() {
       facts += fmt::format("; {}", profile_words(k.profiles));
       if (!k.in_defaults) facts += ", not in [defaults]";
     }
-    out += fmt::format("{}.\n.br\n{}\n", roff(facts), roff(k.doc));
+    out += fmt::format("\\&{}.\n.br\n\\&{}\n", roff(facts), roff(k.doc));
   }
   return out;
 }

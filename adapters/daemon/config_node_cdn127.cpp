@@ -243,9 +243,9 @@ void read_safe_state(const Layers& layers, NodeSettings& s, Problems& r) {
     // says two things; [defaults] may give values other nodes use.
     if (keep_device && f.level == Level::kNode) {
       r.error(f.value->source(),
-              fmt::format("{} has no effect with safe_state = \"device\": the device's own "
+              fmt::format("{} has no effect with safe_state = \"device\"{}: the device's own "
                           "fault and idle actions are kept",
-                          k.key));
+                          k.key, origin(layers.find("safe_state"))));
       continue;
     }
     if (k.discrete) {

@@ -37,7 +37,9 @@ const EdsRead& read_eds_file(const std::string& path, const toml::node& key, Rea
   auto [it, first] = ctx.eds_files.try_emplace(path);
   EdsRead& e = it->second;
   if (!first) {
-    if (!e.file) {
+    // The same key read again (a [defaults]' eds, for each node that
+    // inherits it) has its problems listed already.
+    if (!e.file && line_of(key.source()) != e.first_line) {
       r.error(key.source(), fmt::format("eds = \"{}\" is not usable (its problems are listed at "
                                         "line {})",
                                         path, e.first_line));
@@ -50,10 +52,10 @@ const EdsRead& read_eds_file(const std::string& path, const toml::node& key, Rea
     r.error(key.source(), fmt::format("eds: {}", text.error));
     return e;
   }
-  const eds::Parsed parsed = eds::parse(*text.text);
+  const profiles::eds::Parsed parsed = profiles::eds::parse(*text.text);
   for (const auto& problem : parsed.problems) {
-    const std::string line = fmt::format("eds: {}", eds::format_problem(path, problem));
-    if (problem.severity == eds::Problem::Severity::kError) {
+    const std::string line = fmt::format("eds: {}", profiles::eds::format_problem(path, problem));
+    if (problem.severity == profiles::eds::Problem::Severity::kError) {
       r.error(key.source(), line);
     } else {
       r.warning(key.source(), line);
@@ -64,21 +66,21 @@ const EdsRead& read_eds_file(const std::string& path, const toml::node& key, Rea
                                       path, parsed.not_shown, parsed.errors));
   }
   if (parsed.file) {
-    e.file = std::make_shared<const eds::EdsFile>(*parsed.file);
+    e.file = std::make_shared<const profiles::eds::EdsFile>(*parsed.file);
     e.digest = digest_of(*text.text);
   }
   return e;
 }
 
 // connection = "poll" | "bit-strobe" | "change-of-state" | "cyclic".
-std::optional<eds::ConnectionKind> read_connection(const toml::node& n, Problems& r) {
+std::optional<profiles::eds::ConnectionKind> read_connection(const toml::node& n, Problems& r) {
   auto v = read_string(n, "connection", r);
   if (!v) return std::nullopt;
-  static constexpr std::pair<std::string_view, eds::ConnectionKind> kKinds[] = {
-      {"poll", eds::ConnectionKind::kPoll},
-      {"bit-strobe", eds::ConnectionKind::kStrobe},
-      {"change-of-state", eds::ConnectionKind::kChangeOfState},
-      {"cyclic", eds::ConnectionKind::kCyclic}};
+  static constexpr std::pair<std::string_view, profiles::eds::ConnectionKind> kKinds[] = {
+      {"poll", profiles::eds::ConnectionKind::kPoll},
+      {"bit-strobe", profiles::eds::ConnectionKind::kStrobe},
+      {"change-of-state", profiles::eds::ConnectionKind::kChangeOfState},
+      {"cyclic", profiles::eds::ConnectionKind::kCyclic}};
   for (const auto& [name, kind] : kKinds) {
     if (*v == name) return kind;
   }
@@ -89,9 +91,8 @@ std::optional<eds::ConnectionKind> read_connection(const toml::node& n, Problems
 }
 
 // KEY = [{ name = "...", value = N }, ...]: EDS parameters by name, in order.
-std::optional<std::vector<eds::ParameterValue>> read_parameter_values(const toml::node& n,
-                                                                      std::string_view key,
-                                                                      Problems& r) {
+std::optional<std::vector<profiles::eds::ParameterValue>> read_parameter_values(
+    const toml::node& n, std::string_view key, Problems& r) {
   const toml::array* list = n.as_array();
   if (!list || (!list->empty() && !list->is_array_of_tables())) {
     r.error(n.source(), fmt::format("{} must be an array of {{ name = \"...\", value = ... }}, "
@@ -99,7 +100,7 @@ std::optional<std::vector<eds::ParameterValue>> read_parameter_values(const toml
                                     key, type_name(n.type())));
     return std::nullopt;
   }
-  std::vector<eds::ParameterValue> out;
+  std::vector<profiles::eds::ParameterValue> out;
   bool ok = true;
   for (const toml::node& element : *list) {
     TableReader t(*element.as_table(), std::string(key), r);
@@ -130,37 +131,58 @@ const toml::node* read_eds_connection(const Layers& layers, NodeSettings& s, Pro
     if (v) s.eds_node.connection = *v;
     connection_known = v.has_value();
   }
-  // The change-of-state or cyclic connection's own settings.
-  const bool per_node = layers.per_node();
-  const bool cos = s.eds_node.connection == eds::ConnectionKind::kChangeOfState ||
-                   s.eds_node.connection == eds::ConnectionKind::kCyclic;
-  for (std::string_view k : {"heartbeat_ms", "inhibit_ms", "acknowledged"}) {
-    const toml::node* n = layers.find(k).value;
-    if (n == nullptr || !connection_known) continue;
-    if (per_node && !cos) {
-      r.error(n->source(), fmt::format("{} is for connection = \"change-of-state\" or "
-                                       "\"cyclic\" (this node's is \"{}\")",
-                                       k, to_string(s.eds_node.connection)));
-    } else if (k == "heartbeat_ms") {
-      if (auto v = read_key_ms(*n, KeyPlace::kNode, k, r)) s.eds_node.heartbeat = *v;
-    } else if (k == "inhibit_ms") {
-      if (per_node && s.eds_node.connection == eds::ConnectionKind::kCyclic) {
-        r.error(n->source(),
+  // The change-of-state or cyclic connection's own settings. A node's own
+  // value that its connection does not take is an error; one it inherits
+  // from [defaults] is for the nodes it fits, and left by the others.
+  const bool cos = s.eds_node.connection == profiles::eds::ConnectionKind::kChangeOfState ||
+                   s.eds_node.connection == profiles::eds::ConnectionKind::kCyclic;
+  const bool cyclic = s.eds_node.connection == profiles::eds::ConnectionKind::kCyclic;
+  const Found heartbeat = layers.find("heartbeat_ms");
+  const Found inhibit = layers.find("inhibit_ms");
+  const Found acknowledged = layers.find("acknowledged");
+  if (!connection_known) return connection;
+  const auto own = [](const Found& f) { return f.level == Level::kNode; };
+  const auto takes = [&](const Found& f, std::string_view key) {
+    if (!layers.per_node()) return true;  // [defaults] alone: each as it stands
+    if (cos) return true;
+    if (own(f)) {
+      r.error(f.value->source(),
+              fmt::format("{} is for connection = \"change-of-state\" or \"cyclic\" (this "
+                          "node's is \"{}\")",
+                          key, to_string(s.eds_node.connection)));
+    }
+    return false;
+  };
+  if (heartbeat.value && takes(heartbeat, "heartbeat_ms")) {
+    if (auto v = read_key_ms(*heartbeat.value, KeyPlace::kNode, "heartbeat_ms", r)) {
+      s.eds_node.heartbeat = *v;
+    }
+  }
+  if (acknowledged.value && takes(acknowledged, "acknowledged")) {
+    if (auto v = read_bool(*acknowledged.value, "acknowledged", r)) s.eds_node.acknowledged = *v;
+  }
+  if (inhibit.value && takes(inhibit, "inhibit_ms")) {
+    if (layers.per_node() && cyclic) {
+      if (own(inhibit)) {
+        r.error(inhibit.value->source(),
                 "inhibit_ms is for connection = \"change-of-state\": a cyclic "
                 "connection produces every heartbeat_ms, changes or not");
-      } else if (auto v = read_key_ms(*n, KeyPlace::kNode, k, r)) {
-        s.eds_node.inhibit = *v;
-        if (per_node && *v >= s.eds_node.heartbeat) {
-          r.error(
-              n->source(),
-              fmt::format("inhibit_ms = {} is not shorter than heartbeat_ms ({}): "
-                          "changes could never be sent sooner than heartbeats",
-                          std::chrono::duration_cast<milliseconds>(*v).count(),
-                          std::chrono::duration_cast<milliseconds>(s.eds_node.heartbeat).count()));
-        }
       }
-    } else if (auto v = read_bool(*n, k, r)) {
-      s.eds_node.acknowledged = *v;
+    } else if (auto v = read_key_ms(*inhibit.value, KeyPlace::kNode, "inhibit_ms", r)) {
+      s.eds_node.inhibit = *v;
+      // Compared per node, where one of the two is the node's own; reported
+      // where the more specific of the two is written.
+      if (layers.per_node() && *v >= s.eds_node.heartbeat && (own(inhibit) || own(heartbeat))) {
+        const bool at_inhibit = inhibit.level >= heartbeat.level;
+        const Found& here = at_inhibit ? inhibit : heartbeat;
+        r.error(here.value->source(),
+                fmt::format("inhibit_ms = {}{} is not shorter than heartbeat_ms = {}{}: "
+                            "changes could never be sent sooner than heartbeats",
+                            std::chrono::duration_cast<milliseconds>(*v).count(),
+                            at_inhibit ? std::string() : origin(inhibit),
+                            std::chrono::duration_cast<milliseconds>(s.eds_node.heartbeat).count(),
+                            at_inhibit ? origin(heartbeat) : std::string()));
+      }
     }
   }
   return connection;
@@ -178,9 +200,9 @@ const toml::node* read_eds_safe_state(const Layers& layers, NodeSettings& s, Pro
   Level values_level = params.level;
   if (source.value && source.value->is_array() && source.level == Level::kNode) {
     r.warning(source.value->source(),
-              "safe_state = [ ... ] is read as safe_state_parameters = [ ... ]: safe_state says "
-              "\"configured\" or \"device\" for every profile, the parameters go in "
-              "safe_state_parameters");
+              "safe_state = [ ... ] is read as safe_state = \"configured\" with "
+              "safe_state_parameters = [ ... ]: write it so (safe_state says \"configured\" or "
+              "\"device\" for every profile)");
     if (params.value && params.level == Level::kNode) {
       r.error(params.value->source(),
               "safe_state_parameters and safe_state = [ ... ] both give the parameters: keep "
@@ -201,8 +223,9 @@ const toml::node* read_eds_safe_state(const Layers& layers, NodeSettings& s, Pro
   if (s.eds_node.safe_state_of_device && layers.per_node()) {
     if (values_level == Level::kNode) {
       r.error(values->source(),
-              "safe_state_parameters has no effect with safe_state = "
-              "\"device\": the device's own fault and idle actions are kept");
+              fmt::format("safe_state_parameters has no effect with safe_state = \"device\"{}: "
+                          "the device's own fault and idle actions are kept",
+                          origin(source)));
     }
     return source.value;
   }
@@ -217,17 +240,17 @@ const toml::node* read_eds_safe_state(const Layers& layers, NodeSettings& s, Pro
 // warnings: the device's own, or the parameters nobody set.
 void warn_of_safe_state(const EdsRead& e, const toml::node& eds_key, const toml::node* safe,
                         NodeSettings& s, Problems& r) {
-  const auto& io = eds::node_io(*e.file, s.eds_node.connection);
+  const auto& io = profiles::eds::node_io(*e.file, s.eds_node.connection);
   if (!io || io->consumed.size == 0) return;
   if (s.eds_node.safe_state_of_device) {
-    const auto names = [](const std::vector<const eds::Param*>& params) {
+    const auto names = [](const std::vector<const profiles::eds::Param*>& params) {
       std::string text;
-      for (const eds::Param* p : params) {
+      for (const profiles::eds::Param* p : params) {
         text += fmt::format("{}Param{} \"{}\"", text.empty() ? "" : ", ", p->number, p->name);
       }
       return text;
     };
-    const eds::DeviceSafeState d = eds::device_safe_state(*e.file, s.eds_node);
+    const profiles::eds::DeviceSafeState d = profiles::eds::device_safe_state(*e.file, s.eds_node);
     const toml::source_region& at = safe ? safe->source() : eds_key.source();
     r.warning(at, fmt::format("node {}: its outputs' fault and idle behaviour is the device's own "
                               "(safe_state = \"device\"): {}, never written",
@@ -246,7 +269,8 @@ void warn_of_safe_state(const EdsRead& e, const toml::node& eds_key, const toml:
     }
     return;
   }
-  for (const eds::Param* p : eds::safe_state_left_to_device(*e.file, s.eds_node)) {
+  for (const profiles::eds::Param* p :
+       profiles::eds::safe_state_left_to_device(*e.file, s.eds_node)) {
     r.warning(eds_key.source(),
               fmt::format("node {}: Param{} \"{}\" is set neither in safe_state_parameters nor "
                           "in parameters: the device keeps its own value",
@@ -289,7 +313,7 @@ void read_eds_node(const Layers& layers, ReadContext& ctx, NodeSettings& s, Prob
   s.eds_digest = e.digest;
   warn_of_safe_state(e, *key, safe, s, r);
   std::string why;
-  if (!eds::make_node_profile(e.file, s.eds_node, &why)) {
+  if (!profiles::eds::make_node_profile(e.file, s.eds_node, &why)) {
     // At the key the problem is about.
     const toml::node* at = key;
     if (why.starts_with("parameters") && parameters) at = parameters;

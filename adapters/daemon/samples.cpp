@@ -226,15 +226,15 @@ void fill_node_status(dnbridge_NodeStatus& out, std::string_view rack, std::stri
 namespace {
 
 // A sequence of fields the sample owns (freed with it).
-void set_fields(dds_sequence_dnbridge_DeviceField& seq, const eds::IoLayout& layout,
-                const std::vector<eds::FieldValue>& values) {
+void set_fields(dds_sequence_dnbridge_DeviceField& seq, const profiles::eds::IoLayout& layout,
+                const std::vector<profiles::eds::FieldValue>& values) {
   seq._length = seq._maximum = static_cast<std::uint32_t>(values.size());
   seq._release = true;
   seq._buffer =
       values.empty() ? nullptr : dds_sequence_dnbridge_DeviceField_allocbuf(values.size());
   for (std::size_t i = 0; i < values.size(); ++i) {
-    const eds::FieldValue& v = values[i];
-    const eds::IoField& f = layout.fields[v.field];
+    const profiles::eds::FieldValue& v = values[i];
+    const profiles::eds::IoField& f = layout.fields[v.field];
     auto& o = seq._buffer[i];
     set_string(o.name, f.name);
     o.param = f.param;
@@ -258,7 +258,7 @@ void fill_device_state(dnbridge_DeviceState& out, std::string_view rack, std::st
   set_string(out.product, cip::utf8_from_iso8859_1(v.product));
   out.online = v.online;
   out.inputs_valid = v.online && v.has_inputs;
-  const std::vector<eds::FieldValue> none;
+  const std::vector<profiles::eds::FieldValue> none;
   set_octets(out.inputs, out.inputs_valid ? std::span<const std::uint8_t>(v.inputs)
                                           : std::span<const std::uint8_t>{});
   set_fields(out.input_fields, v.io->produced, out.inputs_valid ? v.input_values : none);
@@ -378,7 +378,7 @@ rack::NodeCommand command_of(const dnbridge_DeviceCommand& c) {
   }
   if (!bytes.empty())
     return rack::NodeCommand(std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
-  std::vector<eds::FieldSetting> fields;
+  std::vector<profiles::eds::FieldSetting> fields;
   const std::span<const dnbridge_DeviceFieldValue> given(c.fields._buffer, c.fields._length);
   for (const auto& f : given) fields.push_back({std::string(dds::view(f.name)), f.value});
   return rack::NodeCommand(std::move(fields));

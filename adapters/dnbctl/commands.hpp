@@ -128,7 +128,7 @@ CLI::App* add_eds(CLI::App& app, EdsArgs& args);
 Exit run_eds(const GlobalOptions& options, const EdsArgs& args);
 // The EDS file at `path`, as the bridge reads it; CommandError (usage) with
 // its errors when it is not usable.
-eds::EdsFile read_eds(const std::string& path);
+profiles::eds::EdsFile read_eds(const std::string& path);
 
 // --- param_command.cpp: param --------------------------------------------------------------
 // A device's parameter (Parameter object, class 0x0F) read or written by its

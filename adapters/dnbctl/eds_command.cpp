@@ -16,10 +16,10 @@
 namespace dnbridge::dnbctl {
 namespace {
 
-using eds::ConnectionKind;
-using eds::EdsFile;
-using eds::Member;
-using eds::Problem;
+using profiles::eds::ConnectionKind;
+using profiles::eds::EdsFile;
+using profiles::eds::Member;
+using profiles::eds::Problem;
 
 std::string read_text(const std::string& path) {
   std::error_code ec;
@@ -39,10 +39,10 @@ std::string read_text(const std::string& path) {
   return text.str();
 }
 
-std::string io_data_text(const EdsFile& f, const eds::IoData& d, const char* what) {
+std::string io_data_text(const EdsFile& f, const profiles::eds::IoData& d, const char* what) {
   std::string text = fmt::format("{} {} ({} byte{}, \"{}\"", what, d.number, d.size,
                                  d.size == 1 ? "" : "s", d.name);
-  if (const eds::Assembly* a = f.assembly_at(d.path)) {
+  if (const profiles::eds::Assembly* a = f.assembly_at(d.path)) {
     text += fmt::format(", assembly {}", a->number);
   } else {
     text += ", " + cip::describe(d.path);
@@ -58,7 +58,7 @@ std::string member_text(const EdsFile& f, const Member& m) {
     case Member::Kind::kPath:
       return bits + " " + cip::describe(m.path);
     case Member::Kind::kParam: {
-      const eds::Param* p = f.param(m.number);
+      const profiles::eds::Param* p = f.param(m.number);
       return fmt::format("{} Param{} ({})", bits, m.number, p ? p->name : "?");
     }
     case Member::Kind::kAssembly:
@@ -84,12 +84,13 @@ std::string summary(const std::string& path, const EdsFile& f) {
     out += "I/O connections: none (explicit messages only)\n";
   } else {
     out += "I/O connections:\n";
-    for (ConnectionKind k : eds::kConnectionKinds) {
-      const eds::ConnectionInfo* c = f.io.connection(k);
+    for (ConnectionKind k : profiles::eds::kConnectionKinds) {
+      const profiles::eds::ConnectionInfo* c = f.io.connection(k);
       if (c == nullptr) continue;
-      out += fmt::format("  {}{}:", eds::to_string(k), f.io.defaults.has(k) ? " (default)" : "");
-      const eds::IoData* in = f.io.input(c->input);
-      const eds::IoData* o = f.io.output(c->output);
+      out += fmt::format("  {}{}:", profiles::eds::to_string(k),
+                         f.io.defaults.has(k) ? " (default)" : "");
+      const profiles::eds::IoData* in = f.io.input(c->input);
+      const profiles::eds::IoData* o = f.io.output(c->output);
       out += in ? " produces " + io_data_text(f, *in, "input") : " produces nothing";
       out += o ? ", consumes " + io_data_text(f, *o, "output") : ", consumes nothing";
       out += "\n";
@@ -112,7 +113,7 @@ std::string summary(const std::string& path, const EdsFile& f) {
   return out;
 }
 
-std::string json(const std::string& path, const eds::Parsed& parsed) {
+std::string json(const std::string& path, const profiles::eds::Parsed& parsed) {
   JsonWriter w;
   w.begin_object().field("file", path).field("valid", parsed.file.has_value());
   w.key("problems").begin_array();
@@ -142,10 +143,10 @@ std::string json(const std::string& path, const eds::Parsed& parsed) {
     w.key("connections").begin_array();
     for (const auto& c : f.io.connections) {
       w.begin_object()
-          .field("kind", eds::to_string(c.kind))
+          .field("kind", profiles::eds::to_string(c.kind))
           .field("default", f.io.defaults.has(c.kind));
-      const eds::IoData* in = f.io.input(c.input);
-      const eds::IoData* o = f.io.output(c.output);
+      const profiles::eds::IoData* in = f.io.input(c.input);
+      const profiles::eds::IoData* o = f.io.output(c.output);
       w.key("input_bytes");
       in ? w.value(unsigned{in->size}) : w.null();
       w.key("output_bytes");
@@ -182,12 +183,13 @@ std::string json(const std::string& path, const eds::Parsed& parsed) {
 
 }  // namespace
 
-eds::EdsFile read_eds(const std::string& path) {
-  eds::Parsed parsed = eds::parse(read_text(path));
+profiles::eds::EdsFile read_eds(const std::string& path) {
+  profiles::eds::Parsed parsed = profiles::eds::parse(read_text(path));
   if (!parsed.file) {
     std::string problems;
     for (const Problem& p : parsed.problems) {
-      if (p.severity == Problem::Severity::kError) problems += "\n" + eds::format_problem(path, p);
+      if (p.severity == Problem::Severity::kError)
+        problems += "\n" + profiles::eds::format_problem(path, p);
     }
     throw CommandError(Exit::kUsage,
                        fmt::format("{}: not usable, {} error{}{}", path, parsed.errors,
@@ -208,12 +210,12 @@ CLI::App* add_eds(CLI::App& app, EdsArgs& args) {
 }
 
 Exit run_eds(const GlobalOptions& options, const EdsArgs& args) {
-  const eds::Parsed parsed = eds::parse(read_text(args.file));
+  const profiles::eds::Parsed parsed = profiles::eds::parse(read_text(args.file));
   if (options.json) {
     print(json(args.file, parsed));
   } else {
     for (const Problem& p : parsed.problems) {
-      std::fprintf(stderr, "%s\n", eds::format_problem(args.file, p).c_str());
+      std::fprintf(stderr, "%s\n", profiles::eds::format_problem(args.file, p).c_str());
     }
     if (parsed.not_shown > 0) {
       std::fprintf(stderr, "%s: %zu more problems not shown\n", args.file.c_str(),

@@ -414,7 +414,7 @@ bool shows(const dnbridge_DeviceState& s, const DeviceOutputs& wanted) {
   const std::span<const dnbridge_DeviceField> fields(s.output_fields._buffer,
                                                      s.output_fields._length);
   for (const auto& [name, value] : wanted.fields) {
-    const auto number = eds::param_number(name);
+    const auto number = profiles::eds::param_number(name);
     const auto it = std::find_if(fields.begin(), fields.end(), [&](const dnbridge_DeviceField& f) {
       return number ? f.param == *number : iequals(dds::view(f.name), name);
     });

@@ -36,7 +36,7 @@ constexpr const char* kParamNote =
     "After a write the value is read back: another value than the one written is an error.";
 
 // The attribute that holds parameter `p`.
-devicenet::AttributeSetting target_of(const eds::Param& p) {
+devicenet::AttributeSetting target_of(const profiles::eds::Param& p) {
   devicenet::AttributeSetting t;
   const cip::EPath& link = p.link;
   if (link.class_id && link.instance_id && link.attribute && *link.class_id <= 0xFFFF &&
@@ -55,29 +55,29 @@ devicenet::AttributeSetting target_of(const eds::Param& p) {
 // The value `data` holds as the parameter's type reads it: a number (a REAL
 // as the single-precision value it is), exactly for 64-bit integers; empty
 // when it is not a finite number of the parameter's size.
-std::optional<std::string> raw_text(const eds::Param& p, Bytes data) {
+std::optional<std::string> raw_text(const profiles::eds::Param& p, Bytes data) {
   if (p.type.size == 0 || data.size() != p.size) return std::nullopt;
   const std::uint64_t raw = little_endian(data);
   const auto bits = static_cast<std::uint16_t>(p.size * 8);
   if (!p.type.is_float) {
     if (!p.type.is_signed) return fmt::format("{}", raw);
     if (p.size >= 8) return fmt::format("{}", static_cast<std::int64_t>(raw));
-    return fmt::format("{}", static_cast<std::int64_t>(eds::from_raw(p.type, bits, raw)));
+    return fmt::format("{}", static_cast<std::int64_t>(profiles::eds::from_raw(p.type, bits, raw)));
   }
-  const double v = eds::from_raw(p.type, bits, raw);
+  const double v = profiles::eds::from_raw(p.type, bits, raw);
   if (!std::isfinite(v)) return std::nullopt;
   return p.size == 4 ? fmt::format("{}", static_cast<float>(v)) : fmt::format("{}", v);
 }
 
 // "5 ms"; with the EDS's scaling "5.0 ms (raw 50)"; the bytes when they are
 // not a number of the parameter's size.
-std::string value_text(const eds::Param& p, Bytes data) {
+std::string value_text(const profiles::eds::Param& p, Bytes data) {
   const auto raw = raw_text(p, data);
   if (!raw) return hex_bytes(data);
   const std::string units = p.units.empty() ? "" : " " + p.units;
   if (p.multiplier == 1 && p.divisor == 1 && p.base == 1 && p.offset == 0) return *raw + units;
   const double v =
-      eds::from_raw(p.type, static_cast<std::uint16_t>(p.size * 8), little_endian(data));
+      profiles::eds::from_raw(p.type, static_cast<std::uint16_t>(p.size * 8), little_endian(data));
   const double shown = (v + p.offset) * p.multiplier * p.base / p.divisor;
   return fmt::format("{:.{}f}{} (raw {})", shown, p.decimals, units, *raw);
 }
@@ -105,11 +105,11 @@ Exit run_param(const GlobalOptions& o, const ParamArgs& args) {
   // Everything typed is checked before anything is sent.
   auto ref = parse_node(args.node);
   if (!ref) throw CommandError(Exit::kUsage, ref.error());
-  const eds::EdsFile file = read_eds(args.eds);
+  const profiles::eds::EdsFile file = read_eds(args.eds);
   std::string why;
-  auto found = eds::find_param(file, args.param, args.eds, &why);
+  auto found = profiles::eds::find_param(file, args.param, args.eds, &why);
   if (!found) throw CommandError(Exit::kUsage, why);
-  const eds::Param& p = **found;
+  const profiles::eds::Param& p = **found;
   std::optional<devicenet::AttributeSetting> write;
   if (!args.value.empty()) {
     char* end = nullptr;
@@ -117,7 +117,8 @@ Exit run_param(const GlobalOptions& o, const ParamArgs& args) {
     if (end != args.value.c_str() + args.value.size() || !std::isfinite(v)) {
       throw CommandError(Exit::kUsage, fmt::format("\"{}\" is not a number", args.value));
     }
-    auto s = eds::parameter_setting(file, {fmt::format("Param{}", p.number), v}, args.eds, &why);
+    auto s = profiles::eds::parameter_setting(file, {fmt::format("Param{}", p.number), v}, args.eds,
+                                              &why);
     if (!s) throw CommandError(Exit::kUsage, why);
     write = std::move(*s);
   }

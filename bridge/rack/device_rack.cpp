@@ -13,7 +13,7 @@ using devicenet::MacId;
 
 namespace {
 
-const eds::EdsFile& eds_of(const DeviceConfig& d) {
+const profiles::eds::EdsFile& eds_of(const DeviceConfig& d) {
   if (!d.eds) {
     throw std::invalid_argument(
         fmt::format("node {} ({}): no EDS file read", d.node.mac.value(), d.node.name));
@@ -26,7 +26,7 @@ const eds::EdsFile& eds_of(const DeviceConfig& d) {
 devicenet::NodeConfig DeviceRack::scan_entry(const DeviceConfig& d) {
   std::string why;
   (void)eds_of(d);  // throws without a file
-  auto profile = eds::make_node_profile(d.eds, d.settings, &why);
+  auto profile = profiles::eds::make_node_profile(d.eds, d.settings, &why);
   if (!profile) {
     throw std::invalid_argument(
         fmt::format("node {} ({}): {}: {}", d.node.mac.value(), d.node.name, d.eds_path, why));
@@ -49,12 +49,12 @@ bool DeviceRack::same_device_settings(const DeviceConfig& a, const DeviceConfig&
 
 DeviceProfile::Slot DeviceProfile::slot_of(const DeviceConfig& d) {
   std::string why;
-  auto io = eds::node_io(eds_of(d), d.settings.connection, &why);
+  auto io = profiles::eds::node_io(eds_of(d), d.settings.connection, &why);
   if (!io) {
     throw std::invalid_argument(
         fmt::format("node {} ({}): {}", d.node.mac.value(), d.node.name, why));
   }
-  return {std::make_shared<const eds::NodeIo>(std::move(*io)), d.eds, d.settings};
+  return {std::make_shared<const profiles::eds::NodeIo>(std::move(*io)), d.eds, d.settings};
 }
 
 DeviceView DeviceProfile::view_of(const DeviceConfig& d, const Slot& slot) {
@@ -71,12 +71,12 @@ DeviceView DeviceProfile::view_of(const DeviceConfig& d, const Slot& slot) {
 void DeviceProfile::carry_over(const DeviceView&, DeviceView&) {}
 
 void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::Node& node) {
-  // The safe state's settings follow the parameters' (eds::make_node_profile):
+  // The safe state's settings follow the parameters' (profiles::eds::make_node_profile):
   // the safe_state parameters, or with safe_state = "device" the ones the
   // EDS names for it, read and kept.
-  std::vector<const eds::Param*> params;
+  std::vector<const profiles::eds::Param*> params;
   if (slot.settings.safe_state_of_device) {
-    params = eds::device_safe_state(*slot.eds, slot.settings).read;
+    params = profiles::eds::device_safe_state(*slot.eds, slot.settings).read;
   } else {
     for (const auto& given : slot.settings.safe_state)
       params.push_back(slot.eds->param(given.name));
@@ -86,14 +86,15 @@ void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::
   std::string text;
   bool read = false;
   for (std::size_t i = 0; i < params.size(); ++i) {
-    const eds::Param* p = params[i];
+    const profiles::eds::Param* p = params[i];
     if (p == nullptr || first + i >= in_force.size()) continue;
     read = true;
     const auto& bytes = in_force[first + i];
     const std::uint64_t raw = little_endian(bytes);
     const auto bits = static_cast<std::uint16_t>(std::min<std::size_t>(bytes.size() * 8, 64));
     text += fmt::format("{}Param{} {} = {}{}", text.empty() ? "" : "; ", p->number, p->name,
-                        eds::from_raw(p->type, bits, raw), p->units.empty() ? "" : " " + p->units);
+                        profiles::eds::from_raw(p->type, bits, raw),
+                        p->units.empty() ? "" : " " + p->units);
   }
   if (slot.settings.safe_state_of_device) {
     text = text.empty() ? "the device's own (safe_state = \"device\"): its EDS names no "
@@ -106,37 +107,37 @@ void DeviceProfile::on_online(DeviceView& v, const Slot& slot, const devicenet::
 
 bool DeviceProfile::take_inputs(DeviceView& v, const Slot& slot, Bytes data) {
   v.inputs.assign(data.begin(), data.end());
-  v.input_values = eds::decode(slot.io->produced, data);
+  v.input_values = profiles::eds::decode(slot.io->produced, data);
   return true;
 }
 
 void DeviceProfile::take_applied(DeviceView& v, const Slot& slot, Bytes outputs) {
   v.outputs_applied.assign(outputs.begin(), outputs.end());
-  v.output_values = eds::decode(slot.io->consumed, outputs);
+  v.output_values = profiles::eds::decode(slot.io->consumed, outputs);
 }
 
 Status DeviceRack::command(MacId mac, const std::vector<std::uint8_t>& data,
                            std::string_view issuer, TimePoint now) {
   DeviceView* v = find(mac);
   if (!v || !scanner()) return Errc::kOutOfRange;
-  const eds::IoLayout& out = slot(mac).io->consumed;
+  const profiles::eds::IoLayout& out = slot(mac).io->consumed;
   if (out.size == 0) {
     return refuse(*v, Errc::kUnsupported,
                   fmt::format("from {}: the node's connection has no outputs", issuer));
   }
   std::string why;
-  if (auto s = eds::check(out, Bytes(data.data(), data.size()), &why); !s) {
+  if (auto s = profiles::eds::check(out, Bytes(data.data(), data.size()), &why); !s) {
     return refuse(*v, s, fmt::format("from {}: {}", issuer, why));
   }
   if (auto s = refuse_unless_online(*v, issuer); !s) return s;
   return apply_command(*v, Bytes(data.data(), data.size()), data, issuer, now);
 }
 
-Status DeviceRack::command(MacId mac, const std::vector<eds::FieldSetting>& fields,
+Status DeviceRack::command(MacId mac, const std::vector<profiles::eds::FieldSetting>& fields,
                            std::string_view issuer, TimePoint now) {
   DeviceView* v = find(mac);
   if (!v || !scanner()) return Errc::kOutOfRange;
-  const eds::IoLayout& out = slot(mac).io->consumed;
+  const profiles::eds::IoLayout& out = slot(mac).io->consumed;
   if (out.size != 0 && out.fields.empty()) {
     return refuse(*v, Errc::kUnsupported,
                   fmt::format("from {}: the EDS names no fields of the node's outputs (\"{}\"); "
@@ -144,7 +145,7 @@ Status DeviceRack::command(MacId mac, const std::vector<eds::FieldSetting>& fiel
                               issuer, out.name));
   }
   std::string why;
-  auto data = eds::encode(out, fields, &why);
+  auto data = profiles::eds::encode(out, fields, &why);
   if (!data) return refuse(*v, data.error(), fmt::format("from {}: {}", issuer, why));
   return command(mac, *data, issuer, now);
 }
@@ -161,7 +162,7 @@ Status DeviceRack::command(MacId mac, const NodeCommand& command, std::string_vi
   if (const auto* bytes = command.as<std::vector<std::uint8_t>>()) {
     return this->command(mac, *bytes, issuer, now);
   }
-  if (const auto* fields = command.as<std::vector<eds::FieldSetting>>()) {
+  if (const auto* fields = command.as<std::vector<profiles::eds::FieldSetting>>()) {
     return this->command(mac, *fields, issuer, now);
   }
   if (const auto* malformed = command.as<MalformedCommand>()) {

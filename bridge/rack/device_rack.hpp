@@ -29,24 +29,24 @@ struct DeviceConfig {
   // Zero: off. Otherwise a command must be written again at least this
   // often to stay in force (NodeRack::expire_silent_commanders).
   Duration command_refresh{};
-  std::shared_ptr<const eds::EdsFile> eds;
-  std::string eds_path;          // as configured, for people
-  std::uint64_t eds_digest = 0;  // of the file's text: a changed file is a changed device
-  eds::EdsNode settings;         // connection, parameters, safe state
+  std::shared_ptr<const profiles::eds::EdsFile> eds;
+  std::string eds_path;             // as configured, for people
+  std::uint64_t eds_digest = 0;     // of the file's text: a changed file is a changed device
+  profiles::eds::EdsNode settings;  // connection, parameters, safe state
 };
 
 struct DeviceView : NodeView {
   std::string product;  // the EDS's product name
   // The connection's data as the EDS lays it out (field names, types, units).
-  std::shared_ptr<const eds::NodeIo> io;
+  std::shared_ptr<const profiles::eds::NodeIo> io;
   // Inputs from the last poll response (valid once `has_inputs`): the bytes
   // and their numeric fields.
   std::vector<std::uint8_t> inputs;
-  std::vector<eds::FieldValue> input_values;
+  std::vector<profiles::eds::FieldValue> input_values;
   // Outputs the device applied with its last answered poll (when not
   // `outputs_idle`).
   std::vector<std::uint8_t> outputs_applied;
-  std::vector<eds::FieldValue> output_values;
+  std::vector<profiles::eds::FieldValue> output_values;
   // Outputs requested by the layer above (not yet necessarily applied), by
   // `commanded_by`.
   std::optional<std::vector<std::uint8_t>> outputs_requested;
@@ -67,9 +67,9 @@ struct DeviceProfile {
   using View = DeviceView;
   using Outputs = std::vector<std::uint8_t>;
   struct Slot {
-    std::shared_ptr<const eds::NodeIo> io;
-    std::shared_ptr<const eds::EdsFile> eds;
-    eds::EdsNode settings;
+    std::shared_ptr<const profiles::eds::NodeIo> io;
+    std::shared_ptr<const profiles::eds::EdsFile> eds;
+    profiles::eds::EdsNode settings;
   };
   static Slot slot_of(const DeviceConfig& device);
   static DeviceView view_of(const DeviceConfig& device, const Slot& slot);
@@ -108,7 +108,7 @@ class DeviceRack final : public NodeRack<DeviceProfile> {
   Status command(devicenet::MacId mac, const std::vector<std::uint8_t>& data,
                  std::string_view issuer, TimePoint now);
   // The same, the outputs given field by field (every numeric field once).
-  Status command(devicenet::MacId mac, const std::vector<eds::FieldSetting>& fields,
+  Status command(devicenet::MacId mac, const std::vector<profiles::eds::FieldSetting>& fields,
                  std::string_view issuer, TimePoint now);
   // Refused, counted and its reason kept as any refusal.
   Status command(devicenet::MacId mac, const MalformedCommand& command, std::string_view issuer,

@@ -14,6 +14,7 @@
 namespace dnbridge::daemon {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 // Lines 1..5: a rack with one simulated port.
@@ -63,7 +64,7 @@ TEST(ConfigEds, ANodeDescribedByItsEdsLoadsWithItsParametersAndSafeState) {
   EXPECT_EQ(n.eds_path, std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-io-block.eds");
   EXPECT_NE(n.eds_digest, 0u);
   ASSERT_EQ(n.eds_node.parameters.size(), 1u);
-  EXPECT_EQ(n.eds_node.parameters[0], (eds::ParameterValue{"Input filter", 5}));
+  EXPECT_EQ(n.eds_node.parameters[0], (profiles::eds::ParameterValue{"Input filter", 5}));
   EXPECT_EQ(n.eds_node.safe_state.size(), 4u);
 
   const rack::PortNodes nodes = to_port_nodes(c.ports[0]);
@@ -152,9 +153,32 @@ TEST(ConfigEds, SafeStateAsAnArrayIsReadAsItsParametersAndWarnedOf) {
   EXPECT_FALSE(n.eds_node.safe_state_of_device);
   ASSERT_EQ(c.warnings.size(), 1u);
   EXPECT_EQ(c.warnings[0],
-            "t.toml:11:14: safe_state = [ ... ] is read as safe_state_parameters = [ ... ]: "
-            "safe_state says \"configured\" or \"device\" for every profile, the parameters go "
-            "in safe_state_parameters");
+            "t.toml:11:14: safe_state = [ ... ] is read as safe_state = \"configured\" with "
+            "safe_state_parameters = [ ... ]: write it so (safe_state says \"configured\" or "
+            "\"device\" for every profile)");
+  // A node's own array is its own configured safe state, whatever [defaults] says.
+  const DaemonConfig d = parse(
+      "rack = \"r\"\n[defaults]\nsafe_state = \"device\"\n"
+      "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"
+      "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+      "eds = \"dnbridge-example-io-block.eds\"\n"
+      "safe_state = [ { name = \"Output fault action\", value = 0 },\n"
+      "               { name = \"Output fault value\", value = 0 },\n"
+      "               { name = \"Output idle action\", value = 0 },\n"
+      "               { name = \"Output idle value\", value = 0 } ]\n");
+  EXPECT_FALSE(d.ports.at(0).nodes.at(0).eds_node.safe_state_of_device);
+  EXPECT_EQ(d.ports[0].nodes[0].eds_node.safe_state.size(), 4u);
+  // Its parameters alone, under [defaults]' "device", say two things: where
+  // "device" comes from is named.
+  EXPECT_THAT(
+      problems("rack = \"r\"\n[defaults]\nsafe_state = \"device\"\n"
+               "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"
+               "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+               "eds = \"dnbridge-example-io-block.eds\"\n"
+               "safe_state_parameters = [ { name = \"Output idle action\", value = 0 } ]\n"),
+      HasSubstr("t.toml:13:25: safe_state_parameters has no effect with safe_state = "
+                "\"device\" (from [defaults], line 3): the device's own fault and idle "
+                "actions are kept"));
   EXPECT_THAT(problems(ONE_PORT "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
                                 "eds = \"dnbridge-example-io-block.eds\"\n"
                                 "safe_state = [ { name = \"Output idle action\", value = 0 } ]\n"
@@ -199,7 +223,7 @@ TEST(ConfigEds, DefaultsHoldAnEdsNodesKeysForTheEdsNodes) {
   for (const NodeSettings* n : {&nodes[1], &nodes[2]}) {
     EXPECT_TRUE(n->is_eds());
     ASSERT_NE(n->eds, nullptr);
-    EXPECT_EQ(n->eds_node.connection, eds::ConnectionKind::kChangeOfState);
+    EXPECT_EQ(n->eds_node.connection, profiles::eds::ConnectionKind::kChangeOfState);
     ASSERT_EQ(n->eds_node.parameters.size(), 1u);
   }
   EXPECT_EQ(nodes[1].eds_node.heartbeat, milliseconds(700));
@@ -207,6 +231,32 @@ TEST(ConfigEds, DefaultsHoldAnEdsNodesKeysForTheEdsNodes) {
   EXPECT_EQ(nodes[2].eds_node.heartbeat, milliseconds(900));
   EXPECT_FALSE(nodes[2].eds_node.safe_state_of_device);
   EXPECT_EQ(nodes[2].eds_node.safe_state.size(), 4u);
+  // [defaults]' connection settings are for the nodes whose connection takes
+  // them; a node's own that its connection does not take is an error.
+  const DaemonConfig mixed = parse(
+      "rack = \"r\"\n[defaults]\nprofile = \"eds\"\neds = \"dnbridge-example-io-block.eds\"\n"
+      "safe_state = \"device\"\nheartbeat_ms = 700\ninhibit_ms = 800\n"
+      "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"
+      "[[port.node]]\nmac = 20\nname = \"io-1\"\n"
+      "[[port.node]]\nmac = 21\nname = \"io-2\"\nconnection = \"change-of-state\"\n"
+      "inhibit_ms = 5\n");
+  ASSERT_EQ(mixed.ports.at(0).nodes.size(), 2u);
+  EXPECT_EQ(mixed.ports[0].nodes[0].eds_node.connection, profiles::eds::ConnectionKind::kPoll);
+  EXPECT_EQ(mixed.ports[0].nodes[1].eds_node.heartbeat, milliseconds(700));
+  EXPECT_EQ(mixed.ports[0].nodes[1].eds_node.inhibit, milliseconds(5));
+  EXPECT_THAT(
+      problems("rack = \"r\"\n[defaults]\nheartbeat_ms = 700\n"
+               "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"
+               "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+               "eds = \"dnbridge-example-io-block.eds\"\nsafe_state = \"device\"\n"
+               "connection = \"change-of-state\"\ninhibit_ms = 900\n"
+               "[[port.node]]\nmac = 21\nname = \"io-2\"\nprofile = \"eds\"\n"
+               "eds = \"dnbridge-example-io-block.eds\"\nsafe_state = \"device\"\n"
+               "acknowledged = false\n"),
+      AllOf(HasSubstr("t.toml:15:14: inhibit_ms = 900 is not shorter than heartbeat_ms = 700 (from "
+                      "[defaults], line 3)"),
+            HasSubstr("t.toml:22:16: acknowledged is for connection = \"change-of-state\" or "
+                      "\"cyclic\" (this node's is \"poll\")")));
   // [defaults]' values are checked even when no node takes them, and its
   // CDN127 keys are for the CDN127s whatever profile it gives the others.
   EXPECT_TRUE(parse("rack = \"r\"\n"
@@ -239,13 +289,15 @@ TEST(ConfigEds, TheShippedExampleLoads) {
   ASSERT_EQ(nodes.of<rack::DeviceConfig>().size(), 3u);
   EXPECT_EQ(nodes.of<rack::DeviceConfig>()[0].eds->device.product_name,
             "Example IO block 8DI/8DO/1AI");
-  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[0].settings.connection, eds::ConnectionKind::kPoll);
+  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[0].settings.connection,
+            profiles::eds::ConnectionKind::kPoll);
   EXPECT_EQ(nodes.of<rack::DeviceConfig>()[1].settings.connection,
-            eds::ConnectionKind::kChangeOfState);
+            profiles::eds::ConnectionKind::kChangeOfState);
   EXPECT_EQ(nodes.of<rack::DeviceConfig>()[1].settings.heartbeat, milliseconds(500));
   EXPECT_EQ(nodes.of<rack::DeviceConfig>()[2].eds->device.product_name,
             "Example valve manifold 16");
-  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[2].settings.connection, eds::ConnectionKind::kStrobe);
+  EXPECT_EQ(nodes.of<rack::DeviceConfig>()[2].settings.connection,
+            profiles::eds::ConnectionKind::kStrobe);
 }
 
 TEST(ConfigEds, APumpAndADeviceShareAPort) {
@@ -295,6 +347,13 @@ TEST(ConfigEds, AnEdsFilesProblemsAreReportedAtTheKeyWithTheirOwnLines) {
                                 "eds = \"no-such.eds\"\n"),
               HasSubstr("t.toml:10:7: eds: " + std::string(DNBRIDGE_EDS_DIR) +
                         "/no-such.eds: cannot open: No such file or directory"));
+  // One [defaults]' eds for every node: its problems said once, at it.
+  EXPECT_EQ(problems("rack = \"r\"\n[defaults]\neds = \"no-such.eds\"\n"
+                     "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"
+                     "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
+                     "[[port.node]]\nmac = 21\nname = \"io-2\"\nprofile = \"eds\"\n"),
+            "t.toml:3:7: eds: " + std::string(DNBRIDGE_EDS_DIR) +
+                "/no-such.eds: cannot open: No such file or directory");
 }
 
 TEST(ConfigEds, WhatTheMasterWouldRefuseIsAnErrorAtItsKey) {
@@ -327,7 +386,7 @@ TEST(ConfigEds, AChangeOfStateNodeTakesItsHeartbeatInhibitAndAcknowledgment) {
                                "inhibit_ms = 15\n"
                                "acknowledged = false\n");
   const NodeSettings& n = c.ports.at(0).nodes.at(0);
-  EXPECT_EQ(n.eds_node.connection, eds::ConnectionKind::kChangeOfState);
+  EXPECT_EQ(n.eds_node.connection, profiles::eds::ConnectionKind::kChangeOfState);
   EXPECT_EQ(n.eds_node.heartbeat, milliseconds(250));
   EXPECT_EQ(n.eds_node.inhibit, milliseconds(15));
   EXPECT_FALSE(n.eds_node.acknowledged);

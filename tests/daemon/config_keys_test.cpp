@@ -130,7 +130,15 @@ TEST(ConfigKeys, EveryKeyOfTheTableIsReadWhereTheTablePutsIt) {
       const std::string text = rack_with(k, profile, in_defaults);
       SCOPED_TRACE(text);
       const std::string p = problems(text);
-      EXPECT_THAT(p, HasSubstr(std::string(k.name)));
+      // At the line the value is on, naming the key.
+      std::size_t line = 1;
+      for (std::size_t i = 0; i < text.find(kNoKeysValue); ++i) line += text[i] == '\n';
+      std::istringstream lines(p);
+      std::string at_line, l;
+      while (std::getline(lines, l)) {
+        if (l.starts_with(fmt::format("t.toml:{}:", line))) at_line += l + "\n";
+      }
+      EXPECT_THAT(at_line, HasSubstr(std::string(k.name)));
       EXPECT_THAT(p, Not(HasSubstr("unknown key")));
       EXPECT_THAT(p, Not(HasSubstr(" stands in ")));
     }
@@ -201,6 +209,18 @@ TEST(ConfigKeys, AKeyWhereItDoesNotStandIsToldWhereItStands) {
             "table\n"
             "t.toml:11:1: bus_off_recovery is a port key: it stands in the [[port]] table, before "
             "its [[port.node]] tables");
+  EXPECT_EQ(problems("rack = \"r\"\n"
+                     "mac = 3\n"
+                     "name = \"x\"\n"
+                     "[defaults]\n"
+                     "poll_batch_ms = 3\n"
+                     "[[port]]\n" +
+                     std::string(kPortKeys)),
+            "t.toml:2:1: mac is a node key: it stands in a [[port.node]] table only, not at the "
+            "top level\n"
+            "t.toml:3:1: name stands in a [[port]] or [[port.node]] table, not at the top level\n"
+            "t.toml:5:1: poll_batch_ms is a port key: it stands in a [[port]] table, not in "
+            "[defaults]");
   EXPECT_THAT(problems("rack = \"r\"\n"
                        "[defaults]\n"
                        "serial = 3\n"

@@ -93,7 +93,7 @@ TEST(Samples, ADevicesSafeStateSourceIsPublished) {
   rack::DeviceConfig d;
   d.node.mac = devicenet::MacId::from(20).value();
   d.node.name = "io-20";
-  d.eds = std::make_shared<const eds::EdsFile>(test::example_eds(test::kIoBlockEds));
+  d.eds = std::make_shared<const profiles::eds::EdsFile>(test::example_eds(test::kIoBlockEds));
   d.settings.safe_state_of_device = true;
   rack::DeviceRack rack({d});
   NullSink sink;

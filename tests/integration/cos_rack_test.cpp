@@ -29,17 +29,18 @@ constexpr unsigned kDigitalInputs = 3;  // the example I/O block's Param3
 
 // The example I/O block at MAC 21 on change of state: polled once a second
 // (its outputs), a heartbeat every 200 ms, changes no closer than 10 ms.
-rack::DeviceConfig cos_block(eds::ConnectionKind kind = eds::ConnectionKind::kChangeOfState) {
+rack::DeviceConfig cos_block(
+    profiles::eds::ConnectionKind kind = profiles::eds::ConnectionKind::kChangeOfState) {
   rack::DeviceConfig d;
   d.node.mac = mac(kIo);
   d.node.name = "cos block";
   d.node.poll_period = milliseconds(1000);
   d.node.expected_packet_rate = milliseconds(1000);
-  d.eds = std::make_shared<const eds::EdsFile>(example_eds(kIoBlockEds));
+  d.eds = std::make_shared<const profiles::eds::EdsFile>(example_eds(kIoBlockEds));
   d.eds_path = kIoBlockEds;
   d.settings.connection = kind;
   d.settings.heartbeat = milliseconds(200);
-  if (kind != eds::ConnectionKind::kCyclic) d.settings.inhibit = milliseconds(10);
+  if (kind != profiles::eds::ConnectionKind::kCyclic) d.settings.inhibit = milliseconds(10);
   d.settings.safe_state = {{"Output fault action", 0},
                            {"Output fault value", 0x01},
                            {"Output idle action", 0},
@@ -279,7 +280,7 @@ TEST_F(CosRackTest, IdlePollsAnsweredEmptyLeaveTheInputsOfTheChangeOfStateConnec
 }
 
 TEST_F(CosRackTest, ACyclicDeviceProducesEveryCycleAndAChangeWaitsForIt) {
-  start(cos_block(eds::ConnectionKind::kCyclic));
+  start(cos_block(profiles::eds::ConnectionKind::kCyclic));
   ASSERT_TRUE(run_until_online()) << node().reason();
   EXPECT_EQ(device().connections().cos_connection().allocated_as, devicenet::allocation::kCyclic);
   world().run_for(milliseconds(100));

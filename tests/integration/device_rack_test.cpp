@@ -31,7 +31,7 @@ rack::DeviceConfig io_block(unsigned mac_value = kIo) {
   d.node.name = "io " + std::to_string(mac_value);
   d.node.poll_period = milliseconds(50);
   d.node.expected_packet_rate = milliseconds(250);
-  d.eds = std::make_shared<const eds::EdsFile>(example_eds(kIoBlockEds));
+  d.eds = std::make_shared<const profiles::eds::EdsFile>(example_eds(kIoBlockEds));
   d.eds_path = kIoBlockEds;
   d.settings.parameters = {{"Input filter", 5}};
   d.settings.safe_state = {{"Output fault action", 0},
@@ -115,7 +115,8 @@ TEST_F(DeviceRackTest, ACommandByFieldsOrBytesReachesTheOutputsAfterItsChecks) {
   start();
   ASSERT_TRUE(run_until_online()) << view().reason;
   ASSERT_TRUE(devices()
-                  .command(mac(kIo), std::vector<eds::FieldSetting>{{"Digital outputs", 0x81}},
+                  .command(mac(kIo),
+                           std::vector<profiles::eds::FieldSetting>{{"Digital outputs", 0x81}},
                            "supervisor-a", now())
                   .ok())
       << view().last_command_refused;
@@ -135,11 +136,12 @@ TEST_F(DeviceRackTest, ACommandByFieldsOrBytesReachesTheOutputsAfterItsChecks) {
     const char* says;
   };
   const Bad refused[] = {
-      {devices().command(mac(kIo), std::vector<eds::FieldSetting>{{"Digital outputs", 256}}, "x",
+      {devices().command(mac(kIo),
+                         std::vector<profiles::eds::FieldSetting>{{"Digital outputs", 256}}, "x",
                          now()),
        "from x: Digital outputs: 256 is outside 0..255"},
-      {devices().command(mac(kIo), std::vector<eds::FieldSetting>{{"Digital output", 1}}, "x",
-                         now()),
+      {devices().command(mac(kIo), std::vector<profiles::eds::FieldSetting>{{"Digital output", 1}},
+                         "x", now()),
        "from x: no field \"Digital output\""},
       {devices().command(mac(kIo), ByteVec{0x03}, "x", now()),
        "from x: 1 bytes given, \"Outputs\" is 2 bytes"},
@@ -206,7 +208,7 @@ TEST_F(DeviceRackTest, AfterALossTheOutputsTakeTheFaultValueAndComeBackIdle) {
 
 TEST_F(DeviceRackTest, ADeviceWhoseMemberListDiffersFromTheEdsIsAConfigurationFault) {
   // The device's own EDS has the input assembly's first two members swapped.
-  eds::EdsFile differing = example_eds(kIoBlockEds);
+  profiles::eds::EdsFile differing = example_eds(kIoBlockEds);
   for (auto& a : differing.assemblies) {
     if (a.number == 100) std::swap(a.members[0], a.members[1]);
   }

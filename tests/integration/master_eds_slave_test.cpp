@@ -71,7 +71,7 @@ devicenet::NodeConfig eds_node() {
 class EdsSlaveOnTheBus : public ::testing::Test {
  protected:
   void start(sim::EdsSlaveOptions options = {},
-             eds::EdsFile file = test::example_eds(test::kIoBlockEds)) {
+             profiles::eds::EdsFile file = test::example_eds(test::kIoBlockEds)) {
     options.mac = kSlaveMac;
     options.serial_number = 0x0A0B0C0D;
     slave_.emplace(world_, std::move(file), options, world_.now());
@@ -190,8 +190,8 @@ TEST_F(EdsSlaveOnTheBus, TheOutputsTakeTheIdleAndFaultValuesTheirParametersHold)
 }
 
 TEST_F(EdsSlaveOnTheBus, WithoutTheSafeStateParametersTheOptionsDecide) {
-  eds::EdsFile file = test::example_eds(test::kIoBlockEds);
-  std::erase_if(file.params, [](const eds::Param& p) { return p.number >= 6; });
+  profiles::eds::EdsFile file = test::example_eds(test::kIoBlockEds);
+  std::erase_if(file.params, [](const profiles::eds::Param& p) { return p.number >= 6; });
   sim::EdsSlaveOptions options;
   options.idle_action = sim::OutputAction::kHold;
   start(options, std::move(file));

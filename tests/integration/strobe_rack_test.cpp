@@ -34,9 +34,9 @@ rack::DeviceConfig strobed_manifold(unsigned m, Duration poll = milliseconds(100
   d.node.name = "valves";
   d.node.poll_period = poll;
   d.node.expected_packet_rate = milliseconds(400);
-  d.eds = std::make_shared<const eds::EdsFile>(example_eds(kValveManifoldEds));
+  d.eds = std::make_shared<const profiles::eds::EdsFile>(example_eds(kValveManifoldEds));
   d.eds_path = kValveManifoldEds;
-  d.settings.connection = eds::ConnectionKind::kStrobe;
+  d.settings.connection = profiles::eds::ConnectionKind::kStrobe;
   d.settings.safe_state = {{"Output fault action", 0},
                            {"Output fault value", 0x0001},
                            {"Output idle action", 0},
@@ -161,7 +161,7 @@ TEST_F(StrobeRackTest, ANodeAddedWithAShorterPeriodIsStrobedAtItsPeriodAtOnce) {
   world().run_for(milliseconds(300));
   auto fast = strobed_manifold(kValves2, milliseconds(20));
   fast.node.expected_packet_rate = milliseconds(80);
-  const auto eds = std::make_shared<const eds::EdsFile>(example_eds(kValveManifoldEds));
+  const auto eds = std::make_shared<const profiles::eds::EdsFile>(example_eds(kValveManifoldEds));
   rack_->add_eds_device(*eds, sim::default_eds_slave_options(mac(kValves2)), now());
   rack_->port().reconfigure(rack_->scanner().config(),
                             rack::PortNodes(std::vector<rack::DeviceConfig>{slow, fast}), now());

@@ -22,10 +22,10 @@ inline std::string example_eds_text(const std::string& name) {
 }
 
 // deploy/eds/`name` read; a test failure (and an empty file) if it does not read.
-inline eds::EdsFile example_eds(const std::string& name) {
-  auto parsed = eds::parse(example_eds_text(name));
+inline profiles::eds::EdsFile example_eds(const std::string& name) {
+  auto parsed = profiles::eds::parse(example_eds_text(name));
   EXPECT_TRUE(parsed.file.has_value()) << name << " does not read";
-  return parsed.file.value_or(eds::EdsFile{});
+  return parsed.file.value_or(profiles::eds::EdsFile{});
 }
 
 }  // namespace dnbridge::test

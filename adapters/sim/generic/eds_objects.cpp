@@ -23,7 +23,7 @@ constexpr std::uint16_t kParameterClass = cip::class_id::kParameter;
 constexpr std::uint16_t kAckHandlerClass = cip::class_id::kAcknowledgeHandler;
 
 // A parameter's value as bytes (little-endian, its data size) from a number.
-std::vector<std::uint8_t> encode_value(const eds::Param& p, double v) {
+std::vector<std::uint8_t> encode_value(const profiles::eds::Param& p, double v) {
   std::vector<std::uint8_t> out(p.size, 0);
   if (p.type.is_float) {
     if (p.size == 4) {
@@ -52,7 +52,7 @@ std::vector<std::uint8_t> encode_value(const eds::Param& p, double v) {
 }
 
 // The number `value` holds, as its type reads it.
-std::optional<double> decode_value(const eds::Param& p, Bytes value) {
+std::optional<double> decode_value(const profiles::eds::Param& p, Bytes value) {
   if (value.size() != p.size || p.type.size == 0) return std::nullopt;
   std::uint64_t bits = little_endian(value);
   if (p.type.is_float) {
@@ -76,7 +76,7 @@ std::vector<std::uint8_t> encode_path(const cip::EPath& path) {
 
 }  // namespace
 
-EdsObjects::EdsObjects(eds::EdsFile file, std::uint32_t serial_number, bool member_lists)
+EdsObjects::EdsObjects(profiles::eds::EdsFile file, std::uint32_t serial_number, bool member_lists)
     : file_(std::move(file)), serial_number_(serial_number), member_lists_(member_lists) {
   for (const auto& p : file_.params) {
     values_[p.number] = encode_value(p, p.default_value.value_or(0.0));
@@ -89,7 +89,7 @@ std::vector<std::uint8_t> EdsObjects::param_value(unsigned number) const {
 }
 
 std::optional<double> EdsObjects::param_number(unsigned number) const {
-  const eds::Param* p = file_.param(number);
+  const profiles::eds::Param* p = file_.param(number);
   if (p == nullptr) return std::nullopt;
   const auto value = param_value(number);
   return decode_value(*p, Bytes(value.data(), value.size()));
@@ -103,18 +103,18 @@ bool EdsObjects::set_param_value(unsigned number, Bytes value) {
 }
 
 bool EdsObjects::set_param_number(unsigned number, double value) {
-  const eds::Param* p = file_.param(number);
+  const profiles::eds::Param* p = file_.param(number);
   if (p == nullptr || p->type.size == 0) return false;
-  if (!eds::to_raw(p->type, static_cast<std::uint16_t>(p->size * 8), value)) return false;
+  if (!profiles::eds::to_raw(p->type, static_cast<std::uint16_t>(p->size * 8), value)) return false;
   const auto bytes = encode_value(*p, value);
   return set_param_value(number, Bytes(bytes.data(), bytes.size()));
 }
 
-const eds::Assembly* EdsObjects::assembly(unsigned instance) const noexcept {
+const profiles::eds::Assembly* EdsObjects::assembly(unsigned instance) const noexcept {
   return file_.assembly_at(cip::EPath{cip::class_id::kAssembly, instance, std::nullopt, 3});
 }
 
-const eds::Assembly* EdsObjects::assembly_numbered(unsigned number) const noexcept {
+const profiles::eds::Assembly* EdsObjects::assembly_numbered(unsigned number) const noexcept {
   for (const auto& a : file_.assemblies) {
     if (a.number == number) return &a;
   }
@@ -122,12 +122,13 @@ const eds::Assembly* EdsObjects::assembly_numbered(unsigned number) const noexce
 }
 
 std::vector<std::uint8_t> EdsObjects::assembly_data(unsigned instance) const {
-  const eds::Assembly* a = assembly(instance);
+  const profiles::eds::Assembly* a = assembly(instance);
   return a == nullptr ? std::vector<std::uint8_t>{} : packed(*a, 0);
 }
 
-std::vector<std::uint8_t> EdsObjects::packed(const eds::Assembly& assembly, unsigned depth) const {
-  const eds::Assembly* a = &assembly;
+std::vector<std::uint8_t> EdsObjects::packed(const profiles::eds::Assembly& assembly,
+                                             unsigned depth) const {
+  const profiles::eds::Assembly* a = &assembly;
   const std::uint32_t total = a->size_bits();
   std::vector<std::uint8_t> out((total + 7) / 8, 0);
   std::uint32_t at = 0;
@@ -139,15 +140,15 @@ std::vector<std::uint8_t> EdsObjects::packed(const eds::Assembly& assembly, unsi
     }
   };
   for (const auto& m : a->members) {
-    if (m.kind == eds::Member::Kind::kParam) put(param_value(m.number), m.bits);
-    if (m.kind == eds::Member::Kind::kPath) {
+    if (m.kind == profiles::eds::Member::Kind::kParam) put(param_value(m.number), m.bits);
+    if (m.kind == profiles::eds::Member::Kind::kPath) {
       if (auto it = path_values_.find(cip::encoded(m.path)); it != path_values_.end()) {
         put(it->second, m.bits);
       }
     }
     // Nested assemblies, kMaxNesting deep (the EDS reader refuses cycles).
-    if (m.kind == eds::Member::Kind::kAssembly && depth < kMaxNesting) {
-      if (const eds::Assembly* nested = assembly_numbered(m.number)) {
+    if (m.kind == profiles::eds::Member::Kind::kAssembly && depth < kMaxNesting) {
+      if (const profiles::eds::Assembly* nested = assembly_numbered(m.number)) {
         put(packed(*nested, depth + 1), m.bits);
       }
     }
@@ -157,7 +158,7 @@ std::vector<std::uint8_t> EdsObjects::packed(const eds::Assembly& assembly, unsi
 }
 
 bool EdsObjects::set_assembly_data(unsigned instance, Bytes data) {
-  const eds::Assembly* a = assembly(instance);
+  const profiles::eds::Assembly* a = assembly(instance);
   if (a == nullptr || data.size() != (a->size_bits() + 7) / 8) return false;
   unpack(*a, data, 0, 0);
   return true;
@@ -165,13 +166,13 @@ bool EdsObjects::set_assembly_data(unsigned instance, Bytes data) {
 
 // The inverse of packed(): each parameter member's bits from `data`, the
 // assembly starting at bit `at`; a parameter's bits past its member's stay.
-void EdsObjects::unpack(const eds::Assembly& assembly, Bytes data, std::uint32_t at,
+void EdsObjects::unpack(const profiles::eds::Assembly& assembly, Bytes data, std::uint32_t at,
                         unsigned depth) {
   const auto bit = [&](std::uint32_t i) {
     return i / 8 < data.size() && ((static_cast<unsigned>(data[i / 8]) >> (i % 8)) & 1u) != 0;
   };
   for (const auto& m : assembly.members) {
-    if (m.kind == eds::Member::Kind::kParam) {
+    if (m.kind == profiles::eds::Member::Kind::kParam) {
       auto it = values_.find(m.number);
       if (it != values_.end()) {
         auto& value = it->second;
@@ -182,7 +183,7 @@ void EdsObjects::unpack(const eds::Assembly& assembly, Bytes data, std::uint32_t
         }
       }
     }
-    if (m.kind == eds::Member::Kind::kPath) {
+    if (m.kind == profiles::eds::Member::Kind::kPath) {
       auto& value = path_values_[cip::encoded(m.path)];
       value.resize(std::max<std::size_t>(value.size(), (m.bits + 7u) / 8u), 0);
       for (std::uint32_t i = 0; i < m.bits; ++i) {
@@ -191,8 +192,8 @@ void EdsObjects::unpack(const eds::Assembly& assembly, Bytes data, std::uint32_t
             static_cast<std::uint8_t>(bit(at + i) ? value[i / 8] | mask : value[i / 8] & ~mask);
       }
     }
-    if (m.kind == eds::Member::Kind::kAssembly && depth < kMaxNesting) {
-      if (const eds::Assembly* nested = assembly_numbered(m.number)) {
+    if (m.kind == profiles::eds::Member::Kind::kAssembly && depth < kMaxNesting) {
+      if (const profiles::eds::Assembly* nested = assembly_numbered(m.number)) {
         unpack(*nested, data, at, depth + 1);
       }
     }
@@ -200,27 +201,27 @@ void EdsObjects::unpack(const eds::Assembly& assembly, Bytes data, std::uint32_t
   }
 }
 
-std::vector<cip::AssemblyMember> EdsObjects::member_list(const eds::Assembly& a) const {
+std::vector<cip::AssemblyMember> EdsObjects::member_list(const profiles::eds::Assembly& a) const {
   std::vector<cip::AssemblyMember> list;
   for (const auto& m : a.members) {
     cip::AssemblyMember out;
     out.bits = m.bits;
     std::optional<cip::EPath> path;
     switch (m.kind) {
-      case eds::Member::Kind::kPadding:
+      case profiles::eds::Member::Kind::kPadding:
         break;
-      case eds::Member::Kind::kPath:
+      case profiles::eds::Member::Kind::kPath:
         path = m.path;
         break;
-      case eds::Member::Kind::kParam: {
-        const eds::Param* p = file_.param(m.number);
+      case profiles::eds::Member::Kind::kParam: {
+        const profiles::eds::Param* p = file_.param(m.number);
         path = p != nullptr && !p->link.empty()
                    ? p->link
                    : cip::EPath{kParameterClass, m.number, std::nullopt, 1};
         break;
       }
-      case eds::Member::Kind::kAssembly: {
-        const eds::Assembly* nested = assembly_numbered(m.number);
+      case profiles::eds::Member::Kind::kAssembly: {
+        const profiles::eds::Assembly* nested = assembly_numbered(m.number);
         if (nested != nullptr) path = nested->path;
         break;
       }
@@ -283,7 +284,7 @@ EdsObjects::Outcome EdsObjects::get_assembly(std::uint16_t instance, std::uint8_
     }
     return {};
   }
-  const eds::Assembly* a = assembly(instance);
+  const profiles::eds::Assembly* a = assembly(instance);
   if (a == nullptr) return {GeneralStatus::kObjectDoesNotExist};
   if (!member_lists_ && attribute != cip::assembly_attr::kData) {
     return {GeneralStatus::kAttributeNotSupported};
@@ -317,7 +318,7 @@ EdsObjects::Outcome EdsObjects::get_parameter(std::uint16_t instance, std::uint8
     out.u16le(static_cast<std::uint16_t>(max));
     return {};
   }
-  const eds::Param* p = file_.param(instance);
+  const profiles::eds::Param* p = file_.param(instance);
   if (p == nullptr) return {GeneralStatus::kObjectDoesNotExist};
   if (attribute != 1) return {GeneralStatus::kAttributeNotSupported};
   if (p->type.size == 0) {
@@ -423,7 +424,7 @@ EdsObjects::Outcome EdsObjects::set(const devicenet::RequestMessage& r) {
   const Outcome supported = get(r, probe);
   if (supported.status == GeneralStatus::kAttributeNotSupported) return supported;
   if (r.class_id == kParameterClass && attribute == 1) {
-    const eds::Param* p = file_.param(r.instance_id);
+    const profiles::eds::Param* p = file_.param(r.instance_id);
     if (p->read_only() || p->type.size == 0) return {GeneralStatus::kAttributeNotSettable};
     if (auto bad = size_check(p->size)) return *bad;
     const auto v = decode_value(*p, r.data);

@@ -58,7 +58,7 @@ class EdsObjects {
   // `member_lists`: false, the Assembly object's attributes 1 and 2 are not
   // supported (0x14), as on a device that describes its assemblies only in
   // its EDS.
-  EdsObjects(eds::EdsFile file, std::uint32_t serial_number, bool member_lists = true);
+  EdsObjects(profiles::eds::EdsFile file, std::uint32_t serial_number, bool member_lists = true);
 
   // Runs `request` and writes the response message (service byte first,
   // success or error) into `out` (devicenet::kMaxExplicitMessage bytes);
@@ -92,7 +92,7 @@ class EdsObjects {
 
   const AckHandler& ack_handler() const noexcept { return ack_; }
   AckHandler& ack_handler() noexcept { return ack_; }
-  const eds::EdsFile& file() const noexcept { return file_; }
+  const profiles::eds::EdsFile& file() const noexcept { return file_; }
 
  private:
   struct Outcome {
@@ -107,13 +107,14 @@ class EdsObjects {
   Outcome get_ack_handler(std::uint16_t instance, std::uint8_t attribute, ByteWriter& out) const;
   bool exists(std::uint16_t class_id, std::uint16_t instance) const noexcept;
   // The assembly at an instance (its path's), and AssemN.
-  const eds::Assembly* assembly(unsigned instance) const noexcept;
-  const eds::Assembly* assembly_numbered(unsigned number) const noexcept;
-  std::vector<std::uint8_t> packed(const eds::Assembly& assembly, unsigned depth) const;
-  void unpack(const eds::Assembly& assembly, Bytes data, std::uint32_t at, unsigned depth);
-  std::vector<cip::AssemblyMember> member_list(const eds::Assembly& a) const;
+  const profiles::eds::Assembly* assembly(unsigned instance) const noexcept;
+  const profiles::eds::Assembly* assembly_numbered(unsigned number) const noexcept;
+  std::vector<std::uint8_t> packed(const profiles::eds::Assembly& assembly, unsigned depth) const;
+  void unpack(const profiles::eds::Assembly& assembly, Bytes data, std::uint32_t at,
+              unsigned depth);
+  std::vector<cip::AssemblyMember> member_list(const profiles::eds::Assembly& a) const;
 
-  eds::EdsFile file_;
+  profiles::eds::EdsFile file_;
   std::uint32_t serial_number_;
   bool member_lists_ = true;
   std::map<unsigned, std::vector<std::uint8_t>> values_;  // per ParamN

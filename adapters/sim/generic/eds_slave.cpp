@@ -24,9 +24,10 @@ namespace alloc = devicenet::allocation;
 constexpr std::uint16_t kExplicitMessageSize = devicenet::kMaxExplicitMessage;
 
 // The assembly an [IO_Info] input or output names; 0 for none.
-std::uint16_t io_assembly(const eds::EdsFile& file, const eds::IoData* data) noexcept {
+std::uint16_t io_assembly(const profiles::eds::EdsFile& file,
+                          const profiles::eds::IoData* data) noexcept {
   if (data == nullptr) return 0;
-  const eds::Assembly* a = file.assembly_at(data->path);
+  const profiles::eds::Assembly* a = file.assembly_at(data->path);
   if (a == nullptr || !a->path.instance_id || *a->path.instance_id > 0xFFFF) return 0;
   return static_cast<std::uint16_t>(*a->path.instance_id);
 }
@@ -37,19 +38,20 @@ bool fits_one_frame(std::size_t size) noexcept { return size > 0 && size <= kMax
 
 // The parameters of the outputs' safe state, by this simulator's convention
 // (eds_slave.hpp), when the EDS has all four.
-std::optional<std::array<unsigned, 4>> safe_state_params(const eds::EdsFile& file) noexcept {
+std::optional<std::array<unsigned, 4>> safe_state_params(
+    const profiles::eds::EdsFile& file) noexcept {
   std::array<unsigned, 4> numbers{};
   const std::array<std::string_view, 4> names{"Output fault action", "Output fault value",
                                               "Output idle action", "Output idle value"};
   for (std::size_t i = 0; i < names.size(); ++i) {
-    const eds::Param* p = file.param(names[i]);
+    const profiles::eds::Param* p = file.param(names[i]);
     if (p == nullptr) return std::nullopt;
     numbers[i] = p->number;
   }
   return numbers;
 }
 
-Group2Options wire_options(const eds::EdsFile& file, const EdsSlaveOptions& o) noexcept {
+Group2Options wire_options(const profiles::eds::EdsFile& file, const EdsSlaveOptions& o) noexcept {
   Group2Options w = o.wire;
   w.vendor_id = file.device.vendor_code;
   w.serial_number = o.serial_number;
@@ -62,26 +64,26 @@ Group2Options wire_options(const eds::EdsFile& file, const EdsSlaveOptions& o) n
 // not fit a frame is none, rather than data cut short on the wire while
 // attributes 7/8 say its full size.
 EdsSlave::IoDefaults EdsSlave::io_defaults(const EdsObjects& objects) noexcept {
-  const eds::EdsFile& file = objects.file();
-  const auto fitting = [&](const eds::IoData* data) -> std::uint16_t {
+  const profiles::eds::EdsFile& file = objects.file();
+  const auto fitting = [&](const profiles::eds::IoData* data) -> std::uint16_t {
     const std::uint16_t a = io_assembly(file, data);
     return a != 0 && fits_one_frame(objects.assembly_data(a).size()) ? a : 0;
   };
   IoDefaults d;
   d.choices = alloc::kExplicit | alloc::kPoll;
-  const eds::IoInfo& io = file.io;
-  if (const auto* poll = io.connection(eds::ConnectionKind::kPoll)) {
+  const profiles::eds::IoInfo& io = file.io;
+  if (const auto* poll = io.connection(profiles::eds::ConnectionKind::kPoll)) {
     d.poll_input = fitting(io.input(poll->input));
     d.poll_output = fitting(io.output(poll->output));
   }
-  const auto* cos = io.connection(eds::ConnectionKind::kChangeOfState);
-  const auto* cyclic = io.connection(eds::ConnectionKind::kCyclic);
+  const auto* cos = io.connection(profiles::eds::ConnectionKind::kChangeOfState);
+  const auto* cyclic = io.connection(profiles::eds::ConnectionKind::kCyclic);
   if (cos != nullptr) d.choices |= alloc::kChangeOfState | alloc::kAckSuppression;
   if (cyclic != nullptr) d.choices |= alloc::kCyclic | alloc::kAckSuppression;
   if (const auto* produced = cos != nullptr ? cos : cyclic) {
     d.cos_input = fitting(io.input(produced->input));
   }
-  if (const auto* strobe = io.connection(eds::ConnectionKind::kStrobe)) {
+  if (const auto* strobe = io.connection(profiles::eds::ConnectionKind::kStrobe)) {
     d.choices |= alloc::kBitStrobe;
     d.strobe_input = fitting(io.input(strobe->input));
   }
@@ -100,7 +102,8 @@ ConnectionSetOptions EdsSlave::connection_options(const EdsSlaveOptions& o,
   return c;
 }
 
-EdsSlave::EdsSlave(can::FrameSink& sink, eds::EdsFile file, EdsSlaveOptions options, Logger log)
+EdsSlave::EdsSlave(can::FrameSink& sink, profiles::eds::EdsFile file, EdsSlaveOptions options,
+                   Logger log)
     : Group2Slave(sink, wire_options(file, options), std::move(log)),
       options_(options),
       objects_(std::move(file), options.serial_number, options.member_lists),
@@ -326,17 +329,17 @@ bool EdsSlave::assembly_allowed(std::uint16_t instance, bool produced,
 bool EdsSlave::input_carried_by(std::uint16_t assembly, std::uint16_t instance) const noexcept {
   // An [IO_Info] input names the connections that may carry it; an
   // assembly no input names (an output's echo) is not checked.
-  const eds::EdsFile& file = objects_.file();
-  for (const eds::IoData& in : file.io.inputs) {
+  const profiles::eds::EdsFile& file = objects_.file();
+  for (const profiles::eds::IoData& in : file.io.inputs) {
     if (io_assembly(file, &in) != assembly || in.carried_by.bits == 0) continue;
     switch (instance) {
       case connection_instance::kPoll:
-        return in.carried_by.has(eds::ConnectionKind::kPoll);
+        return in.carried_by.has(profiles::eds::ConnectionKind::kPoll);
       case connection_instance::kBitStrobe:
-        return in.carried_by.has(eds::ConnectionKind::kStrobe);
+        return in.carried_by.has(profiles::eds::ConnectionKind::kStrobe);
       case connection_instance::kChangeOfState:
-        return in.carried_by.has(eds::ConnectionKind::kChangeOfState) ||
-               in.carried_by.has(eds::ConnectionKind::kCyclic);
+        return in.carried_by.has(profiles::eds::ConnectionKind::kChangeOfState) ||
+               in.carried_by.has(profiles::eds::ConnectionKind::kCyclic);
       default:
         return false;
     }
@@ -345,9 +348,10 @@ bool EdsSlave::input_carried_by(std::uint16_t assembly, std::uint16_t instance) 
 }
 
 bool EdsSlave::is_output_assembly(std::uint16_t assembly) const noexcept {
-  const eds::EdsFile& file = objects_.file();
-  return std::any_of(file.io.outputs.begin(), file.io.outputs.end(),
-                     [&](const eds::IoData& out) { return io_assembly(file, &out) == assembly; });
+  const profiles::eds::EdsFile& file = objects_.file();
+  return std::any_of(
+      file.io.outputs.begin(), file.io.outputs.end(),
+      [&](const profiles::eds::IoData& out) { return io_assembly(file, &out) == assembly; });
 }
 
 // --- explicit requests -------------------------------------------------------------

@@ -110,7 +110,8 @@ struct EdsSlaveOptions {
 
 class EdsSlave final : public Group2Slave, private ConnectionEvents, private IoAssemblies {
  public:
-  EdsSlave(can::FrameSink& sink, eds::EdsFile file, EdsSlaveOptions options = {}, Logger log = {});
+  EdsSlave(can::FrameSink& sink, profiles::eds::EdsFile file, EdsSlaveOptions options = {},
+           Logger log = {});
 
   devicenet::MacId mac() const noexcept { return mac_; }
   // 255 when no master owns the connection set.

@@ -101,14 +101,14 @@ std::optional<EdsDevice> read_eds(const toml::node& key, const std::filesystem::
     p.error(key.source(), fmt::format("eds: {}", text.error));
     return std::nullopt;
   }
-  const eds::Parsed parsed = eds::parse(*text.text);
+  const profiles::eds::Parsed parsed = profiles::eds::parse(*text.text);
   for (const auto& problem : parsed.problems) {
-    if (problem.severity == eds::Problem::Severity::kError) {
-      p.error(key.source(), fmt::format("eds: {}", eds::format_problem(d.path, problem)));
+    if (problem.severity == profiles::eds::Problem::Severity::kError) {
+      p.error(key.source(), fmt::format("eds: {}", profiles::eds::format_problem(d.path, problem)));
     }
   }
   if (!parsed.file || parsed.errors > 0) return std::nullopt;
-  d.file = std::make_shared<const eds::EdsFile>(*parsed.file);
+  d.file = std::make_shared<const profiles::eds::EdsFile>(*parsed.file);
   return d;
 }
 

@@ -80,7 +80,7 @@ struct DeviceSettings {
 // A device driven by an EDS file.
 struct EdsDevice {
   std::string path;  // as resolved, for the log
-  std::shared_ptr<const eds::EdsFile> file;
+  std::shared_ptr<const profiles::eds::EdsFile> file;
   std::optional<std::uint32_t> serial_number;
   bool member_lists = true;
 };

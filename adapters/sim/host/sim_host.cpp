@@ -396,7 +396,7 @@ std::string SimHost::set_input(SocketDevice& d, const ControlCommand& c, TimePoi
           d.mac().value());
     }
     sim::EdsSlave& s = *d.eds();
-    const eds::Param* p = s.objects().file().param(c.param);
+    const profiles::eds::Param* p = s.objects().file().param(c.param);
     if (p == nullptr) return fmt::format("error: the EDS has no Param{}", c.param);
     if (!s.objects().set_param_number(c.param, c.value)) {
       return fmt::format("error: {} is not a value of Param{} \"{}\"", c.value, c.param, p->name);

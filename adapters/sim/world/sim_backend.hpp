@@ -21,7 +21,7 @@ namespace dnbridge::sim {
 // A simulated device driven by its EDS file, at a MAC.
 struct EdsDeviceSpec {
   devicenet::MacId mac;
-  std::shared_ptr<const eds::EdsFile> eds;
+  std::shared_ptr<const profiles::eds::EdsFile> eds;
 };
 
 class SimBackend final : public port::CanBackend, private BusPort {

@@ -11,7 +11,7 @@ class SimEdsSlave final : public SimDevice<EdsSlave> {
  public:
   // Attaches to the world's bus; the device powers up at `power_on` (no
   // value: stays off until power_on() is called).
-  SimEdsSlave(SimWorld& world, eds::EdsFile file, EdsSlaveOptions options,
+  SimEdsSlave(SimWorld& world, profiles::eds::EdsFile file, EdsSlaveOptions options,
               std::optional<TimePoint> power_on, Logger log = {})
       : SimDevice(world) {
     build(power_on, std::move(file), options, std::move(log));

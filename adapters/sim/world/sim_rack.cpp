@@ -55,7 +55,7 @@ SimSlave& SimRack::device(devicenet::MacId mac) {
   return *it->second;
 }
 
-SimEdsSlave& SimRack::add_eds_device(const eds::EdsFile& file, EdsSlaveOptions options,
+SimEdsSlave& SimRack::add_eds_device(const profiles::eds::EdsFile& file, EdsSlaveOptions options,
                                      std::optional<TimePoint> power_on) {
   const unsigned mac = options.mac;
   Logger log = log_ ? Logger(*log_, fmt::format("sim {}", mac)) : Logger();

@@ -57,7 +57,7 @@ class SimRack {
   SimSlave& device(devicenet::MacId mac);
   bool has_device(devicenet::MacId mac) const { return devices_.count(mac.value()) != 0; }
   // A simulated device driven by `file`, powered on at `power_on` if given.
-  SimEdsSlave& add_eds_device(const eds::EdsFile& file, EdsSlaveOptions options,
+  SimEdsSlave& add_eds_device(const profiles::eds::EdsFile& file, EdsSlaveOptions options,
                               std::optional<TimePoint> power_on);
   SimEdsSlave& eds_device(devicenet::MacId mac);
 

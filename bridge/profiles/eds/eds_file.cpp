@@ -11,7 +11,7 @@
 #include "bridge/common/text.hpp"
 #include "bridge/profiles/eds/eds_file_internal.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 
 using eds_file_detail::number_after;
 using eds_file_detail::numbered;
@@ -212,4 +212,4 @@ Parsed parse(std::string_view text) {
   return out;
 }
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

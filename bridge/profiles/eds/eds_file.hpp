@@ -32,7 +32,7 @@
 #include "bridge/cip/epath.hpp"
 #include "bridge/profiles/eds/eds_text.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 
 struct Device {
   std::uint16_t vendor_code = 0;
@@ -195,4 +195,4 @@ Parsed parse(std::string_view text);
 // "FILE:LINE: error: MESSAGE" (or warning), as compilers write them.
 std::string format_problem(std::string_view file, const Problem& problem);
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

@@ -9,7 +9,7 @@
 
 #include "bridge/profiles/eds/eds_file_internal.hpp"
 
-namespace dnbridge::eds::eds_file_detail {
+namespace dnbridge::profiles::eds::eds_file_detail {
 
 // AssemN members that lead back to an assembly they are in.
 void Reader::assembly_cycles(const EdsFile& f) {
@@ -108,4 +108,4 @@ void Reader::cross_check(const EdsFile& f) {
   }
 }
 
-}  // namespace dnbridge::eds::eds_file_detail
+}  // namespace dnbridge::profiles::eds::eds_file_detail

@@ -9,7 +9,7 @@
 #include "bridge/common/text.hpp"
 #include "bridge/profiles/eds/eds_file_internal.hpp"
 
-namespace dnbridge::eds::eds_file_detail {
+namespace dnbridge::profiles::eds::eds_file_detail {
 
 void Reader::error(std::uint32_t line, std::string message) {
   add(line, Problem::Severity::kError, std::move(message));
@@ -142,4 +142,4 @@ std::optional<cip::EPath> Reader::path(const Entry& e, std::size_t i, std::strin
   return *decoded;
 }
 
-}  // namespace dnbridge::eds::eds_file_detail
+}  // namespace dnbridge::profiles::eds::eds_file_detail

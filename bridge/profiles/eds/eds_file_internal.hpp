@@ -20,7 +20,7 @@
 #include "bridge/profiles/eds/eds_file.hpp"
 #include "bridge/profiles/eds/eds_text.hpp"
 
-namespace dnbridge::eds::eds_file_detail {
+namespace dnbridge::profiles::eds::eds_file_detail {
 
 // The entry numbered `number` of `list`, or nullptr.
 const IoData* numbered(const std::vector<IoData>& list, unsigned number) noexcept;
@@ -100,4 +100,4 @@ class Reader {
   std::uint32_t defaults_line_ = 0;
 };
 
-}  // namespace dnbridge::eds::eds_file_detail
+}  // namespace dnbridge::profiles::eds::eds_file_detail

@@ -8,7 +8,7 @@
 #include "bridge/common/text.hpp"
 #include "bridge/profiles/eds/eds_file_internal.hpp"
 
-namespace dnbridge::eds::eds_file_detail {
+namespace dnbridge::profiles::eds::eds_file_detail {
 
 void Reader::device(const Section& s, Device& d) {
   const auto required = [&](std::string_view keyword, std::int64_t hi, auto& out) -> void {
@@ -126,4 +126,4 @@ void Reader::io_data(const Entry& e, unsigned number, std::vector<IoData>& list)
   list.push_back(std::move(d));
 }
 
-}  // namespace dnbridge::eds::eds_file_detail
+}  // namespace dnbridge::profiles::eds::eds_file_detail

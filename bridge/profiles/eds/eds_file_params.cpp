@@ -8,7 +8,7 @@
 #include "bridge/profiles/eds/eds_file_internal.hpp"
 #include "bridge/profiles/eds/io_layout.hpp"
 
-namespace dnbridge::eds::eds_file_detail {
+namespace dnbridge::profiles::eds::eds_file_detail {
 
 std::optional<Param> Reader::param(const Entry& e, unsigned number) {
   Param p;
@@ -157,4 +157,4 @@ std::optional<Assembly> Reader::assembly(const Entry& e, unsigned number) {
   return a;
 }
 
-}  // namespace dnbridge::eds::eds_file_detail
+}  // namespace dnbridge::profiles::eds::eds_file_detail

@@ -4,7 +4,7 @@
 
 #include "bridge/common/text.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 namespace {
 
 // A blank within a line (a newline ends one).
@@ -242,4 +242,4 @@ const Section* Text::find(std::string_view name) const noexcept {
 
 Lexed lex(std::string_view input) { return Lexer(input).run(); }
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

@@ -19,7 +19,7 @@
 #include <string_view>
 #include <vector>
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 
 // Something wrong in the file, at a line (1-based). An error leaves the file
 // unusable; a warning names what was skipped or assumed.
@@ -77,4 +77,4 @@ struct Lexed {
 // A UTF-8 byte order mark at the start is skipped.
 Lexed lex(std::string_view input);
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

@@ -10,7 +10,7 @@
 #include "bridge/cip/assembly.hpp"
 #include "bridge/common/text.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 namespace {
 
 constexpr DataType kBits{0, "bits", 0, false, false};
@@ -320,4 +320,4 @@ Status check(const IoLayout& layout, Bytes data, std::string* why) {
   return {};
 }
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

@@ -18,7 +18,7 @@
 #include "bridge/common/result.hpp"
 #include "bridge/profiles/eds/eds_file.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 
 struct IoField {
   std::string name;   // the parameter's; a path member: its path described
@@ -98,4 +98,4 @@ Result<std::vector<std::uint8_t>> encode(const IoLayout& layout,
 // another size, kOutOfRange for a field, `why` saying which and what.
 Status check(const IoLayout& layout, Bytes data, std::string* why = nullptr);
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

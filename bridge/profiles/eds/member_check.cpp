@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <optional>
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 namespace {
 
 // What an EDS member should be on the device: padding (an empty path), a
@@ -72,4 +72,4 @@ std::vector<std::string> member_differences(const EdsFile& file, const Assembly&
   return out;
 }
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

@@ -8,7 +8,7 @@
 #include "bridge/cip/assembly.hpp"
 #include "bridge/profiles/eds/eds_file.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 
 // One sentence per difference, empty when they agree. A member is compared
 // by its size in bits and by what it is: padding, or a path (a ParamN member
@@ -17,4 +17,4 @@ namespace dnbridge::eds {
 std::vector<std::string> member_differences(const EdsFile& file, const Assembly& expected,
                                             const std::vector<cip::AssemblyMember>& reported);
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

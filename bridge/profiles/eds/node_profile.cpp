@@ -14,7 +14,7 @@
 #include "bridge/common/text.hpp"
 #include "bridge/profiles/eds/member_check.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 namespace {
 
 // Says why in `why` and returns `code`.
@@ -386,4 +386,4 @@ std::optional<devicenet::AttributeSetting> kept_setting(const Param& p) {
   return s;
 }
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

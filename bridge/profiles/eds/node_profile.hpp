@@ -21,7 +21,7 @@
 #include "bridge/profiles/eds/eds_file.hpp"
 #include "bridge/profiles/eds/io_layout.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 
 // A parameter's value as the device holds it (the EDS's minimum, maximum
 // and default are in these units; no scaling).
@@ -118,4 +118,4 @@ DeviceSafeState device_safe_state(const EdsFile& file, const EdsNode& node);
 // path to an attribute or is not of 1, 2 or 4 bytes.
 std::optional<devicenet::AttributeSetting> kept_setting(const Param& p);
 
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

@@ -14,7 +14,7 @@
 #include "tests/fuzz/support/fuzz_check.hpp"
 
 using namespace dnbridge;
-using namespace dnbridge::eds;
+using namespace dnbridge::profiles::eds;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

@@ -32,7 +32,7 @@ Assem2 = "y", , 16, 0, , , 16, Param1;
 )";
 
 sim::EdsObjects& device() {
-  static sim::EdsObjects objects(*eds::parse(kEds).file, 1);
+  static sim::EdsObjects objects(*profiles::eds::parse(kEds).file, 1);
   return objects;
 }
 
@@ -47,7 +47,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(out[0] == (request->service | 0x80) || (out[0] == 0x94 && n == 3));
   // No Set leaves a value outside its limits, nor one that is not a number.
   for (unsigned number = 1; number <= 4; ++number) {
-    const eds::Param* p = device().file().param(number);
+    const profiles::eds::Param* p = device().file().param(number);
     const auto v = device().param_number(number);
     FUZZ_CHECK(p != nullptr && v.has_value() && std::isfinite(*v));
     const auto limit = [&](double l) {

@@ -44,22 +44,22 @@ constexpr std::uint8_t kMac = 1;
 constexpr unsigned kDigitalInputs = 3;
 constexpr unsigned kModuleStatus = 5;
 
-eds::EdsFile read_example(const char* name) {
+profiles::eds::EdsFile read_example(const char* name) {
   std::ifstream in(std::string(DNBRIDGE_EDS_DIR) + "/" + name);
   std::stringstream text;
   text << in.rdbuf();
-  auto parsed = eds::parse(text.str());
+  auto parsed = profiles::eds::parse(text.str());
   FUZZ_CHECK(parsed.file.has_value());
   return std::move(*parsed.file);
 }
 
 // deploy/eds's examples, read once.
-const eds::EdsFile& io_block() {
-  static const eds::EdsFile file = read_example("dnbridge-example-io-block.eds");
+const profiles::eds::EdsFile& io_block() {
+  static const profiles::eds::EdsFile file = read_example("dnbridge-example-io-block.eds");
   return file;
 }
-const eds::EdsFile& valve_manifold() {
-  static const eds::EdsFile file = read_example("dnbridge-example-valve-manifold.eds");
+const profiles::eds::EdsFile& valve_manifold() {
+  static const profiles::eds::EdsFile file = read_example("dnbridge-example-valve-manifold.eds");
   return file;
 }
 
@@ -126,7 +126,7 @@ void check_consistent(const EdsSlave& slave) {
   FUZZ_CHECK(slave.connections().strobe_connection().consumed_assembly == 0);
 }
 
-void run(const eds::EdsFile& file, Bytes input) {
+void run(const profiles::eds::EdsFile& file, Bytes input) {
   CheckingSink sink;
   sim::EdsSlaveOptions options;
   options.mac = kMac;

@@ -66,11 +66,11 @@ struct Scenario {
   bool valves = true;  // the valve manifold at MAC 3
 };
 
-eds::EdsFile valve_manifold() {
+profiles::eds::EdsFile valve_manifold() {
   std::ifstream in(std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-valve-manifold.eds");
   std::stringstream text;
   text << in.rdbuf();
-  auto parsed = eds::parse(text.str());
+  auto parsed = profiles::eds::parse(text.str());
   if (!parsed.file) {
     std::fprintf(stderr, "the valve manifold's EDS does not read\n");
     std::exit(1);

@@ -112,7 +112,7 @@ class DioProfileTest : public ::testing::Test {
     auto backend = std::make_unique<sim::SimBackend>(
         can::kBitrate500k, std::vector<MacId>{}, nullptr,
         std::vector<sim::EdsDeviceSpec>{
-            {kNode, std::make_shared<const eds::EdsFile>(example_eds(kIoBlockEds))}});
+            {kNode, std::make_shared<const profiles::eds::EdsFile>(example_eds(kIoBlockEds))}});
     loop_.emplace(port_config(with_io_block), std::move(backend), publisher_, null_log_sink());
     input_.emplace(bridge_, publisher_, rack_,
                    std::map<std::string, port::PortLoop*, std::less<>>{{kPort, &*loop_}}, Logger(),

@@ -23,13 +23,13 @@ namespace {
 constexpr std::uint8_t kGet = 0x0E;
 constexpr std::uint8_t kSet = 0x10;
 
-eds::EdsFile io_block() {
+profiles::eds::EdsFile io_block() {
   std::ifstream in(std::string(DNBRIDGE_EDS_DIR) + "/dnbridge-example-io-block.eds");
   std::stringstream text;
   text << in.rdbuf();
-  auto parsed = eds::parse(text.str());
+  auto parsed = profiles::eds::parse(text.str());
   EXPECT_TRUE(parsed.file.has_value());
-  return parsed.file.value_or(eds::EdsFile{});
+  return parsed.file.value_or(profiles::eds::EdsFile{});
 }
 
 // The response message of `objects` to a request: service byte first.
@@ -91,8 +91,9 @@ TEST_F(EdsObjectsTest, AssemblyMemberListsAgreeWithTheirEds) {
   ASSERT_TRUE(members.ok());
   ASSERT_EQ(members->size(), 3u);
   EXPECT_EQ(cip::describe((*members)[1]), "8 bits: class 0x0F instance 0x05 attribute 0x01");
-  const eds::EdsFile& f = objects_.file();
-  EXPECT_TRUE(eds::member_differences(f, *f.assembly_at(f.io.input(1)->path), *members).empty());
+  const profiles::eds::EdsFile& f = objects_.file();
+  EXPECT_TRUE(
+      profiles::eds::member_differences(f, *f.assembly_at(f.io.input(1)->path), *members).empty());
   const auto outputs = get(4, 150, 2);
   auto out_members = cip::decode_member_list(Bytes(outputs.data(), outputs.size()));
   ASSERT_TRUE(out_members.ok());
@@ -164,8 +165,8 @@ TEST_F(EdsObjectsTest, RequestsAreCheckedInTheCdn127SimulatorsOrder) {
 
 // A device of its own EDS: members at bit offsets, a nested assembly, a REAL
 // parameter, a string parameter.
-eds::EdsFile packed_device() {
-  auto parsed = eds::parse(R"(
+profiles::eds::EdsFile packed_device() {
+  auto parsed = profiles::eds::parse(R"(
 [Device]
 VendCode = 1; ProdType = 0; ProdCode = 2; MajRev = 1; MinRev = 1;
 [Params]
@@ -178,7 +179,7 @@ Assem1 = "outer", "20 04 24 01 30 03", 16, 0, , , 4, Param1, 1, Param2, 3, , 8, 
 Assem2 = "inner", "20 04 24 02 30 03", 8, 0, , , 4, Param1, 4, ;
 )");
   EXPECT_TRUE(parsed.file.has_value());
-  return parsed.file.value_or(eds::EdsFile{});
+  return parsed.file.value_or(profiles::eds::EdsFile{});
 }
 
 TEST(EdsObjectsPacking, MembersArePackedAtTheirBitsAndNestedAssembliesInside) {

@@ -234,15 +234,15 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
-eds::EdsFile parsed(const std::string& text) {
-  auto r = eds::parse(text);
+profiles::eds::EdsFile parsed(const std::string& text) {
+  auto r = profiles::eds::parse(text);
   EXPECT_TRUE(r.file.has_value());
-  return r.file.value_or(eds::EdsFile{});
+  return r.file.value_or(profiles::eds::EdsFile{});
 }
 
 // The example I/O block with its input (Input1, Assembly 100) 10 bytes long:
 // 48 bits of padding after the analog input.
-eds::EdsFile io_block_with_long_input() {
+profiles::eds::EdsFile io_block_with_long_input() {
   std::string t = test::example_eds_text(test::kIoBlockEds);
   t = replaced(t, "4,                      $ size in bytes", "10,");
   t = replaced(t, "32,                     $ size in bits", "80,");
@@ -251,7 +251,7 @@ eds::EdsFile io_block_with_long_input() {
 }
 
 // The same with its output (Output1, Assembly 150) 10 bytes long.
-eds::EdsFile io_block_with_long_output() {
+profiles::eds::EdsFile io_block_with_long_output() {
   std::string t = test::example_eds_text(test::kIoBlockEds);
   t = replaced(t, "Output1 =\n                2,", "Output1 =\n                10,");
   t = replaced(t, "\n                16,\n", "\n                80,\n");
@@ -262,7 +262,7 @@ eds::EdsFile io_block_with_long_output() {
 // The example I/O block with a second output, Output2: Assembly 151, the
 // input filter (Param1, 2 bytes) as a master may set it on every poll.
 constexpr std::uint16_t kOutputs2 = 151;
-eds::EdsFile io_block_with_two_outputs() {
+profiles::eds::EdsFile io_block_with_two_outputs() {
   std::string t = test::example_eds_text(test::kIoBlockEds);
   t = replaced(t, R"("Digital outputs 0..7, then a pad byte";)",
                R"("Digital outputs 0..7, then a pad byte";
@@ -278,7 +278,7 @@ class EdsSlaveByFrames : public ::testing::Test {
  protected:
   EdsSlaveByFrames() : tester_(world_) {}
 
-  void start(eds::EdsFile file = test::example_eds(test::kIoBlockEds)) {
+  void start(profiles::eds::EdsFile file = test::example_eds(test::kIoBlockEds)) {
     sim::EdsSlaveOptions o;
     o.mac = kSlaveMac;
     slave_.emplace(world_, std::move(file), o, world_.now());

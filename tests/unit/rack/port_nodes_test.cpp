@@ -36,7 +36,7 @@ DeviceConfig io_block(unsigned m) {
   DeviceConfig d;
   d.node.mac = mac(m);
   d.node.name = "io " + std::to_string(m);
-  d.eds = std::make_shared<const eds::EdsFile>(test::example_eds(test::kIoBlockEds));
+  d.eds = std::make_shared<const profiles::eds::EdsFile>(test::example_eds(test::kIoBlockEds));
   d.eds_path = test::kIoBlockEds;
   d.settings.safe_state_of_device = true;
   return d;

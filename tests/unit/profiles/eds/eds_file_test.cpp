@@ -13,7 +13,7 @@
 
 #include "tests/support/example_eds.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 namespace {
 
 using ::testing::HasSubstr;
@@ -394,4 +394,4 @@ TEST(EdsFile, AProblemIsWrittenAsCompilersWriteThem) {
 }
 
 }  // namespace
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

@@ -12,7 +12,7 @@
 
 #include "tests/support/example_eds.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 namespace {
 
 using ::testing::HasSubstr;
@@ -233,4 +233,4 @@ TEST(EdsIoLayout, DataToSendHasItsSizeEveryFieldWithinItsLimitsAndPaddingZero) {
 }
 
 }  // namespace
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

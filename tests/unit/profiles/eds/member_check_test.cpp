@@ -7,7 +7,7 @@
 
 #include "tests/support/example_eds.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 namespace {
 
 using ::testing::ElementsAre;
@@ -77,4 +77,4 @@ TEST(EdsMemberCheck, APaddingMemberExpectedIsComparedAsPadding) {
 }
 
 }  // namespace
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds

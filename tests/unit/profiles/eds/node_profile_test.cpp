@@ -12,7 +12,7 @@
 #include "bridge/cip/assembly.hpp"
 #include "tests/support/example_eds.hpp"
 
-namespace dnbridge::eds {
+namespace dnbridge::profiles::eds {
 namespace {
 
 using ::testing::HasSubstr;
@@ -369,4 +369,4 @@ TEST(EdsNodeProfile, TheSafeStateParametersNotGivenAreTheDevicesOwn) {
 }
 
 }  // namespace
-}  // namespace dnbridge::eds
+}  // namespace dnbridge::profiles::eds
