@@ -286,7 +286,6 @@ void warn_of_safe_state(const EdsRead& e, const toml::node& eds_key, const toml:
 // against the EDS as the master will take them. [defaults] read alone
 // (layers.node null) has its values and its EDS file checked as they stand.
 void read_eds_node(const Layers& layers, ReadContext& ctx, NodeSettings& s, Problems& r) {
-  if (layers.per_node()) refuse_other_profiles_keys(*layers.node, kEdsNodes, r);
   const toml::node* connection = read_eds_connection(layers, s, r);
   const toml::node* parameters = layers.find("parameters").value;
   if (parameters) {

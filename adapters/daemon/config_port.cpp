@@ -263,11 +263,8 @@ void read_port_nodes(TableReader& t, const toml::table& table, PortConfig& port,
                             "the outputs of a commander that falls silent stay as it left them",
                             s.pump.node.name));
     }
-    if (s.is_eds()) {
-      read_eds_node(Layers{&nt, defaults}, ctx, s, r);
-    } else {
-      refuse_other_profiles_keys(nt, kCdn127Nodes, r);
-    }
+    refuse_other_profiles_keys(nt, s.is_eds() ? kEdsNodes : kCdn127Nodes, r);
+    if (s.is_eds()) read_eds_node(Layers{&nt, defaults}, ctx, s, r);
     if (ok) port.nodes.push_back(std::move(s));
   }
 }

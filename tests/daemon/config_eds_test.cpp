@@ -25,17 +25,21 @@ using ::testing::HasSubstr;
   "interface = \"simulated\"\n" \
   "bitrate = 500000\n"
 
-// Lines 6..: the example I/O block at MAC 20, with its safe state.
-#define IO_BLOCK                                                               \
-  "[[port.node]]\n"                                                            \
-  "mac = 20\n"                                                                 \
-  "name = \"io-1\"\n"                                                          \
-  "profile = \"eds\"\n"                                                        \
-  "eds = \"dnbridge-example-io-block.eds\"\n"                                  \
-  "safe_state_parameters = [ { name = \"Output fault action\", value = 0 },\n" \
-  "               { name = \"Output fault value\", value = 0 },\n"             \
-  "               { name = \"Output idle action\", value = 0 },\n"             \
+// The example I/O block's safe state: its four parameters, on four lines.
+#define IO_BLOCK_SAFE_STATE                                        \
+  "[ { name = \"Output fault action\", value = 0 },\n"             \
+  "               { name = \"Output fault value\", value = 0 },\n" \
+  "               { name = \"Output idle action\", value = 0 },\n" \
   "               { name = \"Output idle value\", value = 0 } ]\n"
+
+// Lines 6..: the example I/O block at MAC 20, with its safe state.
+#define IO_BLOCK                              \
+  "[[port.node]]\n"                           \
+  "mac = 20\n"                                \
+  "name = \"io-1\"\n"                         \
+  "profile = \"eds\"\n"                       \
+  "eds = \"dnbridge-example-io-block.eds\"\n" \
+  "safe_state_parameters = " IO_BLOCK_SAFE_STATE
 
 DaemonConfig parse(std::string_view text, const std::filesystem::path& base = DNBRIDGE_EDS_DIR) {
   return parse_config(text, "t.toml", base);
@@ -144,10 +148,7 @@ TEST(ConfigEds, SafeStateAsAnArrayIsReadAsItsParametersAndWarnedOf) {
   const DaemonConfig c = parse(ONE_PORT
                                "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
                                "eds = \"dnbridge-example-io-block.eds\"\n"
-                               "safe_state = [ { name = \"Output fault action\", value = 0 },\n"
-                               "               { name = \"Output fault value\", value = 0 },\n"
-                               "               { name = \"Output idle action\", value = 0 },\n"
-                               "               { name = \"Output idle value\", value = 0 } ]\n");
+                               "safe_state = " IO_BLOCK_SAFE_STATE);
   const NodeSettings& n = c.ports.at(0).nodes.at(0);
   EXPECT_EQ(n.eds_node.safe_state.size(), 4u);
   EXPECT_FALSE(n.eds_node.safe_state_of_device);
@@ -162,10 +163,7 @@ TEST(ConfigEds, SafeStateAsAnArrayIsReadAsItsParametersAndWarnedOf) {
       "[[port]]\nname = \"A\"\ninterface = \"simulated\"\nbitrate = 500000\n"
       "[[port.node]]\nmac = 20\nname = \"io-1\"\nprofile = \"eds\"\n"
       "eds = \"dnbridge-example-io-block.eds\"\n"
-      "safe_state = [ { name = \"Output fault action\", value = 0 },\n"
-      "               { name = \"Output fault value\", value = 0 },\n"
-      "               { name = \"Output idle action\", value = 0 },\n"
-      "               { name = \"Output idle value\", value = 0 } ]\n");
+      "safe_state = " IO_BLOCK_SAFE_STATE);
   EXPECT_FALSE(d.ports.at(0).nodes.at(0).eds_node.safe_state_of_device);
   EXPECT_EQ(d.ports[0].nodes[0].eds_node.safe_state.size(), 4u);
   // Its parameters alone, under [defaults]' "device", say two things: where
