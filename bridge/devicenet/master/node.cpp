@@ -39,8 +39,8 @@ Node::Node(NodeConfig config, const ScannerConfig& port, can::FrameSink& sink,
       client_(port.master_mac, config_.mac, client_config(config_, port), sink, *this),
       retry_delay_(port.allocate_retry_min),
       jitter_state_(0x9E3779B9u ^ (static_cast<std::uint32_t>(config_.mac.value()) * 0x85EBCA6Bu)),
-      poll_epr_(config_.expected_packet_rate),
-      explicit_epr_(config_.explicit_packet_rate) {}
+      explicit_epr_(config_.explicit_packet_rate),
+      poll_(config_, port, sink, counters_, *this) {}
 
 void Node::apply_port_timings() {
   client_.set_response_timeout(client_config(config_, port_).response_timeout);
@@ -109,13 +109,10 @@ void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
   if (state_ == NodeState::kOnline) {
     ++counters_.reconnects;
     // Outputs to the device's idle state before the connections go.
-    idle_poll_before_release(now);
+    poll_.send_idle_before_release(now);
   }
-  next_poll_ = kNever;
-  deferred_poll_ = kNever;
-  poll_deadline_ = kNever;
+  poll_.stop();
   keepalive_at_ = kNever;
-  poll_outstanding_ = false;
   cos_.reset();
   set_state(fault, std::move(reason), now);
   retry_at_ = now + port_.fault_recheck;
@@ -143,7 +140,7 @@ void Node::begin_shutdown(TimePoint now) {
   if (shutting_down_) return;
   shutting_down_ = true;
   retry_at_ = kNever;
-  next_poll_ = kNever;
+  poll_.stop_slots();
   keepalive_at_ = kNever;
   step_ = Step::kNone;
   client_.cancel_all(Errc::kStopped, now);
@@ -154,9 +151,8 @@ void Node::begin_shutdown(TimePoint now) {
     // is one poll per node, so it cannot flood the bus, and a delay would
     // only leave the device in its commanded state longer. It supersedes a
     // poll held back by the gap (shutdown stops the node's timers).
-    idle_ = true;
-    outputs_dirty_ = true;
-    if (!poll_outstanding_) send_poll(now);
+    poll_.force_idle();
+    if (!poll_.outstanding()) poll_.send(now);
     return;
   }
   if (connected_) {
@@ -168,24 +164,18 @@ void Node::begin_shutdown(TimePoint now) {
 
 void Node::release_for_shutdown(TimePoint now) {
   if (step_ == Step::kReleaseShutdown || state_ == NodeState::kStopped) return;
-  poll_outstanding_ = false;
-  poll_deadline_ = kNever;
+  poll_.drop_outstanding();
   release(Step::kReleaseShutdown, held_connections(), now);
 }
 
 void Node::forget_connections(Errc why, TimePoint now) {
   retry_at_ = kNever;
-  next_poll_ = kNever;
-  deferred_poll_ = kNever;
-  poll_deadline_ = kNever;
+  poll_.stop();
   keepalive_at_ = kNever;
-  poll_outstanding_ = false;
   step_ = Step::kNone;
   connected_ = false;
-  poll_allocated_ = false;
-  poll_requested_ = false;
-  cos_allocated_ = false;
-  cos_requested_ = false;
+  poll_.allocation().forget();
+  cos_allocation_.forget();
   cos_.reset();
   client_.cancel_all(why, now);
 }
@@ -229,10 +219,8 @@ void Node::on_timer(TimePoint now) {
   if (now >= retry_at_ && !shutting_down_) attempt_allocate(now);
   if (state_ != NodeState::kOnline) return;
 
-  if (poll_outstanding_ && now >= poll_deadline_) {
-    poll_outstanding_ = false;
-    poll_unanswered_ = true;
-    poll_deadline_ = kNever;
+  if (now >= poll_.response_deadline()) {
+    poll_.give_up();
     ++counters_.timeouts;
     record(NodeError::Kind::kPollTimeout, now);
     // A stopping node's poll went unanswered: its idle poll next, if the
@@ -243,10 +231,10 @@ void Node::on_timer(TimePoint now) {
   if (shutting_down_) return;
   // The device drops the connection after 4 x EPR without a poll; the master
   // drops the node after 4 x EPR without a response.
-  if (now - last_response_ >= 4 * poll_epr_) {
+  if (poll_.silence(now) >= 4 * poll_.epr()) {
     record(NodeError::Kind::kConnectionLost, now);
     lose(fmt::format("no poll response for {} ms (4 x EPR)",
-                     std::chrono::duration_cast<milliseconds>(now - last_response_).count()),
+                     std::chrono::duration_cast<milliseconds>(poll_.silence(now)).count()),
          now);
     return;
   }
@@ -271,17 +259,7 @@ void Node::on_timer(TimePoint now) {
         now);
     return;
   }
-  if (now >= next_poll_) {
-    next_poll_ = next_poll_slot(now + Duration(1));
-    if (!poll_outstanding_) send_poll(now);
-  }
-  if (now >= deferred_poll_) {
-    // The end of the minimum gap after the last poll for changed outputs. A
-    // poll outstanding now (none should be: any poll sent clears this) leaves
-    // the changes to its response, as without the gap.
-    deferred_poll_ = kNever;
-    if (outputs_dirty_ && !poll_outstanding_) poll_on_change(now);  // the gap is over: now
-  }
+  poll_.on_timer(now);
   if (now >= keepalive_at_) {
     keepalive_at_ = now + explicit_epr_;
     // The keep-alive reads the device's health: Identity.Status (fault bits)
@@ -300,11 +278,11 @@ void Node::on_timer(TimePoint now) {
 
 TimePoint Node::deadline() const {
   TimePoint t = client_.deadline();
-  if (state_ == NodeState::kOnline && poll_outstanding_) t = std::min(t, poll_deadline_);
+  if (state_ == NodeState::kOnline) t = std::min(t, poll_.response_deadline());
   if (shutting_down_) return t;
   t = std::min(t, retry_at_);
   if (state_ == NodeState::kOnline) {
-    t = std::min({t, next_poll_, deferred_poll_, keepalive_at_, last_response_ + 4 * poll_epr_});
+    t = std::min({t, poll_.timers_deadline(), keepalive_at_});
     if (cos_) t = std::min(t, cos_->watchdog_deadline());
   }
   return t;
@@ -362,19 +340,6 @@ bool Node::check_health(TimePoint now) {
   return false;
 }
 
-void Node::idle_poll_before_release(TimePoint now) {
-  // Frames written to the port leave in the order written: the Release
-  // that follows reaches the device after this poll.
-  stray_poll_responses_ = poll_outstanding_ ? 2 : 1;
-  const bool idle = idle_;
-  idle_ = true;
-  send_poll(now);
-  idle_ = idle;
-  // Its answer is a stray, counted above: no poll of the node's own waits.
-  poll_outstanding_ = false;
-  poll_deadline_ = kNever;
-}
-
 void Node::device_fault(std::string reason, TimePoint now) {
   enter_fault(NodeState::kDeviceFault, std::move(reason), now);
 }
@@ -383,7 +348,7 @@ void Node::lose_and_release(std::string reason, TimePoint now) {
   // The poll connection lives: the outputs go to the device's idle state at
   // once rather than after its own watchdog, and what the device holds is
   // released (the node is allocated afresh after the back-off).
-  if (state_ == NodeState::kOnline) idle_poll_before_release(now);
+  if (state_ == NodeState::kOnline) poll_.send_idle_before_release(now);
   const std::uint8_t held = held_connections();
   lose(std::move(reason), now);
   if (held != 0) release(Step::kReleaseFault, held, now);
@@ -391,20 +356,14 @@ void Node::lose_and_release(std::string reason, TimePoint now) {
 
 void Node::go_online(TimePoint now) {
   retry_delay_ = port_.allocate_retry_min;
-  stray_poll_responses_ = 0;
   cos_consecutive_errors_ = 0;
-  poll_outstanding_ = false;
-  poll_unanswered_ = false;
-  consecutive_errors_ = 0;
-  last_response_ = now;
+  poll_.start(now);
   last_explicit_answer_ = now;
-  next_poll_ = next_poll_slot(now);
   keepalive_at_ = now + explicit_epr_;
-  io_reassembler_.reset();
   std::string reason =
       fmt::format("polled every {} ms; EPR {} ms (explicit {} ms); {} B out, {} B in",
                   std::chrono::duration_cast<milliseconds>(config_.poll_period).count(),
-                  std::chrono::duration_cast<milliseconds>(poll_epr_).count(),
+                  std::chrono::duration_cast<milliseconds>(poll_.epr()).count(),
                   std::chrono::duration_cast<milliseconds>(explicit_epr_).count(),
                   config_.profile.consumed_size, config_.profile.produced_size);
   if (produced_from_fallback_ || consumed_from_fallback_) {
@@ -434,7 +393,7 @@ void Node::go_online(TimePoint now) {
   if (!identity_state_supported_) reason += "; Identity.State not supported: state unknown";
   set_state(NodeState::kOnline, std::move(reason), now);
   // Outputs set before the node came online go out with the first poll.
-  send_poll(now);
+  poll_.send(now);
 }
 
 Status Node::request_explicit(std::uint32_t request_id, const RequestMessage& request,

@@ -19,16 +19,17 @@
 #include "bridge/devicenet/master/cos_consumer.hpp"
 #include "bridge/devicenet/master/explicit_client.hpp"
 #include "bridge/devicenet/master/node_state.hpp"
+#include "bridge/devicenet/master/poll_connection.hpp"
 #include "bridge/devicenet/master/scan_list.hpp"
 #include "bridge/devicenet/master/scanner_events.hpp"
 #include "bridge/devicenet/wire/fragmentation.hpp"
 
 namespace dnbridge::devicenet {
 
-class Node final : private ExplicitClient::Listener {
+class Node final : private ExplicitClient::Listener, private PollConnection::Listener {
  public:
   // Largest poll message handled (fragmented I/O above 8 bytes).
-  static constexpr std::size_t kMaxIoSize = 64;
+  static constexpr std::size_t kMaxIoSize = kMaxIoMessageSize;
   // Internal request tags have this bit set; external request ids must not.
   static constexpr std::uint32_t kInternalTag = 0x8000'0000u;
 
@@ -79,7 +80,7 @@ class Node final : private ExplicitClient::Listener {
   Status request_explicit(std::uint32_t request_id, const RequestMessage& request, TimePoint now);
 
   // Poll slot: the node polls at phase + k * poll_period.
-  void set_poll_phase(TimePoint phase) { poll_phase_ = phase; }
+  void set_poll_phase(TimePoint phase) { poll_.set_phase(phase); }
   // The slot of the next poll; kNever when the node is not being polled.
   TimePoint next_poll() const;
   // Serves the next slot now, ahead of time (the scanner batches polls due
@@ -104,11 +105,11 @@ class Node final : private ExplicitClient::Listener {
   const std::vector<std::vector<std::uint8_t>>& settings_in_force() const {
     return settings_in_force_;
   }
-  bool idle() const { return idle_; }
+  bool idle() const { return poll_.idle(); }
   // Outputs and idle flag of the last poll the device answered.
-  Bytes applied_outputs() const { return applied_outputs_.view(); }
-  bool applied_idle() const { return applied_idle_; }
-  Duration poll_epr() const { return poll_epr_; }
+  Bytes applied_outputs() const { return poll_.applied_outputs(); }
+  bool applied_idle() const { return poll_.applied_idle(); }
+  Duration poll_epr() const { return poll_.epr(); }
   // The wait for an explicit answer that requests from now on get.
   Duration explicit_response_timeout() const { return client_.response_timeout(); }
   Duration explicit_epr() const { return explicit_epr_; }
@@ -235,8 +236,7 @@ class Node final : private ExplicitClient::Listener {
   // released (`release_step`) and allocated once more; owned by another
   // master, or another refusal (with `needed_by` after the status), a fault.
   Step io_allocate_refused(const ExplicitResult& r, TimePoint now, std::string_view what,
-                           std::string_view needed_by, bool& release_tried, bool& requested,
-                           Step release_step);
+                           std::string_view needed_by, IoAllocation& allocation, Step release_step);
   Step after_cos_step(const ExplicitResult& r, TimePoint now);
   // The change-of-state steps in order, those that do not apply skipped.
   Step cos_step_after(Step step) const;
@@ -249,11 +249,6 @@ class Node final : private ExplicitClient::Listener {
   // watchdog, bad poll responses): the outputs idle with one poll, every
   // connection released, then absent as after any loss.
   void lose_and_release(std::string reason, TimePoint now);
-  // One idle poll now, whatever the outputs in force, before the
-  // connections go: the device applies its idle action, not whatever it
-  // does on a Release (the manual names nothing). Its answer, and that to a
-  // poll outstanding, are strays: the node is not online when they come.
-  void idle_poll_before_release(TimePoint now);
   void on_keepalive_result(const ExplicitResult& r, TimePoint now);
   // The Identity Status and State read last: a major fault takes the node to
   // kDeviceFault (false); a minor one is warned of when it appears.
@@ -304,26 +299,14 @@ class Node final : private ExplicitClient::Listener {
   // port's maximum, with jitter, so that a broken node never floods the bus.
   Duration next_backoff();
 
-  void send_poll(TimePoint now);
-  // The poll for outputs that changed: now, or at the end of the minimum gap
-  // after the last one (NodeConfig::immediate_poll_min_gap).
-  void poll_on_change(TimePoint now);
-  void accept_poll_response(Bytes data, TimePoint now);
-  void bad_poll_response(NodeError::Kind kind, std::uint32_t got, TimePoint now);
+  // The poll connection's answers (PollConnection::Listener).
+  void on_poll_answer(Bytes inputs, bool late, TimePoint now) override;
+  void on_bad_poll_answer(NodeError::Kind kind, std::uint32_t got, TimePoint now) override;
+  // A poll for outputs that changed, if the node is online and polls on change.
+  void poll_for_change(TimePoint now);
   void on_input_message(bool strobe_response, Bytes payload, TimePoint now);
   void take_cos_message(Bytes data, TimePoint now);
-  // One frame of an I/O message of `size` bytes: whole in it when it fits
-  // one frame, else a fragment for `reassembler` (reset it after a complete
-  // message, of the right size or not: `message` is its buffer).
-  struct IoFrame {
-    enum Outcome : std::uint8_t { kIncomplete, kComplete, kWrongSize, kOutOfOrder };
-    Outcome outcome = kComplete;
-    Bytes message;
-    std::uint32_t got = 0;  // the size received (kWrongSize, kOutOfOrder)
-  };
-  static IoFrame io_frame(IoReassembler& reassembler, Bytes payload, std::size_t size);
   void bad_cos_message(NodeError::Kind kind, std::uint32_t got, TimePoint now);
-  TimePoint next_poll_slot(TimePoint after) const;
 
   const NodeConfig config_;
   const ScannerConfig& port_;
@@ -335,9 +318,7 @@ class Node final : private ExplicitClient::Listener {
   NodeState state_ = NodeState::kAbsent;
   std::string reason_ = "not started";
   Step step_ = Step::kNone;
-  bool connected_ = false;       // the master holds the explicit connection
-  bool poll_allocated_ = false;  // ... and the poll connection
-  bool poll_requested_ = false;  // Allocate(poll) sent: the device may hold it unanswered
+  bool connected_ = false;  // the master holds the explicit connection
   bool shutting_down_ = false;
   bool started_ = false;
   bool reports_data_ = true;  // false once retired
@@ -347,10 +328,9 @@ class Node final : private ExplicitClient::Listener {
   std::uint32_t jitter_state_ = 0;  // xorshift state, seeded from the MAC
   std::size_t setting_index_ = 0;
   std::vector<std::vector<std::uint8_t>> settings_in_force_;
-  bool setting_retried_ = false;     // a refused Set retried once after releasing the poll
-  std::size_t check_index_ = 0;      // the check in hand
-  bool poll_release_tried_ = false;  // the poll Allocate retried once after a Release
-  std::uint8_t stale_choice_ = 0;    // I/O connections left from before, to release
+  bool setting_retried_ = false;   // a refused Set retried once after releasing the poll
+  std::size_t check_index_ = 0;    // the check in hand
+  std::uint8_t stale_choice_ = 0;  // I/O connections left from before, to release
   // A Release refused whole (0x0B): the connections still to release one
   // at a time (the one in hand included); 0 otherwise.
   std::uint8_t releases_left_ = 0;
@@ -379,43 +359,21 @@ class Node final : private ExplicitClient::Listener {
   bool identity_state_supported_ = true;
   bool keepalive_reads_status_ = false;  // which the last keep-alive read
   std::string minor_faults_;             // as last warned of
-  unsigned stray_poll_responses_ = 0;    // answers to expect to an idle poll before a Release
   bool epr_warned_ = false;
 
   NodeIdentity identity_;
   std::optional<std::uint8_t> device_state_;
-  Duration poll_epr_{};
   Duration explicit_epr_{};
 
-  // Poll connection.
-  TimePoint poll_phase_{};
-  TimePoint next_poll_ = kNever;
-  TimePoint poll_deadline_ = kNever;
-  TimePoint last_response_{};
+  NodeCounters counters_;
+  PollConnection poll_;
   TimePoint keepalive_at_ = kNever;
-  bool poll_outstanding_ = false;
-  bool poll_unanswered_ = false;  // the last poll timed out: the next is a retry
-  bool outputs_dirty_ = false;
-  // The last poll sent early because the outputs changed, and the time of the
-  // one held back until the minimum gap after it has elapsed (kNever: none).
-  TimePoint last_change_poll_ = TimePoint::min();
-  TimePoint deferred_poll_ = kNever;
-  bool idle_ = true;  // no outputs until the layer above sets them
-  unsigned consecutive_errors_ = 0;
   TimePoint last_explicit_answer_{};  // last explicit response, error or not
-  InlineBytes<kMaxIoSize> outputs_;
-  InlineBytes<kMaxIoSize> sent_outputs_;
-  bool sent_idle_ = true;
-  InlineBytes<kMaxIoSize> applied_outputs_;
-  bool applied_idle_ = true;
-  IoReassembler io_reassembler_{kMaxIoSize};
 
   // The input connection (change of state, cyclic or bit-strobe): what the
   // start-up learnt, then the consumer of its messages (from its Set of EPR
   // on; a bit-strobe connection's with acknowledgment suppressed).
-  bool cos_allocated_ = false;
-  bool cos_requested_ = false;
-  bool cos_release_tried_ = false;  // its Allocate retried once after a Release
+  IoAllocation cos_allocation_;
   unsigned cos_consecutive_errors_ = 0;
   bool ack_handler_unread_ = false;  // its timer or retry limit refused: defaults taken
   std::string cos_path_refusal_;
@@ -423,7 +381,6 @@ class Node final : private ExplicitClient::Listener {
   std::optional<CosConsumer> cos_;
   IoReassembler cos_reassembler_{kMaxIoSize};
 
-  NodeCounters counters_;
   NodeError last_error_;
   RateLimitedLog error_log_limit_;
 };

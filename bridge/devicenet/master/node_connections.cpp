@@ -170,7 +170,7 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
     explicit_epr_ = epr;
     return Step::kPollEpr;
   }
-  poll_epr_ = epr;
+  poll_.set_epr(epr);
   // A device that rounds the rate up beyond 4 poll periods makes a lost
   // connection noticed later than the configuration suggests: said once. (A
   // configured rate above that is the configuration's choice, not news.)
@@ -226,14 +226,14 @@ Node::Step Node::cos_step_after(Step step) const {
 
 Node::Step Node::after_allocate_cos(const ExplicitResult& r, TimePoint now) {
   if (r.ok()) {
-    cos_allocated_ = true;
+    cos_allocation_.allocated = true;
     return cos_step_after(Step::kAllocateCos);
   }
   const std::string_view kind = to_string(config_.profile.input_connection->kind);
   return io_allocate_refused(
       r, now, fmt::format("Allocate of the {} connection (choice 0x{:02X})", kind, cos_choice()),
-      fmt::format("; the node's connection = \"{}\" needs it", kind), cos_release_tried_,
-      cos_requested_, Step::kReleaseCosForAllocate);
+      fmt::format("; the node's connection = \"{}\" needs it", kind), cos_allocation_,
+      Step::kReleaseCosForAllocate);
 }
 
 // The answers to the change-of-state connection's set-up: what the device

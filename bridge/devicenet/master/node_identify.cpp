@@ -79,25 +79,26 @@ Node::Step Node::after_allocation_info(const ExplicitResult& r, TimePoint) {
 
 Node::Step Node::after_allocate_poll(const ExplicitResult& r, TimePoint now) {
   if (r.ok()) {
-    poll_allocated_ = true;
+    poll_.allocation().allocated = true;
     if (!config_.profile.produced_path.empty()) return Step::kGetProducedPath;
     if (!config_.profile.consumed_path.empty()) return Step::kGetConsumedPath;
     return begin_verify(now);
   }
-  return io_allocate_refused(r, now, "Allocate of the poll connection", "", poll_release_tried_,
-                             poll_requested_, Step::kReleasePollForAllocate);
+  return io_allocate_refused(r, now, "Allocate of the poll connection", "", poll_.allocation(),
+                             Step::kReleasePollForAllocate);
 }
 
 Node::Step Node::io_allocate_refused(const ExplicitResult& r, TimePoint now, std::string_view what,
-                                     std::string_view needed_by, bool& release_tried,
-                                     bool& requested, Step release_step) {
+                                     std::string_view needed_by, IoAllocation& allocation,
+                                     Step release_step) {
   // Held already (its answer to an Allocate lost on the bus, or left from
   // before): released, then allocated once more.
-  if (r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode && !release_tried) {
-    release_tried = true;
+  if (r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode &&
+      !allocation.release_tried) {
+    allocation.release_tried = true;
     return release_step;
   }
-  requested = false;  // refused: the device did not give it
+  allocation.requested = false;  // refused: the device did not give it
   if (r.general_status == cip::GeneralStatus::kObjectStateConflict && r.additional_status == 0x01) {
     enter_fault(NodeState::kOwnedByOtherMaster,
                 fmt::format("{} refused: owned by another master (0x0C/0x01)", what), now);
@@ -332,7 +333,7 @@ Node::Step Node::after_write_setting(const ExplicitResult& r, TimePoint now) {
 
 Node::Step Node::after_release_for_setting(const ExplicitResult&, TimePoint) {
   // "Not allocated" (0x0B) or done: either way no poll connection is left.
-  poll_allocated_ = poll_requested_ = false;
+  poll_.allocation().forget();
   return Step::kWriteSetting;
 }
 

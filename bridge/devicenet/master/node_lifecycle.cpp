@@ -180,8 +180,8 @@ std::uint8_t Node::held_connections() const {
   // Release with 0x0B, and the explicit connection is released alone).
   // The same holds of a change-of-state connection.
   return static_cast<std::uint8_t>((connected_ ? allocation::kExplicit : 0) |
-                                   (poll_allocated_ || poll_requested_ ? allocation::kPoll : 0) |
-                                   (cos_allocated_ || cos_requested_ ? cos_connection_bits() : 0));
+                                   (poll_.allocation().held() ? allocation::kPoll : 0) |
+                                   (cos_allocation_.held() ? cos_connection_bits() : 0));
 }
 
 std::uint8_t Node::cos_connection_bits() const {
@@ -221,7 +221,7 @@ void Node::release_after_loss(TimePoint now) {
   reports_data_ = false;
   // Its idle poll on retiring may have been lost with the bus, and the device
   // may have kept the connection through a short loss: idle first.
-  idle_poll_before_release(now);
+  poll_.send_idle_before_release(now);
   release(
       Step::kReleaseShutdown,
       static_cast<std::uint8_t>(allocation::kExplicit | allocation::kPoll | cos_connection_bits()),
@@ -231,9 +231,9 @@ void Node::release_after_loss(TimePoint now) {
 void Node::attempt_allocate(TimePoint now) {
   retry_at_ = kNever;
   step_timeouts_ = 0;
-  poll_release_tried_ = false;
-  cos_release_tried_ = false;
-  stray_poll_responses_ = 0;  // what did not come by now is not coming
+  poll_.allocation().release_tried = false;
+  cos_allocation_.release_tried = false;
+  poll_.forget_strays();  // what did not come by now is not coming
   ack_handler_unread_ = false;
   setting_retried_ = false;
   // What an attempt learns is its own: paths and refusals from an earlier one
@@ -257,8 +257,8 @@ void Node::run(Step step, TimePoint now) {
   if (r.phase != NodeState::kAbsent && r.phase != state_) {
     set_state(r.phase, std::string(phase_reason(r.phase)), now);
   }
-  if (step == Step::kAllocatePoll) poll_requested_ = true;
-  if (step == Step::kAllocateCos) cos_requested_ = true;
+  if (step == Step::kAllocatePoll) poll_.allocation().requested = true;
+  if (step == Step::kAllocateCos) cos_allocation_.requested = true;
   if (step == Step::kCosEpr) {
     // Setting EPR starts production: a message may come before the answer.
     cos_.emplace(config_.mac, cos_asked_, now);
@@ -283,7 +283,7 @@ void Node::run(Step step, TimePoint now) {
       // A poll connection released during the start-up may be one left from
       // before (a restart, or a bus lost and back, within the device's own
       // timeout), still carrying the outputs last commanded: idle first.
-      if ((choice & allocation::kPoll) != 0) idle_poll_before_release(now);
+      if ((choice & allocation::kPoll) != 0) poll_.send_idle_before_release(now);
       release(step, choice, now);
       return;
     }
@@ -321,7 +321,7 @@ void Node::run(Step step, TimePoint now) {
         case Step::kCosEpr:
           // Right after the poll connection's start, bounded as its Set was.
           value.assign(Bytes(uint_le(to_ms(input_epr_asked()))));
-          timeout = std::min(client_.response_timeout(), 2 * poll_epr_);
+          timeout = std::min(client_.response_timeout(), 2 * poll_.epr());
           break;
         default:
           break;
@@ -434,7 +434,9 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
           return;
         }
       }
-      connected_ = poll_allocated_ = poll_requested_ = cos_allocated_ = cos_requested_ = false;
+      connected_ = false;
+      poll_.allocation().forget();
+      cos_allocation_.forget();
       cos_.reset();
       // Whatever the answer, a faulted node is left alone until the re-check.
       if (step == Step::kReleaseShutdown) {
