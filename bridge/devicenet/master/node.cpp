@@ -40,7 +40,8 @@ Node::Node(NodeConfig config, const ScannerConfig& port, can::FrameSink& sink,
       retry_delay_(port.allocate_retry_min),
       jitter_state_(0x9E3779B9u ^ (static_cast<std::uint32_t>(config_.mac.value()) * 0x85EBCA6Bu)),
       explicit_epr_(config_.explicit_packet_rate),
-      poll_(config_, port, sink, counters_, *this) {}
+      poll_(config_, port, sink, counters_, *this),
+      input_(config_, sink, counters_, *this) {}
 
 void Node::apply_port_timings() {
   client_.set_response_timeout(client_config(config_, port_).response_timeout);
@@ -113,7 +114,7 @@ void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
   }
   poll_.stop();
   keepalive_at_ = kNever;
-  cos_.reset();
+  input_.stop();
   set_state(fault, std::move(reason), now);
   retry_at_ = now + port_.fault_recheck;
   // Leave a device that is not ours to poll unowned, so that its own
@@ -175,8 +176,8 @@ void Node::forget_connections(Errc why, TimePoint now) {
   step_ = Step::kNone;
   connected_ = false;
   poll_.allocation().forget();
-  cos_allocation_.forget();
-  cos_.reset();
+  input_.allocation().forget();
+  input_.stop();
   client_.cancel_all(why, now);
 }
 
@@ -240,22 +241,21 @@ void Node::on_timer(TimePoint now) {
   }
   // Likewise 4 x EPR without a message of the input connection (change of
   // state or cyclic, heartbeats included; bit-strobe responses).
-  if (cos_ && now >= cos_->watchdog_deadline() && cos_->check_watchdog(now)) {
+  if (input_.watchdog_expired(now)) {
+    const InputConnection& in = *input_.configured();
     // Messages that came but were refused say why none was taken.
-    const std::string refused = cos_consecutive_errors_ > 0
-                                    ? fmt::format("; the last {} were refused: {}",
-                                                  cos_consecutive_errors_, last_error_.describe())
-                                    : std::string();
+    const unsigned refused_count = input_.errors_in_a_row();
+    const std::string refused =
+        refused_count > 0
+            ? fmt::format("; the last {} were refused: {}", refused_count, last_error_.describe())
+            : std::string();
     ++counters_.heartbeats_missed;
-    record(config_.profile.input_connection->strobed() ? NodeError::Kind::kStrobeMissed
-                                                       : NodeError::Kind::kHeartbeatMissed,
-           now);
+    record(in.strobed() ? NodeError::Kind::kStrobeMissed : NodeError::Kind::kHeartbeatMissed, now);
     lose_and_release(
-        fmt::format("no {} {} for {} ms (4 x EPR of {} ms){}",
-                    to_string(config_.profile.input_connection->kind),
-                    config_.profile.input_connection->strobed() ? "response" : "message",
-                    std::chrono::duration_cast<milliseconds>(now - cos_->last_message()).count(),
-                    to_ms(cos_->settings().expected_packet_rate), refused),
+        fmt::format("no {} {} for {} ms (4 x EPR of {} ms){}", to_string(in.kind),
+                    in.strobed() ? "response" : "message",
+                    std::chrono::duration_cast<milliseconds>(now - input_.last_message()).count(),
+                    to_ms(input_.settings()->expected_packet_rate), refused),
         now);
     return;
   }
@@ -283,7 +283,7 @@ TimePoint Node::deadline() const {
   t = std::min(t, retry_at_);
   if (state_ == NodeState::kOnline) {
     t = std::min({t, poll_.timers_deadline(), keepalive_at_});
-    if (cos_) t = std::min(t, cos_->watchdog_deadline());
+    t = std::min(t, input_.watchdog_deadline());
   }
   return t;
 }
@@ -356,7 +356,7 @@ void Node::lose_and_release(std::string reason, TimePoint now) {
 
 void Node::go_online(TimePoint now) {
   retry_delay_ = port_.allocate_retry_min;
-  cos_consecutive_errors_ = 0;
+  input_.reset_errors();
   poll_.start(now);
   last_explicit_answer_ = now;
   keepalive_at_ = now + explicit_epr_;
@@ -372,24 +372,7 @@ void Node::go_online(TimePoint now) {
         fmt::format(" (sizes read from {} and {})", size_attribute(true, produced_from_fallback_),
                     size_attribute(false, consumed_from_fallback_));
   }
-  if (cos_) {
-    const CosSettings& c = cos_->settings();
-    const InputKind kind = config_.profile.input_connection->kind;
-    reason += fmt::format(
-        "; inputs {} (EPR {} ms, {})",
-        kind == InputKind::kCyclic          ? "cyclic"
-        : kind == InputKind::kChangeOfState ? "on change of state"
-                                            : "bit-strobed",
-        to_ms(c.expected_packet_rate),
-        kind == InputKind::kBitStrobe ? std::string("strobed with the port's other nodes")
-        : c.ack_suppressed
-            ? std::string("acknowledgment suppressed")
-            : fmt::format("acknowledged: the device retries after {} ms, {} time(s){}",
-                          to_ms(c.ack_timer), unsigned{c.retry_limit},
-                          ack_handler_unread_ ? " (defaults: its Acknowledge "
-                                                "Handler not read)"
-                                              : ""));
-  }
+  reason += input_.describe();
   if (!identity_state_supported_) reason += "; Identity.State not supported: state unknown";
   set_state(NodeState::kOnline, std::move(reason), now);
   // Outputs set before the node came online go out with the first poll.

@@ -18,6 +18,7 @@
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/master/cos_consumer.hpp"
 #include "bridge/devicenet/master/explicit_client.hpp"
+#include "bridge/devicenet/master/input_link.hpp"
 #include "bridge/devicenet/master/node_state.hpp"
 #include "bridge/devicenet/master/poll_connection.hpp"
 #include "bridge/devicenet/master/scan_list.hpp"
@@ -26,7 +27,9 @@
 
 namespace dnbridge::devicenet {
 
-class Node final : private ExplicitClient::Listener, private PollConnection::Listener {
+class Node final : private ExplicitClient::Listener,
+                   private PollConnection::Listener,
+                   private InputLink::Listener {
  public:
   // Largest poll message handled (fragmented I/O above 8 bytes).
   static constexpr std::size_t kMaxIoSize = kMaxIoMessageSize;
@@ -118,12 +121,9 @@ class Node final : private ExplicitClient::Listener, private PollConnection::Lis
   // A bit-strobe connection: the node answers the port's bit-strobe
   // commands (from the Set of its EPR on; the scanner sends them).
   bool strobed() const {
-    return cos_.has_value() && config_.profile.input_connection->strobed() && !shutting_down_;
+    return input_.consuming() && input_.configured()->strobed() && !shutting_down_;
   }
-  std::optional<CosSettings> cos_settings() const {
-    if (!cos_) return std::nullopt;
-    return cos_->settings();
-  }
+  std::optional<CosSettings> cos_settings() const { return input_.settings(); }
   bool stopped() const { return state_ == NodeState::kStopped; }
   // start() was called (a node never started holds no connection).
   bool started() const { return started_; }
@@ -240,11 +240,6 @@ class Node final : private ExplicitClient::Listener, private PollConnection::Lis
   Step after_cos_step(const ExplicitResult& r, TimePoint now);
   // The change-of-state steps in order, those that do not apply skipped.
   Step cos_step_after(Step step) const;
-  std::uint8_t cos_choice() const;
-  // The EPR asked for the input connection (a bit-strobe one takes the node's).
-  Duration input_epr_asked() const;
-  // Its allocation bits without acknowledgment suppression (for Release).
-  std::uint8_t cos_connection_bits() const;
   // A connection lost while the others live (the change-of-state
   // watchdog, bad poll responses): the outputs idle with one poll, every
   // connection released, then absent as after any loss.
@@ -305,8 +300,9 @@ class Node final : private ExplicitClient::Listener, private PollConnection::Lis
   // A poll for outputs that changed, if the node is online and polls on change.
   void poll_for_change(TimePoint now);
   void on_input_message(bool strobe_response, Bytes payload, TimePoint now);
-  void take_cos_message(Bytes data, TimePoint now);
-  void bad_cos_message(NodeError::Kind kind, std::uint32_t got, TimePoint now);
+  // The input connection's messages (InputLink::Listener).
+  void on_inputs(Bytes data, TimePoint now) override;
+  void on_bad_inputs(NodeError::Kind kind, std::uint32_t got, TimePoint now) override;
 
   const NodeConfig config_;
   const ScannerConfig& port_;
@@ -367,19 +363,9 @@ class Node final : private ExplicitClient::Listener, private PollConnection::Lis
 
   NodeCounters counters_;
   PollConnection poll_;
+  InputLink input_;
   TimePoint keepalive_at_ = kNever;
   TimePoint last_explicit_answer_{};  // last explicit response, error or not
-
-  // The input connection (change of state, cyclic or bit-strobe): what the
-  // start-up learnt, then the consumer of its messages (from its Set of EPR
-  // on; a bit-strobe connection's with acknowledgment suppressed).
-  IoAllocation cos_allocation_;
-  unsigned cos_consecutive_errors_ = 0;
-  bool ack_handler_unread_ = false;  // its timer or retry limit refused: defaults taken
-  std::string cos_path_refusal_;
-  CosSettings cos_asked_;
-  std::optional<CosConsumer> cos_;
-  IoReassembler cos_reassembler_{kMaxIoSize};
 
   NodeError last_error_;
   RateLimitedLog error_log_limit_;

@@ -186,12 +186,6 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
 
 // --- the input connection: change of state, cyclic or bit-strobe -------------------
 
-Duration Node::input_epr_asked() const {
-  const auto& in = config_.profile.input_connection;
-  if (!in) return Duration::zero();
-  return in->strobed() ? config_.expected_packet_rate : in->expected_packet_rate;
-}
-
 // The input connection is set up once the poll connection's sizes are
 // verified, and started (its EPR) right after the poll connection's:
 // nothing runs between the poll connection's start and its first poll but
@@ -226,13 +220,13 @@ Node::Step Node::cos_step_after(Step step) const {
 
 Node::Step Node::after_allocate_cos(const ExplicitResult& r, TimePoint now) {
   if (r.ok()) {
-    cos_allocation_.allocated = true;
+    input_.allocation().allocated = true;
     return cos_step_after(Step::kAllocateCos);
   }
   const std::string_view kind = to_string(config_.profile.input_connection->kind);
   return io_allocate_refused(
-      r, now, fmt::format("Allocate of the {} connection (choice 0x{:02X})", kind, cos_choice()),
-      fmt::format("; the node's connection = \"{}\" needs it", kind), cos_allocation_,
+      r, now, fmt::format("Allocate of the {} connection (choice 0x{:02X})", kind, input_.choice()),
+      fmt::format("; the node's connection = \"{}\" needs it", kind), input_.allocation(),
       Step::kReleaseCosForAllocate);
 }
 
@@ -246,10 +240,10 @@ Node::Step Node::after_cos_step(const ExplicitResult& r, TimePoint now) {
   switch (step) {
     case Step::kSetCosPath:
       if (!r.ok()) {
-        cos_path_refusal_ = fmt::format("; Set of {} to {} refused: {}", target.name,
-                                        hex(Bytes(cos.produced_path)), status_text(r));
+        input_.set_path_refusal(fmt::format("; Set of {} to {} refused: {}", target.name,
+                                            hex(Bytes(cos.produced_path)), status_text(r)));
         log_.info("{}: the size tells whether the device's own path serves",
-                  cos_path_refusal_.substr(2));
+                  input_.path_refusal().substr(2));
       }
       break;
     case Step::kCosInhibit:
@@ -266,7 +260,7 @@ Node::Step Node::after_cos_step(const ExplicitResult& r, TimePoint now) {
         enter_fault(NodeState::kConfigurationFault,
                     fmt::format("{} is {}, the configuration expects {} bytes{}", target.name,
                                 size ? fmt::format("{} bytes", *size) : hex(r.data.view()),
-                                cos.produced_size, cos_path_refusal_),
+                                cos.produced_size, input_.path_refusal()),
                     now);
         return Step::kNone;
       }
@@ -276,22 +270,20 @@ Node::Step Node::after_cos_step(const ExplicitResult& r, TimePoint now) {
     case Step::kRetryLimit: {
       const auto v = r.ok() ? read_uint(r.data.view()) : std::nullopt;
       if (!v) {
-        ack_handler_unread_ = true;
+        input_.note_ack_handler_unread();
         log_.info("{} not read ({}): taking the default, {}", target.name,
                   r.ok() ? hex(r.data.view()) : status_text(r),
                   step == Step::kAckTimer ? "20 ms" : "1 retry");
       } else if (step == Step::kAckTimer) {
-        cos_asked_.ack_timer = milliseconds(*v);
+        input_.set_ack_timer(milliseconds(*v));
       } else {
-        cos_asked_.retry_limit = static_cast<std::uint8_t>(std::min<std::uint32_t>(*v, 255));
+        input_.set_retry_limit(static_cast<std::uint8_t>(std::min<std::uint32_t>(*v, 255)));
       }
       break;
     }
     case Step::kCosEpr: {
       // As the poll's: the value the device returned is the one it uses.
-      const Duration epr = returned_epr(r, input_epr_asked());
-      cos_asked_.expected_packet_rate = epr;
-      if (cos_) cos_->set_expected_packet_rate(epr);
+      input_.set_epr(returned_epr(r, input_.epr_asked()));
       break;
     }
     default:

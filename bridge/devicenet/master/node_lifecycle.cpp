@@ -75,7 +75,7 @@ const Node::StepRow Node::kStartup[] = {
   {Step::kFallbackConsumedSize, NodeState::kVerifying, Verb::kGet,     kProfileSizeFallback,                  0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_size},
   {Step::kExplicitEpr,      NodeState::kVerifying,    Verb::kSet,      conn::kExplicitExpectedPacketRate,     0,                     OnRefusal::kFault,       Step::kPollEpr,         &Node::after_epr},
   {Step::kPollEpr,          NodeState::kVerifying,    Verb::kSet,      conn::kPollExpectedPacketRate,         0,                     OnRefusal::kFault,       Step::kNone,            &Node::after_epr},
-  // The choice of kAllocateCos is the profile's (cos_choice()).
+  // The choice of kAllocateCos is the profile's (InputLink::choice()).
   {Step::kAllocateCos,      NodeState::kVerifying,    Verb::kAllocate, kDeviceNetObject,                      0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_allocate_cos},
   {Step::kReleaseCosForAllocate, NodeState::kVerifying, Verb::kRelease, kDeviceNetObject,              0,                     OnRefusal::kGoOn,        Step::kAllocateCos,     nullptr},
   {Step::kSetCosPath,       NodeState::kVerifying,    Verb::kSet,      conn::kCosProducedPath,                0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
@@ -181,27 +181,7 @@ std::uint8_t Node::held_connections() const {
   // The same holds of a change-of-state connection.
   return static_cast<std::uint8_t>((connected_ ? allocation::kExplicit : 0) |
                                    (poll_.allocation().held() ? allocation::kPoll : 0) |
-                                   (cos_allocation_.held() ? cos_connection_bits() : 0));
-}
-
-std::uint8_t Node::cos_connection_bits() const {
-  return static_cast<std::uint8_t>(cos_choice() & ~allocation::kAckSuppression);
-}
-
-std::uint8_t Node::cos_choice() const {
-  const auto& in = config_.profile.input_connection;
-  if (!in) return 0;
-  switch (in->kind) {
-    case InputKind::kBitStrobe:
-      return allocation::kBitStrobe;
-    case InputKind::kCyclic:
-      return static_cast<std::uint8_t>(allocation::kCyclic |
-                                       (in->acknowledged ? 0 : allocation::kAckSuppression));
-    case InputKind::kChangeOfState:
-      break;
-  }
-  return static_cast<std::uint8_t>(allocation::kChangeOfState |
-                                   (in->acknowledged ? 0 : allocation::kAckSuppression));
+                                   (input_.allocation().held() ? input_.connection_bits() : 0));
 }
 
 void Node::release(Step step, std::uint8_t choice, TimePoint now) {
@@ -222,32 +202,24 @@ void Node::release_after_loss(TimePoint now) {
   // Its idle poll on retiring may have been lost with the bus, and the device
   // may have kept the connection through a short loss: idle first.
   poll_.send_idle_before_release(now);
-  release(
-      Step::kReleaseShutdown,
-      static_cast<std::uint8_t>(allocation::kExplicit | allocation::kPoll | cos_connection_bits()),
-      now);
+  release(Step::kReleaseShutdown,
+          static_cast<std::uint8_t>(allocation::kExplicit | allocation::kPoll |
+                                    input_.connection_bits()),
+          now);
 }
 
 void Node::attempt_allocate(TimePoint now) {
   retry_at_ = kNever;
   step_timeouts_ = 0;
   poll_.allocation().release_tried = false;
-  cos_allocation_.release_tried = false;
   poll_.forget_strays();  // what did not come by now is not coming
-  ack_handler_unread_ = false;
   setting_retried_ = false;
   // What an attempt learns is its own: paths and refusals from an earlier one
   // would otherwise pile up in the reasons.
   path_refusal_.clear();
   produced_path_in_force_.clear();
   consumed_path_in_force_.clear();
-  cos_path_refusal_.clear();
-  cos_asked_ = CosSettings{};
-  if (const auto& in = config_.profile.input_connection) {
-    cos_asked_.expected_packet_rate = input_epr_asked();
-    // Nothing acknowledges a bit-strobe response.
-    cos_asked_.ack_suppressed = !in->acknowledged || in->strobed();
-  }
+  input_.begin_attempt();
   ++counters_.allocate_attempts;
   run(Step::kAllocateExplicit, now);
 }
@@ -258,15 +230,14 @@ void Node::run(Step step, TimePoint now) {
     set_state(r.phase, std::string(phase_reason(r.phase)), now);
   }
   if (step == Step::kAllocatePoll) poll_.allocation().requested = true;
-  if (step == Step::kAllocateCos) cos_allocation_.requested = true;
+  if (step == Step::kAllocateCos) input_.allocation().requested = true;
   if (step == Step::kCosEpr) {
     // Setting EPR starts production: a message may come before the answer.
-    cos_.emplace(config_.mac, cos_asked_, now);
-    cos_reassembler_.reset();
+    input_.start_consuming(now);
   }
   switch (r.verb) {
     case Verb::kAllocate: {
-      const std::uint8_t choice = step == Step::kAllocateCos ? cos_choice() : r.choice;
+      const std::uint8_t choice = step == Step::kAllocateCos ? input_.choice() : r.choice;
       const std::array<std::uint8_t, 2> data{choice, port_.master_mac.value()};
       RequestMessage m;
       m.service = cip::code(cip::Service::kAllocateMasterSlave);
@@ -278,7 +249,7 @@ void Node::run(Step step, TimePoint now) {
     }
     case Verb::kRelease: {
       const std::uint8_t choice = step == Step::kReleaseStalePoll        ? stale_choice_
-                                  : step == Step::kReleaseCosForAllocate ? cos_connection_bits()
+                                  : step == Step::kReleaseCosForAllocate ? input_.connection_bits()
                                                                          : r.choice;
       // A poll connection released during the start-up may be one left from
       // before (a restart, or a bus lost and back, within the device's own
@@ -320,7 +291,7 @@ void Node::run(Step step, TimePoint now) {
           break;
         case Step::kCosEpr:
           // Right after the poll connection's start, bounded as its Set was.
-          value.assign(Bytes(uint_le(to_ms(input_epr_asked()))));
+          value.assign(Bytes(uint_le(to_ms(input_.epr_asked()))));
           timeout = std::min(client_.response_timeout(), 2 * poll_.epr());
           break;
         default:
@@ -436,8 +407,8 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
       }
       connected_ = false;
       poll_.allocation().forget();
-      cos_allocation_.forget();
-      cos_.reset();
+      input_.allocation().forget();
+      input_.stop();
       // Whatever the answer, a faulted node is left alone until the re-check.
       if (step == Step::kReleaseShutdown) {
         set_state(NodeState::kStopped, "released by " + shutdown_why_, now);

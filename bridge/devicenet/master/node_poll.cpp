@@ -53,9 +53,7 @@ void Node::on_poll_answer(Bytes data, bool late, TimePoint now) {
   }
   // An idle poll answered with no data says nothing of the inputs; where a
   // change-of-state connection produces them, they are its last message's.
-  if (data.empty() && cos_ && !cos_->last_data().empty()) {
-    data = Bytes(cos_->last_data().data(), cos_->last_data().size());
-  }
+  if (data.empty() && !input_.last_data().empty()) data = input_.last_data();
   if (reports_data_) observer_.on_poll_response(config_.mac, data, now);
   if (shutting_down_) {
     continue_shutdown(now);
@@ -92,67 +90,41 @@ void Node::on_strobe_response(Bytes payload, TimePoint now) {
 }
 
 void Node::on_input_message(bool strobe_response, Bytes payload, TimePoint now) {
-  const auto& in = config_.profile.input_connection;
   // From the Set of its EPR on (a first message may come before the answer),
   // on the message its kind produces.
-  if (!cos_ || in->strobed() != strobe_response ||
+  if (!input_.consuming() || input_.configured()->strobed() != strobe_response ||
       (state_ != NodeState::kOnline && step_ != Step::kCosEpr)) {
-    bad_cos_message(
+    on_bad_inputs(
         strobe_response ? NodeError::Kind::kStrobeUnexpected : NodeError::Kind::kCosUnexpected,
         static_cast<std::uint32_t>(payload.size()), now);
     return;
   }
-  const IoFrame f = take_io_frame(cos_reassembler_, payload, in->produced_size);
-  if (f.outcome == IoFrame::kComplete) {
-    take_cos_message(f.message, now);
-  } else if (f.outcome != IoFrame::kIncomplete) {
-    // A bit-strobe response is one frame: never out of order.
-    bad_cos_message(f.outcome != IoFrame::kWrongSize ? NodeError::Kind::kCosMalformed
-                    : strobe_response                ? NodeError::Kind::kStrobeLength
-                                                     : NodeError::Kind::kCosLength,
-                    f.got, now);
-  }
-  if (f.outcome == IoFrame::kComplete || f.outcome == IoFrame::kWrongSize) cos_reassembler_.reset();
+  input_.on_message(payload, now);
 }
 
-void Node::take_cos_message(Bytes data, TimePoint now) {
-  const CosConsumer::Taken taken = cos_->on_message(data, now);
-  ++counters_.cos_messages;
-  if (taken.repeat) ++counters_.cos_retries;
-  if (taken.acknowledge) {
-    sink_.send(cos_->ack_frame(), now);
-    ++counters_.cos_acks;
-  }
-  cos_consecutive_errors_ = 0;
-  // A retry carries nothing new.
-  if (state_ == NodeState::kOnline && reports_data_ && !taken.repeat) {
+void Node::on_inputs(Bytes data, TimePoint now) {
+  if (state_ == NodeState::kOnline && reports_data_) {
     observer_.on_poll_response(config_.mac, data, now);
   }
 }
 
-void Node::bad_cos_message(NodeError::Kind kind, std::uint32_t got, TimePoint now) {
+void Node::on_bad_inputs(NodeError::Kind kind, std::uint32_t got, TimePoint now) {
   // Neither taken nor acknowledged: the device sends it again, or the
   // watchdog ends the connection.
   // A straggler of a connection just released, or a message for another
   // master's connection of a node this one polls, is no news.
   const bool unexpected =
       kind == NodeError::Kind::kCosUnexpected || kind == NodeError::Kind::kStrobeUnexpected;
-  if (unexpected &&
-      (!config_.profile.input_connection || (!cos_ && state_ != NodeState::kOnline))) {
-    ++counters_.cos_errors;
-    return;
-  }
+  const InputConnection* in = input_.configured();
   ++counters_.cos_errors;
-  const auto& in = config_.profile.input_connection;
-  const std::size_t expected = in ? in->produced_size : 0;
-  record(kind, now, got, static_cast<std::uint32_t>(expected));
+  if (unexpected && (!in || (!input_.consuming() && state_ != NodeState::kOnline))) return;
+  record(kind, now, got, static_cast<std::uint32_t>(in ? in->produced_size : 0));
   error_log_limit_.warn(log_, now, "{}", last_error_.describe());
   if (state_ != NodeState::kOnline) return;
-  if (++cos_consecutive_errors_ >= port_.max_consecutive_errors) {
-    lose_and_release(
-        fmt::format("{} bad {} messages in a row: {}", cos_consecutive_errors_,
-                    to_string(config_.profile.input_connection->kind), last_error_.describe()),
-        now);
+  if (const unsigned in_a_row = input_.count_error(); in_a_row >= port_.max_consecutive_errors) {
+    lose_and_release(fmt::format("{} bad {} messages in a row: {}", in_a_row, to_string(in->kind),
+                                 last_error_.describe()),
+                     now);
   }
 }
 
