@@ -39,9 +39,9 @@ Node::Node(NodeConfig config, const ScannerConfig& port, can::FrameSink& sink,
       client_(port.master_mac, config_.mac, client_config(config_, port), sink, *this),
       retry_delay_(port.allocate_retry_min),
       jitter_state_(0x9E3779B9u ^ (static_cast<std::uint32_t>(config_.mac.value()) * 0x85EBCA6Bu)),
-      explicit_epr_(config_.explicit_packet_rate),
       poll_(config_, port, sink, counters_, *this),
-      input_(config_, sink, counters_, *this) {}
+      input_(config_, sink, counters_, *this),
+      keep_alive_(config_.explicit_packet_rate) {}
 
 void Node::apply_port_timings() {
   client_.set_response_timeout(client_config(config_, port_).response_timeout);
@@ -113,7 +113,7 @@ void Node::enter_fault(NodeState fault, std::string reason, TimePoint now) {
     poll_.send_idle_before_release(now);
   }
   poll_.stop();
-  keepalive_at_ = kNever;
+  keep_alive_.stop();
   input_.stop();
   set_state(fault, std::move(reason), now);
   retry_at_ = now + port_.fault_recheck;
@@ -142,7 +142,7 @@ void Node::begin_shutdown(TimePoint now) {
   shutting_down_ = true;
   retry_at_ = kNever;
   poll_.stop_slots();
-  keepalive_at_ = kNever;
+  keep_alive_.stop();
   step_ = Step::kNone;
   client_.cancel_all(Errc::kStopped, now);
   if (state_ == NodeState::kOnline) {
@@ -172,7 +172,7 @@ void Node::release_for_shutdown(TimePoint now) {
 void Node::forget_connections(Errc why, TimePoint now) {
   retry_at_ = kNever;
   poll_.stop();
-  keepalive_at_ = kNever;
+  keep_alive_.stop();
   step_ = Step::kNone;
   connected_ = false;
   poll_.allocation().forget();
@@ -260,19 +260,10 @@ void Node::on_timer(TimePoint now) {
     return;
   }
   poll_.on_timer(now);
-  if (now >= keepalive_at_) {
-    keepalive_at_ = now + explicit_epr_;
-    // The keep-alive reads the device's health: Identity.Status (fault bits)
-    // and Identity.State in turn, Status alone where the device has no
-    // State. Every period, busy or not: other requests keep the connection
-    // alive, but only this one tells a major fault. It has its own place in
-    // the client's queue (request_explicit leaves it); one still unanswered
-    // is not doubled.
-    if (step_ != Step::kKeepAlive) {
-      keepalive_reads_status_ = !identity_state_supported_ || !keepalive_reads_status_;
-      get(Step::kKeepAlive,
-          keepalive_reads_status_ ? cip::identity::kStatus : cip::identity::kState, now);
-    }
+  // The keep-alive has its own place in the client's queue (request_explicit
+  // leaves it); one still unanswered is not doubled.
+  if (keep_alive_.due(now) && step_ != Step::kKeepAlive) {
+    get(Step::kKeepAlive, keep_alive_.next_read(), now);
   }
 }
 
@@ -282,7 +273,7 @@ TimePoint Node::deadline() const {
   if (shutting_down_) return t;
   t = std::min(t, retry_at_);
   if (state_ == NodeState::kOnline) {
-    t = std::min({t, poll_.timers_deadline(), keepalive_at_});
+    t = std::min({t, poll_.timers_deadline(), keep_alive_.next()});
     t = std::min(t, input_.watchdog_deadline());
   }
   return t;
@@ -292,14 +283,14 @@ TimePoint Node::deadline() const {
 
 void Node::on_keepalive_result(const ExplicitResult& r, TimePoint now) {
   if (r.ok() || r.error == Errc::kDeviceError) {
-    if (r.ok() && !keepalive_reads_status_ && r.data.size() == 1) {
+    if (r.ok() && !keep_alive_.reads_status() && r.data.size() == 1) {
       identity_.state = r.data[0];
       if (device_state_ != r.data[0]) {
         device_state_ = r.data[0];
         observer_.on_device_state(config_.mac, r.data[0], now);
       }
     }
-    if (r.ok() && keepalive_reads_status_ && r.data.size() == 2) {
+    if (r.ok() && keep_alive_.reads_status() && r.data.size() == 2) {
       const auto status = static_cast<std::uint16_t>(*read_uint(r.data.view()));
       if (identity_.status != status) {
         identity_.status = status;
@@ -313,14 +304,14 @@ void Node::on_keepalive_result(const ExplicitResult& r, TimePoint now) {
   // The device drops the explicit connection after 4 x EPR without a
   // request; single lost frames must not be taken for that. Try again at
   // once, and give up only when nothing has come back for that long.
-  if (now - last_explicit_answer_ >= 4 * explicit_epr_) {
+  if (keep_alive_.lost(now)) {
     lose(fmt::format("explicit connection lost: no answer for {} ms (4 x EPR; {})",
-                     std::chrono::duration_cast<milliseconds>(now - last_explicit_answer_).count(),
+                     std::chrono::duration_cast<milliseconds>(keep_alive_.silence(now)).count(),
                      status_text(r)),
          now);
     return;
   }
-  keepalive_at_ = now;
+  keep_alive_.again(now);
 }
 
 void Node::note_minor_faults() {
@@ -358,13 +349,12 @@ void Node::go_online(TimePoint now) {
   retry_delay_ = port_.allocate_retry_min;
   input_.reset_errors();
   poll_.start(now);
-  last_explicit_answer_ = now;
-  keepalive_at_ = now + explicit_epr_;
+  keep_alive_.start(now);
   std::string reason =
       fmt::format("polled every {} ms; EPR {} ms (explicit {} ms); {} B out, {} B in",
                   std::chrono::duration_cast<milliseconds>(config_.poll_period).count(),
                   std::chrono::duration_cast<milliseconds>(poll_.epr()).count(),
-                  std::chrono::duration_cast<milliseconds>(explicit_epr_).count(),
+                  std::chrono::duration_cast<milliseconds>(keep_alive_.epr()).count(),
                   config_.profile.consumed_size, config_.profile.produced_size);
   if (produced_from_fallback_ || consumed_from_fallback_) {
     // Worth knowing about a device: it refused Connection 2 attributes 7/8.
@@ -373,7 +363,7 @@ void Node::go_online(TimePoint now) {
                     size_attribute(false, consumed_from_fallback_));
   }
   reason += input_.describe();
-  if (!identity_state_supported_) reason += "; Identity.State not supported: state unknown";
+  if (!keep_alive_.state_supported()) reason += "; Identity.State not supported: state unknown";
   set_state(NodeState::kOnline, std::move(reason), now);
   // Outputs set before the node came online go out with the first poll.
   poll_.send(now);

@@ -19,6 +19,7 @@
 #include "bridge/devicenet/master/cos_consumer.hpp"
 #include "bridge/devicenet/master/explicit_client.hpp"
 #include "bridge/devicenet/master/input_link.hpp"
+#include "bridge/devicenet/master/keep_alive.hpp"
 #include "bridge/devicenet/master/node_state.hpp"
 #include "bridge/devicenet/master/poll_connection.hpp"
 #include "bridge/devicenet/master/scan_list.hpp"
@@ -115,7 +116,7 @@ class Node final : private ExplicitClient::Listener,
   Duration poll_epr() const { return poll_.epr(); }
   // The wait for an explicit answer that requests from now on get.
   Duration explicit_response_timeout() const { return client_.response_timeout(); }
-  Duration explicit_epr() const { return explicit_epr_; }
+  Duration explicit_epr() const { return keep_alive_.epr(); }
   // The input connection's settings as the device gave them (EPR,
   // acknowledge timer, retry limit); empty without one.
   // A bit-strobe connection: the node answers the port's bit-strobe
@@ -351,21 +352,17 @@ class Node final : private ExplicitClient::Listener,
   std::string size_refusal_;
   // The serial number first seen at this MAC (when none is pinned).
   std::optional<std::uint32_t> first_serial_;
-  // Identity.State answers: the keep-alive reads it; otherwise Identity.Status.
-  bool identity_state_supported_ = true;
-  bool keepalive_reads_status_ = false;  // which the last keep-alive read
-  std::string minor_faults_;             // as last warned of
+  std::string minor_faults_;  // as last warned of
   bool epr_warned_ = false;
 
   NodeIdentity identity_;
   std::optional<std::uint8_t> device_state_;
-  Duration explicit_epr_{};
 
+  // The node's connections once the start-up has made them.
   NodeCounters counters_;
   PollConnection poll_;
   InputLink input_;
-  TimePoint keepalive_at_ = kNever;
-  TimePoint last_explicit_answer_{};  // last explicit response, error or not
+  KeepAlive keep_alive_;
 
   NodeError last_error_;
   RateLimitedLog error_log_limit_;

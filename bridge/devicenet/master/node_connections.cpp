@@ -167,7 +167,7 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
   const Duration asked = poll ? config_.expected_packet_rate : config_.explicit_packet_rate;
   const Duration epr = returned_epr(r, asked);
   if (!poll) {
-    explicit_epr_ = epr;
+    keep_alive_.set_epr(epr);
     return Step::kPollEpr;
   }
   poll_.set_epr(epr);

@@ -211,7 +211,7 @@ Node::Step Node::after_identity_state(const ExplicitResult& r, TimePoint now) {
   // not supported, or 0x08 service not supported) is not at fault; its
   // state is unknown and the keep-alive reads Identity.Status instead.
   identity_.state.reset();
-  identity_state_supported_ = r.ok();
+  keep_alive_.set_state_supported(r.ok());
   if (r.ok() && r.data.size() == 1) {
     identity_.state = r.data[0];
     if (device_state_ != r.data[0]) {

@@ -355,7 +355,7 @@ cip::AttributeRef Node::target_of(Step step) const {
 // --- answers -------------------------------------------------------------------
 
 void Node::on_explicit_result(std::uint32_t tag, const ExplicitResult& result, TimePoint now) {
-  if (result.ok() || result.error == Errc::kDeviceError) last_explicit_answer_ = now;
+  if (result.ok() || result.error == Errc::kDeviceError) keep_alive_.answered(now);
   if ((tag & kInternalTag) == 0) {
     observer_.on_explicit_result(tag, config_.mac, result, now);
     return;
