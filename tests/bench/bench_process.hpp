@@ -1,7 +1,7 @@
 #pragma once
-// What the benchmarks that run the bridge as a child process share: its
-// process seen from /proc (CPU time, by thread, RSS), starting and stopping
-// it, and pacing.
+// What the benchmarks share of processes: a process seen from /proc (CPU
+// time, by thread, RSS), the bridge's or their own; child processes (the
+// bridge, a benchmark's peer) started, read and stopped; and pacing.
 #include <dds/version.h>
 #include <fcntl.h>
 #include <fmt/chrono.h>
@@ -93,7 +93,7 @@ inline int hold_cpus_awake() {
 }
 
 // ---------------------------------------------------------------------------
-// The bridge's process, seen from /proc
+// A process seen from /proc: the bridge's, or the benchmark's own
 
 struct ThreadTimes {
   std::string name;
@@ -130,6 +130,16 @@ inline std::uint64_t status_value(const std::filesystem::path& status, std::stri
     }
   }
   return 0;
+}
+
+// Clock ticks of /proc (utime, stime) in seconds.
+inline double ticks_seconds(std::uint64_t ticks) {
+  return static_cast<double>(ticks) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+// Clock ticks over `seconds` of wall time, in % of one core.
+inline double core_percent(std::uint64_t ticks, double seconds) {
+  return 100.0 * static_cast<double>(ticks) / static_cast<double>(sysconf(_SC_CLK_TCK)) / seconds;
 }
 
 struct ProcessSample {
@@ -270,6 +280,29 @@ class LineReader {
   bool eof_ = false;
   bool timed_out_ = false;
 };
+
+// Hands every line of a child's output but its last, "done", to `on_line`,
+// up to the end of that output or until `deadline` (monotonic ns) passes
+// (then the child is killed), and waits for the child to exit. Throws when
+// it failed or never said "done" (`role` names it in the message).
+template <class OnLine>
+void read_child_output(Child child, std::int64_t deadline, std::string_view role, OnLine on_line) {
+  LineReader lines(child.out);
+  bool done = false;
+  while (auto line = lines.next(deadline)) {
+    if (*line == "done") {
+      done = true;
+    } else {
+      on_line(*line);
+    }
+  }
+  if (lines.timed_out()) kill(child.pid, SIGKILL);
+  close(child.out);
+  const int status = wait_child(child.pid);
+  if (status != 0 || !done) {
+    throw std::runtime_error(fmt::format("the {} process failed (exit {})", role, status));
+  }
+}
 
 inline std::string exit_text(int status) {
   if (WIFEXITED(status)) return fmt::format("exit {}", WEXITSTATUS(status));

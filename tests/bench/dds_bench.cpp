@@ -579,28 +579,17 @@ struct PeerRecords {
 
 PeerRecords read_peer(Child child, std::int64_t deadline) {
   PeerRecords r;
-  LineReader lines(child.out);
-  bool done = false;
-  while (auto line = lines.next(deadline)) {
+  read_child_output(child, deadline, "peer", [&](const std::string& line) {
     char kind = 0;
     std::size_t path = 0;
     unsigned long seq = 0;
     long long at = 0, call = 0;
-    if (*line == "done") {
-      done = true;
-    } else if (std::sscanf(line->c_str(), "%c %zu %lu %lld %lld", &kind, &path, &seq, &at, &call) >=
-               4) {
+    if (std::sscanf(line.c_str(), "%c %zu %lu %lld %lld", &kind, &path, &seq, &at, &call) >= 4) {
       (kind == 'w' ? r.writes : r.takes)[path].push_back({static_cast<std::uint32_t>(seq),
                                                           static_cast<std::int64_t>(at),
                                                           static_cast<std::int64_t>(call)});
     }
-  }
-  close(child.out);
-  if (lines.timed_out()) kill(child.pid, SIGKILL);
-  const int status = wait_child(child.pid);
-  if (status != 0 || !done) {
-    throw std::runtime_error(fmt::format("the peer process failed (exit {})", status));
-  }
+  });
   return r;
 }
 
@@ -635,11 +624,9 @@ Latencies match(const std::vector<Record>& writes, const std::vector<Record>& ta
 
 std::string us(double v) { return fmt::format("{:.1f}", v); }
 
-int run_bench(const Options& o) {
-  const int domain = o.domain >= 0 ? o.domain : 170 + static_cast<int>(getpid() % 30);
-  const std::string tag = fmt::format("dnbridge-dds-bench-{}", getpid());
-  setenv("CYCLONEDDS_URI", dds::loopback_config(tag).c_str(), 1);
-  const auto paths = paths_of(o);
+// Every command path writes fewer commands than its 16-bit sequence numbers
+// tell apart.
+void check_sequence_numbers(const std::vector<Path>& paths, const Options& o) {
   for (const auto& p : paths) {
     const auto shortest_gap = static_cast<double>(p.random_gaps ? p.period_ns / 2 : p.period_ns);
     if (p.type == Type::kCommand && o.seconds * 1e9 / shortest_gap * o.rounds >= 65536) {
@@ -649,6 +636,131 @@ int run_bench(const Options& o) {
           p.label));
     }
   }
+}
+
+// The command line that re-executes this program as the peer.
+std::vector<std::string> peer_args(const Options& o, int domain, std::int64_t t0) {
+  std::vector<std::string> args{"/proc/self/exe",
+                                "--peer",
+                                "--domain",
+                                std::to_string(domain),
+                                "--t0",
+                                std::to_string(t0),
+                                "--seconds",
+                                fmt::format("{}", o.seconds),
+                                "--rounds",
+                                std::to_string(o.rounds),
+                                "--command-interval-us",
+                                std::to_string(o.command_interval_us)};
+  if (!o.ddsperf) args.push_back("--no-ddsperf");
+  return args;
+}
+
+// Round starts, for the per-round figures.
+std::vector<std::int64_t> round_starts(const Schedule& schedule, int rounds, std::size_t paths) {
+  std::vector<std::int64_t> starts;
+  for (int r = 0; r < rounds; ++r)
+    starts.push_back(schedule.starts[static_cast<std::size_t>(r) * paths]);
+  return starts;
+}
+
+// The table of figures (Markdown), a row a path.
+class Table {
+ public:
+  Table() {
+    fmt::print(
+        "| path | samples | p50 us | p99 us | max us | p99 by round us | p99 / ddsperf p99 | "
+        "p50, p99 change from the row above us | write() p50 us |\n");
+    fmt::print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+  }
+
+  // A path's one-way latencies; `chain`: with their change from the row above.
+  void row(const std::string& label, const Latencies& l, std::optional<double> write_p50,
+           bool chain) {
+    const auto s = summarize(l.all);
+    std::string by_round;
+    for (const auto& r : l.by_round) {
+      by_round += (by_round.empty() ? "" : " / ") + (r.empty() ? "-" : us(summarize(r).p99));
+    }
+    // A row that is not chained starts a chain: the reference of the rows
+    // below it.
+    const auto change =
+        chain && above_ ? fmt::format("{:+.1f}, {:+.1f}", s.p50 - above_->p50, s.p99 - above_->p99)
+                        : std::string();
+    fmt::print("| {} | {}{} | {} | {} | {} | {} | {} | {} | {} |\n", label, s.count,
+               l.lost ? fmt::format(" ({} lost)", l.lost) : "", us(s.p50), us(s.p99), us(s.max),
+               by_round, ddsperf_p99_ > 0 ? fmt::format("{:.2f}", s.p99 / ddsperf_p99_) : "",
+               change, write_p50 ? us(*write_p50) : "");
+    above_ = s;
+  }
+
+  // ddsperf's row, its windows of every round pooled: the reference of the
+  // rows' p99 ratios.
+  void ddsperf_row(const std::string& label, const std::vector<DdsperfResult>& ddsperf) {
+    std::vector<DdsperfWindow> windows;
+    for (const auto& d : ddsperf) windows.insert(windows.end(), d.windows.begin(), d.windows.end());
+    double count = 0, max = 0;
+    for (const auto& w : windows) {
+      count += w.count;
+      max = std::max(max, w.max);
+    }
+    // ddsperf prints its round trips halved already (see ddsperf.hpp).
+    ddsperf_p99_ = pooled_quantile(windows, 0.99);
+    std::string by_round;
+    for (const auto& d : ddsperf) {
+      by_round += (by_round.empty() ? "" : " / ") + us(d.half_rtt_p99);
+    }
+    fmt::print("| {} | {:.0f} | {} | {} | {} | {} | 1.00 | | |\n", label, count,
+               us(pooled_quantile(windows, 0.5)), us(ddsperf_p99_), us(max), by_round);
+  }
+
+ private:
+  double ddsperf_p99_ = 0;
+  std::optional<Summary> above_;
+};
+
+// Every path's row, in the paths' order.
+void print_table(const std::vector<Path>& paths, const std::vector<DdsperfResult>& ddsperf,
+                 const Side& side, const PeerRecords& peer_records,
+                 const std::vector<std::int64_t>& rounds) {
+  Table table;
+  for (std::size_t p = 0; p < paths.size(); ++p) {
+    const auto& path = paths[p];
+    if (path.ddsperf) {
+      table.ddsperf_row(path.label, ddsperf);
+      continue;
+    }
+    const auto* mine = side.endpoint(p);
+    const auto& peer_writes =
+        peer_records.writes.count(p) ? peer_records.writes.at(p) : std::vector<Record>{};
+    const auto& peer_takes =
+        peer_records.takes.count(p) ? peer_records.takes.at(p) : std::vector<Record>{};
+    const auto& writes = path.peer_writes ? peer_writes : mine->writes;
+    std::vector<double> calls;
+    for (const auto& w : writes) calls.push_back(static_cast<double>(w.call_ns) / 1e3);
+    const auto call_p50 = summarize(calls).p50;
+    if (path.round_trip) {
+      table.row(path.label, match(peer_writes, peer_takes, rounds, 0.5), call_p50, false);
+      table.row("  its first leg (supervisor -> bridge), one way",
+                match(peer_writes, mine->takes, rounds), std::nullopt, false);
+      // The second leg: from the take on this side, which writes it back at once.
+      table.row("  its second leg (take, write back, take), one way",
+                match(mine->takes, peer_takes, rounds), std::nullopt, false);
+      continue;
+    }
+    table.row(path.label,
+              path.peer_writes ? match(peer_writes, mine->takes, rounds)
+                               : match(mine->writes, peer_takes, rounds),
+              call_p50, path.chained);
+  }
+}
+
+int run_bench(const Options& o) {
+  const int domain = o.domain >= 0 ? o.domain : 170 + static_cast<int>(getpid() % 30);
+  const std::string tag = fmt::format("dnbridge-dds-bench-{}", getpid());
+  setenv("CYCLONEDDS_URI", dds::loopback_config(tag).c_str(), 1);
+  const auto paths = paths_of(o);
+  check_sequence_numbers(paths, o);
 
   print_run_header("dnbridge DDS benchmark", domain, tag);
   const int awake = o.hold_awake ? hold_cpus_awake() : -1;
@@ -664,19 +776,7 @@ int run_bench(const Options& o) {
   Side side(domain, paths, false);
   const auto t0 = monotonic_ns() + 5'000'000'000;
   const auto schedule = make_schedule(paths, t0, slot_ns(o), o.rounds);
-  std::vector<std::string> args{"/proc/self/exe",
-                                "--peer",
-                                "--domain",
-                                std::to_string(domain),
-                                "--t0",
-                                std::to_string(t0),
-                                "--seconds",
-                                fmt::format("{}", o.seconds),
-                                "--rounds",
-                                std::to_string(o.rounds),
-                                "--command-interval-us",
-                                std::to_string(o.command_interval_us)};
-  if (!o.ddsperf) args.push_back("--no-ddsperf");
+  const auto args = peer_args(o, domain, t0);
   Child peer = spawn_child(args, true, cpus.peer);
   if (!side.wait_matched(t0)) {
     kill(peer.pid, SIGKILL);
@@ -712,79 +812,7 @@ int run_bench(const Options& o) {
   }
   fmt::print("load average at end: {}\n\n", load_average());
 
-  // Round starts, for the per-round figures.
-  std::vector<std::int64_t> rounds;
-  for (int r = 0; r < o.rounds; ++r)
-    rounds.push_back(schedule.starts[static_cast<std::size_t>(r) * paths.size()]);
-
-  fmt::print(
-      "| path | samples | p50 us | p99 us | max us | p99 by round us | p99 / ddsperf p99 | "
-      "p50, p99 change from the row above us | write() p50 us |\n");
-  fmt::print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
-  double ddsperf_p99 = 0;
-  std::optional<Summary> above;
-  auto row = [&](const std::string& label, const Latencies& l, std::optional<double> write_p50,
-                 bool chain) {
-    const auto s = summarize(l.all);
-    std::string by_round;
-    for (const auto& r : l.by_round) {
-      by_round += (by_round.empty() ? "" : " / ") + (r.empty() ? "-" : us(summarize(r).p99));
-    }
-    // A row that is not chained starts a chain: the reference of the rows
-    // below it.
-    const auto change =
-        chain && above ? fmt::format("{:+.1f}, {:+.1f}", s.p50 - above->p50, s.p99 - above->p99)
-                       : std::string();
-    fmt::print("| {} | {}{} | {} | {} | {} | {} | {} | {} | {} |\n", label, s.count,
-               l.lost ? fmt::format(" ({} lost)", l.lost) : "", us(s.p50), us(s.p99), us(s.max),
-               by_round, ddsperf_p99 > 0 ? fmt::format("{:.2f}", s.p99 / ddsperf_p99) : "", change,
-               write_p50 ? us(*write_p50) : "");
-    above = s;
-  };
-  for (std::size_t p = 0; p < paths.size(); ++p) {
-    const auto& path = paths[p];
-    if (path.ddsperf) {
-      std::vector<DdsperfWindow> windows;
-      for (const auto& d : ddsperf)
-        windows.insert(windows.end(), d.windows.begin(), d.windows.end());
-      double count = 0, max = 0;
-      for (const auto& w : windows) {
-        count += w.count;
-        max = std::max(max, w.max);
-      }
-      // ddsperf prints its round trips halved already (see ddsperf.hpp).
-      ddsperf_p99 = pooled_quantile(windows, 0.99);
-      std::string by_round;
-      for (const auto& d : ddsperf) {
-        by_round += (by_round.empty() ? "" : " / ") + us(d.half_rtt_p99);
-      }
-      fmt::print("| {} | {:.0f} | {} | {} | {} | {} | 1.00 | | |\n", path.label, count,
-                 us(pooled_quantile(windows, 0.5)), us(ddsperf_p99), us(max), by_round);
-      continue;
-    }
-    const auto* mine = side.endpoint(p);
-    const auto& peer_writes =
-        peer_records.writes.count(p) ? peer_records.writes.at(p) : std::vector<Record>{};
-    const auto& peer_takes =
-        peer_records.takes.count(p) ? peer_records.takes.at(p) : std::vector<Record>{};
-    const auto& writes = path.peer_writes ? peer_writes : mine->writes;
-    std::vector<double> calls;
-    for (const auto& w : writes) calls.push_back(static_cast<double>(w.call_ns) / 1e3);
-    const auto call_p50 = summarize(calls).p50;
-    if (path.round_trip) {
-      row(path.label, match(peer_writes, peer_takes, rounds, 0.5), call_p50, false);
-      row("  its first leg (supervisor -> bridge), one way",
-          match(peer_writes, mine->takes, rounds), std::nullopt, false);
-      // The second leg: from the take on this side, which writes it back at once.
-      row("  its second leg (take, write back, take), one way",
-          match(mine->takes, peer_takes, rounds), std::nullopt, false);
-      continue;
-    }
-    row(path.label,
-        path.peer_writes ? match(peer_writes, mine->takes, rounds)
-                         : match(mine->writes, peer_takes, rounds),
-        call_p50, path.chained);
-  }
+  print_table(paths, ddsperf, side, peer_records, round_starts(schedule, o.rounds, paths.size()));
   if (awake >= 0) close(awake);
   return 0;
 }

@@ -1,6 +1,6 @@
 #pragma once
 // What the benchmarks share to report their figures: clocks, the machine's
-// load and percentiles of a set of measurements.
+// load, percentiles of a set of measurements and targets' verdicts.
 #include <time.h>
 
 #include <algorithm>
@@ -28,6 +28,9 @@ inline std::string load_average() {
   f >> a >> b >> c;
   return a + " " + b + " " + c;
 }
+
+// A target's verdict, as the reports print it.
+inline std::string verdict(bool met) { return met ? "met" : "NOT met"; }
 
 struct Summary {
   std::size_t count = 0;

@@ -138,7 +138,6 @@ WindowFigures measure_window(const std::vector<std::unique_ptr<BridgeProcess>>& 
   const auto lo_after = loopback_bytes();
   const ProcessSample own_after = sample_process(getpid(), false);
   const double wall = static_cast<double>(monotonic_ns() - start) / 1e9;
-  const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
   for (const auto& b : bridges) {
     if (auto ended = b->ended()) throw std::runtime_error("a bridge ended: " + *ended);
   }
@@ -146,7 +145,7 @@ WindowFigures measure_window(const std::vector<std::unique_ptr<BridgeProcess>>& 
   const auto cpu_of = [&](const ProcessSample& from, const ProcessSample& to) {
     // Each over its own interval: the bridges are sampled one after another.
     const double interval = static_cast<double>(to.at - from.at) / 1e9;
-    return 100.0 * static_cast<double>(to.ticks - from.ticks) / tick / interval;
+    return core_percent(to.ticks - from.ticks, interval);
   };
   for (std::size_t i = 0; i < bridges.size(); ++i) {
     const ProcessSample after = sample_process(bridges[i]->pid(), false);

@@ -29,7 +29,6 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <poll.h>
-#include <sched.h>
 #include <signal.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
@@ -565,7 +564,6 @@ std::uint64_t paced(int rate, double seconds, Write write) {
 }
 
 void print_threads(const ProcessSample& a, const ProcessSample& b, double wall_s) {
-  const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
   struct Row {
     std::string name;
     double cpu = 0, switches = 0;
@@ -578,7 +576,7 @@ void print_threads(const ProcessSample& a, const ProcessSample& b, double wall_s
     const std::uint64_t sw0 = it == a.threads.end() ? 0 : it->second.switches;
     Row& r = rows[t1.name];
     r.name = t1.name;
-    r.cpu += 100.0 * static_cast<double>(t1.ticks - ticks0) / tick / wall_s;
+    r.cpu += core_percent(t1.ticks - ticks0, wall_s);
     r.switches += static_cast<double>(t1.switches - sw0) / wall_s;
     ++r.threads;
   }
@@ -603,6 +601,52 @@ class Runner {
       : o_(o), bridge_(bridge), load_(load) {}
 
   Result run(Kind kind, int rate) {
+    Result r = announce(kind, rate);
+    const double seconds = kind == Kind::kIdle ? o_.idle_seconds : o_.seconds;
+
+    LogCounts logs;
+    log_offset_ = count_log(bridge_.log_path(), log_offset_, logs);  // before: not counted
+    logs = {};
+    const std::uint32_t first_txid = load_.next_txid();
+    load_.begin_window();
+    const ProcessSample before = sample_process(bridge_.pid());
+    const Writes writes = write_load(kind, rate, seconds);
+    const ProcessSample after = sample_process(bridge_.pid());
+    const Observed seen = load_.end_window();
+    if (auto ended = bridge_.ended()) {
+      throw std::runtime_error(fmt::format("dnbridge ended during the scenario ({}); its log: {}",
+                                           *ended, bridge_.log_path().string()));
+    }
+    r.wall_s = static_cast<double>(after.at - before.at) / 1e9;
+    r.cpu_percent = core_percent(after.ticks - before.ticks, r.wall_s);
+    r.rss_before = before.rss_kb;
+    r.rss_after = after.rss_kb;
+
+    if (kind == Kind::kRequests) {
+      report_requests(first_txid, writes.failed, r);
+    } else if (kind == Kind::kCommands || kind == Kind::kSameCommands) {
+      fmt::print("    commands written {} ({:.1f}/s; {} writes failed)\n",
+                 writes.written - writes.failed,
+                 static_cast<double>(writes.written - writes.failed) / r.wall_s, writes.failed);
+    }
+    report_node_counters(seen, r);
+    report_states(seen, r);
+    report_cpu(kind, before, after, writes, r);
+    log_offset_ = count_log(bridge_.log_path(), log_offset_, logs);
+    fmt::print("    bridge log meanwhile: {} warn, {} error line(s){}\n\n", logs.warn, logs.error,
+               logs.first.empty() ? "" : "; first: " + logs.first);
+    std::fflush(stdout);
+    return r;
+  }
+
+ private:
+  // Writes made by a scenario, and how many of them failed.
+  struct Writes {
+    std::uint64_t written = 0, failed = 0;
+  };
+
+  // The scenario's name and first line.
+  Result announce(Kind kind, int rate) const {
     Result r;
     r.kind = kind;
     r.rate = rate;
@@ -635,72 +679,57 @@ class Runner {
         break;
     }
     std::fflush(stdout);
-    const double seconds = kind == Kind::kIdle ? o_.idle_seconds : o_.seconds;
+    return r;
+  }
 
-    LogCounts logs;
-    log_offset_ = count_log(bridge_.log_path(), log_offset_, logs);  // before: not counted
-    logs = {};
-    const std::uint32_t first_txid = load_.next_txid();
-    std::uint64_t written = 0, failed = 0;
-    load_.begin_window();
-    const ProcessSample before = sample_process(bridge_.pid());
+  // The scenario's load, for `seconds`.
+  Writes write_load(Kind kind, int rate, double seconds) {
+    Writes w;
     if (kind == Kind::kRequests) {
-      written = paced(rate, seconds, [&](std::uint64_t i) {
-        if (!load_.request(1 + static_cast<unsigned>(i % kNodes))) ++failed;
+      w.written = paced(rate, seconds, [&](std::uint64_t i) {
+        if (!load_.request(1 + static_cast<unsigned>(i % kNodes))) ++w.failed;
       });
     } else if (kind == Kind::kCommands) {
-      written = paced(rate, seconds, [&](std::uint64_t i) {
+      w.written = paced(rate, seconds, [&](std::uint64_t i) {
         const unsigned mac = 1 + static_cast<unsigned>(i % kNodes);
         const bool on = (i / kNodes) % 2 == 0;
-        if (!load_.command(mac, on, on ? 1000 : 3000)) ++failed;
+        if (!load_.command(mac, on, on ? 1000 : 3000)) ++w.failed;
       });
     } else if (kind == Kind::kSameCommands) {
-      written = paced(rate, seconds, [&](std::uint64_t i) {
-        if (!load_.command(1 + static_cast<unsigned>(i % kNodes), true, 2000)) ++failed;
+      w.written = paced(rate, seconds, [&](std::uint64_t i) {
+        if (!load_.command(1 + static_cast<unsigned>(i % kNodes), true, 2000)) ++w.failed;
       });
     } else {
       sleep_until_monotonic(monotonic_ns() + static_cast<std::int64_t>(seconds * 1e9));
     }
-    const ProcessSample after = sample_process(bridge_.pid());
-    const Observed seen = load_.end_window();
-    if (auto ended = bridge_.ended()) {
-      throw std::runtime_error(fmt::format("dnbridge ended during the scenario ({}); its log: {}",
-                                           *ended, bridge_.log_path().string()));
-    }
-    r.wall_s = static_cast<double>(after.at - before.at) / 1e9;
-    const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
-    r.cpu_percent = 100.0 * static_cast<double>(after.ticks - before.ticks) / tick / r.wall_s;
-    r.rss_before = before.rss_kb;
-    r.rss_after = after.rss_kb;
+    return w;
+  }
 
-    if (kind == Kind::kRequests) {
-      const std::uint32_t last_txid = load_.next_txid();
-      load_.wait_answered(first_txid, last_txid,
-                          monotonic_ns() + static_cast<std::int64_t>(o_.reply_wait_seconds * 1e9));
-      auto rep = load_.replies(first_txid, last_txid);
-      r.sent = rep.sent;
-      r.answered = rep.answered;
-      r.device_success = rep.device_success;
-      r.reply = summarize(std::move(rep.latency_us));
-      fmt::print(
-          "    requests sent {} ({:.1f}/s; {} writes failed), answered {} ({:.2f} %; waited at "
-          "most {} s after the last)\n",
-          rep.sent, static_cast<double>(rep.sent) / r.wall_s, failed, rep.answered,
-          rep.sent ? 100.0 * static_cast<double>(rep.answered) / static_cast<double>(rep.sent)
-                   : 0.0,
-          o_.reply_wait_seconds);
-      fmt::print("      by status:");
-      for (const auto& [status, n] : rep.by_status) fmt::print(" [{}] {}", status, n);
-      fmt::print("; of status 1, CIP success: {}\n", rep.device_success);
-      fmt::print("    reply latency, written -> reply taken: p50 {}  p99 {}  max {}\n",
-                 duration_text(r.reply.p50), duration_text(r.reply.p99),
-                 duration_text(r.reply.max));
-    } else if (kind == Kind::kCommands || kind == Kind::kSameCommands) {
-      fmt::print("    commands written {} ({:.1f}/s; {} writes failed)\n", written - failed,
-                 static_cast<double>(written - failed) / r.wall_s, failed);
-    }
+  // The requests' replies, waited for.
+  void report_requests(std::uint32_t first_txid, std::uint64_t failed, Result& r) {
+    const std::uint32_t last_txid = load_.next_txid();
+    load_.wait_answered(first_txid, last_txid,
+                        monotonic_ns() + static_cast<std::int64_t>(o_.reply_wait_seconds * 1e9));
+    auto rep = load_.replies(first_txid, last_txid);
+    r.sent = rep.sent;
+    r.answered = rep.answered;
+    r.device_success = rep.device_success;
+    r.reply = summarize(std::move(rep.latency_us));
+    fmt::print(
+        "    requests sent {} ({:.1f}/s; {} writes failed), answered {} ({:.2f} %; waited at "
+        "most {} s after the last)\n",
+        rep.sent, static_cast<double>(rep.sent) / r.wall_s, failed, rep.answered,
+        rep.sent ? 100.0 * static_cast<double>(rep.answered) / static_cast<double>(rep.sent) : 0.0,
+        o_.reply_wait_seconds);
+    fmt::print("      by status:");
+    for (const auto& [status, n] : rep.by_status) fmt::print(" [{}] {}", status, n);
+    fmt::print("; of status 1, CIP success: {}\n", rep.device_success);
+    fmt::print("    reply latency, written -> reply taken: p50 {}  p99 {}  max {}\n",
+               duration_text(r.reply.p50), duration_text(r.reply.p99), duration_text(r.reply.max));
+  }
 
-    // NodeStatus counters: rates per node over the samples of the window.
+  // NodeStatus counters: rates per node over the samples of the window.
+  static void report_node_counters(const Observed& seen, Result& r) {
     double polls_sum = 0, polls_min = 1e18, polls_max = 0, idle_sum = 0, responses_sum = 0;
     double accepted = 0, refused = 0, explicit_requests = 0, timeouts = 0;
     unsigned nodes = 0;
@@ -735,6 +764,10 @@ class Runner {
       fmt::print(
           "    polls per node per second: no two NodeStatus samples of a node in the window\n");
     }
+  }
+
+  // The last PortStatus, and the PumpStates' freshness and gaps.
+  static void report_states(const Observed& seen, Result& r) {
     if (seen.port) {
       fmt::print(
           "    port A (last PortStatus): {:.0f} frames/s, bus load {:.1f} %, scan cycle {:.1f} "
@@ -755,33 +788,30 @@ class Runner {
         seen.pump_samples, static_cast<double>(seen.pump_samples) / r.wall_s,
         duration_text(r.freshness.p50), duration_text(r.freshness.p99),
         duration_text(r.freshness.max), duration_text(r.max_gap_us), gap_mac);
+  }
+
+  // The bridge's CPU time and RSS over the window, and by thread.
+  static void report_cpu(Kind kind, const ProcessSample& before, const ProcessSample& after,
+                         const Writes& writes, const Result& r) {
+    const double cpu_s = ticks_seconds(after.ticks - before.ticks);
     fmt::print(
         "    bridge CPU: {:.1f} % of one core ({:.2f} s of utime + stime over {:.1f} s); RSS "
         "{} kB before, {} kB after ({:+} kB)\n",
-        r.cpu_percent, static_cast<double>(after.ticks - before.ticks) / tick, r.wall_s,
-        r.rss_before, r.rss_after,
+        r.cpu_percent, cpu_s, r.wall_s, r.rss_before, r.rss_after,
         static_cast<std::int64_t>(r.rss_after) - static_cast<std::int64_t>(r.rss_before));
-    if ((kind == Kind::kCommands || kind == Kind::kSameCommands) && written > failed) {
+    if ((kind == Kind::kCommands || kind == Kind::kSameCommands) &&
+        writes.written > writes.failed) {
       fmt::print("      = {:.1f} us of bridge CPU per command written\n",
-                 static_cast<double>(after.ticks - before.ticks) / tick * 1e6 /
-                     static_cast<double>(written - failed));
+                 cpu_s * 1e6 / static_cast<double>(writes.written - writes.failed));
     }
     print_threads(before, after, r.wall_s);
-    log_offset_ = count_log(bridge_.log_path(), log_offset_, logs);
-    fmt::print("    bridge log meanwhile: {} warn, {} error line(s){}\n\n", logs.warn, logs.error,
-               logs.first.empty() ? "" : "; first: " + logs.first);
-    std::fflush(stdout);
-    return r;
   }
 
- private:
   const Options& o_;
   BridgeProcess& bridge_;
   Load& load_;
   std::streamoff log_offset_ = 0;
 };
-
-std::string verdict(bool met) { return met ? "met" : "NOT met"; }
 
 int run(const Options& o) {
   const auto run_from = monotonic_ns();
@@ -819,13 +849,8 @@ int run(const Options& o) {
   } else {
     fmt::print("CPUs: every process and thread where the kernel puts it\n");
   }
-  if (o.load_cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(static_cast<std::size_t>(o.load_cpu), &set);
-    if (sched_setaffinity(0, sizeof set, &set) != 0) {
-      throw std::runtime_error(fmt::format("cannot keep this process on CPU {}", o.load_cpu));
-    }
+  if (!pin_to_cpu(o.load_cpu)) {
+    throw std::runtime_error(fmt::format("cannot keep this process on CPU {}", o.load_cpu));
   }
 
   Load load(domain, fmt::format("dnbridge-load-bench@{}:{}", host, getpid()), max_requests);
