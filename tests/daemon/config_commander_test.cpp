@@ -5,18 +5,12 @@
 
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/reload.hpp"
+#include "config_text.hpp"
 
 namespace dnbridge::daemon {
 namespace {
 
-std::string problems(std::string_view text) {
-  try {
-    parse_config(text, "t.toml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(none)";
-}
+using config_test::problems;
 
 Duration refresh_of(const DaemonConfig& c, std::size_t port, std::size_t node) {
   return c.ports.at(port).nodes.at(node).pump.command_refresh;

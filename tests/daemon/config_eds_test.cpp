@@ -10,20 +10,13 @@
 #include <string>
 
 #include "adapters/daemon/config.hpp"
+#include "config_text.hpp"
 
 namespace dnbridge::daemon {
 namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
-
-// Lines 1..5: a rack with one simulated port.
-#define ONE_PORT                \
-  "rack = \"r\"\n"              \
-  "[[port]]\n"                  \
-  "name = \"A\"\n"              \
-  "interface = \"simulated\"\n" \
-  "bitrate = 500000\n"
 
 // The example I/O block's safe state: its four parameters, on four lines.
 #define IO_BLOCK_SAFE_STATE                                        \
@@ -45,14 +38,7 @@ DaemonConfig parse(std::string_view text, const std::filesystem::path& base = DN
   return parse_config(text, "t.toml", base);
 }
 
-std::string problems(std::string_view text, const std::filesystem::path& base = DNBRIDGE_EDS_DIR) {
-  try {
-    parse(text, base);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(none)";
-}
+using config_test::problems;
 
 TEST(ConfigEds, ANodeDescribedByItsEdsLoadsWithItsParametersAndSafeState) {
   const DaemonConfig c = parse(ONE_PORT IO_BLOCK

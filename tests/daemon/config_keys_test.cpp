@@ -15,6 +15,7 @@
 
 #include "adapters/daemon/config.hpp"
 #include "bridge/rack/explicit_policy.hpp"
+#include "config_text.hpp"
 
 namespace dnbridge::daemon {
 namespace {
@@ -22,14 +23,7 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string problems(const std::string& text) {
-  try {
-    parse_config(text, "t.toml", DNBRIDGE_EDS_DIR);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(none)";
-}
+using config_test::problems;
 
 // No key takes a date-time: whoever reads KEY = this says what it must be.
 constexpr std::string_view kNoKeysValue = "1979-05-27T07:32:00Z";
