@@ -17,7 +17,7 @@
 #include "adapters/daemon/config_internal.hpp"
 #include "adapters/daemon/host_identity.hpp"
 #include "adapters/security/toml_settings.hpp"
-#include "adapters/toml/reader.hpp"
+#include "adapters/toml_config/reader.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
 namespace dnbridge::daemon {

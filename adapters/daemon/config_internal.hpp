@@ -17,7 +17,7 @@
 
 #include "adapters/daemon/config.hpp"
 #include "adapters/daemon/config_keys.hpp"
-#include "adapters/toml/reader.hpp"
+#include "adapters/toml_config/reader.hpp"
 #include "bridge/common/time.hpp"
 #include "bridge/devicenet/wire/mac_id.hpp"
 #include "bridge/profiles/cdn127/poll_format.hpp"

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "adapters/security/settings.hpp"
-#include "adapters/toml/reader.hpp"
+#include "adapters/toml_config/reader.hpp"
 
 namespace dnbridge::security {
 

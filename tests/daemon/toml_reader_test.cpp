@@ -1,11 +1,11 @@
-// The TOML kit every configuration is read with (adapters/toml/reader.hpp):
+// The TOML kit every configuration is read with (adapters/toml_config/reader.hpp):
 // the keys a table may hold are the keys its reader asked for, within the
 // table of its keys where it is held to one.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 
-#include "adapters/toml/reader.hpp"
+#include "adapters/toml_config/reader.hpp"
 
 namespace dnbridge::toml_config {
 namespace {

@@ -12,7 +12,7 @@
 #include <utility>
 
 #include "adapters/sim/world/sim_rack.hpp"
-#include "adapters/toml/reader.hpp"
+#include "adapters/toml_config/reader.hpp"
 #include "bridge/profiles/cdn127/objects.hpp"
 
 namespace dnbridge::sim::host {

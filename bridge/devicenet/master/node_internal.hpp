@@ -1,7 +1,7 @@
 #pragma once
 // What the parts of Node (node.cpp, node_lifecycle.cpp, node_identify.cpp,
-// node_connections.cpp, node_poll.cpp) share: the DeviceNet objects the life
-// cycle addresses, and text helpers.
+// node_connections.cpp, node_poll.cpp) and its connections share: the
+// DeviceNet objects the life cycle addresses, and text helpers.
 #include <fmt/format.h>
 
 #include <algorithm>

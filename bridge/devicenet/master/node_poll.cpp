@@ -1,4 +1,6 @@
-// Node: the poll connection (scheduling, idle, outputs, responses).
+// Node: its I/O connections' traffic (PollConnection, InputLink): the
+// outputs and idle flag handed to the poll connection, and what their
+// answers, bad answers and strays lead to.
 #include <fmt/format.h>
 
 #include <algorithm>

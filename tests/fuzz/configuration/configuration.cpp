@@ -1,4 +1,4 @@
-// The configuration readers (adapters/toml/reader.hpp and the three files
+// The configuration readers (adapters/toml_config/reader.hpp and the three files
 // read with it) on any text. Input: [selector] then the file's text;
 // selector % 3: 0 a rack configuration (dnbridge), 1 a device configuration
 // (cdn127-sim), 2 a [security] table.

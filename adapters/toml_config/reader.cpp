@@ -1,4 +1,4 @@
-#include "adapters/toml/reader.hpp"
+#include "adapters/toml_config/reader.hpp"
 
 #include <fmt/format.h>
 

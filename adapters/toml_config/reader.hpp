@@ -21,7 +21,7 @@
 #include <tuple>
 #include <vector>
 
-#include "adapters/toml/problems.hpp"
+#include "adapters/toml_config/problems.hpp"
 #include "bridge/common/time.hpp"
 
 namespace dnbridge::toml_config {

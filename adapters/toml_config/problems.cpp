@@ -1,4 +1,4 @@
-#include "adapters/toml/problems.hpp"
+#include "adapters/toml_config/problems.hpp"
 
 #include <fmt/format.h>
 
