@@ -3,9 +3,9 @@
 // cyclic (Connection 4), or bit-strobe (Connection 3). Its allocation, the
 // settings the start-up asks and learns (EPR, the Acknowledge Handler's
 // timer and retry limit), and from the Set of its EPR on the consumer of its
-// messages: their framing, the acknowledgments, the run of bad ones and the
-// 4 x EPR watchdog. Node owns one and decides what a bad message or a
-// silence leads to.
+// messages: their framing, the acknowledgments and the 4 x EPR watchdog.
+// Node owns one, counts the bad messages in a row here, and decides what
+// they or a silence lead to.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -54,8 +54,8 @@ class InputLink {
   // --- the start-up ---
   // A new attempt: what an earlier one learnt is forgotten.
   void begin_attempt();
-  // The settings asked, as the start-up learns the device's.
-  const CosSettings& asked() const { return asked_; }
+  // The settings asked, as the start-up learns the device's (the
+  // consumer's from start_consuming() on).
   void set_ack_timer(Duration timer) { asked_.ack_timer = timer; }
   void set_retry_limit(std::uint8_t limit) { asked_.retry_limit = limit; }
   // Its timer or retry limit refused: the defaults are taken.
@@ -77,8 +77,10 @@ class InputLink {
   void stop() { consumer_.reset(); }
   // Online: no bad messages in a row yet.
   void reset_errors() { errors_in_a_row_ = 0; }
-  // A frame of a message: reported to the listener once whole.
+  // A frame of a message: reported to the listener once whole. Only while
+  // consuming().
   void on_message(Bytes payload, TimePoint now);
+  // A bad message in a row more: their count (a good message ends the run).
   unsigned count_error() { return ++errors_in_a_row_; }
   unsigned errors_in_a_row() const { return errors_in_a_row_; }
   // When nothing has come for 4 x EPR; kNever while not consuming.

@@ -29,17 +29,17 @@ class KeepAlive {
   }
   void stop() { next_ = kNever; }
   TimePoint next() const { return next_; }
-  // Due at `now`: the one after it an EPR on.
-  bool due(TimePoint now) {
-    if (now < next_) return false;
+  // At `now`: when one is due, the next is scheduled an EPR on, and the
+  // attribute to read is returned, unless the last one is still unanswered
+  // (`outstanding`: it is not doubled); nullptr otherwise.
+  const cip::AttributeRef* on_timer(TimePoint now, bool outstanding) {
+    if (now < next_) return nullptr;
     next_ = now + epr_;
-    return true;
-  }
-  // What the keep-alive due reads; reads_status() then tells which it is.
-  const cip::AttributeRef& next_read() {
+    if (outstanding) return nullptr;
     reads_status_ = !state_supported_ || !reads_status_;
-    return reads_status_ ? cip::identity::kStatus : cip::identity::kState;
+    return reads_status_ ? &cip::identity::kStatus : &cip::identity::kState;
   }
+  // Which the last keep-alive read: Identity.Status, or Identity.State.
   bool reads_status() const { return reads_status_; }
 
   // An answer on the explicit connection, a refusal included.

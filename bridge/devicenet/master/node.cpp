@@ -232,7 +232,7 @@ void Node::on_timer(TimePoint now) {
   if (shutting_down_) return;
   // The device drops the connection after 4 x EPR without a poll; the master
   // drops the node after 4 x EPR without a response.
-  if (poll_.silence(now) >= 4 * poll_.epr()) {
+  if (poll_.watchdog_expired(now)) {
     record(NodeError::Kind::kConnectionLost, now);
     lose(fmt::format("no poll response for {} ms (4 x EPR)",
                      std::chrono::duration_cast<milliseconds>(poll_.silence(now)).count()),
@@ -262,8 +262,8 @@ void Node::on_timer(TimePoint now) {
   poll_.on_timer(now);
   // The keep-alive has its own place in the client's queue (request_explicit
   // leaves it); one still unanswered is not doubled.
-  if (keep_alive_.due(now) && step_ != Step::kKeepAlive) {
-    get(Step::kKeepAlive, keep_alive_.next_read(), now);
+  if (const cip::AttributeRef* read = keep_alive_.on_timer(now, step_ == Step::kKeepAlive)) {
+    get(Step::kKeepAlive, *read, now);
   }
 }
 

@@ -295,13 +295,15 @@ class Node final : private ExplicitClient::Listener,
   // port's maximum, with jitter, so that a broken node never floods the bus.
   Duration next_backoff();
 
-  // The poll connection's answers (PollConnection::Listener).
+  // The poll connection's answers (PollConnection::Listener); a bad one
+  // also for a response while the node is not online.
   void on_poll_answer(Bytes inputs, bool late, TimePoint now) override;
   void on_bad_poll_answer(NodeError::Kind kind, std::uint32_t got, TimePoint now) override;
   // A poll for outputs that changed, if the node is online and polls on change.
   void poll_for_change(TimePoint now);
   void on_input_message(bool strobe_response, Bytes payload, TimePoint now);
-  // The input connection's messages (InputLink::Listener).
+  // The input connection's messages (InputLink::Listener); a bad one also
+  // for a message the connection does not take (none, or of the other kind).
   void on_inputs(Bytes data, TimePoint now) override;
   void on_bad_inputs(NodeError::Kind kind, std::uint32_t got, TimePoint now) override;
 

@@ -211,8 +211,7 @@ void Node::release_after_loss(TimePoint now) {
 void Node::attempt_allocate(TimePoint now) {
   retry_at_ = kNever;
   step_timeouts_ = 0;
-  poll_.allocation().release_tried = false;
-  poll_.forget_strays();  // what did not come by now is not coming
+  poll_.begin_attempt();
   setting_retried_ = false;
   // What an attempt learns is its own: paths and refusals from an earlier one
   // would otherwise pile up in the reasons.

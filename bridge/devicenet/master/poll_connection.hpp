@@ -1,9 +1,9 @@
 #pragma once
-// A node's poll connection (Connection 2): its allocation, its slots, the
-// outputs and idle flag it carries, the poll in flight and its response,
-// and the silence its 4 x EPR watchdog measures. Node owns one and decides
-// what an answer, a bad answer or a silence leads to; this class only
-// frames, schedules and counts.
+// A node's poll connection (Connection 2): its allocation and EPR as the
+// start-up makes them, its slots, the outputs and idle flag it carries, the
+// poll in flight and its response, the strays of the idle poll before a
+// Release, and the silence its 4 x EPR watchdog measures. Node owns one and
+// decides what an answer, a bad answer or a silence leads to.
 #include <cstdint>
 
 #include "bridge/can/frame_sink.hpp"
@@ -23,8 +23,8 @@ class PollConnection {
    public:
     virtual ~Listener() = default;
     // A response of the produced size, or an empty one to an idle poll;
-    // `late`: no poll was waiting for it (it timed out). The connection has
-    // taken it as answered.
+    // `late`: no poll was waiting for it (it timed out, or a bad answer
+    // ended the wait). The connection has taken it as answered.
     virtual void on_poll_answer(Bytes inputs, bool late, TimePoint now) = 0;
     // A response of another size, or fragments out of order.
     virtual void on_bad_poll_answer(NodeError::Kind kind, std::uint32_t got, TimePoint now) = 0;
@@ -51,6 +51,12 @@ class PollConnection {
   void stop();
   // No more slots; a poll in flight is still waited for (shutdown).
   void stop_slots() { next_slot_ = kNever; }
+  // A new start-up attempt: its Allocate may be retried once more, and the
+  // answers to an idle poll that did not come by now are not coming.
+  void begin_attempt() {
+    allocation_.release_tried = false;
+    strays_ = 0;
+  }
   TimePoint next_slot() const { return next_slot_; }
   // Serves the next slot now, ahead of time; the slot after it is next.
   // Nothing while a poll is unanswered: the slot is then served at its time.
@@ -58,7 +64,8 @@ class PollConnection {
   // Serves a slot that is due, and the poll held back by the minimum gap
   // once the gap is over.
   void on_timer(TimePoint now);
-  // The earliest of the next slot, the held-back poll and the watchdog.
+  // The earliest of the next slot, the held-back poll and the watchdog;
+  // meaningful while polling (from start() until stop() or stop_slots()).
   TimePoint timers_deadline() const;
 
   // --- outputs ---
@@ -69,7 +76,7 @@ class PollConnection {
   // Idle, to be sent: the shutdown's last poll.
   void force_idle();
   bool idle() const { return idle_; }
-  // The outputs differ from what the last poll carried.
+  // The outputs or the idle flag were set anew since the last poll.
   bool dirty() const { return dirty_; }
   // Outputs and idle flag of the last poll the device answered.
   Bytes applied_outputs() const { return applied_outputs_.view(); }
@@ -94,11 +101,12 @@ class PollConnection {
   void give_up();
   // The poll outstanding is no longer waited for (a bad answer, a release).
   void drop_outstanding();
-  // A bad answer in a row more: their count.
+  // A bad answer in a row more: their count (a good answer ends the run).
   unsigned count_error() { return ++consecutive_errors_; }
   // Since the last response.
   Duration silence(TimePoint now) const { return now - last_response_; }
-  TimePoint last_response() const { return last_response_; }
+  // 4 x EPR without a response: the device has dropped the connection.
+  bool watchdog_expired(TimePoint now) const { return silence(now) >= 4 * epr_; }
 
   // --- responses ---
   // A frame of a response: reported to the listener once whole.
@@ -107,7 +115,6 @@ class PollConnection {
   bool strays_expected() const { return strays_ > 0; }
   // A frame of one of them: counted off once its message is complete.
   void take_stray(Bytes payload);
-  void forget_strays() { strays_ = 0; }
 
  private:
   TimePoint slot_after(TimePoint after) const;

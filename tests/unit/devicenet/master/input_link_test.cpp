@@ -72,19 +72,30 @@ TEST_F(InputLinkTest, ANewAttemptForgetsWhatTheLastOneLearnt) {
   link_.begin_attempt();
   link_.set_ack_timer(milliseconds(40));
   link_.set_retry_limit(3);
+  link_.note_ack_handler_unread();
   link_.set_path_refusal("; Set of its path refused");
   link_.allocation().release_tried = true;
+  link_.start_consuming(kT0);
+  EXPECT_EQ(link_.settings()->ack_timer, milliseconds(40));
+  EXPECT_NE(link_.describe().find("(defaults: its Acknowledge Handler not read)"),
+            std::string::npos);
+
+  link_.stop();
   link_.begin_attempt();
-  EXPECT_EQ(link_.asked().ack_timer, CosSettings{}.ack_timer);
-  EXPECT_EQ(link_.asked().retry_limit, CosSettings{}.retry_limit);
-  EXPECT_EQ(link_.asked().expected_packet_rate, milliseconds(100));
-  EXPECT_FALSE(link_.asked().ack_suppressed);
+  link_.start_consuming(kT0);
+  const CosSettings s = *link_.settings();
+  EXPECT_EQ(s.ack_timer, CosSettings{}.ack_timer);
+  EXPECT_EQ(s.retry_limit, CosSettings{}.retry_limit);
+  EXPECT_EQ(s.expected_packet_rate, milliseconds(100));
+  EXPECT_FALSE(s.ack_suppressed);
   EXPECT_TRUE(link_.path_refusal().empty());
   EXPECT_FALSE(link_.allocation().release_tried);
+  EXPECT_EQ(link_.describe().find("defaults"), std::string::npos) << link_.describe();
 
   in().kind = InputKind::kBitStrobe;
   link_.begin_attempt();
-  EXPECT_TRUE(link_.asked().ack_suppressed) << "nothing acknowledges a bit-strobe response";
+  link_.start_consuming(kT0);
+  EXPECT_TRUE(link_.settings()->ack_suppressed) << "nothing acknowledges a bit-strobe response";
 }
 
 TEST_F(InputLinkTest, MessagesAreAcknowledgedAndRetriesAreNotReportedAgain) {
@@ -118,8 +129,8 @@ TEST_F(InputLinkTest, AMessageOfAnotherSizeIsBadAndAGoodOneEndsTheRun) {
   ASSERT_EQ(inputs_.bad.size(), 1u);
   EXPECT_EQ(inputs_.bad[0], NodeError::Kind::kCosLength);
   EXPECT_EQ(inputs_.bad_sizes[0], 3u);
+  EXPECT_EQ(link_.errors_in_a_row(), 0u) << "the node counts the bad ones";
   EXPECT_EQ(link_.count_error(), 1u);
-  EXPECT_EQ(link_.errors_in_a_row(), 1u);
   const std::vector<std::uint8_t> two{1, 2};
   link_.on_message(Bytes(two), kT0 + milliseconds(1));
   EXPECT_EQ(link_.errors_in_a_row(), 0u);
