@@ -22,6 +22,7 @@
 #include "bridge/devicenet/master/keep_alive.hpp"
 #include "bridge/devicenet/master/node_state.hpp"
 #include "bridge/devicenet/master/poll_connection.hpp"
+#include "bridge/devicenet/master/release_sequence.hpp"
 #include "bridge/devicenet/master/scan_list.hpp"
 #include "bridge/devicenet/master/scanner_events.hpp"
 #include "bridge/devicenet/wire/fragmentation.hpp"
@@ -184,68 +185,133 @@ class Node final : private ExplicitClient::Listener,
   enum class OnRefusal : std::uint8_t {
     kFault,        // configuration fault naming object, attribute, status, expectation
     kWrongDevice,  // the identity the scan list expects cannot be read
-    kGoOn,         // information only: the next step all the same
+    kGoOn,         // information only: the handler records it, then `next`
     kHandler,      // the step's handler decides (allocation, paths, sizes)
   };
-  // One row of the start-up table.
+  // What no answer (a timeout, an aborted or malformed reply) leads to.
+  enum class OnSilence : std::uint8_t {
+    kResend,   // sent again twice, then the node is lost
+    kHandler,  // the handler decides (an absent node, a back-off)
+  };
+  // What a handler found, and so where the start-up goes.
+  enum class Verdict : std::uint8_t {
+    kNext,   // the row's `next`
+    kAlt,    // the row's `alt`: the other way the answer may lead
+    kAgain,  // this row once more, for the next setting or check
+    kStop,   // the handler moved the node itself: a fault, a wait
+  };
+  // What a row's request takes from the node rather than from the row.
+  struct Ask {
+    InlineBytes<16> value;            // Set: the value
+    std::uint8_t choice = 0;          // Allocate, Release: the row's unless changed
+    std::optional<Duration> timeout;  // a bound on the wait for the answer
+  };
+  // One row of the start-up table: everything about a step. A step that
+  // does not apply (`applies` false) is passed over to its `next`.
   struct StepRow {
     Step step{};
     NodeState phase{};  // the state reported while it runs
     Verb verb{};
     cip::AttributeRef target;  // Get/Set: the attribute; a profile's from the profile
     std::uint8_t choice = 0;   // Allocate/Release: allocation choice bits
-    OnRefusal on_refusal{};
-    Step next{};  // after a good answer, unless the handler chooses
-    // Checks a good answer (and, with kHandler, a refusal); returns the next
-    // step, or kNone when it has moved the node itself (a fault, a wait).
-    Step (Node::*handler)(const ExplicitResult&, TimePoint) = nullptr;
+    // Fills what the request takes from the node; and what sending it starts.
+    void (Node::*ask)(Ask&, TimePoint) = nullptr;
+    bool (Node::*applies)() const = nullptr;  // nullptr: always
+    OnRefusal on_refusal = OnRefusal::kHandler;
+    OnSilence on_silence = OnSilence::kResend;
+    // Records what an answer says and judges it; nullptr: a good answer is
+    // `next`.
+    Verdict (Node::*handler)(const ExplicitResult&, TimePoint) = nullptr;
+    Step next = Step::kNone;  // after a good answer, and where the row does not apply
+    Step alt = Step::kNone;   // where Verdict::kAlt leads
   };
   static const StepRow kStartup[];
   static const StepRow& row(Step step);
 
   void on_explicit_result(std::uint32_t tag, const ExplicitResult& result, TimePoint now) override;
   void on_step_result(Step step, const ExplicitResult& result, TimePoint now);
-  // Runs a start-up step: builds its request from its row.
-  void run(Step step, TimePoint now);
-  void advance(Step next, TimePoint now);
+  // The errors of an answer counted and kept as the node's last error.
+  void record_answer(const ExplicitResult& result, TimePoint now);
+  // What the answer to a row leads to: its handler's verdict, or the
+  // row's own rule for a refusal.
+  Verdict judge(const StepRow& rule, const ExplicitResult& r, TimePoint now);
+  // Runs `step`, or the first row from it on that applies; kOnline starts
+  // the poll connection.
+  void enter(Step step, TimePoint now);
+  // Sends a row's request, built from the row and its `ask`.
+  void run(const StepRow& row, TimePoint now);
   // The attribute a step addresses (a profile's from the profile).
   cip::AttributeRef target_of(Step step) const;
 
-  // The handlers of the start-up table (kStartup, node_lifecycle.cpp): from
-  // the allocation to the configuration in node_identify.cpp, the I/O
-  // connections' in node_connections.cpp.
-  Step after_allocate_explicit(const ExplicitResult& r, TimePoint now);
-  Step after_allocation_info(const ExplicitResult& r, TimePoint now);
-  Step after_identity_match(const ExplicitResult& r, TimePoint now);
-  Step after_revision(const ExplicitResult& r, TimePoint now);
-  Step after_serial(const ExplicitResult& r, TimePoint now);
-  Step after_name(const ExplicitResult& r, TimePoint now);
-  Step after_identity_status(const ExplicitResult& r, TimePoint now);
-  Step after_identity_state(const ExplicitResult& r, TimePoint now);
-  Step after_read_setting(const ExplicitResult& r, TimePoint now);
-  Step after_write_setting(const ExplicitResult& r, TimePoint now);
-  Step after_release_for_setting(const ExplicitResult& r, TimePoint now);
-  Step after_verify_setting(const ExplicitResult& r, TimePoint now);
-  Step after_check(const ExplicitResult& r, TimePoint now);
-  Step after_allocate_poll(const ExplicitResult& r, TimePoint now);
-  Step after_get_path(const ExplicitResult& r, TimePoint now);
-  Step after_set_path(const ExplicitResult& r, TimePoint now);
-  Step after_size(const ExplicitResult& r, TimePoint now);
-  Step after_epr(const ExplicitResult& r, TimePoint now);
-  Step after_allocate_cos(const ExplicitResult& r, TimePoint now);
+  // The start-up table's handlers (kStartup, node_lifecycle.cpp): from the
+  // allocation to the configuration in node_identify.cpp, the I/O
+  // connections' in node_connections.cpp. Each records what the answer
+  // says and returns where it leads as a Verdict.
+  Verdict after_allocate_explicit(const ExplicitResult& r, TimePoint now);
+  Verdict after_release_stale(const ExplicitResult& r, TimePoint now);
+  Verdict after_allocation_info(const ExplicitResult& r, TimePoint now);
+  Verdict after_identity_match(const ExplicitResult& r, TimePoint now);
+  Verdict after_revision(const ExplicitResult& r, TimePoint now);
+  Verdict after_serial(const ExplicitResult& r, TimePoint now);
+  Verdict after_name(const ExplicitResult& r, TimePoint now);
+  Verdict after_identity_status(const ExplicitResult& r, TimePoint now);
+  Verdict after_identity_state(const ExplicitResult& r, TimePoint now);
+  Verdict after_read_setting(const ExplicitResult& r, TimePoint now);
+  Verdict after_write_setting(const ExplicitResult& r, TimePoint now);
+  Verdict after_release_for_setting(const ExplicitResult& r, TimePoint now);
+  Verdict after_verify_setting(const ExplicitResult& r, TimePoint now);
+  Verdict after_check(const ExplicitResult& r, TimePoint now);
+  Verdict after_allocate_poll(const ExplicitResult& r, TimePoint now);
+  Verdict after_get_path(const ExplicitResult& r, TimePoint now);
+  Verdict after_set_path(const ExplicitResult& r, TimePoint now);
+  Verdict after_size(const ExplicitResult& r, TimePoint now);
+  Verdict after_explicit_epr(const ExplicitResult& r, TimePoint now);
+  Verdict after_poll_epr(const ExplicitResult& r, TimePoint now);
+  Verdict after_allocate_cos(const ExplicitResult& r, TimePoint now);
+  Verdict after_cos_path(const ExplicitResult& r, TimePoint now);
+  Verdict after_cos_inhibit(const ExplicitResult& r, TimePoint now);
+  Verdict after_cos_size(const ExplicitResult& r, TimePoint now);
+  Verdict after_ack_setting(const ExplicitResult& r, TimePoint now);
+  Verdict after_cos_epr(const ExplicitResult& r, TimePoint now);
   // A refused Allocate of an I/O connection (`what`): "already allocated"
-  // released (`release_step`) and allocated once more; owned by another
+  // released (Verdict::kAlt) and allocated once more; owned by another
   // master, or another refusal (with `needed_by` after the status), a fault.
-  Step io_allocate_refused(const ExplicitResult& r, TimePoint now, std::string_view what,
-                           std::string_view needed_by, IoAllocation& allocation, Step release_step);
-  Step after_cos_step(const ExplicitResult& r, TimePoint now);
-  // The change-of-state steps in order, those that do not apply skipped.
-  Step cos_step_after(Step step) const;
+  Verdict io_allocate_refused(const ExplicitResult& r, TimePoint now, std::string_view what,
+                              std::string_view needed_by, IoAllocation& allocation);
+  // The setting in hand done, with what the device has: the next one.
+  void next_setting(Bytes in_force);
+
+  // The rows' `ask`: what their requests take from the node.
+  void ask_stale_io(Ask& ask, TimePoint now);
+  void ask_setting(Ask& ask, TimePoint now);
+  void ask_allocate_poll(Ask& ask, TimePoint now);
+  void ask_produced_path(Ask& ask, TimePoint now);
+  void ask_consumed_path(Ask& ask, TimePoint now);
+  void ask_explicit_epr(Ask& ask, TimePoint now);
+  void ask_poll_epr(Ask& ask, TimePoint now);
+  void ask_allocate_cos(Ask& ask, TimePoint now);
+  void ask_cos_release(Ask& ask, TimePoint now);
+  void ask_cos_path(Ask& ask, TimePoint now);
+  void ask_cos_inhibit(Ask& ask, TimePoint now);
+  void ask_cos_epr(Ask& ask, TimePoint now);
+  // The rows' `applies`: the optional steps, by what the profile asks for.
+  bool has_setting() const;
+  bool has_check() const;
+  bool has_produced_path() const;
+  bool has_consumed_path() const;
+  bool has_input() const;
+  bool has_input_path() const;
+  bool has_input_inhibit() const;
+  bool has_ack_handler() const;
+
   // A connection lost while the others live (the change-of-state
   // watchdog, bad poll responses): the outputs idle with one poll, every
   // connection released, then absent as after any loss.
   void lose_and_release(std::string reason, TimePoint now);
   void on_keepalive_result(const ExplicitResult& r, TimePoint now);
+  // The answer to a Release after a fault or a loss, or at shutdown: the
+  // next connection of the sequence, or the node left.
+  void on_release_result(Step step, const ExplicitResult& r, TimePoint now);
   // The Identity Status and State read last: a major fault takes the node to
   // kDeviceFault (false); a minor one is warned of when it appears.
   bool check_health(TimePoint now);
@@ -260,20 +326,17 @@ class Node final : private ExplicitClient::Listener,
   std::uint8_t held_connections() const;
 
   void attempt_allocate(TimePoint now);
+  // A Release of `choice` (a new sequence, ReleaseSequence), or of the
+  // next connection of the sequence in hand.
   void release(Step step, std::uint8_t choice, TimePoint now);
-  // The setting in hand (setting_index_), or the checks after the last.
-  Step first_setting_step();
-  // The check in hand (check_index_), or the poll connection after the last.
-  Step next_check_step();
+  void send_release(Step step, std::uint8_t choice, TimePoint now);
   // What a refused Get of the setting in hand was for, for the reason:
   // "; the configuration needs 03"; empty for other steps.
   std::string setting_expectation(Step step) const;
   // The path a step reads or writes, and the one the profile needs.
   bool path_step_produced(Step step) const;
   Bytes wanted_path(bool produced) const;
-  Step after_path(bool produced, TimePoint now);
-  Step begin_verify(TimePoint now);
-  Step check_sizes(TimePoint now);
+  Verdict check_sizes(TimePoint now);
   // "Connection 2 attribute 7", or the profile's fallback for the same size.
   std::string size_attribute(bool produced, bool fallback) const;
   void go_online(TimePoint now);
@@ -330,9 +393,7 @@ class Node final : private ExplicitClient::Listener,
   bool setting_retried_ = false;   // a refused Set retried once after releasing the poll
   std::size_t check_index_ = 0;    // the check in hand
   std::uint8_t stale_choice_ = 0;  // I/O connections left from before, to release
-  // A Release refused whole (0x0B): the connections still to release one
-  // at a time (the one in hand included); 0 otherwise.
-  std::uint8_t releases_left_ = 0;
+  ReleaseSequence releases_;
   InlineBytes<16> setting_found_;  // what the device had before the Set
   unsigned step_timeouts_ = 0;     // consecutive timeouts of the current life-cycle step
   Step last_step_ = Step::kNone;

@@ -1,7 +1,8 @@
 // Node: the start-up's answers about its I/O connections: the poll
 // connection's paths, sizes and expected packet rates, and the input
-// connection (change of state, cyclic or bit-strobe). The steps themselves
-// are the table of node_lifecycle.cpp.
+// connection (change of state, cyclic or bit-strobe): the handlers, what the
+// requests take from the node, and when the optional steps apply. Where each
+// verdict leads is the table's (kStartup, node_lifecycle.cpp).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -37,12 +38,18 @@ Bytes Node::wanted_path(bool produced) const {
   return Bytes(produced ? config_.profile.produced_path : config_.profile.consumed_path);
 }
 
-Node::Step Node::after_path(bool produced, TimePoint now) {
-  if (produced && !config_.profile.consumed_path.empty()) return Step::kGetConsumedPath;
-  return begin_verify(now);
-}
+bool Node::has_produced_path() const { return !config_.profile.produced_path.empty(); }
 
-Node::Step Node::after_get_path(const ExplicitResult& r, TimePoint now) {
+bool Node::has_consumed_path() const { return !config_.profile.consumed_path.empty(); }
+
+void Node::ask_allocate_poll(Ask&, TimePoint) { poll_.allocation().requested = true; }
+
+void Node::ask_produced_path(Ask& ask, TimePoint) { ask.value.assign(wanted_path(true)); }
+
+void Node::ask_consumed_path(Ask& ask, TimePoint) { ask.value.assign(wanted_path(false)); }
+
+// A path that differs is set (Verdict::kAlt); one that is right, next.
+Node::Verdict Node::after_get_path(const ExplicitResult& r, TimePoint) {
   const bool produced = path_step_produced(last_step_);
   auto& in_force = produced ? produced_path_in_force_ : consumed_path_in_force_;
   in_force.clear();
@@ -50,17 +57,17 @@ Node::Step Node::after_get_path(const ExplicitResult& r, TimePoint now) {
   const Bytes want = wanted_path(produced);
   if (r.ok() &&
       std::equal(in_force.view().begin(), in_force.view().end(), want.begin(), want.end())) {
-    return after_path(produced, now);
+    return Verdict::kNext;
   }
-  return produced ? Step::kSetProducedPath : Step::kSetConsumedPath;
+  return Verdict::kAlt;
 }
 
-Node::Step Node::after_set_path(const ExplicitResult& r, TimePoint now) {
+Node::Verdict Node::after_set_path(const ExplicitResult& r, TimePoint) {
   const bool produced = path_step_produced(last_step_);
   auto& in_force = produced ? produced_path_in_force_ : consumed_path_in_force_;
   if (r.ok()) {
     in_force.assign(wanted_path(produced));
-    return after_path(produced, now);
+    return Verdict::kNext;
   }
   // The paths are fixed in some devices (the CDN127 manual's table lists
   // them Get only). What the device has may serve all the same: the sizes
@@ -70,20 +77,12 @@ Node::Step Node::after_set_path(const ExplicitResult& r, TimePoint now) {
   path_refusal_ += fmt::format(
       "device refused Set {} = {} ({}); it has {}", target.name, hex(wanted_path(produced)),
       status_text(r), in_force.empty() ? std::string("(unreadable)") : hex(in_force.view()));
-  return after_path(produced, now);
+  return Verdict::kNext;
 }
 
 // --- sizes, expected packet rates -------------------------------------------------
 
-Node::Step Node::begin_verify(TimePoint) {
-  produced_size_.reset();
-  consumed_size_.reset();
-  produced_from_fallback_ = consumed_from_fallback_ = false;
-  size_refusal_.clear();
-  return Step::kProducedSize;
-}
-
-Node::Step Node::after_size(const ExplicitResult& r, TimePoint now) {
+Node::Verdict Node::after_size(const ExplicitResult& r, TimePoint now) {
   const Step step = last_step_;
   const auto value = r.ok() ? read_uint(r.data.view()) : std::nullopt;
   const bool produced = step == Step::kProducedSize || step == Step::kFallbackProducedSize;
@@ -98,7 +97,7 @@ Node::Step Node::after_size(const ExplicitResult& r, TimePoint now) {
       size_refusal_ = fmt::format("{}: {}", size_attribute(produced, false), answer());
       log_.debug("poll {} size: {}; asking {}", which, size_refusal_,
                  size_attribute(produced, true));
-      return produced ? Step::kFallbackProducedSize : Step::kFallbackConsumedSize;
+      return Verdict::kAlt;
     }
     // The consumed size's own attribute was not asked when the produced
     // size's was refused: say so rather than name the other's refusal.
@@ -112,14 +111,14 @@ Node::Step Node::after_size(const ExplicitResult& r, TimePoint now) {
                          : fmt::format("cannot read the poll {} size: {}: {}", which,
                                        size_attribute(produced, false), answer()),
                 now);
-    return Step::kNone;
+    return Verdict::kStop;
   }
   if (produced) {
     produced_size_ = *value;
     produced_from_fallback_ = fallback;
-    // A device that refused attribute 7 refuses 8 too: ask the fallback for
-    // the consumed size straight away.
-    return fallback ? Step::kFallbackConsumedSize : Step::kConsumedSize;
+    // A device that refused attribute 7 refuses 8 too: the fallback's row
+    // asks the fallback for the consumed size straight away.
+    return Verdict::kNext;
   }
   consumed_size_ = *value;
   consumed_from_fallback_ = fallback;
@@ -137,7 +136,7 @@ std::string Node::size_attribute(bool produced, bool fallback) const {
                      fb.instance_id, produced ? fb.produced_attribute : fb.consumed_attribute);
 }
 
-Node::Step Node::check_sizes(TimePoint now) {
+Node::Verdict Node::check_sizes(TimePoint now) {
   const auto& p = config_.profile;
   if (*produced_size_ != p.produced_size || *consumed_size_ != p.consumed_size) {
     // Never guess which of the two is right: say both, where the device's
@@ -150,26 +149,38 @@ Node::Step Node::check_sizes(TimePoint now) {
                             p.produced_size, p.consumed_size, p.format_description,
                             path_refusal_.empty() ? "" : "; ", path_refusal_),
                 now);
-    return Step::kNone;
+    return Verdict::kStop;
   }
   if (!path_refusal_.empty()) {
     log_.info("{}; the paths in force give the sizes the configuration needs: going on",
               path_refusal_);
   }
-  return config_.profile.input_connection ? Step::kAllocateCos : Step::kExplicitEpr;
+  return Verdict::kNext;
 }
 
-Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
-  const bool poll = last_step_ == Step::kPollEpr;
-  // The device rounds EPR to its timer resolution and returns the value it
-  // uses; every timeout that depends on EPR uses that value. A device that
-  // returns nothing keeps the value asked.
-  const Duration asked = poll ? config_.expected_packet_rate : config_.explicit_packet_rate;
+void Node::ask_explicit_epr(Ask& ask, TimePoint) {
+  ask.value.assign(Bytes(uint_le(to_ms(config_.explicit_packet_rate))));
+}
+
+void Node::ask_poll_epr(Ask& ask, TimePoint) {
+  // Setting EPR establishes the poll connection and starts the device's
+  // 4 x EPR watchdog, so the first poll follows at once. A lost answer is
+  // retried after 2 x EPR, while the connection lives.
+  ask.value.assign(Bytes(uint_le(to_ms(config_.expected_packet_rate))));
+  ask.timeout = std::min(client_.response_timeout(), 2 * config_.expected_packet_rate);
+}
+
+// The device rounds EPR to its timer resolution and returns the value it
+// uses; every timeout that depends on EPR uses that value. A device that
+// returns nothing keeps the value asked.
+Node::Verdict Node::after_explicit_epr(const ExplicitResult& r, TimePoint) {
+  keep_alive_.set_epr(returned_epr(r, config_.explicit_packet_rate));
+  return Verdict::kNext;
+}
+
+Node::Verdict Node::after_poll_epr(const ExplicitResult& r, TimePoint) {
+  const Duration asked = config_.expected_packet_rate;
   const Duration epr = returned_epr(r, asked);
-  if (!poll) {
-    keep_alive_.set_epr(epr);
-    return Step::kPollEpr;
-  }
   poll_.set_epr(epr);
   // A device that rounds the rate up beyond 4 poll periods makes a lost
   // connection noticed later than the configuration suggests: said once. (A
@@ -181,7 +192,7 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
         "poll period of {} ms: a lost connection is noticed only after {} ms",
         to_ms(epr), to_ms(asked), to_ms(config_.poll_period), 4 * to_ms(epr));
   }
-  return config_.profile.input_connection ? Step::kCosEpr : Step::kOnline;
+  return Verdict::kNext;
 }
 
 // --- the input connection: change of state, cyclic or bit-strobe -------------------
@@ -189,107 +200,117 @@ Node::Step Node::after_epr(const ExplicitResult& r, TimePoint) {
 // The input connection is set up once the poll connection's sizes are
 // verified, and started (its EPR) right after the poll connection's:
 // nothing runs between the poll connection's start and its first poll but
-// that one Set. A bit-strobe connection has no inhibit time and no
-// Acknowledge Handler.
-Node::Step Node::cos_step_after(Step step) const {
-  if (step == Step::kCosEpr) return Step::kOnline;
-  static constexpr Step kOrder[] = {Step::kAllocateCos, Step::kSetCosPath, Step::kCosInhibit,
-                                    Step::kCosSize,     Step::kAckTimer,   Step::kRetryLimit,
-                                    Step::kExplicitEpr};
-  const InputConnection& cos = *config_.profile.input_connection;
-  const auto applies = [&](Step s) {
-    switch (s) {
-      case Step::kSetCosPath:
-        return !cos.produced_path.empty();
-      case Step::kCosInhibit:
-        return cos.kind == InputKind::kChangeOfState && cos.inhibit.has_value();
-      case Step::kAckTimer:
-      case Step::kRetryLimit:
-        return cos.acknowledged && !cos.strobed();
-      default:
-        return true;
-    }
-  };
-  const auto* at = std::find(std::begin(kOrder), std::end(kOrder), step);
-  if (at == std::end(kOrder)) return Step::kExplicitEpr;  // not a step of the input connection
-  for (++at; at != std::end(kOrder); ++at) {
-    if (applies(*at)) return *at;
-  }
-  return Step::kExplicitEpr;
+// that one Set.
+bool Node::has_input() const { return config_.profile.input_connection.has_value(); }
+
+bool Node::has_input_path() const {
+  return has_input() && !config_.profile.input_connection->produced_path.empty();
 }
 
-Node::Step Node::after_allocate_cos(const ExplicitResult& r, TimePoint now) {
+bool Node::has_input_inhibit() const {
+  const auto& in = config_.profile.input_connection;
+  return in && in->kind == InputKind::kChangeOfState && in->inhibit.has_value();
+}
+
+bool Node::has_ack_handler() const {
+  const auto& in = config_.profile.input_connection;
+  return in && in->acknowledged && !in->strobed();
+}
+
+void Node::ask_allocate_cos(Ask& ask, TimePoint) {
+  input_.allocation().requested = true;
+  ask.choice = input_.choice();
+}
+
+void Node::ask_cos_release(Ask& ask, TimePoint) { ask.choice = input_.connection_bits(); }
+
+void Node::ask_cos_path(Ask& ask, TimePoint) {
+  ask.value.assign(Bytes(config_.profile.input_connection->produced_path));
+}
+
+void Node::ask_cos_inhibit(Ask& ask, TimePoint) {
+  ask.value.assign(Bytes(uint_le(to_ms(*config_.profile.input_connection->inhibit))));
+}
+
+void Node::ask_cos_epr(Ask& ask, TimePoint now) {
+  // Setting EPR starts production: a message may come before the answer.
+  input_.start_consuming(now);
+  // Right after the poll connection's start, bounded as its Set was.
+  ask.value.assign(Bytes(uint_le(to_ms(input_.epr_asked()))));
+  ask.timeout = std::min(client_.response_timeout(), 2 * poll_.epr());
+}
+
+Node::Verdict Node::after_allocate_cos(const ExplicitResult& r, TimePoint now) {
   if (r.ok()) {
     input_.allocation().allocated = true;
-    return cos_step_after(Step::kAllocateCos);
+    return Verdict::kNext;
   }
   const std::string_view kind = to_string(config_.profile.input_connection->kind);
   return io_allocate_refused(
       r, now, fmt::format("Allocate of the {} connection (choice 0x{:02X})", kind, input_.choice()),
-      fmt::format("; the node's connection = \"{}\" needs it", kind), input_.allocation(),
-      Step::kReleaseCosForAllocate);
+      fmt::format("; the node's connection = \"{}\" needs it", kind), input_.allocation());
 }
 
-// The answers to the change-of-state connection's set-up: what the device
-// refuses but can do without is logged and the set-up goes on; a produced
-// size other than the configuration's is a fault.
-Node::Step Node::after_cos_step(const ExplicitResult& r, TimePoint now) {
-  const Step step = last_step_;
-  const cip::AttributeRef target = target_of(step);
-  const InputConnection& cos = *config_.profile.input_connection;
-  switch (step) {
-    case Step::kSetCosPath:
-      if (!r.ok()) {
-        input_.set_path_refusal(fmt::format("; Set of {} to {} refused: {}", target.name,
-                                            hex(Bytes(cos.produced_path)), status_text(r)));
-        log_.info("{}: the size tells whether the device's own path serves",
-                  input_.path_refusal().substr(2));
-      }
-      break;
-    case Step::kCosInhibit:
-      if (!r.ok()) {
-        log_.warn("the device refused {} = {} ms ({}): it keeps its own", target.name,
-                  to_ms(*cos.inhibit), status_text(r));
-      }
-      break;
-    case Step::kCosSize: {
-      const auto size = r.ok() ? read_uint(r.data.view()) : std::nullopt;
-      if (!r.ok()) {
-        log_.info("{} not read ({}): every message's size is checked", target.name, status_text(r));
-      } else if (!size || *size != cos.produced_size) {
-        enter_fault(NodeState::kConfigurationFault,
-                    fmt::format("{} is {}, the configuration expects {} bytes{}", target.name,
-                                size ? fmt::format("{} bytes", *size) : hex(r.data.view()),
-                                cos.produced_size, input_.path_refusal()),
-                    now);
-        return Step::kNone;
-      }
-      break;
-    }
-    case Step::kAckTimer:
-    case Step::kRetryLimit: {
-      const auto v = r.ok() ? read_uint(r.data.view()) : std::nullopt;
-      if (!v) {
-        input_.note_ack_handler_unread();
-        log_.info("{} not read ({}): taking the default, {}", target.name,
-                  r.ok() ? hex(r.data.view()) : status_text(r),
-                  step == Step::kAckTimer ? "20 ms" : "1 retry");
-      } else if (step == Step::kAckTimer) {
-        input_.set_ack_timer(milliseconds(*v));
-      } else {
-        input_.set_retry_limit(static_cast<std::uint8_t>(std::min<std::uint32_t>(*v, 255)));
-      }
-      break;
-    }
-    case Step::kCosEpr: {
-      // As the poll's: the value the device returned is the one it uses.
-      input_.set_epr(returned_epr(r, input_.epr_asked()));
-      break;
-    }
-    default:
-      break;
+// The answers to the input connection's set-up: what the device refuses but
+// can do without is logged and the set-up goes on; a produced size other
+// than the configuration's is a fault.
+Node::Verdict Node::after_cos_path(const ExplicitResult& r, TimePoint) {
+  if (!r.ok()) {
+    const InputConnection& in = *config_.profile.input_connection;
+    input_.set_path_refusal(fmt::format("; Set of {} to {} refused: {}", target_of(last_step_).name,
+                                        hex(Bytes(in.produced_path)), status_text(r)));
+    log_.info("{}: the size tells whether the device's own path serves",
+              input_.path_refusal().substr(2));
   }
-  return cos_step_after(step);
+  return Verdict::kNext;
+}
+
+Node::Verdict Node::after_cos_inhibit(const ExplicitResult& r, TimePoint) {
+  if (!r.ok()) {
+    log_.warn("the device refused {} = {} ms ({}): it keeps its own", target_of(last_step_).name,
+              to_ms(*config_.profile.input_connection->inhibit), status_text(r));
+  }
+  return Verdict::kNext;
+}
+
+Node::Verdict Node::after_cos_size(const ExplicitResult& r, TimePoint now) {
+  const cip::AttributeRef target = target_of(last_step_);
+  const auto want = config_.profile.input_connection->produced_size;
+  const auto size = r.ok() ? read_uint(r.data.view()) : std::nullopt;
+  if (!r.ok()) {
+    log_.info("{} not read ({}): every message's size is checked", target.name, status_text(r));
+  } else if (!size || *size != want) {
+    enter_fault(NodeState::kConfigurationFault,
+                fmt::format("{} is {}, the configuration expects {} bytes{}", target.name,
+                            size ? fmt::format("{} bytes", *size) : hex(r.data.view()), want,
+                            input_.path_refusal()),
+                now);
+    return Verdict::kStop;
+  }
+  return Verdict::kNext;
+}
+
+// The Acknowledge Handler's timer and retry limit: the defaults where the
+// device does not tell.
+Node::Verdict Node::after_ack_setting(const ExplicitResult& r, TimePoint) {
+  const bool timer = last_step_ == Step::kAckTimer;
+  const auto v = r.ok() ? read_uint(r.data.view()) : std::nullopt;
+  if (!v) {
+    input_.note_ack_handler_unread();
+    log_.info("{} not read ({}): taking the default, {}", target_of(last_step_).name,
+              r.ok() ? hex(r.data.view()) : status_text(r), timer ? "20 ms" : "1 retry");
+  } else if (timer) {
+    input_.set_ack_timer(milliseconds(*v));
+  } else {
+    input_.set_retry_limit(static_cast<std::uint8_t>(std::min<std::uint32_t>(*v, 255)));
+  }
+  return Verdict::kNext;
+}
+
+// As the poll's: the value the device returned is the one it uses.
+Node::Verdict Node::after_cos_epr(const ExplicitResult& r, TimePoint) {
+  input_.set_epr(returned_epr(r, input_.epr_asked()));
+  return Verdict::kNext;
 }
 
 }  // namespace dnbridge::devicenet

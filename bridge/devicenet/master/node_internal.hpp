@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -23,6 +24,11 @@ constexpr unsigned kStepTimeoutRetries = 2;
 inline std::uint16_t to_ms(Duration d) {
   const auto ms = std::chrono::duration_cast<milliseconds>(d).count();
   return static_cast<std::uint16_t>(std::clamp<std::int64_t>(ms, 0, 0xFFFF));
+}
+
+// A UINT as the wire has it, little-endian.
+inline std::array<std::uint8_t, 2> uint_le(std::uint16_t v) {
+  return {static_cast<std::uint8_t>(v & 0xFF), static_cast<std::uint8_t>(v >> 8)};
 }
 
 inline std::optional<std::uint32_t> read_uint(Bytes data) {

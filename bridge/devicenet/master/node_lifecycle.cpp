@@ -1,6 +1,8 @@
-// Node: its start-up as one ordered table of steps (kStartup below), each
-// step's request built and sent, and its answer taken to the row's handler
-// (node_identify.cpp, node_connections.cpp) or to where the row leads.
+// Node: its start-up as one table of steps (kStartup below). A row says
+// what its step asks, when it applies, which answers it takes and where
+// each leads; its handler (node_identify.cpp, node_connections.cpp) records
+// what an answer says and gives its verdict. Here the requests are built and
+// sent, each answer taken to its row, and a node that is left released.
 //
 // The rule the table follows: read what the device has before writing; write
 // only what differs, and read it back; where the device refuses but what it
@@ -38,52 +40,108 @@ constexpr cip::AttributeRef kDeviceNetObject{cip::devicenet_object::kClass, 1, 0
 
 }  // namespace
 
-// The start-up, in order. A step's request is built from its row; a good
-// answer goes to `next` unless the handler chooses; a refusal (CIP error
-// reply) goes where `on_refusal` says; no answer is retried twice on the
-// explicit connection and then taken for a lost node (Allocate of the
-// explicit connection: the node is absent, retried with back-off).
+// The start-up, in the order it runs. A row's request is built from the row
+// (and its `ask`); its answer goes to the row's handler, which records what
+// it says and gives a verdict: `next`, `alt`, the row again, or stop. A
+// refusal (CIP error reply) goes where `on_refusal` says; no answer is
+// retried twice on the explicit connection and then taken for a lost node,
+// unless `on_silence` gives it to the handler (the Allocate of the explicit
+// connection: an absent node, retried with back-off). A row that does not
+// apply (`applies`) is passed over to its `next`.
 // clang-format off
 const Node::StepRow Node::kStartup[] = {
-  // step                        phase                          verb               target                                    choice                on refusal                     next                         handler
-  {Step::kAllocateExplicit, NodeState::kAbsent,       Verb::kAllocate, kDeviceNetObject,                      allocation::kExplicit, OnRefusal::kHandler,     Step::kAllocationInfo,  &Node::after_allocate_explicit},
-  {Step::kReleaseStale,     NodeState::kAbsent,       Verb::kRelease,  kDeviceNetObject,                      allocation::kExplicit, OnRefusal::kGoOn,        Step::kAllocateExplicit, nullptr},
-  {Step::kAllocationInfo,   NodeState::kIdentifying,  Verb::kGet,      cip::devicenet_object::kAllocationInformation, 0,             OnRefusal::kGoOn,        Step::kVendor,          &Node::after_allocation_info},
-  {Step::kReleaseStalePoll, NodeState::kIdentifying,  Verb::kRelease,  kDeviceNetObject,                      allocation::kPoll,     OnRefusal::kGoOn,        Step::kVendor,          nullptr},
-  {Step::kVendor,           NodeState::kIdentifying,  Verb::kGet,      ident::kVendorId,                      0,                     OnRefusal::kWrongDevice, Step::kProductType,     &Node::after_identity_match},
-  {Step::kProductType,      NodeState::kIdentifying,  Verb::kGet,      ident::kProductType,                   0,                     OnRefusal::kWrongDevice, Step::kProductCode,     &Node::after_identity_match},
-  {Step::kProductCode,      NodeState::kIdentifying,  Verb::kGet,      ident::kProductCode,                   0,                     OnRefusal::kWrongDevice, Step::kRevision,        &Node::after_identity_match},
-  {Step::kRevision,         NodeState::kIdentifying,  Verb::kGet,      ident::kRevision,                      0,                     OnRefusal::kGoOn,        Step::kSerial,          &Node::after_revision},
-  {Step::kSerial,           NodeState::kIdentifying,  Verb::kGet,      ident::kSerialNumber,                  0,                     OnRefusal::kHandler,     Step::kName,            &Node::after_serial},
-  {Step::kName,             NodeState::kIdentifying,  Verb::kGet,      ident::kProductName,                   0,                     OnRefusal::kGoOn,        Step::kIdentityStatus,  &Node::after_name},
-  {Step::kIdentityStatus,   NodeState::kIdentifying,  Verb::kGet,      ident::kStatus,                        0,                     OnRefusal::kHandler,     Step::kIdentityState,   &Node::after_identity_status},
-  {Step::kIdentityState,    NodeState::kIdentifying,  Verb::kGet,      ident::kState,                         0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_identity_state},
-  {Step::kReadSetting,      NodeState::kConfiguring,  Verb::kGet,      kProfileSetting,                       0,                     OnRefusal::kFault,       Step::kNone,            &Node::after_read_setting},
-  {Step::kWriteSetting,     NodeState::kConfiguring,  Verb::kSet,      kProfileSetting,                       0,                     OnRefusal::kHandler,     Step::kVerifySetting,   &Node::after_write_setting},
-  {Step::kReleasePollForSetting, NodeState::kConfiguring, Verb::kRelease, kDeviceNetObject,                   allocation::kPoll,     OnRefusal::kHandler,     Step::kWriteSetting,    &Node::after_release_for_setting},
-  {Step::kVerifySetting,    NodeState::kConfiguring,  Verb::kGet,      kProfileSetting,                       0,                     OnRefusal::kFault,       Step::kNone,            &Node::after_verify_setting},
-  {Step::kCheckAttribute,   NodeState::kConfiguring,  Verb::kGet,      kProfileCheck,                         0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_check},
-  {Step::kAllocatePoll,     NodeState::kConfiguring,  Verb::kAllocate, kDeviceNetObject,                      allocation::kPoll,     OnRefusal::kHandler,     Step::kGetProducedPath, &Node::after_allocate_poll},
-  {Step::kReleasePollForAllocate, NodeState::kConfiguring, Verb::kRelease, kDeviceNetObject,                  allocation::kPoll,     OnRefusal::kGoOn,        Step::kAllocatePoll,    nullptr},
-  {Step::kGetProducedPath,  NodeState::kConfiguring,  Verb::kGet,      conn::kPollProducedPath,               0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_get_path},
-  {Step::kSetProducedPath,  NodeState::kConfiguring,  Verb::kSet,      conn::kPollProducedPath,               0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_set_path},
-  {Step::kGetConsumedPath,  NodeState::kConfiguring,  Verb::kGet,      conn::kPollConsumedPath,               0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_get_path},
-  {Step::kSetConsumedPath,  NodeState::kConfiguring,  Verb::kSet,      conn::kPollConsumedPath,               0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_set_path},
-  {Step::kProducedSize,     NodeState::kVerifying,    Verb::kGet,      conn::kPollProducedSize,               0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_size},
-  {Step::kConsumedSize,     NodeState::kVerifying,    Verb::kGet,      conn::kPollConsumedSize,               0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_size},
-  {Step::kFallbackProducedSize, NodeState::kVerifying, Verb::kGet,     kProfileSizeFallback,                  0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_size},
-  {Step::kFallbackConsumedSize, NodeState::kVerifying, Verb::kGet,     kProfileSizeFallback,                  0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_size},
-  {Step::kExplicitEpr,      NodeState::kVerifying,    Verb::kSet,      conn::kExplicitExpectedPacketRate,     0,                     OnRefusal::kFault,       Step::kPollEpr,         &Node::after_epr},
-  {Step::kPollEpr,          NodeState::kVerifying,    Verb::kSet,      conn::kPollExpectedPacketRate,         0,                     OnRefusal::kFault,       Step::kNone,            &Node::after_epr},
-  // The choice of kAllocateCos is the profile's (InputLink::choice()).
-  {Step::kAllocateCos,      NodeState::kVerifying,    Verb::kAllocate, kDeviceNetObject,                      0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_allocate_cos},
-  {Step::kReleaseCosForAllocate, NodeState::kVerifying, Verb::kRelease, kDeviceNetObject,              0,                     OnRefusal::kGoOn,        Step::kAllocateCos,     nullptr},
-  {Step::kSetCosPath,       NodeState::kVerifying,    Verb::kSet,      conn::kCosProducedPath,                0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
-  {Step::kCosInhibit,       NodeState::kVerifying,    Verb::kSet,      conn::kCosInhibitTime,                 0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
-  {Step::kCosSize,          NodeState::kVerifying,    Verb::kGet,      conn::kCosProducedSize,                0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
-  {Step::kAckTimer,         NodeState::kVerifying,    Verb::kGet,      ack::kAckTimer,                        0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
-  {Step::kRetryLimit,       NodeState::kVerifying,    Verb::kGet,      ack::kRetryLimit,                      0,                     OnRefusal::kHandler,     Step::kNone,            &Node::after_cos_step},
-  {Step::kCosEpr,           NodeState::kVerifying,    Verb::kSet,      conn::kCosExpectedPacketRate,          0,                     OnRefusal::kFault,       Step::kNone,            &Node::after_cos_step},
+  // The explicit connection; what was left allocated from before, released.
+  {.step = Step::kAllocateExplicit, .phase = NodeState::kAbsent, .verb = Verb::kAllocate, .target = kDeviceNetObject, .choice = allocation::kExplicit,
+   .on_silence = OnSilence::kHandler, .handler = &Node::after_allocate_explicit, .next = Step::kAllocationInfo, .alt = Step::kReleaseStale},
+  {.step = Step::kReleaseStale, .phase = NodeState::kAbsent, .verb = Verb::kRelease, .target = kDeviceNetObject, .choice = allocation::kExplicit,
+   .on_silence = OnSilence::kHandler, .handler = &Node::after_release_stale},  // allocated again after a back-off
+  {.step = Step::kAllocationInfo, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = cip::devicenet_object::kAllocationInformation,
+   .on_refusal = OnRefusal::kGoOn, .handler = &Node::after_allocation_info, .next = Step::kVendor, .alt = Step::kReleaseStalePoll},
+  {.step = Step::kReleaseStalePoll, .phase = NodeState::kIdentifying, .verb = Verb::kRelease, .target = kDeviceNetObject, .ask = &Node::ask_stale_io,
+   .on_refusal = OnRefusal::kGoOn, .next = Step::kVendor},
+
+  // The identity the scan list expects, then what the device tells of itself.
+  {.step = Step::kVendor, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = ident::kVendorId,
+   .on_refusal = OnRefusal::kWrongDevice, .handler = &Node::after_identity_match, .next = Step::kProductType},
+  {.step = Step::kProductType, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = ident::kProductType,
+   .on_refusal = OnRefusal::kWrongDevice, .handler = &Node::after_identity_match, .next = Step::kProductCode},
+  {.step = Step::kProductCode, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = ident::kProductCode,
+   .on_refusal = OnRefusal::kWrongDevice, .handler = &Node::after_identity_match, .next = Step::kRevision},
+  {.step = Step::kRevision, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = ident::kRevision,
+   .on_refusal = OnRefusal::kGoOn, .handler = &Node::after_revision, .next = Step::kSerial},
+  {.step = Step::kSerial, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = ident::kSerialNumber,
+   .handler = &Node::after_serial, .next = Step::kName},
+  {.step = Step::kName, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = ident::kProductName,
+   .on_refusal = OnRefusal::kGoOn, .handler = &Node::after_name, .next = Step::kIdentityStatus},
+  {.step = Step::kIdentityStatus, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = ident::kStatus,
+   .handler = &Node::after_identity_status, .next = Step::kIdentityState},
+  {.step = Step::kIdentityState, .phase = NodeState::kIdentifying, .verb = Verb::kGet, .target = ident::kState,
+   .handler = &Node::after_identity_state, .next = Step::kReadSetting},
+
+  // The profile's settings, one after the other: read, written only where
+  // it differs, read back. Then its checks, read and compared.
+  {.step = Step::kReadSetting, .phase = NodeState::kConfiguring, .verb = Verb::kGet, .target = kProfileSetting, .applies = &Node::has_setting,
+   .on_refusal = OnRefusal::kFault, .handler = &Node::after_read_setting, .next = Step::kCheckAttribute, .alt = Step::kWriteSetting},
+  {.step = Step::kWriteSetting, .phase = NodeState::kConfiguring, .verb = Verb::kSet, .target = kProfileSetting, .ask = &Node::ask_setting,
+   .handler = &Node::after_write_setting, .next = Step::kVerifySetting, .alt = Step::kReleasePollForSetting},
+  {.step = Step::kReleasePollForSetting, .phase = NodeState::kConfiguring, .verb = Verb::kRelease, .target = kDeviceNetObject, .choice = allocation::kPoll,
+   .handler = &Node::after_release_for_setting, .next = Step::kWriteSetting},
+  {.step = Step::kVerifySetting, .phase = NodeState::kConfiguring, .verb = Verb::kGet, .target = kProfileSetting,
+   .on_refusal = OnRefusal::kFault, .handler = &Node::after_verify_setting, .next = Step::kReadSetting},
+  {.step = Step::kCheckAttribute, .phase = NodeState::kConfiguring, .verb = Verb::kGet, .target = kProfileCheck, .applies = &Node::has_check,
+   .handler = &Node::after_check, .next = Step::kAllocatePoll},
+
+  // The poll connection: allocated, its paths set where they differ.
+  {.step = Step::kAllocatePoll, .phase = NodeState::kConfiguring, .verb = Verb::kAllocate, .target = kDeviceNetObject, .choice = allocation::kPoll, .ask = &Node::ask_allocate_poll,
+   .handler = &Node::after_allocate_poll, .next = Step::kGetProducedPath, .alt = Step::kReleasePollForAllocate},
+  {.step = Step::kReleasePollForAllocate, .phase = NodeState::kConfiguring, .verb = Verb::kRelease, .target = kDeviceNetObject, .choice = allocation::kPoll,
+   .on_refusal = OnRefusal::kGoOn, .next = Step::kAllocatePoll},
+  {.step = Step::kGetProducedPath, .phase = NodeState::kConfiguring, .verb = Verb::kGet, .target = conn::kPollProducedPath, .applies = &Node::has_produced_path,
+   .handler = &Node::after_get_path, .next = Step::kGetConsumedPath, .alt = Step::kSetProducedPath},
+  {.step = Step::kSetProducedPath, .phase = NodeState::kConfiguring, .verb = Verb::kSet, .target = conn::kPollProducedPath, .ask = &Node::ask_produced_path,
+   .handler = &Node::after_set_path, .next = Step::kGetConsumedPath},
+  {.step = Step::kGetConsumedPath, .phase = NodeState::kConfiguring, .verb = Verb::kGet, .target = conn::kPollConsumedPath, .applies = &Node::has_consumed_path,
+   .handler = &Node::after_get_path, .next = Step::kProducedSize, .alt = Step::kSetConsumedPath},
+  {.step = Step::kSetConsumedPath, .phase = NodeState::kConfiguring, .verb = Verb::kSet, .target = conn::kPollConsumedPath, .ask = &Node::ask_consumed_path,
+   .handler = &Node::after_set_path, .next = Step::kProducedSize},
+
+  // Its sizes, from Connection 2 or where the profile says the same sizes are kept.
+  {.step = Step::kProducedSize, .phase = NodeState::kVerifying, .verb = Verb::kGet, .target = conn::kPollProducedSize,
+   .handler = &Node::after_size, .next = Step::kConsumedSize, .alt = Step::kFallbackProducedSize},
+  {.step = Step::kConsumedSize, .phase = NodeState::kVerifying, .verb = Verb::kGet, .target = conn::kPollConsumedSize,
+   .handler = &Node::after_size, .next = Step::kAllocateCos, .alt = Step::kFallbackConsumedSize},
+  {.step = Step::kFallbackProducedSize, .phase = NodeState::kVerifying, .verb = Verb::kGet, .target = kProfileSizeFallback,
+   .handler = &Node::after_size, .next = Step::kFallbackConsumedSize},
+  {.step = Step::kFallbackConsumedSize, .phase = NodeState::kVerifying, .verb = Verb::kGet, .target = kProfileSizeFallback,
+   .handler = &Node::after_size, .next = Step::kAllocateCos},
+
+  // The input connection, where the profile has one: change of state or
+  // cyclic (Connection 4), or bit-strobe (Connection 3: target_of()), which
+  // has no inhibit time and no Acknowledge Handler.
+  {.step = Step::kAllocateCos, .phase = NodeState::kVerifying, .verb = Verb::kAllocate, .target = kDeviceNetObject, .ask = &Node::ask_allocate_cos, .applies = &Node::has_input,
+   .handler = &Node::after_allocate_cos, .next = Step::kSetCosPath, .alt = Step::kReleaseCosForAllocate},
+  {.step = Step::kReleaseCosForAllocate, .phase = NodeState::kVerifying, .verb = Verb::kRelease, .target = kDeviceNetObject, .ask = &Node::ask_cos_release,
+   .on_refusal = OnRefusal::kGoOn, .next = Step::kAllocateCos},
+  {.step = Step::kSetCosPath, .phase = NodeState::kVerifying, .verb = Verb::kSet, .target = conn::kCosProducedPath, .ask = &Node::ask_cos_path, .applies = &Node::has_input_path,
+   .handler = &Node::after_cos_path, .next = Step::kCosInhibit},
+  {.step = Step::kCosInhibit, .phase = NodeState::kVerifying, .verb = Verb::kSet, .target = conn::kCosInhibitTime, .ask = &Node::ask_cos_inhibit, .applies = &Node::has_input_inhibit,
+   .handler = &Node::after_cos_inhibit, .next = Step::kCosSize},
+  {.step = Step::kCosSize, .phase = NodeState::kVerifying, .verb = Verb::kGet, .target = conn::kCosProducedSize, .applies = &Node::has_input,
+   .handler = &Node::after_cos_size, .next = Step::kAckTimer},
+  {.step = Step::kAckTimer, .phase = NodeState::kVerifying, .verb = Verb::kGet, .target = ack::kAckTimer, .applies = &Node::has_ack_handler,
+   .handler = &Node::after_ack_setting, .next = Step::kRetryLimit},
+  {.step = Step::kRetryLimit, .phase = NodeState::kVerifying, .verb = Verb::kGet, .target = ack::kRetryLimit, .applies = &Node::has_ack_handler,
+   .handler = &Node::after_ack_setting, .next = Step::kExplicitEpr},
+
+  // The expected packet rates: the explicit connection's, then the poll
+  // connection's, which starts it (its first poll follows at once), then
+  // the input connection's, which starts that one.
+  {.step = Step::kExplicitEpr, .phase = NodeState::kVerifying, .verb = Verb::kSet, .target = conn::kExplicitExpectedPacketRate, .ask = &Node::ask_explicit_epr,
+   .on_refusal = OnRefusal::kFault, .handler = &Node::after_explicit_epr, .next = Step::kPollEpr},
+  {.step = Step::kPollEpr, .phase = NodeState::kVerifying, .verb = Verb::kSet, .target = conn::kPollExpectedPacketRate, .ask = &Node::ask_poll_epr,
+   .on_refusal = OnRefusal::kFault, .handler = &Node::after_poll_epr, .next = Step::kCosEpr},
+  {.step = Step::kCosEpr, .phase = NodeState::kVerifying, .verb = Verb::kSet, .target = conn::kCosExpectedPacketRate, .ask = &Node::ask_cos_epr, .applies = &Node::has_input,
+   .on_refusal = OnRefusal::kFault, .handler = &Node::after_cos_epr, .next = Step::kOnline},
 };
 // clang-format on
 
@@ -92,8 +150,7 @@ const Node::StepRow& Node::row(Step step) {
     if (r.step == step) return r;
   }
   // Outside start-up: the keep-alive and the releases have no row.
-  static constexpr StepRow kNoRow{Step::kNone, NodeState::kAbsent, Verb::kGet,  {},
-                                  0,           OnRefusal::kGoOn,   Step::kNone, nullptr};
+  static constexpr StepRow kNoRow{};
   return kNoRow;
 }
 
@@ -125,10 +182,6 @@ std::string_view verb_name(std::uint8_t service) {
     default:
       return "request";
   }
-}
-
-std::array<std::uint8_t, 2> uint_le(std::uint16_t v) {
-  return {static_cast<std::uint8_t>(v & 0xFF), static_cast<std::uint8_t>(v >> 8)};
 }
 
 }  // namespace
@@ -185,7 +238,11 @@ std::uint8_t Node::held_connections() const {
 }
 
 void Node::release(Step step, std::uint8_t choice, TimePoint now) {
-  releases_left_ = 0;
+  releases_.begin();
+  send_release(step, choice, now);
+}
+
+void Node::send_release(Step step, std::uint8_t choice, TimePoint now) {
   const std::array<std::uint8_t, 1> data{choice};
   RequestMessage r;
   r.service = cip::code(cip::Service::kReleaseMasterSlave);
@@ -213,108 +270,75 @@ void Node::attempt_allocate(TimePoint now) {
   step_timeouts_ = 0;
   poll_.begin_attempt();
   setting_retried_ = false;
-  // What an attempt learns is its own: paths and refusals from an earlier one
-  // would otherwise pile up in the reasons.
+  // What an attempt learns is its own: paths, sizes and refusals from an
+  // earlier one would otherwise pile up in the reasons.
   path_refusal_.clear();
   produced_path_in_force_.clear();
   consumed_path_in_force_.clear();
+  produced_size_.reset();
+  consumed_size_.reset();
+  produced_from_fallback_ = consumed_from_fallback_ = false;
+  size_refusal_.clear();
   input_.begin_attempt();
   ++counters_.allocate_attempts;
-  run(Step::kAllocateExplicit, now);
+  enter(Step::kAllocateExplicit, now);
 }
 
-void Node::run(Step step, TimePoint now) {
-  const StepRow& r = row(step);
+void Node::enter(Step step, TimePoint now) {
+  while (step != Step::kNone) {
+    if (step == Step::kOnline) {
+      go_online(now);
+      return;
+    }
+    const StepRow& r = row(step);
+    if (r.applies == nullptr || (this->*r.applies)()) {
+      run(r, now);
+      return;
+    }
+    step = r.next;
+  }
+}
+
+void Node::run(const StepRow& r, TimePoint now) {
   if (r.phase != NodeState::kAbsent && r.phase != state_) {
     set_state(r.phase, std::string(phase_reason(r.phase)), now);
   }
-  if (step == Step::kAllocatePoll) poll_.allocation().requested = true;
-  if (step == Step::kAllocateCos) input_.allocation().requested = true;
-  if (step == Step::kCosEpr) {
-    // Setting EPR starts production: a message may come before the answer.
-    input_.start_consuming(now);
-  }
+  Ask ask;
+  ask.choice = r.choice;
+  if (r.ask != nullptr) (this->*r.ask)(ask, now);
   switch (r.verb) {
     case Verb::kAllocate: {
-      const std::uint8_t choice = step == Step::kAllocateCos ? input_.choice() : r.choice;
-      const std::array<std::uint8_t, 2> data{choice, port_.master_mac.value()};
+      const std::array<std::uint8_t, 2> data{ask.choice, port_.master_mac.value()};
       RequestMessage m;
       m.service = cip::code(cip::Service::kAllocateMasterSlave);
       m.class_id = kDeviceNetObject.class_id;
       m.instance_id = 1;
       m.data = Bytes(data);
-      issue(step, m, true, now);
+      issue(r.step, m, true, now);
       return;
     }
-    case Verb::kRelease: {
-      const std::uint8_t choice = step == Step::kReleaseStalePoll        ? stale_choice_
-                                  : step == Step::kReleaseCosForAllocate ? input_.connection_bits()
-                                                                         : r.choice;
+    case Verb::kRelease:
       // A poll connection released during the start-up may be one left from
       // before (a restart, or a bus lost and back, within the device's own
       // timeout), still carrying the outputs last commanded: idle first.
-      if ((choice & allocation::kPoll) != 0) poll_.send_idle_before_release(now);
-      release(step, choice, now);
+      if ((ask.choice & allocation::kPoll) != 0) poll_.send_idle_before_release(now);
+      release(r.step, ask.choice, now);
       return;
-    }
     case Verb::kGet:
-      get(step, target_of(step), now);
+      get(r.step, target_of(r.step), now);
       return;
     case Verb::kSet: {
-      const cip::AttributeRef target = target_of(step);
-      InlineBytes<16> value;
-      std::optional<Duration> timeout;
-      switch (step) {
-        case Step::kWriteSetting:
-          value.assign(Bytes(config_.profile.settings[setting_index_].value));
-          break;
-        case Step::kSetProducedPath:
-        case Step::kSetConsumedPath:
-          value.assign(wanted_path(step == Step::kSetProducedPath));
-          break;
-        case Step::kExplicitEpr:
-          value.assign(Bytes(uint_le(to_ms(config_.explicit_packet_rate))));
-          break;
-        case Step::kPollEpr:
-          // Setting EPR establishes the poll connection and starts the
-          // device's 4 x EPR watchdog, so the first poll follows at once. A
-          // lost answer is retried after 2 x EPR, while the connection lives.
-          value.assign(Bytes(uint_le(to_ms(config_.expected_packet_rate))));
-          timeout = std::min(client_.response_timeout(), 2 * config_.expected_packet_rate);
-          break;
-        case Step::kSetCosPath:
-          value.assign(Bytes(config_.profile.input_connection->produced_path));
-          break;
-        case Step::kCosInhibit:
-          value.assign(Bytes(uint_le(to_ms(*config_.profile.input_connection->inhibit))));
-          break;
-        case Step::kCosEpr:
-          // Right after the poll connection's start, bounded as its Set was.
-          value.assign(Bytes(uint_le(to_ms(input_.epr_asked()))));
-          timeout = std::min(client_.response_timeout(), 2 * poll_.epr());
-          break;
-        default:
-          break;
-      }
+      const cip::AttributeRef target = target_of(r.step);
       RequestMessage m;
       m.service = cip::code(cip::Service::kSetAttributeSingle);
       m.class_id = target.class_id;
       m.instance_id = target.instance_id;
       m.attribute = target.attribute;
-      m.data = value.view();
-      issue(step, m, false, now, timeout);
+      m.data = ask.value.view();
+      issue(r.step, m, false, now, ask.timeout);
       return;
     }
   }
-}
-
-void Node::advance(Step next, TimePoint now) {
-  if (next == Step::kNone) return;
-  if (next == Step::kOnline) {
-    go_online(now);
-    return;
-  }
-  run(next, now);
 }
 
 cip::AttributeRef Node::target_of(Step step) const {
@@ -367,67 +391,17 @@ void Node::on_explicit_result(std::uint32_t tag, const ExplicitResult& result, T
 
 void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
   if (r.error == Errc::kStopped) return;  // cancelled by shutdown or halt
-  // What a Release after a loss or a fault answers (a refusal of what the
-  // device no longer holds, or nothing from a device gone) is not news: the
-  // last error stays the one that made the node leave.
-  const bool releasing = step == Step::kReleaseFault || step == Step::kReleaseShutdown;
-  if (!releasing) {
-    if (r.error == Errc::kDeviceError) record_device_error(r, now);
-    if (r.error == Errc::kTimeout) record(NodeError::Kind::kExplicitTimeout, now);
-    if (r.error == Errc::kAborted) record(NodeError::Kind::kExplicitAborted, now);
-    if (r.error == Errc::kMalformed) record(NodeError::Kind::kExplicitMalformed, now);
+  if (step == Step::kReleaseFault || step == Step::kReleaseShutdown) {
+    on_release_result(step, r, now);
+    return;
   }
-
-  switch (step) {
-    case Step::kKeepAlive:
-      on_keepalive_result(r, now);
-      return;
-    case Step::kReleaseFault:
-    case Step::kReleaseShutdown:
-      // Released with a connection the device did not have: refused whole
-      // (0x0B). Then one connection at a time, whatever each answer: the
-      // I/O connections first, the explicit connection last.
-      if (!last_request_data_.empty()) {
-        const std::uint8_t asked = last_request_data_.view()[0];
-        std::uint8_t left = static_cast<std::uint8_t>(releases_left_ & ~asked);
-        if (releases_left_ == 0 && r.error == Errc::kDeviceError &&
-            r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode &&
-            (asked & (asked - 1)) != 0) {
-          left = asked;
-        }
-        if (left != 0) {
-          // Its lowest bit but the explicit connection's, while there is one.
-          const std::uint8_t io = left & static_cast<std::uint8_t>(~allocation::kExplicit);
-          const auto next = static_cast<std::uint8_t>(io != 0 ? io & -io : left);
-          release(step, next, now);
-          releases_left_ = left;
-          return;
-        }
-      }
-      connected_ = false;
-      poll_.allocation().forget();
-      input_.allocation().forget();
-      input_.stop();
-      // Whatever the answer, a faulted node is left alone until the re-check.
-      if (step == Step::kReleaseShutdown) {
-        set_state(NodeState::kStopped, "released by " + shutdown_why_, now);
-      }
-      return;
-    case Step::kAllocateExplicit:
-      // No answer here is an absent node: the handler retries with back-off.
-      advance((this->*row(step).handler)(r, now), now);
-      return;
-    case Step::kReleaseStale:
-      // Whatever the answer, allocate again after a back-off: a device that
-      // keeps saying "already allocated" is not asked more often than that.
-      retry_at_ = now + next_backoff();
-      return;
-    default:
-      break;
+  record_answer(r, now);
+  if (step == Step::kKeepAlive) {
+    on_keepalive_result(r, now);
+    return;
   }
-
   const StepRow& rule = row(step);
-  if (r.error && r.error != Errc::kDeviceError) {
+  if (r.error && r.error != Errc::kDeviceError && rule.on_silence == OnSilence::kResend) {
     // A lost frame is retried; a node silent on its explicit connection is
     // gone.
     if (++step_timeouts_ <= kStepTimeoutRetries) {
@@ -440,31 +414,73 @@ void Node::on_step_result(Step step, const ExplicitResult& r, TimePoint now) {
     return;
   }
   step_timeouts_ = 0;  // answered, even if with an error
-
-  if (r.ok()) {
-    advance(rule.handler ? (this->*rule.handler)(r, now) : rule.next, now);
-    return;
+  switch (judge(rule, r, now)) {
+    case Verdict::kNext:
+      enter(rule.next, now);
+      return;
+    case Verdict::kAlt:
+      enter(rule.alt, now);
+      return;
+    case Verdict::kAgain:
+      enter(rule.step, now);
+      return;
+    case Verdict::kStop:
+      return;
   }
-  const cip::AttributeRef target = target_of(step);
-  switch (rule.on_refusal) {
-    case OnRefusal::kFault:
-      enter_fault(NodeState::kConfigurationFault,
-                  fmt::format("device refused {} {}: {}{}", verb_name(last_request_.service),
-                              target.name, status_text(r), setting_expectation(step)),
-                  now);
+}
+
+void Node::record_answer(const ExplicitResult& r, TimePoint now) {
+  if (r.error == Errc::kDeviceError) record_device_error(r, now);
+  if (r.error == Errc::kTimeout) record(NodeError::Kind::kExplicitTimeout, now);
+  if (r.error == Errc::kAborted) record(NodeError::Kind::kExplicitAborted, now);
+  if (r.error == Errc::kMalformed) record(NodeError::Kind::kExplicitMalformed, now);
+}
+
+Node::Verdict Node::judge(const StepRow& rule, const ExplicitResult& r, TimePoint now) {
+  if (r.error == Errc::kDeviceError) {
+    const cip::AttributeRef target = target_of(rule.step);
+    switch (rule.on_refusal) {
+      case OnRefusal::kFault:
+        enter_fault(NodeState::kConfigurationFault,
+                    fmt::format("device refused {} {}: {}{}", verb_name(last_request_.service),
+                                target.name, status_text(r), setting_expectation(rule.step)),
+                    now);
+        return Verdict::kStop;
+      case OnRefusal::kWrongDevice:
+        enter_fault(NodeState::kWrongDevice,
+                    fmt::format("{} unreadable: {}", target.name, status_text(r)), now);
+        return Verdict::kStop;
+      case OnRefusal::kGoOn:
+        log_.debug("{} {} refused ({}): going on", verb_name(last_request_.service), target.name,
+                   status_text(r));
+        break;
+      case OnRefusal::kHandler:
+        break;
+    }
+  }
+  return rule.handler != nullptr ? (this->*rule.handler)(r, now) : Verdict::kNext;
+}
+
+void Node::on_release_result(Step step, const ExplicitResult& r, TimePoint now) {
+  // What a Release after a loss or a fault answers (a refusal of what the
+  // device no longer holds, or nothing from a device gone) is not news: the
+  // last error stays the one that made the node leave.
+  if (!last_request_data_.empty()) {
+    const bool refused_whole = r.error == Errc::kDeviceError &&
+                               r.general_status == cip::GeneralStatus::kAlreadyInRequestedMode;
+    const std::uint8_t next = releases_.after(last_request_data_.view()[0], refused_whole);
+    if (next != 0) {
+      send_release(step, next, now);
       return;
-    case OnRefusal::kWrongDevice:
-      enter_fault(NodeState::kWrongDevice,
-                  fmt::format("{} unreadable: {}", target.name, status_text(r)), now);
-      return;
-    case OnRefusal::kGoOn:
-      log_.debug("{} {} refused ({}): going on", verb_name(last_request_.service), target.name,
-                 status_text(r));
-      advance(rule.next, now);
-      return;
-    case OnRefusal::kHandler:
-      advance((this->*rule.handler)(r, now), now);
-      return;
+    }
+  }
+  connected_ = false;
+  poll_.allocation().forget();
+  input_.allocation().forget();
+  input_.stop();
+  // Whatever the answer, a faulted node is left alone until the re-check.
+  if (step == Step::kReleaseShutdown) {
+    set_state(NodeState::kStopped, "released by " + shutdown_why_, now);
   }
 }
 
