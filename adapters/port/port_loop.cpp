@@ -17,17 +17,17 @@ PortLoop::PortLoop(PortLoopConfig config, std::unique_ptr<CanBackend> backend,
     : config_(std::move(config)),
       backend_(std::move(backend)),
       publisher_(publisher),
-      log_(Logger(log, fmt::format("port {}", config_.port)).with("PORT", config_.port)) {
+      log_(Logger(log, fmt::format("port {}", config_.port)).with("PORT", config_.port)),
+      publication_(config_.port, config_.status_period, publisher),
+      status_(config_.status_period),
+      metrics_(config_.status_period),
+      scans_(config_.port, publisher) {
   // The master's events reach the rack model first, then this loop.
   port_.emplace(config_.scanner, config_.nodes, backend_->sink(), log_);
   port_->observe(static_cast<devicenet::ScannerObserver&>(*this));
   gateway_.emplace(scanner(), rack::ExplicitGateway::Limits{}, config_.explicit_policy, log_);
-  rack::ScanListChange all;
-  for (const rack::ProfileNodes* nodes : port_->profiles()) {
-    for (std::size_t i = 0; i < nodes->size(); ++i) all.added.push_back(nodes->view(i).mac);
-  }
-  std::vector<MacId> unused;
-  carry_published(all, unused);
+  reconfiguration_.emplace(*port_, publication_, metrics_, publisher_, log_);
+  reconfiguration_->start(config_);
   note_scan_list();
 }
 
@@ -117,21 +117,22 @@ void PortLoop::command(MacId mac, rack::NodeCommand command, std::string issuer)
 }
 void PortLoop::release_command(MacId mac) { push(Release{mac, profile_of(mac)}); }
 void PortLoop::explicit_request(rack::ExplicitCall call) {
-  bool queued = false;
+  std::optional<rack::ExplicitCall> refused;
   {
     std::lock_guard lock(inbox_mutex_);
     if (calls_.size() < kMaxQueuedCalls) {
-      calls_.push_back(call);
-      queued = true;
+      calls_.push_back(std::move(call));
+    } else {
+      refused = std::move(call);
     }
   }
-  if (queued) {
+  if (!refused) {
     backend_->wake();
     return;
   }
   calls_refused_.fetch_add(1, std::memory_order_relaxed);
   publisher_.explicit_reply(config_.port,
-                            rack::refuse(call, rack::TransactionStatus::kOutOfBuffers,
+                            rack::refuse(*refused, rack::TransactionStatus::kOutOfBuffers,
                                          fmt::format("{} requests already wait for port {}",
                                                      kMaxQueuedCalls, config_.port)));
 }
@@ -147,152 +148,20 @@ std::future<PortChange> PortLoop::reconfigure(PortLoopConfig next) {
 }
 
 void PortLoop::apply(const Reconfigure& r, TimePoint now) {
-  PortLoopConfig& next = *r.config;
-  PortChange change;
-  // A node of another profile after the reload: its instances of the old one go.
-  std::array<std::string_view, MacId::kMax + 1> profile_before{};
-  for (unsigned m = 0; m <= MacId::kMax; ++m) profile_before[m] = profile_of(*MacId::from(m));
-  try {
-    change.scan_list = port_->reconfigure(next.scanner, next.nodes, now);
-  } catch (const std::exception& e) {
-    change.refused = e.what();
-    log_.error("configuration not applied: {}", change.refused);
-    r.done->set_value(std::move(change));
-    return;
+  PortChange change = reconfiguration_->apply(config_, *r.config, *gateway_, now);
+  if (change.refused.empty()) {
+    note_scan_list();
+    status_.changed(now);
   }
-  const auto& sc = change.scan_list;
-  config_.nodes = std::move(next.nodes);
-  config_.publish = std::move(next.publish);
-  carry_published(sc, change.publish_changed);
-  for (MacId mac : sc.removed) publisher_.node_removed(config_.port, mac);
-  for (MacId mac : sc.reconfigured) {
-    const rack::ProfileNodes* nodes = port_->nodes_of(mac);
-    if (!nodes || nodes->profile() != profile_before[mac.value()]) {
-      publisher_.node_removed(config_.port, mac);
-    }
-  }
-  if (!(gateway_->policy() == next.explicit_policy)) {
-    gateway_->set_policy(next.explicit_policy);
-    change.explicit_policy_changed = true;
-  }
-  config_.explicit_policy = next.explicit_policy;
-  note_scan_list();
-  port_dirty_ = true;
-  port_event_time_ = now;
-  const auto macs = [](const std::vector<MacId>& list) {
-    std::string s;
-    for (MacId m : list) s += fmt::format("{}{}", s.empty() ? "" : " ", m.value());
-    return s.empty() ? std::string("none") : s;
-  };
-  if (!change.any()) {
-    r.done->set_value(std::move(change));
-    return;
-  }
-  log_.info(
-      "configuration applied: added {}; removed {}; configured again {}; policies changed {}; "
-      "publish policies changed {}; untouched {}{}{}",
-      macs(sc.added), macs(sc.removed), macs(sc.reconfigured), macs(sc.updated),
-      macs(change.publish_changed), macs(sc.unchanged),
-      sc.timings_changed ? "; the port's timings changed" : "",
-      change.explicit_policy_changed ? "; the explicit policy changed" : "");
   r.done->set_value(std::move(change));
 }
 
-rack::PublishPolicy PortLoop::policy_of(MacId mac) const {
-  const auto it = config_.publish.find(mac);
-  return it == config_.publish.end() ? rack::PublishPolicy{} : it->second;
-}
-
-void PortLoop::carry_published(const rack::ScanListChange& sc, std::vector<MacId>& policy_changed) {
-  const auto listed = [](const std::vector<MacId>& macs, MacId mac) {
-    return std::find(macs.begin(), macs.end(), mac) != macs.end();
-  };
-  for (unsigned m = 0; m <= MacId::kMax; ++m) {
-    const MacId mac = *MacId::from(m);
-    auto& p = published_[m];
-    const rack::ProfileNodes* nodes = port_->nodes_of(mac);
-    if (!nodes) {
-      p.reset();
-      continue;
-    }
-    const rack::PublishPolicy policy = policy_of(mac);
-    if (!p || listed(sc.added, mac) || listed(sc.reconfigured, mac)) {
-      p.emplace(Published{nodes->state_gate(policy)});
-      continue;
-    }
-    if (!(p->gate->policy() == policy)) {
-      p->gate = nodes->state_gate(policy);
-      policy_changed.push_back(mac);
-    }
-  }
-}
-
-void PortLoop::handle_scan_call(ScanCall call, TimePoint now) {
-  // A request written again while its scan runs (a requester repeats until
-  // answered) is the same transaction: it waits once.
-  if (std::any_of(scan_waiters_.begin(), scan_waiters_.end(), [&](const ScanCall& w) {
-        return w.requester == call.requester && w.txid == call.txid;
-      })) {
-    return;
-  }
-  if (last_scan_ && last_scan_->error.empty() && now - last_scan_->finished < kScanHoldoff &&
-      !scanner().scanning_bus()) {
-    answer_scan(call, *last_scan_, now);
-    return;
-  }
-  const auto refuse = [&](rack::TransactionStatus status, std::string message) {
-    publisher_.bus_scan_reply(config_.port, port::refuse(call, status, std::move(message)));
-  };
-  if (scan_waiters_.size() >= kMaxScanWaiters) {
-    refuse(rack::TransactionStatus::kOutOfBuffers,
-           fmt::format("{} requests already wait for port {}'s bus scan", kMaxScanWaiters,
-                       config_.port));
-    return;
-  }
-  if (!scanner().scanning_bus() && bus_lost(bus_seen_)) {
-    // Every MAC would be silent: a scan would say nothing is there.
-    refuse(rack::TransactionStatus::kPortOffline,
-           fmt::format("port {}: the bus is {}: no bus scan", config_.port, to_string(bus_seen_)));
-    return;
-  }
-  // Waiting before the scan starts: a scan with nothing to ask ends at once.
-  scan_waiters_.push_back(call);
-  if (scanner().scanning_bus()) return;
+void PortLoop::handle_scan_call(const ScanCall& call, TimePoint now) {
+  if (!scans_.request(call, scanner().scanning_bus(), bus_seen_, now)) return;
   if (auto started = scanner().scan_bus(now); !started) {
-    scan_waiters_.pop_back();
-    refuse(rack::TransactionStatus::kPortOffline,
-           fmt::format("port {} is not scanning its nodes ({}: {}): no bus scan", config_.port,
-                       devicenet::to_string(scanner().state()), scanner().reason()));
+    scans_.start_refused(
+        fmt::format("{}: {}", devicenet::to_string(scanner().state()), scanner().reason()));
   }
-}
-
-void PortLoop::on_bus_scan(const devicenet::BusScan& scan, TimePoint at) {
-  last_scan_ = scan;
-  std::vector<ScanCall> waiters;
-  waiters.swap(scan_waiters_);
-  for (const auto& call : waiters) answer_scan(call, scan, at);
-}
-
-void PortLoop::answer_scan(const ScanCall& call, const devicenet::BusScan& scan, TimePoint now) {
-  BusScanAnswer a;
-  a.requester = call.requester;
-  a.txid = call.txid;
-  a.duration = scan.finished - scan.started;
-  a.age = now - scan.finished;
-  a.findings = scan.findings;
-  const auto seconds_of = [](Duration d) { return std::chrono::duration<double>(d).count(); };
-  if (scan.error.empty()) {
-    a.status = rack::TransactionStatus::kSuccess;
-    a.message =
-        a.age > Duration::zero()
-            ? fmt::format("port {}: the bus scan of {:.1f} s ago (at most one every {:.0f} s)",
-                          config_.port, seconds_of(a.age), seconds_of(kScanHoldoff))
-            : fmt::format("port {}: bus scanned in {:.1f} s", config_.port, seconds_of(a.duration));
-  } else {
-    a.status = rack::TransactionStatus::kPortOffline;
-    a.message = fmt::format("port {}: bus scan cut short ({})", config_.port, scan.error);
-  }
-  publisher_.bus_scan_reply(config_.port, a);
 }
 
 void PortLoop::push(Item item) {
@@ -337,7 +206,7 @@ bool PortLoop::drain_inbox(TimePoint now) {
         log_.info("node {}: no live commander left", r->mac.value());
       }
     } else if (auto* scan = std::get_if<ScanCall>(&item)) {
-      handle_scan_call(std::move(*scan), now);
+      handle_scan_call(*scan, now);
     } else if (auto* re = std::get_if<Reconfigure>(&item)) {
       if (keep_running) {
         apply(*re, now);
@@ -362,9 +231,9 @@ bool PortLoop::drain_inbox(TimePoint now) {
 
 void PortLoop::run() {
   TimePoint now = backend_->now();
-  started_ = now;
-  metrics_time_ = now;
-  port_status_time_ = now;
+  publication_.start(now);
+  metrics_.start(now);
+  status_.start(now);
   bool stopping = false;
   TimePoint stop_deadline = kNever;
   for (;;) {
@@ -385,43 +254,11 @@ void PortLoop::run() {
       log_.info("stopping: idling and releasing every node");
       scanner().stop(now);
     }
-    const BusCounters counters = backend_->counters();
-    const BusState bus = counters.state;
-    // A bus that comes back (bus-off recovered, the interface up again):
-    // the master checks its own MAC again before it scans, and every node
-    // comes back idle. A loss that began and ended while the loop was not
-    // looking (both within one wait) counts as much as one it saw.
-    const bool unseen_loss =
-        counters.losses != bus_losses_seen_ && !bus_lost(bus_seen_) && !bus_lost(bus);
-    bus_losses_seen_ = counters.losses;
-    if (bus != bus_seen_ || unseen_loss) {
-      if ((unseen_loss || (bus_lost(bus_seen_) && !bus_lost(bus))) && master_was_started &&
-          !stopping) {
-        scanner().recheck_mac(unseen_loss                    ? "the bus was lost and is back"
-                              : bus_seen_ == BusState::kDown ? "the interface is up again"
-                                                             : "bus-off recovered",
-                              now);
-      }
-      bus_seen_ = bus;
-    }
-    // A change of the bus or interface state is published at once.
-    if (bus != bus_state_) {
-      port_dirty_ = true;
-      port_event_time_ = now;
-    }
+    follow_bus(backend_->counters(), master_was_started, stopping, now);
     publish(now, false);
     // Requests still queued are handled first: each gets its one reply.
     if (stopping && !calls_waiting_ && (scanner().stopped() || now >= stop_deadline)) break;
-
-    TimePoint wake = std::min({scanner().next_deadline(), stop_deadline,
-                               port_status_time_ + config_.status_period, gateway_->next_expiry()});
-    for (const rack::ProfileNodes* nodes : port_->profiles()) {
-      wake = std::min(wake, nodes->next_refresh_deadline());
-    }
-    for (const auto& p : published_) {
-      if (p) wake = std::min({wake, p->gate->deadline(), p->status_time + config_.status_period});
-    }
-    if (calls_waiting_) wake = now;
+    const TimePoint wake = calls_waiting_ ? now : next_wake(stop_deadline);
     note_busy(pass_start);
     FrameReceiver& receiver = *this;
     backend_->wait(wake, receiver);
@@ -430,6 +267,42 @@ void PortLoop::run() {
   publish(backend_->now(), true);
   publisher_.port_stopped(config_.port);
   running_ = false;
+}
+
+void PortLoop::follow_bus(const BusCounters& counters, bool master_was_started, bool stopping,
+                          TimePoint now) {
+  const BusState bus = counters.state;
+  // A bus that comes back (bus-off recovered, the interface up again):
+  // the master checks its own MAC again before it scans, and every node
+  // comes back idle. A loss that began and ended while the loop was not
+  // looking (both within one wait) counts as much as one it saw.
+  const bool unseen_loss =
+      counters.losses != bus_losses_seen_ && !bus_lost(bus_seen_) && !bus_lost(bus);
+  bus_losses_seen_ = counters.losses;
+  if (bus != bus_seen_ || unseen_loss) {
+    if ((unseen_loss || (bus_lost(bus_seen_) && !bus_lost(bus))) && master_was_started &&
+        !stopping) {
+      scanner().recheck_mac(unseen_loss                    ? "the bus was lost and is back"
+                            : bus_seen_ == BusState::kDown ? "the interface is up again"
+                                                           : "bus-off recovered",
+                            now);
+    }
+    bus_seen_ = bus;
+  }
+  // A change of the bus or interface state is published at once.
+  if (bus != bus_state_) status_.changed(now);
+}
+
+TimePoint PortLoop::next_wake(TimePoint stop_deadline) const {
+  // BusMetrics measures only as a PortStatus is made (bus_metrics.hpp), a
+  // bus scan's steps are the master's timers and a reload is applied as it
+  // comes: none has a time of its own here.
+  TimePoint wake = std::min({port_->scanner().next_deadline(), stop_deadline,
+                             gateway_->next_expiry(), status_.next_due(), publication_.next_due()});
+  for (const rack::ProfileNodes* nodes : port_->profiles()) {
+    wake = std::min(wake, nodes->next_refresh_deadline());
+  }
+  return wake;
 }
 
 void PortLoop::start_master_when_up(TimePoint now) {
@@ -449,38 +322,9 @@ void PortLoop::start_master_when_up(TimePoint now) {
   }
 }
 
-void PortLoop::publish_nodes(TimePoint now, bool force) {
-  for (const rack::ProfileNodes* nodes : port_->profiles()) {
-    for (std::size_t i = 0; i < nodes->size(); ++i) {
-      const rack::NodeView& v = nodes->view(i);
-      Published& p = *published_[v.mac.value()];
-      // The source time is that of the latest event the sample reflects; a
-      // node nothing has happened to yet has been absent since the loop started.
-      TimePoint source = std::max(v.state_since, started_);
-      if (v.has_inputs) source = std::max(source, v.inputs_time);
-      // Unchanged since the gate was last asked, a node is due only by time.
-      if (force || v.changes != p.checked || now >= p.gate->deadline()) {
-        p.checked = v.changes;
-        if (force || p.gate->due(v, now)) {
-          publisher_.node_state(config_.port, v, source);
-          p.gate->published(v, now);
-        }
-      }
-      if (force || !p.status_once || v.status_changes != p.changes ||
-          now >= p.status_time + config_.status_period) {
-        publisher_.node_status(config_.port, v, NodeStatusView::of(*scanner().node(v.mac)),
-                               std::max(source, p.status_time));
-        p.changes = v.status_changes;
-        p.status_time = now;
-        p.status_once = true;
-      }
-    }
-  }
-}
-
 void PortLoop::publish(TimePoint now, bool force) {
-  publish_nodes(now, force);
-  if (force || port_dirty_ || now >= port_status_time_ + config_.status_period) publish_port(now);
+  publication_.publish(*port_, now, force);
+  if (status_.due(now, force)) publish_port(now);
 }
 
 void PortLoop::publish_port(TimePoint now) {
@@ -512,10 +356,11 @@ void PortLoop::publish_port(TimePoint now) {
   }
   // Rates are measured over whole status periods; a state change in between
   // publishes the last measured ones.
-  if (now - metrics_time_ >= config_.status_period) update_metrics(s.bus, now);
-  s.frames_per_second = metrics_.frames_per_second;
-  s.bus_load_percent = metrics_.bus_load_percent;
-  s.scan_cycle_ms = metrics_.scan_cycle_ms;
+  metrics_.measure_if_due(s.bus, s.bitrate, node_polls(), now);
+  const BusMetrics::Figures& figures = metrics_.figures();
+  s.frames_per_second = figures.frames_per_second;
+  s.bus_load_percent = figures.bus_load_percent;
+  s.scan_cycle_ms = figures.scan_cycle_ms;
   {
     std::lock_guard lock(inbox_mutex_);
     s.explicit_outstanding = static_cast<std::uint32_t>(calls_.size());
@@ -531,37 +376,21 @@ void PortLoop::publish_port(TimePoint now) {
   }
   longest_pass_ = Duration::zero();
   nodes_online_.store(s.nodes_online, std::memory_order_relaxed);
-  publisher_.port_status(s, std::max(now, port_event_time_));
-  port_status_time_ = now;
-  port_dirty_ = false;
+  publisher_.port_status(s, status_.source_time(now));
+  status_.published(now);
 }
 
-void PortLoop::update_metrics(const BusCounters& bus, TimePoint now) {
-  const double elapsed = std::chrono::duration<double>(now - metrics_time_).count();
-  double cycle_sum = 0;
-  unsigned cycles = 0;
+std::vector<BusMetrics::NodePolls> PortLoop::node_polls() const {
+  std::vector<BusMetrics::NodePolls> polls;
   for (const rack::ProfileNodes* nodes : port_->profiles()) {
     for (std::size_t i = 0; i < nodes->size(); ++i) {
       const MacId mac = nodes->view(i).mac;
-      const auto* node = scanner().node(mac);
-      std::uint64_t& last = published_[mac.value()]->polls;
-      const std::uint64_t polls = node->counters().polls;
-      if (node->state() == devicenet::NodeState::kOnline && polls > last) {
-        cycle_sum += 1000.0 * elapsed / static_cast<double>(polls - last);
-        ++cycles;
-      }
-      last = polls;
+      const auto* node = port_->scanner().node(mac);
+      polls.push_back(
+          {mac, node->state() == devicenet::NodeState::kOnline, node->counters().polls});
     }
   }
-  metrics_.frames_per_second = static_cast<double>(bus.frames - last_counters_.frames) / elapsed;
-  const auto bitrate = backend_->bitrate();
-  metrics_.bus_load_percent = bitrate
-                                  ? 100.0 * static_cast<double>(bus.bits - last_counters_.bits) /
-                                        (static_cast<double>(bitrate) * elapsed)
-                                  : 0.0;
-  metrics_.scan_cycle_ms = cycles ? cycle_sum / cycles : 0.0;
-  last_counters_ = bus;
-  metrics_time_ = now;
+  return polls;
 }
 
 void PortLoop::on_frame(const can::CanFrame& frame, TimePoint rx_time) {
@@ -579,8 +408,7 @@ void PortLoop::on_port_state(devicenet::PortState s, const std::string&, TimePoi
   if (s == devicenet::PortState::kRunning || s == devicenet::PortState::kDuplicateMac) {
     started_up_.store(true, std::memory_order_relaxed);
   }
-  port_dirty_ = true;
-  port_event_time_ = at;
+  status_.changed(at);
 }
 void PortLoop::on_node_state(MacId m, devicenet::NodeState f, devicenet::NodeState t,
                              const std::string& r, TimePoint) {
@@ -592,7 +420,7 @@ void PortLoop::on_node_state(MacId m, devicenet::NodeState f, devicenet::NodeSta
         .info("node {} {} -> {}: {}", m.value(), devicenet::to_string(f), devicenet::to_string(t),
               r);
   }
-  port_dirty_ = true;
+  status_.changed();
 }
 void PortLoop::on_explicit_result(std::uint32_t id, MacId, const devicenet::ExplicitResult& r,
                                   TimePoint at) {

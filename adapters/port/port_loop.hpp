@@ -1,9 +1,13 @@
 #pragma once
 // One CAN port's event loop, on a thread of its own. It owns the port's
 // DeviceNet master (Scanner), the rack model of its nodes (every profile's:
-// rack::RackPort), the explicit gateway and the CAN backend; nothing else touches them. Other
-// threads (the DDS input) talk to it through its inbox, which wakes it. State is published from
-// here.
+// rack::RackPort), the explicit gateway and the CAN backend; nothing else
+// touches them. Other threads (the DDS input) talk to it through its inbox,
+// which wakes it. Each pass runs the master's timers, the inbox, the
+// command refresh, then the components that publish (NodePublication,
+// PortStatusSchedule with BusMetrics), answer bus scans (BusScans) and apply
+// a reload (PortReconfiguration); it then waits for a frame, a wake, or the
+// earliest time any of them says it next needs to run.
 #include <array>
 #include <atomic>
 #include <bit>
@@ -22,8 +26,14 @@
 #include <variant>
 #include <vector>
 
+#include "adapters/port/bus_metrics.hpp"
+#include "adapters/port/bus_scans.hpp"
 #include "adapters/port/can_backend.hpp"
+#include "adapters/port/node_publication.hpp"
+#include "adapters/port/port_config.hpp"
 #include "adapters/port/port_publisher.hpp"
+#include "adapters/port/port_reconfiguration.hpp"
+#include "adapters/port/port_status_schedule.hpp"
 #include "bridge/common/log.hpp"
 #include "bridge/devicenet/master/scanner.hpp"
 #include "bridge/rack/explicit_gateway.hpp"
@@ -31,30 +41,6 @@
 #include "bridge/rack/rack_port.hpp"
 
 namespace dnbridge::port {
-
-struct PortLoopConfig {
-  std::string port;                  // the port's name
-  devicenet::ScannerConfig scanner;  // master MAC and timings; nodes from `nodes`
-  rack::PortNodes nodes;             // the scan list, by profile
-  // Per node; PublishPolicy{} for a node not named.
-  std::map<devicenet::MacId, rack::PublishPolicy> publish;
-  rack::ExplicitPolicy explicit_policy;    // the rack's [explicit_policy]
-  Duration status_period = seconds(1);     // NodeStatus/PortStatus at least this often
-  Duration shutdown_timeout = seconds(3);  // for idling and releasing every node
-};
-
-// What a configuration read again changed on a port (PortLoop::reconfigure).
-struct PortChange {
-  rack::ScanListChange scan_list;
-  std::vector<devicenet::MacId> publish_changed;  // nodes kept whose publish policy changed
-  bool explicit_policy_changed = false;
-  // Not empty: the port refused the configuration, and nothing changed.
-  std::string refused;
-
-  bool any() const {
-    return scan_list.any() || !publish_changed.empty() || explicit_policy_changed;
-  }
-};
 
 class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver {
  public:
@@ -89,10 +75,10 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // waits for it (at most kMaxScanWaiters, the rest answered at once with
   // "out of buffers"); one within kScanHoldoff after a complete scan gets
   // that scan again, so that requests cannot make the bus scanned more
-  // often.
+  // often (bus_scans.hpp).
   void scan_request(ScanCall call);
-  static constexpr std::size_t kMaxScanWaiters = 64;
-  static constexpr Duration kScanHoldoff = seconds(30);
+  static constexpr std::size_t kMaxScanWaiters = BusScans::kMaxWaiters;
+  static constexpr Duration kScanHoldoff = BusScans::kHoldoff;
   // A configuration read again (a reload): the port's scan list, its
   // timings, its nodes' publish policies and the explicit policy, applied
   // on the port's thread at its next pass, only where they differ
@@ -183,9 +169,15 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   // of requests. False once a Stop was seen.
   bool drain_inbox(TimePoint now);
   bool calls_waiting_ = false;  // requests left for the next pass
+  // What the bus's state says to the master: a bus that came back makes it
+  // check its MAC again. A change of the bus's state is published at once.
+  void follow_bus(const BusCounters& counters, bool master_was_started, bool stopping,
+                  TimePoint now);
+  // The earliest time any part of the port next needs a pass.
+  TimePoint next_wake(TimePoint stop_deadline) const;
   void publish(TimePoint now, bool force);
   void publish_port(TimePoint now);
-  void update_metrics(const BusCounters& bus, TimePoint now);
+  std::vector<BusMetrics::NodePolls> node_polls() const;
 
   // ScannerObserver, after the rack model (port_): what the loop itself
   // does with the master's events (the port's status, a log line, the
@@ -193,12 +185,11 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   void on_port_state(devicenet::PortState s, const std::string& r, TimePoint at) override;
   void on_node_state(devicenet::MacId m, devicenet::NodeState f, devicenet::NodeState t,
                      const std::string& r, TimePoint at) override;
-  void on_unconfigured_node(devicenet::MacId, TimePoint) override { port_dirty_ = true; }
-  void on_bus_scan(const devicenet::BusScan& scan, TimePoint at) override;
-  void handle_scan_call(ScanCall call, TimePoint now);
-  void answer_scan(const ScanCall& call, const devicenet::BusScan& scan, TimePoint now);
-  std::vector<ScanCall> scan_waiters_;
-  std::optional<devicenet::BusScan> last_scan_;
+  void on_unconfigured_node(devicenet::MacId, TimePoint) override { status_.changed(); }
+  void on_bus_scan(const devicenet::BusScan& scan, TimePoint at) override {
+    scans_.on_bus_scan(scan, at);
+  }
+  void handle_scan_call(const ScanCall& call, TimePoint now);
   void on_explicit_result(std::uint32_t id, devicenet::MacId m, const devicenet::ExplicitResult& r,
                           TimePoint at) override;
   // FrameReceiver
@@ -212,41 +203,15 @@ class PortLoop final : private devicenet::ScannerObserver, private FrameReceiver
   devicenet::Scanner& scanner() { return port_->scanner(); }
   std::optional<rack::ExplicitGateway> gateway_;
 
-  // What was published of a node, and when its state is next due.
-  struct Published {
-    std::unique_ptr<rack::StateGate> gate;  // its profile's (ProfileNodes::state_gate)
-    std::uint64_t checked = ~0ull;          // the view's changes when the gate was last asked
-    std::uint64_t changes = ~0ull;          // the view's status_changes at the last NodeStatus
-    TimePoint status_time{};
-    bool status_once = false;
-    std::uint64_t polls = 0;  // the node's polls at the last metrics update
-  };
-  // By MAC, for every node of the scan list.
-  std::array<std::optional<Published>, devicenet::MacId::kMax + 1> published_;
-  // The node's publish policy in the configuration.
-  rack::PublishPolicy policy_of(devicenet::MacId mac) const;
-  // Publishes each node whose state or status is due, profile by profile.
-  void publish_nodes(TimePoint now, bool force);
-  // After a reload: a node kept keeps what was published of it (a new gate
-  // if its policy changed, named in `policy_changed`); a new or configured
-  // again one starts afresh; a removed one goes.
-  void carry_published(const rack::ScanListChange& sc,
-                       std::vector<devicenet::MacId>& policy_changed);
-  TimePoint started_{};  // when run() began
+  NodePublication publication_;
+  PortStatusSchedule status_;
+  BusMetrics metrics_;
+  BusScans scans_;
+  std::optional<PortReconfiguration> reconfiguration_;
   bool master_started_ = false;
-  bool port_dirty_ = true;
-  TimePoint port_status_time_{};
-  TimePoint port_event_time_{};
-  BusCounters last_counters_{};
   BusState bus_state_ = BusState::kUnknown;  // as last published
   BusState bus_seen_ = BusState::kUnknown;   // as last seen by the loop
   std::uint64_t bus_losses_seen_ = 0;        // BusCounters::losses, likewise
-  TimePoint metrics_time_{};
-  struct Metrics {
-    double frames_per_second = 0;
-    double bus_load_percent = 0;
-    double scan_cycle_ms = 0;
-  } metrics_;
 
   // The longest the loop was busy at once since the last PortStatus: a pass
   // (woken to waiting again) or the handling of one received frame, on the

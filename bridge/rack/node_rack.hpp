@@ -32,6 +32,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "bridge/devicenet/master/scanner.hpp"
@@ -85,6 +86,7 @@ class NodeRack : public ProfileNodes {
       // Silent for at least its refresh (the loop may see it a little late).
       Silenced s{views_[i].mac, views_[i].commanded_by, e.lapse_at - e.last_command};
       views_[i].silent_for = s.silent_for;
+      mark_changed(s.mac);
       (void)release(s.mac, IdleCause::kCommanderSilent, now);
       s.outputs_held = views_[i].outputs_requested.has_value();
       out.push_back(std::move(s));
@@ -99,6 +101,8 @@ class NodeRack : public ProfileNodes {
     return next;
   }
 
+  std::uint64_t take_changed() noexcept override { return std::exchange(changed_, 0); }
+
   // Live changes, made together with the master's scan list
   // (RackPort::reconfigure). A new node's view is absent, with no command.
   void add(const Config& c) {
@@ -111,6 +115,7 @@ class NodeRack : public ProfileNodes {
     views_.push_back(Profile::view_of(c, entries_.back().slot));
     views_.back().profile = Profile::kName;
     views_.back().command_refresh = c.command_refresh;
+    mark_changed(c.node.mac);
   }
   void remove(devicenet::MacId mac) override {
     const int i = index_[mac.value()];
@@ -145,6 +150,7 @@ class NodeRack : public ProfileNodes {
     fresh.changes = v.changes + 1;
     fresh.status_changes = v.status_changes + 1;
     v = std::move(fresh);
+    mark_changed(c.node.mac);
   }
   // Only what the bridge itself does with the node changed (its name, its
   // no-commander and resume policies, its command refresh): view and command
@@ -167,6 +173,7 @@ class NodeRack : public ProfileNodes {
         e.lapse_at = kNever;
       }
     }
+    mark_changed(c.node.mac);
     v->command_refresh = c.command_refresh;
     v->name = c.node.name;
     ++v->changes;
@@ -196,6 +203,7 @@ class NodeRack : public ProfileNodes {
     using devicenet::NodeState;
     View* v = find(mac);
     if (!v) return;
+    mark_changed(mac);
     // A device fault voids a command even before the node was first online:
     // the fault may clear long after the command was given.
     if ((from == NodeState::kOnline && to != NodeState::kOnline && to != NodeState::kStopped) ||
@@ -222,6 +230,7 @@ class NodeRack : public ProfileNodes {
   void on_node_identity(devicenet::MacId mac, const devicenet::NodeIdentity& identity,
                         TimePoint) override {
     if (View* v = find(mac)) {
+      mark_changed(mac);
       v->identity = identity;
       const devicenet::Node* node = scanner_ ? scanner_->node(mac) : nullptr;
       v->minor_faults = node ? node->minor_faults() : "";
@@ -232,6 +241,7 @@ class NodeRack : public ProfileNodes {
   void on_poll_response(devicenet::MacId mac, Bytes data, TimePoint rx_time) override {
     View* v = find(mac);
     if (!v) return;
+    mark_changed(mac);
     const Slot& slot = entry(mac).slot;
     if (data.empty()) {
       // An idle poll answered with no data: the device applied its idle
@@ -254,6 +264,7 @@ class NodeRack : public ProfileNodes {
   }
   void on_device_state(devicenet::MacId mac, std::uint8_t state, TimePoint) override {
     if (View* v = find(mac)) {
+      mark_changed(mac);
       v->device_state = state;
       ++v->changes;
       ++v->status_changes;
@@ -277,8 +288,13 @@ class NodeRack : public ProfileNodes {
   }
   devicenet::Scanner* scanner() { return scanner_; }
 
+  // Every change to a node's view marks it (take_changed), whether or not
+  // its counters moved: a publisher that looks once too often loses nothing.
+  void mark_changed(devicenet::MacId mac) noexcept { changed_ |= std::uint64_t{1} << mac.value(); }
+
   // A refusal: counted, its reason kept in the view.
   Status refuse(View& view, Status why, std::string&& text) {
+    mark_changed(view.mac);
     ++view.commands_refused;
     view.last_command_refused = std::move(text);
     ++view.changes;
@@ -326,6 +342,7 @@ class NodeRack : public ProfileNodes {
     e.lapse_at = v.command_refresh > Duration::zero() ? now + v.command_refresh : kNever;
     ++v.commands_accepted;
     ++v.changes;
+    mark_changed(v.mac);
     return {};
   }
 
@@ -366,6 +383,7 @@ class NodeRack : public ProfileNodes {
     v->outputs_requested.reset();
     v->commanded_by.clear();
     ++v->changes;
+    mark_changed(mac);
     return scanner_->set_idle(mac, true, now);
   }
   Entry& entry(devicenet::MacId mac) {
@@ -397,6 +415,7 @@ class NodeRack : public ProfileNodes {
   }
 
   devicenet::Scanner* scanner_ = nullptr;
+  std::uint64_t changed_ = 0;  // take_changed's, a bit per MAC
   std::vector<View> views_;
   std::vector<Entry> entries_;
   std::array<int, devicenet::MacId::kMax + 1> index_{};

@@ -9,6 +9,7 @@
 // is one path for all of them.
 #include <any>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -87,6 +88,12 @@ class ProfileNodes : public devicenet::ScannerObserver {
   virtual std::vector<Silenced> expire_silent_commanders(TimePoint now) = 0;
   // When expire_silent_commanders has next something to do; kNever if not.
   virtual TimePoint next_refresh_deadline() const = 0;
+
+  // The nodes whose view may have changed (NodeView::changes or
+  // status_changes) since the last call, a bit per MAC, and none from then
+  // on: a publisher looks again at these nodes only, and at the others when
+  // a period of theirs is due.
+  virtual std::uint64_t take_changed() noexcept = 0;
 
   // When one of these nodes' state is worth a new sample (publish_gate.hpp).
   virtual std::unique_ptr<StateGate> state_gate(const PublishPolicy& policy) const = 0;

@@ -5,6 +5,7 @@
 // every profile (port_nodes.hpp), one model of the nodes per profile (its
 // rack: PumpRack, DeviceRack, ...) hearing the master's events first, in
 // the order of the profiles, then the observers added, in the order added.
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -98,6 +99,14 @@ class RackPort {
   std::span<ProfileNodes* const> profiles() const { return profiles_; }
   // The nodes of the profile the node at `mac` has; null when no node has it.
   ProfileNodes* nodes_of(devicenet::MacId mac) const;
+  // The nodes whose view may have changed since the last call, of every
+  // profile (ProfileNodes::take_changed); a bit per MAC. A removed node's
+  // bit may be among them.
+  std::uint64_t take_changed() noexcept {
+    std::uint64_t changed = 0;
+    for (ProfileNodes* p : profiles_) changed |= p->take_changed();
+    return changed;
+  }
 
  private:
   // The rack of `list`'s profile, made (empty, and attached) when the port
