@@ -39,6 +39,76 @@ std::string security_text(const security::Identity& identity) {
                      identity.valid_until);
 }
 
+// --check-config FILE: what the file configures, or why it cannot serve.
+int check_config(const std::string& file) {
+  try {
+    auto c = load_config_file(file);
+    for (const auto& w : c.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    std::string security;
+    if (c.security) security = ", " + security_text(security::check(*c.security));
+    std::size_t nodes = 0;
+    for (const auto& p : c.ports) nodes += p.nodes.size();
+    std::printf("%s: rack %s, %zu port(s), %zu node(s)%s: OK\n", file.c_str(), c.rack.c_str(),
+                c.ports.size(), nodes, security.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kBadConfiguration;
+  }
+}
+
+// SIGINT, SIGTERM, SIGUSR1 and SIGHUP are taken by sigwait(): blocked
+// before any thread starts, so no other thread is interrupted by them.
+sigset_t block_signals() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGUSR1);
+  sigaddset(&signals, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  return signals;
+}
+
+// Runs the bridge until SIGINT or SIGTERM; SIGHUP reads the configuration
+// again, SIGUSR1 toggles the candump logs.
+int run_until_stopped(const DaemonConfig& config, StderrLogSink& log, ReloadSource reload,
+                      const Program& program, const sigset_t& signals,
+                      const std::string& candump_dir) {
+  Logger main_log(log, "dnbridge");
+  try {
+    Daemon bridge(config, log,
+                  program.simulated_backends != nullptr ? program.simulated_backends(log)
+                                                        : default_backend_factory(log),
+                  std::move(reload));
+    bridge.start();
+    ServiceNotifier service(bridge, Logger(log, "systemd"));
+    service.start();
+    main_log.info(
+        "running ({}); SIGINT or SIGTERM stops it in order, SIGHUP reads the configuration again, "
+        "SIGUSR1 toggles candump logs",
+        config.source);
+    int signal = 0;
+    for (;;) {
+      sigwait(&signals, &signal);
+      if (signal == SIGUSR1) {
+        bridge.toggle_candump(candump_dir);
+      } else if (signal == SIGHUP) {
+        bridge.request_reload({});
+      } else {
+        break;
+      }
+    }
+    main_log.info("{}: stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
+    service.stopping();
+    bridge.stop();
+  } catch (const std::exception& e) {
+    main_log.error("{}", e.what());
+    return kFailed;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int bridge_main(int argc, char** argv, const Program& program) {
@@ -84,24 +154,7 @@ int bridge_main(int argc, char** argv, const Program& program) {
     std::fputs(std::string(embedded_default_config_text()).c_str(), stdout);
     return 0;
   }
-  if (!check_file.empty()) {
-    try {
-      auto c = load_config_file(check_file);
-      for (const auto& w : c.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-      std::string security;
-      if (c.security) {
-        security = ", " + security_text(security::check(*c.security));
-      }
-      std::size_t nodes = 0;
-      for (const auto& p : c.ports) nodes += p.nodes.size();
-      std::printf("%s: rack %s, %zu port(s), %zu node(s)%s: OK\n", check_file.c_str(),
-                  c.rack.c_str(), c.ports.size(), nodes, security.c_str());
-      return 0;
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "%s\n", e.what());
-      return kBadConfiguration;
-    }
-  }
+  if (!check_file.empty()) return check_config(check_file);
   if (simulate && !with_simulator) {
     std::fprintf(stderr,
                  "%s carries no simulator: dnbridge-sim runs the simulated rack (the same "
@@ -145,15 +198,7 @@ int bridge_main(int argc, char** argv, const Program& program) {
         "deploy/cyclonedds/loopback.xml)");
   }
 
-  // SIGINT and SIGTERM are taken by sigwait() below: blocked before any
-  // thread starts, so no other thread is interrupted by them.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGUSR1);
-  sigaddset(&signals, SIGHUP);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  const sigset_t signals = block_signals();
 
   ReloadSource reload;
   if (!config_file.empty()) {
@@ -165,36 +210,7 @@ int bridge_main(int argc, char** argv, const Program& program) {
     reload.set_log_level = [&log](LogLevel level) { log.set_level(level); };
   }
 
-  try {
-    Daemon bridge(config, log,
-                  with_simulator ? program.simulated_backends(log) : default_backend_factory(log),
-                  std::move(reload));
-    bridge.start();
-    ServiceNotifier service(bridge, Logger(log, "systemd"));
-    service.start();
-    main_log.info(
-        "running ({}); SIGINT or SIGTERM stops it in order, SIGHUP reads the configuration again, "
-        "SIGUSR1 toggles candump logs",
-        config.source);
-    int signal = 0;
-    for (;;) {
-      sigwait(&signals, &signal);
-      if (signal == SIGUSR1) {
-        bridge.toggle_candump(candump_dir);
-      } else if (signal == SIGHUP) {
-        bridge.request_reload({});
-      } else {
-        break;
-      }
-    }
-    main_log.info("{}: stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
-    service.stopping();
-    bridge.stop();
-  } catch (const std::exception& e) {
-    main_log.error("{}", e.what());
-    return kFailed;
-  }
-  return 0;
+  return run_until_stopped(config, log, std::move(reload), program, signals, candump_dir);
 }
 
 }  // namespace dnbridge::daemon

@@ -8,12 +8,14 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <deque>
 #include <memory>
 #include <string>
 #include <system_error>
 #include <thread>
+#include <vector>
 
 #include "adapters/demo/rack_table.hpp"
 #include "adapters/demo/scenario.hpp"
@@ -56,6 +58,54 @@ TimePoint mono_now() {
       std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch()));
 }
 
+// The simulated rack: pumps at MACs 1..nodes, polled every 50 ms; the last
+// one of several uses the CDN118 layout (no analog inputs).
+sim::SimRackConfig rack_config(unsigned nodes, unsigned bitrate_k) {
+  sim::SimRackConfig config;
+  config.bus.bitrate = bitrate_k * 1000;
+  config.port.master_mac = devicenet::MacId::from(0).value();
+  config.port.vendor_id = 59;
+  config.port.serial_number = 0xDB000001;
+  for (unsigned m = 1; m <= nodes; ++m) {
+    rack::PumpConfig p;
+    p.node.mac = devicenet::MacId::from(m).value();
+    p.node.name = fmt::format("pump-{}", m);
+    p.node.poll_period = milliseconds(50);
+    p.node.expected_packet_rate = milliseconds(250);
+    p.io = profiles::cdn127::preset(m == nodes && nodes > 1
+                                        ? profiles::cdn127::ConfigurationPreset::kCdn118
+                                        : profiles::cdn127::ConfigurationPreset::kCdn127);
+    config.pumps.push_back(std::move(p));
+  }
+  return config;
+}
+
+// The table, appended (plain) or redrawn over the screen.
+void draw(const std::string& table, bool plain) {
+  if (plain) {
+    std::fputs(table.c_str(), stdout);
+    std::fputs("\n", stdout);
+  } else {
+    std::fputs("\x1b[H\x1b[2J", stdout);
+    std::fputs(table.c_str(), stdout);
+  }
+  std::fflush(stdout);
+}
+
+// Closes the capture and says what it holds; false when frames were lost.
+bool close_capture(sim::BusCapture& capture, const std::string& path) {
+  const std::uint64_t frames = capture.frames();
+  if (capture.close()) {
+    std::fprintf(stderr, "dnbridge-demo: %llu frames captured to %s\n",
+                 static_cast<unsigned long long>(frames), path.c_str());
+    return true;
+  }
+  std::fprintf(stderr, "dnbridge-demo: capture to %s incomplete: %llu write errors (%s)\n",
+               path.c_str(), static_cast<unsigned long long>(capture.writer().write_errors()),
+               capture.writer().error().message().c_str());
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,25 +138,9 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
-  sim::SimRackConfig config;
-  config.bus.bitrate = bitrate_k * 1000;
-  config.port.master_mac = devicenet::MacId::from(0).value();
-  config.port.vendor_id = 59;
-  config.port.serial_number = 0xDB000001;
+  const sim::SimRackConfig config = rack_config(nodes, bitrate_k);
   std::vector<unsigned> macs;
-  for (unsigned m = 1; m <= nodes; ++m) {
-    rack::PumpConfig p;
-    p.node.mac = devicenet::MacId::from(m).value();
-    p.node.name = fmt::format("pump-{}", m);
-    p.node.poll_period = milliseconds(50);
-    p.node.expected_packet_rate = milliseconds(250);
-    // The last pump uses the CDN118 layout: no analog inputs.
-    p.io = profiles::cdn127::preset(m == nodes && nodes > 1
-                                        ? profiles::cdn127::ConfigurationPreset::kCdn118
-                                        : profiles::cdn127::ConfigurationPreset::kCdn127);
-    config.pumps.push_back(std::move(p));
-    macs.push_back(m);
-  }
+  for (const auto& p : config.pumps) macs.push_back(p.node.mac.value());
 
   sim::SimRack rack(config);
   EventLog events(rack.now());
@@ -148,17 +182,7 @@ int main(int argc, char** argv) {
   bool stopping = false;
   TimePoint stop_deadline = kNever;
 
-  auto render = [&] {
-    const std::string table = demo::render_rack(rack, virtual_start, events.lines());
-    if (plain) {
-      std::fputs(table.c_str(), stdout);
-      std::fputs("\n", stdout);
-    } else {
-      std::fputs("\x1b[H\x1b[2J", stdout);
-      std::fputs(table.c_str(), stdout);
-    }
-    std::fflush(stdout);
-  };
+  auto render = [&] { draw(demo::render_rack(rack, virtual_start, events.lines()), plain); };
 
   for (;;) {
     const TimePoint target = mono_now() + offset;
@@ -195,20 +219,6 @@ int main(int argc, char** argv) {
             (wake - offset).time_since_epoch())));
   }
   render();
-  bool capture_ok = true;
-  if (capture) {
-    const std::uint64_t frames = capture->frames();
-    capture_ok = capture->close();
-    if (capture_ok) {
-      std::fprintf(stderr, "dnbridge-demo: %llu frames captured to %s\n",
-                   static_cast<unsigned long long>(frames), pcap_path.c_str());
-    } else {
-      std::fprintf(stderr, "dnbridge-demo: capture to %s incomplete: %llu write errors (%s)\n",
-                   pcap_path.c_str(),
-                   static_cast<unsigned long long>(capture->writer().write_errors()),
-                   capture->writer().error().message().c_str());
-    }
-  }
-  if (!capture_ok) return 2;
+  if (capture && !close_capture(*capture, pcap_path)) return 2;
   return rack.scanner().state() == devicenet::PortState::kStopped ? 0 : 1;
 }

@@ -132,6 +132,41 @@ bool found(const dnbridge_ScanFinding& f) {
   return f.found != dnbridge_FOUND_NO_ANSWER && f.found != dnbridge_FOUND_NOT_ASKED;
 }
 
+// What a port's scan reply found: its rows (over the configured ones at
+// the same MACs), its port record, its summary line and the configuration
+// lines of the CDN127s found unconfigured. True when the scan succeeded.
+bool take_reply(const PortKey& key, const dnbridge_BusScanReply& r,
+                std::map<unsigned, Record>& by_mac, Record& port, std::string& summary,
+                std::string& suggestions) {
+  std::vector<Json> silent;
+  std::string port_suggestions;
+  for (const auto& f : findings_of(r)) {
+    if (!found(f)) {
+      if (f.found == dnbridge_FOUND_NO_ANSWER) silent.emplace_back(unsigned{f.mac});
+      continue;
+    }
+    by_mac.insert_or_assign(f.mac, finding_record(key, f));
+    if (f.found == dnbridge_FOUND_IDENTIFIED && is_cdn127(f)) {
+      port_suggestions += configuration_lines(f) + "\n";
+    }
+  }
+  port.json("status", r.status)
+      .json("message", std::string(dds::view(r.message)))
+      .json("duration_ms", r.duration_ms)
+      .json("age_ms", r.age_ms)
+      .json("silent_macs", Json::values(silent));
+  summary +=
+      fmt::format("rack {}, {}; {} MACs silent\n", key.rack, dds::view(r.message), silent.size());
+  if (!port_suggestions.empty()) {
+    suggestions += fmt::format(
+        "# Found on port \"{}\" of rack \"{}\", not configured: under "
+        "its [[port]] table in the rack configuration,\n",
+        key.port, key.rack);
+    suggestions += port_suggestions;
+  }
+  return r.status == kStatusSuccess;
+}
+
 }  // namespace
 
 CLI::App* add_scan(CLI::App& app) {
@@ -217,34 +252,7 @@ Exit run_scan(const GlobalOptions& o) {
           "configured nodes only\n",
           s.key.rack, s.key.port, std::chrono::duration<double>(wait).count());
     } else {
-      const dnbridge_BusScanReply& r = s.reply->data();
-      std::vector<Json> silent;
-      std::string port_suggestions;
-      for (const auto& f : findings_of(r)) {
-        if (!found(f)) {
-          if (f.found == dnbridge_FOUND_NO_ANSWER) silent.emplace_back(unsigned{f.mac});
-          continue;
-        }
-        by_mac.insert_or_assign(f.mac, finding_record(s.key, f));
-        if (f.found == dnbridge_FOUND_IDENTIFIED && is_cdn127(f)) {
-          port_suggestions += configuration_lines(f) + "\n";
-        }
-      }
-      port.json("status", r.status)
-          .json("message", std::string(dds::view(r.message)))
-          .json("duration_ms", r.duration_ms)
-          .json("age_ms", r.age_ms)
-          .json("silent_macs", Json::values(silent));
-      all_ok = all_ok && r.status == kStatusSuccess;
-      summary += fmt::format("rack {}, {}; {} MACs silent\n", s.key.rack, dds::view(r.message),
-                             silent.size());
-      if (!port_suggestions.empty()) {
-        suggestions += fmt::format(
-            "# Found on port \"{}\" of rack \"{}\", not configured: under "
-            "its [[port]] table in the rack configuration,\n",
-            s.key.port, s.key.rack);
-        suggestions += port_suggestions;
-      }
+      all_ok = take_reply(s.key, s.reply->data(), by_mac, port, summary, suggestions) && all_ok;
     }
     port_records.push_back(std::move(port));
     for (auto& [mac, record] : by_mac) rows.push_back(std::move(record));

@@ -64,6 +64,68 @@ Labels with(Labels labels, std::string name, std::string value) {
   return labels;
 }
 
+// A port's figures from its last PortStatus.
+void add_port_status(Families& f, const Labels& port, const port::PortStatusView& s) {
+  for (auto state : kPortStates) {
+    f.gauge("dnbridge_port_state", "The port's state: 1 for the one it is in",
+            with(port, "state", std::string(devicenet::to_string(state))),
+            s.state == state ? 1 : 0);
+  }
+  for (auto state : kBusStates) {
+    f.gauge("dnbridge_can_bus_state", "The CAN controller's state: 1 for the one it is in",
+            with(port, "state", std::string(port::to_string(state))), s.bus.state == state ? 1 : 0);
+  }
+  f.gauge("dnbridge_can_transmit_errors", "The controller's transmit error counter", port,
+          s.bus.tx_errors);
+  f.gauge("dnbridge_can_receive_errors", "The controller's receive error counter", port,
+          s.bus.rx_errors);
+  f.counter("dnbridge_can_frames_total", "Frames on the bus, both ways", port,
+            static_cast<double>(s.bus.frames));
+  f.gauge("dnbridge_can_bus_load_ratio", "Share of the bus's time its frames take (0..1)", port,
+          s.bus_load_percent / 100.0);
+  f.gauge("dnbridge_port_scan_cycle_seconds", "Mean interval between two polls of an online node",
+          port, s.scan_cycle_ms / 1000.0);
+  f.gauge("dnbridge_port_nodes_online", "Nodes online (polled)", port, s.nodes_online);
+  f.gauge("dnbridge_port_nodes_configured", "Nodes of the port's configuration", port,
+          s.nodes_configured);
+  f.gauge("dnbridge_port_unconfigured_nodes",
+          "Nodes heard on the bus at MACs the configuration does not have", port,
+          static_cast<double>(s.unconfigured_macs.size()));
+  f.gauge("dnbridge_port_explicit_outstanding",
+          "Explicit requests queued for the port or executing", port, s.explicit_outstanding);
+  f.counter("dnbridge_port_explicit_refused_for_limits_total",
+            "Explicit requests refused for the bridge's limits (status 9)", port,
+            static_cast<double>(s.explicit_refused_for_limits));
+  f.gauge("dnbridge_port_loop_longest_pass_seconds",
+          "The port loop's longest pass since its previous status (wall time)", port,
+          s.loop_longest_pass_ms / 1000.0);
+}
+
+// The bridge process's DDS queues and readers.
+void add_process(Families& f, const Labels& rack, const ProcessCounters& p) {
+  for (const auto& q : p.queues) {
+    const Labels labels = with(rack, "queue", q.name);
+    f.counter("dnbridge_dds_samples_written_total", "DDS samples written from the queue", labels,
+              static_cast<double>(q.written));
+    f.counter("dnbridge_dds_samples_refused_total", "Samples not queued: the queue was full",
+              labels, static_cast<double>(q.refused));
+    f.gauge("dnbridge_dds_queue_depth", "Samples waiting to be written", labels,
+            static_cast<double>(q.depth));
+  }
+  f.counter("dnbridge_dds_samples_taken_total", "DDS samples taken by the bridge",
+            with(rack, "topic", "PumpCommand"), static_cast<double>(p.commands_taken));
+  f.counter("dnbridge_dds_samples_taken_total", "DDS samples taken by the bridge",
+            with(rack, "topic", "ExplicitRequest"), static_cast<double>(p.requests_taken));
+  f.counter("dnbridge_dds_command_holdoffs_total",
+            "Times PumpCommand samples came within 1 ms of the take before them (a flood) and "
+            "waited in the reader for the next take, which takes each pump's newest",
+            rack, static_cast<double>(p.command_holdoffs));
+  f.counter("dnbridge_dds_state_write_failures_total",
+            "PumpState, NodeStatus and PortStatus writes, disposals and unregistrations that "
+            "failed (logged; the instance's next sample follows)",
+            rack, static_cast<double>(p.state_write_failures));
+}
+
 }  // namespace
 
 RackMetrics::RackMetrics(std::string rack, std::function<ProcessCounters()> process)
@@ -125,44 +187,7 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
       const auto* s = entry.status ? &*entry.status : nullptr;
       f.gauge("dnbridge_port_up", "1 while the port's loop runs and scans its bus, else 0", port,
               !entry.stopped && s && s->state == devicenet::PortState::kRunning ? 1 : 0);
-      if (s) {
-        for (auto state : kPortStates) {
-          f.gauge("dnbridge_port_state", "The port's state: 1 for the one it is in",
-                  with(port, "state", std::string(devicenet::to_string(state))),
-                  s->state == state ? 1 : 0);
-        }
-        for (auto state : kBusStates) {
-          f.gauge("dnbridge_can_bus_state", "The CAN controller's state: 1 for the one it is in",
-                  with(port, "state", std::string(port::to_string(state))),
-                  s->bus.state == state ? 1 : 0);
-        }
-        f.gauge("dnbridge_can_transmit_errors", "The controller's transmit error counter", port,
-                s->bus.tx_errors);
-        f.gauge("dnbridge_can_receive_errors", "The controller's receive error counter", port,
-                s->bus.rx_errors);
-        f.counter("dnbridge_can_frames_total", "Frames on the bus, both ways", port,
-                  static_cast<double>(s->bus.frames));
-        f.gauge("dnbridge_can_bus_load_ratio", "Share of the bus's time its frames take (0..1)",
-                port, s->bus_load_percent / 100.0);
-        f.gauge("dnbridge_port_scan_cycle_seconds",
-                "Mean interval between two polls of an online node", port,
-                s->scan_cycle_ms / 1000.0);
-        f.gauge("dnbridge_port_nodes_online", "Nodes online (polled)", port, s->nodes_online);
-        f.gauge("dnbridge_port_nodes_configured", "Nodes of the port's configuration", port,
-                s->nodes_configured);
-        f.gauge("dnbridge_port_unconfigured_nodes",
-                "Nodes heard on the bus at MACs the configuration does not have", port,
-                static_cast<double>(s->unconfigured_macs.size()));
-        f.gauge("dnbridge_port_explicit_outstanding",
-                "Explicit requests queued for the port or executing", port,
-                s->explicit_outstanding);
-        f.counter("dnbridge_port_explicit_refused_for_limits_total",
-                  "Explicit requests refused for the bridge's limits (status 9)", port,
-                  static_cast<double>(s->explicit_refused_for_limits));
-        f.gauge("dnbridge_port_loop_longest_pass_seconds",
-                "The port loop's longest pass since its previous status (wall time)", port,
-                s->loop_longest_pass_ms / 1000.0);
-      }
+      if (s) add_port_status(f, port, *s);
       for (const auto& [mac, node] : entry.nodes) {
         const Labels labels = with(with(port, "mac", std::to_string(mac)), "name", node.name);
         f.counter("dnbridge_node_commands_accepted_total", "Pump commands applied", labels,
@@ -206,31 +231,7 @@ std::vector<MetricFamily> RackMetrics::Collect() const {
       }
     }
   }
-  if (process_) {
-    const ProcessCounters p = process_();
-    const Labels rack{{"rack", rack_}};
-    for (const auto& q : p.queues) {
-      const Labels labels = with(rack, "queue", q.name);
-      f.counter("dnbridge_dds_samples_written_total", "DDS samples written from the queue", labels,
-                static_cast<double>(q.written));
-      f.counter("dnbridge_dds_samples_refused_total", "Samples not queued: the queue was full",
-                labels, static_cast<double>(q.refused));
-      f.gauge("dnbridge_dds_queue_depth", "Samples waiting to be written", labels,
-              static_cast<double>(q.depth));
-    }
-    f.counter("dnbridge_dds_samples_taken_total", "DDS samples taken by the bridge",
-              with(rack, "topic", "PumpCommand"), static_cast<double>(p.commands_taken));
-    f.counter("dnbridge_dds_samples_taken_total", "DDS samples taken by the bridge",
-              with(rack, "topic", "ExplicitRequest"), static_cast<double>(p.requests_taken));
-    f.counter("dnbridge_dds_command_holdoffs_total",
-              "Times PumpCommand samples came within 1 ms of the take before them (a flood) and "
-              "waited in the reader for the next take, which takes each pump's newest",
-              rack, static_cast<double>(p.command_holdoffs));
-    f.counter("dnbridge_dds_state_write_failures_total",
-              "PumpState, NodeStatus and PortStatus writes, disposals and unregistrations that "
-              "failed (logged; the instance's next sample follows)",
-              rack, static_cast<double>(p.state_write_failures));
-  }
+  if (process_) add_process(f, Labels{{"rack", rack_}}, process_());
   return f.take();
 }
 

@@ -11,6 +11,9 @@
 #include <cstdio>
 #include <exception>
 #include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "adapters/sim/host/control.hpp"
 #include "adapters/sim/host/device_config.hpp"
@@ -39,6 +42,49 @@ class StderrSink final : public LogSink {
   LogLevel level_;
   std::mutex mutex_;
 };
+
+// The devices --mac, --device-config and --reading describe; nullopt, with
+// every problem printed, when they cannot be used.
+std::optional<std::vector<sim::host::DeviceSpec>> devices_of(const std::vector<unsigned>& macs,
+                                                             const std::string& config_file,
+                                                             const std::string& reading_name) {
+  try {
+    sim::host::DeviceConfig config;
+    if (!config_file.empty()) config = sim::host::load_device_config(config_file);
+    std::vector<devicenet::MacId> ids;
+    ids.reserve(macs.size());
+    for (auto m : macs) ids.push_back(devicenet::MacId::from_bits(m));
+    const auto reading =
+        reading_name == "field" ? sim::host::Reading::kField : sim::host::Reading::kLenient;
+    return sim::host::device_options(ids, config, reading);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return std::nullopt;
+  }
+}
+
+// Where commands come from (--control): standard input for "-", -1 for
+// "none", else a FIFO, created if missing; nullopt when it cannot be opened.
+std::optional<int> open_control(const std::string& control) {
+  if (control == "none") return -1;
+  if (control == "-") {
+    (void)::fcntl(STDIN_FILENO, F_SETFL, ::fcntl(STDIN_FILENO, F_GETFL) | O_NONBLOCK);
+    return STDIN_FILENO;
+  }
+  if (::mkfifo(control.c_str(), 0600) < 0 && errno != EEXIST) {
+    std::fprintf(stderr, "cannot create the control FIFO %s: %s\n", control.c_str(),
+                 std::strerror(errno));
+    return std::nullopt;
+  }
+  // Read and write: the FIFO never reports end of file when writers come and go.
+  const int fd = ::open(control.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    std::fprintf(stderr, "cannot open the control FIFO %s: %s\n", control.c_str(),
+                 std::strerror(errno));
+    return std::nullopt;
+  }
+  return fd;
+}
 
 }  // namespace
 
@@ -107,21 +153,10 @@ int main(int argc, char** argv) {
                        "Print the version and source revision, and exit");
   CLI11_PARSE(app, argc, argv);
 
-  std::vector<sim::host::DeviceSpec> devices;
-  try {
-    sim::host::DeviceConfig config;
-    if (!device_config_file.empty()) config = sim::host::load_device_config(device_config_file);
-    std::vector<devicenet::MacId> ids;
-    ids.reserve(macs.size());
-    for (auto m : macs) ids.push_back(devicenet::MacId::from_bits(m));
-    const auto reading =
-        reading_name == "field" ? sim::host::Reading::kField : sim::host::Reading::kLenient;
-    devices = sim::host::device_options(ids, config, reading);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return kBadConfiguration;
-  }
-  if (devices.empty()) {
+  std::optional<std::vector<sim::host::DeviceSpec>> devices =
+      devices_of(macs, device_config_file, reading_name);
+  if (!devices) return kBadConfiguration;
+  if (devices->empty()) {
     std::fprintf(stderr, "no device: give --mac, or [[device]] in --device-config (--help)\n");
     return kBadConfiguration;
   }
@@ -140,32 +175,15 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGTERM);
   sigprocmask(SIG_BLOCK, &signals, nullptr);
 
-  int control_fd = -1;
-  bool quit_at_end = false;
-  if (control == "-") {
-    control_fd = STDIN_FILENO;
-    quit_at_end = true;
-    (void)::fcntl(control_fd, F_SETFL, ::fcntl(control_fd, F_GETFL) | O_NONBLOCK);
-  } else if (control != "none") {
-    if (::mkfifo(control.c_str(), 0600) < 0 && errno != EEXIST) {
-      std::fprintf(stderr, "cannot create the control FIFO %s: %s\n", control.c_str(),
-                   std::strerror(errno));
-      return 2;
-    }
-    // Read and write: the FIFO never reports end of file when writers come and go.
-    control_fd = ::open(control.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
-    if (control_fd < 0) {
-      std::fprintf(stderr, "cannot open the control FIFO %s: %s\n", control.c_str(),
-                   std::strerror(errno));
-      return 2;
-    }
-  }
+  const bool quit_at_end = control == "-";
+  const std::optional<int> control_fd = open_control(control);
+  if (!control_fd) return kBadConfiguration;
 
   try {
-    sim::host::SimHost host(interface, std::move(devices), log);
+    sim::host::SimHost host(interface, std::move(*devices), log);
     std::printf("ready\n");
     std::fflush(stdout);
-    host.run(control_fd, quit_at_end, stdout);
+    host.run(*control_fd, quit_at_end, stdout);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cdn127-sim: %s\n", e.what());
     return 1;
